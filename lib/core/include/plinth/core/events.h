@@ -1,0 +1,46 @@
+// Discrete events reported by the simulator.
+#pragma once
+
+#include <cstdint>
+
+#include "plinth/core/scene.h"
+#include "plinth/core/state.h"
+
+namespace plinth {
+
+enum class EventKind : std::uint8_t {
+  kRockingStart,       // Eq 16 met; `corner` is the pivot
+  kImpact,             // theta returned to 0; `corner` is the new pivot; before/after: theta'
+  kRockingStop,        // rocking energy spent (rest criterion); the block is in full contact
+  kBaseStopHit,        // Eq 28; `side` +1 right, -1 left; before/after: u'
+  kBaseStopHeld,       // the base came to rest against stop `side`
+  kBaseStopReleased,   // the held base leaves stop `side`
+  kOverturned,         // |theta| passed the critical angle of `corner`
+};
+
+struct Event {
+  double t = 0.0;  // s
+  EventKind kind = EventKind::kRockingStart;
+  Corner corner = Corner::kLeft;
+  std::int8_t side = 0;
+  double before = 0.0;
+  double after = 0.0;
+  State state = State::Zero();  // just after the reset
+};
+
+// Names used in plinth-sim's JSON Lines event log.
+[[nodiscard]] const char* event_name(EventKind kind);
+
+// Receives events as the solver finds them, on the stepping path: must not block.
+class EventSink {
+ public:
+  virtual void on_event(const Event& event) = 0;
+
+ protected:
+  EventSink() = default;
+  EventSink(const EventSink&) = default;
+  EventSink& operator=(const EventSink&) = default;
+  ~EventSink() = default;
+};
+
+}  // namespace plinth

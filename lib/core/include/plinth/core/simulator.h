@@ -1,0 +1,91 @@
+// The fixed-step hybrid solver: RK4 on the current phase's equations, every event located
+// inside the step, the reset applied there, and the step finished in the new phase so the
+// time grid stays fixed.
+#pragma once
+
+#include <cstdint>
+
+#include "plinth/core/error.h"
+#include "plinth/core/events.h"
+#include "plinth/core/excitation.h"
+#include "plinth/core/guards.h"
+#include "plinth/core/scene.h"
+#include "plinth/core/state.h"
+
+namespace plinth {
+
+struct SolverSettings {
+  double step = 1e-4;  // s, the fixed time step of RK4
+  // Rest criterion: rocking ends at an impact that leaves less rocking energy than this
+  // fraction of the energy needed to overturn, I theta'^2 / 2 < ratio m g (r_i - h).
+  double rest_energy_ratio = 1e-6;
+  // The base is held at a stop when it rebounds slower than this while the stop pushes, m/s.
+  double base_rest_speed = 1e-5;
+  // Events located within one step before the remaining ones are treated as chatter (Zeno):
+  // rocking is brought to rest and the base held, and the step finishes without further events.
+  int max_events_per_step = 64;
+  // Events are located in time to within this fraction of the step.
+  double event_time_tolerance = 1e-10;
+};
+
+// Checks the settings; the Error names the field at fault.
+[[nodiscard]] Error validate(const SolverSettings& settings);
+
+class Simulator {
+ public:
+  Simulator() = default;
+
+  // `scene` and the signals `excitation` refers to must outlive the simulator. Fails with
+  // kUnsupported for parts of the model this build does not have (sliding, support edge,
+  // sliding stops).
+  [[nodiscard]] static Error create(const Scene& scene, const Excitation& excitation,
+                                    const SolverSettings& settings, Simulator& out);
+
+  // t = 0, at rest, full contact (rocking starts at once if Eq 16 already holds).
+  void start_at_rest();
+  // Impulse I, the initial condition of Eq 34: the ground's velocity jumps by -I, m/s. On a
+  // base, u'(0+) = I; on the ground, the block turns about the corner the jump throws it on,
+  // with theta'(0+) = -m h I / I_i (angular momentum about that corner).
+  void start_with_impulse(double impulse);
+  // Starts from an arbitrary mode and state at time 0 (tests and estimators).
+  void start_from(const Mode& mode, const State& state);
+
+  // Advances one step (no-op once a terminal phase is reached).
+  void step();
+
+  void set_event_sink(EventSink* sink) { sink_ = sink; }
+
+  [[nodiscard]] double time() const { return static_cast<double>(step_count_) * settings_.step; }
+  [[nodiscard]] std::int64_t step_count() const { return step_count_; }
+  [[nodiscard]] const State& state() const { return y_; }
+  [[nodiscard]] const Mode& mode() const { return mode_; }
+  [[nodiscard]] const Scene& scene() const { return *scene_; }
+  [[nodiscard]] const SolverSettings& settings() const { return settings_; }
+  [[nodiscard]] GroundAcceleration ground(double t) const { return excitation_.at(t); }
+  // Accelerations of the current mode at the current time and state.
+  [[nodiscard]] Accelerations accelerations() const;
+  // Number of steps whose events were cut short as chatter (see max_events_per_step).
+  [[nodiscard]] std::int64_t chatter_steps() const { return chatter_steps_; }
+
+ private:
+  template <Features F>
+  friend struct Stepper;
+
+  void emit(const Event& event) {
+    if (sink_ != nullptr) sink_->on_event(event);
+  }
+
+  const Scene* scene_ = nullptr;
+  Excitation excitation_;
+  SolverSettings settings_;
+  EventSink* sink_ = nullptr;
+  void (*step_fn_)(Simulator&) = nullptr;
+  void (*enter_fn_)(Simulator&, double) = nullptr;  // checks Eq 16 on entering full contact
+  Accelerations (*acc_fn_)(const Simulator&, double, const State&) = nullptr;
+  Mode mode_;
+  State y_ = State::Zero();
+  std::int64_t step_count_ = 0;
+  std::int64_t chatter_steps_ = 0;
+};
+
+}  // namespace plinth

@@ -1,0 +1,54 @@
+// The continuous state of the hybrid system and its discrete mode.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "plinth/core/scene.h"
+
+namespace plinth {
+
+// y = (u, x, theta, u', x', theta'): base displacement relative to the ground, sliding of the
+// body on the base (0 until sliding is modelled), rotation about the active corner (> 0 about
+// corner 1), and their rates. SI units: m, m, rad, m/s, m/s, rad/s.
+using State = Eigen::Matrix<double, 6, 1>;
+
+enum StateIndex : Eigen::Index { kU = 0, kX = 1, kTheta = 2, kUDot = 3, kXDot = 4, kThetaDot = 5 };
+
+// Accelerations (u'', x'', theta'') of one phase's equations of motion.
+struct Accelerations {
+  double u = 0.0;      // m/s2, relative to the ground
+  double x = 0.0;      // m/s2
+  double theta = 0.0;  // rad/s2
+};
+
+enum class Phase : std::uint8_t {
+  kFullContact,
+  kSliding,
+  kRocking,
+  kSlideRocking,
+  kOverturned,
+  kFell,
+};
+
+// The discrete part of the hybrid state.
+struct Mode {
+  Phase phase = Phase::kFullContact;
+  Corner corner = Corner::kLeft;  // rocking phases: the corner the block turns about
+  // +1 / -1: the base rests against the right / left base stop (u = +-u_max, u' = 0) after
+  // its rebounds died out; 0: the base moves freely. See resets.h, base_stop_reset.
+  std::int8_t held_stop = 0;
+
+  [[nodiscard]] bool rocking() const {
+    return phase == Phase::kRocking || phase == Phase::kSlideRocking;
+  }
+  [[nodiscard]] bool terminal() const {
+    return phase == Phase::kOverturned || phase == Phase::kFell;
+  }
+};
+
+// The names used in plinth-sim's CSV and in the monitor's status lines.
+[[nodiscard]] const char* phase_name(Phase phase);
+[[nodiscard]] const char* corner_name(Corner corner);
+
+}  // namespace plinth

@@ -1,0 +1,425 @@
+#include "plinth/core/simulator.h"
+
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include "plinth/core/energy.h"
+#include "plinth/core/flows.h"
+#include "plinth/core/guards.h"
+#include "plinth/core/resets.h"
+
+namespace plinth {
+
+const char* phase_name(Phase phase) {
+  switch (phase) {
+    case Phase::kFullContact:
+      return "full_contact";
+    case Phase::kSliding:
+      return "sliding";
+    case Phase::kRocking:
+      return "rocking";
+    case Phase::kSlideRocking:
+      return "slide_rocking";
+    case Phase::kOverturned:
+      return "overturned";
+    case Phase::kFell:
+      return "fell";
+  }
+  return "unknown";
+}
+
+const char* corner_name(Corner corner) { return corner == Corner::kLeft ? "left" : "right"; }
+
+const char* event_name(EventKind kind) {
+  switch (kind) {
+    case EventKind::kRockingStart:
+      return "rocking_start";
+    case EventKind::kImpact:
+      return "impact";
+    case EventKind::kRockingStop:
+      return "rocking_stop";
+    case EventKind::kBaseStopHit:
+      return "base_stop_hit";
+    case EventKind::kBaseStopHeld:
+      return "base_stop_held";
+    case EventKind::kBaseStopReleased:
+      return "base_stop_released";
+    case EventKind::kOverturned:
+      return "overturned";
+  }
+  return "unknown";
+}
+
+Error validate(const SolverSettings& st) {
+  if (!std::isfinite(st.step) || st.step <= 0.0) {
+    return {ErrorCode::kOutOfRange, "solver.step", "must be a finite number greater than zero"};
+  }
+  if (!std::isfinite(st.rest_energy_ratio) || st.rest_energy_ratio <= 0.0 ||
+      st.rest_energy_ratio >= 1.0) {
+    return {ErrorCode::kOutOfRange, "solver.rest_energy_ratio", "must lie in (0, 1)"};
+  }
+  if (!std::isfinite(st.base_rest_speed) || st.base_rest_speed < 0.0) {
+    return {ErrorCode::kOutOfRange, "solver.base_rest_speed", "must be finite and not negative"};
+  }
+  if (st.max_events_per_step < 1) {
+    return {ErrorCode::kOutOfRange, "solver.max_events_per_step", "must be at least 1"};
+  }
+  if (!std::isfinite(st.event_time_tolerance) || st.event_time_tolerance <= 0.0 ||
+      st.event_time_tolerance > 0.1) {
+    return {ErrorCode::kOutOfRange, "solver.event_time_tolerance", "must lie in (0, 0.1]"};
+  }
+  return ok_error();
+}
+
+// The solver for one set of model features: what a scene does not have is compiled out.
+template <Features F>
+struct Stepper {
+  static bool base_moves(const Mode& mode) {
+    if constexpr (!F.base) {
+      return false;
+    } else {
+      return mode.held_stop == 0;
+    }
+  }
+
+  static Accelerations accelerations(const Scene& s, const Mode& mode, const State& y,
+                                     GroundAcceleration ag) {
+    if (mode.terminal()) return {};
+    if (mode.rocking()) return rocking_flow(s, s.corner(mode.corner), y, ag, base_moves(mode));
+    if (!base_moves(mode)) return {};
+    return full_contact_flow(s, y, ag);
+  }
+
+  static State derivative(const Simulator& sim, const Mode& mode, double t, const State& y) {
+    const Accelerations a = accelerations(*sim.scene_, mode, y, sim.excitation_.at(t));
+    State d;
+    d << y[kUDot], y[kXDot], y[kThetaDot], a.u, a.x, a.theta;
+    return d;
+  }
+
+  // One classical Runge-Kutta step of size h from (t, y) in `mode`.
+  static State rk4(const Simulator& sim, const Mode& mode, double t, const State& y, double h) {
+    const State k1 = derivative(sim, mode, t, y);
+    const State k2 = derivative(sim, mode, t + 0.5 * h, y + 0.5 * h * k1);
+    const State k3 = derivative(sim, mode, t + 0.5 * h, y + 0.5 * h * k2);
+    const State k4 = derivative(sim, mode, t + h, y + h * k3);
+    return y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  }
+
+  static double guard_at(const Simulator& sim, const Mode& mode, GuardId id, double t,
+                         const State& y) {
+    const GroundAcceleration ag = sim.excitation_.at(t);
+    return guard_value(id, *sim.scene_, mode, y, ag, accelerations(*sim.scene_, mode, y, ag));
+  }
+
+  // Time tau in (0, h] at which guard `id` first reaches 0 on the RK4 solution from (t0, y0):
+  // the witness tau -> g(t0 + tau, rk4(y0, tau)) is bracketed by g(0) < 0 <= g(h) and its root
+  // found by the Illinois variant of regula falsi, with a bisection whenever an update fails
+  // to halve the bracket. Returns the bracket's upper end, where the guard holds.
+  static double locate(const Simulator& sim, const Mode& mode, GuardId id, double t0,
+                       const State& y0, double h, double g_start, double g_end) {
+    const double tolerance = sim.settings_.event_time_tolerance * sim.settings_.step;
+    double a = 0.0, fa = g_start, b = h, fb = g_end;
+    int last_side = 0;
+    bool bisect = false;
+    for (int iteration = 0; iteration < 200 && b - a > tolerance; ++iteration) {
+      const double width = b - a;
+      double c = bisect ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
+      if (!(c > a && c < b)) c = 0.5 * (a + b);
+      const double fc = guard_at(sim, mode, id, t0 + c, rk4(sim, mode, t0, y0, c));
+      if (fc >= 0.0) {
+        b = c;
+        fb = fc;
+        if (last_side == 1) fa *= 0.5;
+        last_side = 1;
+      } else {
+        a = c;
+        fa = fc;
+        if (last_side == -1) fb *= 0.5;
+        last_side = -1;
+      }
+      bisect = (b - a) > 0.5 * width;
+    }
+    return b;
+  }
+
+  // Eq 16 on entering (or starting in) full contact: if it already holds, rocking starts now
+  // in the favoured direction.
+  static void enter_full_contact(Simulator& sim, double t) {
+    if (sim.mode_.phase != Phase::kFullContact) return;
+    const Scene& s = *sim.scene_;
+    const GroundAcceleration ag = sim.excitation_.at(t);
+    const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
+    const double left = rocking_onset_guard(s, Corner::kLeft, acc, ag);
+    const double right = rocking_onset_guard(s, Corner::kRight, acc, ag);
+    if (left < 0.0 && right < 0.0) return;
+    start_rocking(sim, t, left >= right ? Corner::kLeft : Corner::kRight);
+  }
+
+  static void start_rocking(Simulator& sim, double t, Corner corner) {
+    rocking_onset_reset(corner, sim.mode_, sim.y_);
+    Event e;
+    e.t = t;
+    e.kind = EventKind::kRockingStart;
+    e.corner = corner;
+    e.state = sim.y_;
+    sim.emit(e);
+  }
+
+  static void stop_rocking(Simulator& sim, double t, double theta_dot_before) {
+    rocking_stop_reset(*sim.scene_, base_moves(sim.mode_), sim.mode_, sim.y_);
+    Event e;
+    e.t = t;
+    e.kind = EventKind::kRockingStop;
+    e.corner = sim.mode_.corner;
+    e.before = theta_dot_before;
+    e.state = sim.y_;
+    sim.emit(e);
+  }
+
+  static void rocking_impact(Simulator& sim, double t) {
+    const Scene& s = *sim.scene_;
+    const double before = sim.y_[kThetaDot];
+    const Corner to = opposite(sim.mode_.corner);
+    const double after = impact_velocity_ratio(s, to, base_moves(sim.mode_)) * before;
+    const double energy_after = 0.5 * s.corner(to).inertia * after * after;
+    const bool spent = after * before <= 0.0 ||
+                       energy_after < sim.settings_.rest_energy_ratio * overturning_energy(s, to);
+    if (spent) {
+      stop_rocking(sim, t, before);
+      enter_full_contact(sim, t);
+      return;
+    }
+    rocking_impact_reset(s, base_moves(sim.mode_), sim.mode_, sim.y_);
+    Event e;
+    e.t = t;
+    e.kind = EventKind::kImpact;
+    e.corner = to;
+    e.before = before;
+    e.after = sim.y_[kThetaDot];
+    e.state = sim.y_;
+    sim.emit(e);
+  }
+
+  static void base_stop_hit(Simulator& sim, double t, int side) {
+    const Scene& s = *sim.scene_;
+    const double before = sim.y_[kUDot];
+    base_stop_reset(s, side, sim.mode_, sim.y_);
+    Event e;
+    e.t = t;
+    e.kind = EventKind::kBaseStopHit;
+    e.corner = sim.mode_.corner;
+    e.side = static_cast<std::int8_t>(side);
+    e.before = before;
+    e.after = sim.y_[kUDot];
+    e.state = sim.y_;
+    sim.emit(e);
+    if (std::fabs(sim.y_[kUDot]) < sim.settings_.base_rest_speed) hold_if_pushed(sim, t, side);
+  }
+
+  // The base's rebound is too slow to matter: if the stop pushes back, the base rests on it.
+  static void hold_if_pushed(Simulator& sim, double t, int side) {
+    const Scene& s = *sim.scene_;
+    Mode held = sim.mode_;
+    held.held_stop = static_cast<std::int8_t>(side);
+    const GroundAcceleration ag = sim.excitation_.at(t);
+    const double reaction =
+        base_stop_reaction(s, held, sim.y_, ag, accelerations(s, held, sim.y_, ag));
+    if (side * reaction > 0.0) return;  // the stop would have to pull: the base moves away
+    base_stop_hold_reset(s, side, sim.mode_, sim.y_);
+    Event e;
+    e.t = t;
+    e.kind = EventKind::kBaseStopHeld;
+    e.corner = sim.mode_.corner;
+    e.side = static_cast<std::int8_t>(side);
+    e.state = sim.y_;
+    sim.emit(e);
+    enter_full_contact(sim, t);
+  }
+
+  static void release_base(Simulator& sim, double t) {
+    Event e;
+    e.t = t;
+    e.kind = EventKind::kBaseStopReleased;
+    e.corner = sim.mode_.corner;
+    e.side = sim.mode_.held_stop;
+    sim.mode_.held_stop = 0;
+    e.state = sim.y_;
+    sim.emit(e);
+    enter_full_contact(sim, t);
+  }
+
+  static void overturn(Simulator& sim, double t) {
+    const CornerGeometry& c = sim.scene_->corner(sim.mode_.corner);
+    sim.y_[kTheta] = c.sign * c.critical_angle;
+    sim.mode_.phase = Phase::kOverturned;
+    Event e;
+    e.t = t;
+    e.kind = EventKind::kOverturned;
+    e.corner = sim.mode_.corner;
+    e.state = sim.y_;
+    sim.emit(e);
+  }
+
+  static void apply(Simulator& sim, GuardId id, double t) {
+    switch (id) {
+      case GuardId::kRockingOnsetLeft:
+        start_rocking(sim, t, Corner::kLeft);
+        return;
+      case GuardId::kRockingOnsetRight:
+        start_rocking(sim, t, Corner::kRight);
+        return;
+      case GuardId::kRockingImpact:
+        rocking_impact(sim, t);
+        return;
+      case GuardId::kOverturning:
+        overturn(sim, t);
+        return;
+      case GuardId::kBaseStopRight:
+        base_stop_hit(sim, t, +1);
+        return;
+      case GuardId::kBaseStopLeft:
+        base_stop_hit(sim, t, -1);
+        return;
+      case GuardId::kBaseStopRelease:
+        release_base(sim, t);
+        return;
+    }
+  }
+
+  // Chatter within one step (Zeno): bring rocking to rest and hold a base that sits on a stop.
+  static void settle(Simulator& sim, double t) {
+    if (sim.mode_.rocking()) stop_rocking(sim, t, sim.y_[kThetaDot]);
+    if constexpr (F.base_stops) {
+      const double u_max = sim.scene_->params.base_stops.max_displacement;
+      if (sim.mode_.held_stop == 0 && std::fabs(sim.y_[kU]) >= u_max * (1.0 - 1e-9)) {
+        hold_if_pushed(sim, t, sim.y_[kU] > 0.0 ? +1 : -1);
+      }
+    }
+    ++sim.chatter_steps_;
+  }
+
+  static void step(Simulator& sim) {
+    if (sim.mode_.terminal()) return;
+    const double dt = sim.settings_.step;
+    const double t_end = static_cast<double>(sim.step_count_ + 1) * dt;
+    double t0 = sim.time();
+    int events = 0;
+    bool guards_live = true;
+    for (;;) {
+      const double h = t_end - t0;
+      if (h <= 0.0) break;
+      const Mode mode = sim.mode_;
+      const State y0 = sim.y_;
+      const State y1 = rk4(sim, mode, t0, y0, h);
+      const ActiveGuards guards = guards_live ? active_guards<F>(mode) : ActiveGuards{};
+      GuardId first = GuardId::kRockingImpact;
+      double first_tau = std::numeric_limits<double>::infinity();
+      for (int i = 0; i < guards.count; ++i) {
+        const GuardId id = guards.ids[static_cast<std::size_t>(i)];
+        const double g_start = guard_at(sim, mode, id, t0, y0);
+        if (g_start >= 0.0) continue;
+        const double g_end = guard_at(sim, mode, id, t_end, y1);
+        if (g_end < 0.0) continue;
+        const double tau = locate(sim, mode, id, t0, y0, h, g_start, g_end);
+        if (tau < first_tau) {
+          first_tau = tau;
+          first = id;
+        }
+      }
+      if (!std::isfinite(first_tau)) {
+        sim.y_ = y1;
+        break;
+      }
+      t0 += first_tau;
+      sim.y_ = rk4(sim, mode, t0 - first_tau, y0, first_tau);
+      apply(sim, first, t0);
+      if (sim.mode_.terminal()) break;
+      if (++events >= sim.settings_.max_events_per_step) {
+        settle(sim, t0);
+        guards_live = false;
+      }
+    }
+    ++sim.step_count_;
+  }
+
+  static Accelerations current(const Simulator& sim, double t, const State& y) {
+    return accelerations(*sim.scene_, sim.mode_, y, sim.excitation_.at(t));
+  }
+};
+
+Error Simulator::create(const Scene& scene, const Excitation& excitation,
+                        const SolverSettings& settings, Simulator& out) {
+  if (Error e = validate(settings); !e.ok()) return e;
+  const SceneParams& p = scene.params;
+  if (p.has_friction) {
+    return {ErrorCode::kUnsupported, "friction",
+            "sliding is not modelled by this version: remove [friction] (the block never slides)"};
+  }
+  if (p.has_support || p.has_sliding_stops) {
+    return {ErrorCode::kUnsupported, p.has_support ? "support" : "sliding_stops",
+            "sliding is not modelled by this version, so the support's edge and sliding stops "
+            "cannot be reached: remove the table"};
+  }
+  Simulator sim;
+  sim.scene_ = &scene;
+  sim.excitation_ = excitation;
+  sim.settings_ = settings;
+  const Features f = features_of(scene);
+  if (!f.base) {
+    sim.step_fn_ = &Stepper<Features{false, false}>::step;
+    sim.enter_fn_ = &Stepper<Features{false, false}>::enter_full_contact;
+    sim.acc_fn_ = &Stepper<Features{false, false}>::current;
+  } else if (!f.base_stops) {
+    sim.step_fn_ = &Stepper<Features{true, false}>::step;
+    sim.enter_fn_ = &Stepper<Features{true, false}>::enter_full_contact;
+    sim.acc_fn_ = &Stepper<Features{true, false}>::current;
+  } else {
+    sim.step_fn_ = &Stepper<Features{true, true}>::step;
+    sim.enter_fn_ = &Stepper<Features{true, true}>::enter_full_contact;
+    sim.acc_fn_ = &Stepper<Features{true, true}>::current;
+  }
+  out = sim;
+  return ok_error();
+}
+
+void Simulator::start_from(const Mode& mode, const State& state) {
+  step_count_ = 0;
+  chatter_steps_ = 0;
+  mode_ = mode;
+  y_ = state;
+  enter_fn_(*this, 0.0);
+}
+
+void Simulator::start_at_rest() { start_from(Mode{}, State::Zero()); }
+
+void Simulator::start_with_impulse(double impulse) {
+  State y = State::Zero();
+  Mode mode;
+  if (scene_->has_base()) {
+    y[kUDot] = impulse;  // the base keeps its absolute velocity; the ground's jumps by -I
+    start_from(mode, y);
+    return;
+  }
+  start_from(mode, y);
+  if (impulse == 0.0) return;
+  // On the ground, the block moves at +I relative to it and is caught by the corner ahead:
+  // angular momentum about that corner, -m h I = I_i theta'(0+).
+  const Corner corner = impulse > 0.0 ? Corner::kRight : Corner::kLeft;
+  mode_.phase = Phase::kRocking;
+  mode_.corner = corner;
+  y_[kThetaDot] = -scene_->m * scene_->h * impulse / scene_->corner(corner).inertia;
+  Event e;
+  e.t = 0.0;
+  e.kind = EventKind::kRockingStart;
+  e.corner = corner;
+  e.state = y_;
+  emit(e);
+}
+
+void Simulator::step() { step_fn_(*this); }
+
+Accelerations Simulator::accelerations() const { return acc_fn_(*this, time(), y_); }
+
+}  // namespace plinth

@@ -1,0 +1,35 @@
+// plinth-sim's output formats: the CSV time history and the JSON Lines event log
+// (documented in docs/output-formats.md; integrators parse them, keep them stable).
+#pragma once
+
+#include <ostream>
+#include <string>
+
+#include "plinth/core/events.h"
+#include "plinth/core/state.h"
+
+namespace plinth::host {
+
+inline constexpr const char* kTimeHistoryHeader = "t,ag,u,u_dot,x,x_dot,theta,theta_dot,phase";
+
+// Writes one CSV row per call: SI units, ag the horizontal ground acceleration in m/s2.
+class TimeHistoryCsv {
+ public:
+  explicit TimeHistoryCsv(std::ostream& out);
+  void write_row(double t, double ag, const State& y, Phase phase);
+
+ private:
+  std::ostream& out_;
+};
+
+enum class Outcome { kSurvived, kOverturned, kFell };
+
+[[nodiscard]] const char* outcome_name(Outcome outcome);
+[[nodiscard]] Outcome outcome_of(Phase final_phase);
+
+// One JSON object per line: {"t": s, "event": name, ...details}.
+[[nodiscard]] std::string event_json(const Event& event);
+// The last line: {"t": s, "event": "end", "outcome": "survived" | "overturned" | "fell"}.
+[[nodiscard]] std::string end_json(double t, Outcome outcome);
+
+}  // namespace plinth::host

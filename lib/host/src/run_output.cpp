@@ -1,0 +1,89 @@
+#include "plinth/host/run_output.h"
+
+#include <cstdio>
+
+namespace plinth::host {
+namespace {
+
+// Shortest round-trip representation is not needed; 10 significant digits keeps the event
+// times exact to far below the solver step.
+std::string number(double value) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.10g", value);
+  return buffer;
+}
+
+std::string field(const char* key, const std::string& json_value) {
+  return std::string(", \"") + key + "\": " + json_value;
+}
+
+std::string quoted(const char* text) { return std::string("\"") + text + "\""; }
+
+}  // namespace
+
+TimeHistoryCsv::TimeHistoryCsv(std::ostream& out) : out_(out) {
+  out_ << kTimeHistoryHeader << '\n';
+}
+
+void TimeHistoryCsv::write_row(double t, double ag, const State& y, Phase phase) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof buffer, "%.6f,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%s\n", t, ag,
+                y[kU], y[kUDot], y[kX], y[kXDot], y[kTheta], y[kThetaDot], phase_name(phase));
+  out_ << buffer;
+}
+
+const char* outcome_name(Outcome outcome) {
+  switch (outcome) {
+    case Outcome::kSurvived:
+      return "survived";
+    case Outcome::kOverturned:
+      return "overturned";
+    case Outcome::kFell:
+      return "fell";
+  }
+  return "survived";
+}
+
+Outcome outcome_of(Phase final_phase) {
+  if (final_phase == Phase::kOverturned) return Outcome::kOverturned;
+  if (final_phase == Phase::kFell) return Outcome::kFell;
+  return Outcome::kSurvived;
+}
+
+std::string event_json(const Event& e) {
+  std::string line = "{\"t\": " + number(e.t) + ", \"event\": " + quoted(event_name(e.kind));
+  switch (e.kind) {
+    case EventKind::kRockingStart:
+    case EventKind::kOverturned:
+      line += field("corner", quoted(corner_name(e.corner)));
+      break;
+    case EventKind::kImpact:
+      line += field("corner", quoted(corner_name(e.corner)));
+      line += field("theta_dot_before", number(e.before));
+      line += field("theta_dot_after", number(e.after));
+      break;
+    case EventKind::kRockingStop:
+      line += field("theta_dot_before", number(e.before));
+      break;
+    case EventKind::kBaseStopHit:
+      line += field("side", quoted(e.side > 0 ? "right" : "left"));
+      line += field("u_dot_before", number(e.before));
+      line += field("u_dot_after", number(e.after));
+      break;
+    case EventKind::kBaseStopHeld:
+    case EventKind::kBaseStopReleased:
+      line += field("side", quoted(e.side > 0 ? "right" : "left"));
+      break;
+  }
+  line += field("u", number(e.state[kU]));
+  line += field("theta", number(e.state[kTheta]));
+  line += "}";
+  return line;
+}
+
+std::string end_json(double t, Outcome outcome) {
+  return "{\"t\": " + number(t) + ", \"event\": \"end\", \"outcome\": " +
+         quoted(outcome_name(outcome)) + "}";
+}
+
+}  // namespace plinth::host

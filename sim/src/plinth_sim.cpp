@@ -1,0 +1,260 @@
+// plinth-sim: one simulation of a scene under a record, an impulse or a pulse.
+// Writes a CSV time history (--out), a JSON Lines event log (--events) and a human summary.
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "plinth/core/simulator.h"
+#include "plinth/host/input_error.h"
+#include "plinth/host/record_io.h"
+#include "plinth/host/run_output.h"
+#include "plinth/host/scene_toml.h"
+#include "plinth/host/units.h"
+
+namespace {
+
+using plinth::host::InputError;
+
+struct Options {
+  std::string scene_path;
+  std::string record_path;
+  std::string vertical_path;
+  std::string pga;
+  std::optional<double> scale;
+  std::optional<double> impulse;
+  std::string pulse;
+  std::string amplitude;
+  std::optional<double> period;
+  double dt = 1e-4;
+  std::optional<double> t_end;
+  std::string out_path;
+  double out_interval = 1e-3;
+  std::string events_path;
+};
+
+// Phase intervals for the summary, built from the events as they come.
+struct TimelineEntry {
+  double t;
+  std::string what;
+};
+
+class RunSink final : public plinth::EventSink {
+ public:
+  explicit RunSink(std::ostream* events_out) : events_out_(events_out) {}
+
+  void on_event(const plinth::Event& e) override {
+    if (events_out_ != nullptr) *events_out_ << plinth::host::event_json(e) << '\n';
+    switch (e.kind) {
+      case plinth::EventKind::kRockingStart:
+        timeline.push_back({e.t, std::string("rocking about the ") +
+                                     plinth::corner_name(e.corner) + " corner"});
+        break;
+      case plinth::EventKind::kImpact:
+        ++impacts;
+        break;
+      case plinth::EventKind::kRockingStop:
+        ++impacts;
+        timeline.push_back({e.t, "full_contact"});
+        break;
+      case plinth::EventKind::kBaseStopHit:
+        ++base_stop_hits;
+        break;
+      case plinth::EventKind::kBaseStopHeld:
+      case plinth::EventKind::kBaseStopReleased:
+        break;
+      case plinth::EventKind::kOverturned:
+        timeline.push_back({e.t, std::string("overturned about the ") +
+                                     plinth::corner_name(e.corner) + " corner"});
+        break;
+    }
+  }
+
+  std::vector<TimelineEntry> timeline{{0.0, "full_contact"}};
+  long impacts = 0;
+  long base_stop_hits = 0;
+
+ private:
+  std::ostream* events_out_;
+};
+
+std::unique_ptr<std::ofstream> open_output(const std::string& path, const char* what) {
+  if (path.empty()) return nullptr;
+  auto out = std::make_unique<std::ofstream>(path);
+  if (!*out) throw InputError(path + ": cannot open " + what + " for writing");
+  return out;
+}
+
+std::string describe_scene(const plinth::Scene& s) {
+  char text[320];
+  int n = std::snprintf(text, sizeof text, "block b=%g m, h=%g m, e=%g m, m=%g kg", s.b, s.h,
+                        s.params.block.eccentricity, s.m);
+  if (s.has_base()) {
+    n += std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n),
+                       "; base m_b=%g kg, T=%g s, xi=%g", s.params.base.mass,
+                       s.params.base.period, s.params.base.damping_ratio);
+    if (s.params.has_base_stops) {
+      std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n),
+                    "; base stops u_max=%g m, eta_i=%g", s.params.base_stops.max_displacement,
+                    s.params.base_stops.restitution);
+    }
+  } else {
+    std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n), "; on the ground");
+  }
+  return text;
+}
+
+int run(const Options& opt) {
+  const plinth::Scene scene = plinth::host::load_scene_file(opt.scene_path);
+  const double g = scene.g;
+
+  plinth::host::Record record;
+  plinth::host::Record vertical;
+  plinth::Excitation excitation;
+  std::string excitation_text = "none";
+  if (!opt.record_path.empty()) {
+    record = plinth::host::read_record(opt.record_path, g);
+    if (!opt.vertical_path.empty()) {
+      vertical = plinth::host::read_record(opt.vertical_path, g);
+      if (std::fabs(vertical.dt - record.dt) > 1e-9 * record.dt) {
+        throw InputError(opt.vertical_path + ": sampling interval " +
+                         std::to_string(vertical.dt) + " s differs from the horizontal record's " +
+                         std::to_string(record.dt) + " s");
+      }
+    }
+    const double peak = record.peak_horizontal();
+    double gamma = 1.0;
+    if (!opt.pga.empty()) {
+      if (peak <= 0.0) throw InputError(opt.record_path + ": record is all zeros, cannot scale to --pga");
+      gamma = plinth::host::parse_acceleration(opt.pga, g, "--pga") / peak;
+    } else if (opt.scale) {
+      gamma = *opt.scale;
+    }
+    excitation = plinth::Excitation::record(
+        record.horizontal_signal(),
+        opt.vertical_path.empty() ? plinth::SampledSignal{} : vertical.horizontal_signal(), gamma);
+    char text[256];
+    std::snprintf(text, sizeof text, "%s, PGA %.4g g (scale %.4g), dt %g s, %.2f s",
+                  record.name.c_str(), gamma * peak / g, gamma, record.dt, record.duration());
+    excitation_text = text;
+  } else if (!opt.pulse.empty()) {
+    const double amplitude = plinth::host::parse_acceleration(opt.amplitude, g, "--amplitude");
+    excitation = opt.pulse == "sine" ? plinth::Excitation::sine_pulse(amplitude, *opt.period)
+                                     : plinth::Excitation::cosine_pulse(amplitude, *opt.period);
+    char text[160];
+    std::snprintf(text, sizeof text, "one-%s pulse, amplitude %.4g g, period %g s",
+                  opt.pulse.c_str(), amplitude / g, *opt.period);
+    excitation_text = text;
+  } else if (opt.impulse) {
+    char text[96];
+    std::snprintf(text, sizeof text, "impulse I = %g m/s (Eq 34)", *opt.impulse);
+    excitation_text = text;
+  }
+
+  plinth::SolverSettings settings;
+  settings.step = opt.dt;
+  plinth::Simulator sim;
+  if (plinth::Error e = plinth::Simulator::create(scene, excitation, settings, sim); !e.ok()) {
+    throw InputError(std::string(e.field) + ": " + e.reason);
+  }
+
+  const double t_end = opt.t_end ? *opt.t_end : std::max(10.0, excitation.duration() + 5.0);
+  auto csv_file = open_output(opt.out_path, "the time history");
+  auto events_file = open_output(opt.events_path, "the event log");
+  std::optional<plinth::host::TimeHistoryCsv> csv;
+  if (csv_file) csv.emplace(*csv_file);
+  RunSink sink(events_file.get());
+  sim.set_event_sink(&sink);
+
+  if (opt.impulse) {
+    sim.start_with_impulse(*opt.impulse);
+  } else {
+    sim.start_at_rest();
+  }
+  const auto steps = static_cast<std::int64_t>(std::llround(t_end / opt.dt));
+  const std::int64_t out_every = std::max<std::int64_t>(1, std::llround(opt.out_interval / opt.dt));
+  double peak_theta = 0.0;
+  double peak_u = 0.0;
+  const auto wall_start = std::chrono::steady_clock::now();
+  for (std::int64_t i = 0; i <= steps; ++i) {
+    const plinth::State& y = sim.state();
+    peak_theta = std::max(peak_theta, std::fabs(y[plinth::kTheta]));
+    peak_u = std::max(peak_u, std::fabs(y[plinth::kU]));
+    if (csv && i % out_every == 0) {
+      csv->write_row(sim.time(), excitation.at(sim.time()).horizontal, y, sim.mode().phase);
+    }
+    if (sim.mode().terminal() || i == steps) break;
+    sim.step();
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  const plinth::host::Outcome outcome = plinth::host::outcome_of(sim.mode().phase);
+  if (events_file) *events_file << plinth::host::end_json(sim.time(), outcome) << '\n';
+  if (csv_file && !csv_file->flush()) throw InputError(opt.out_path + ": write failed");
+  if (events_file && !events_file->flush()) throw InputError(opt.events_path + ": write failed");
+
+  std::printf("scene:      %s (%s)\n", opt.scene_path.c_str(), describe_scene(scene).c_str());
+  std::printf("excitation: %s\n", excitation_text.c_str());
+  std::printf("solver:     RK4, dt %g s, %lld steps to t = %.3f s in %.3f s (%.0fx real time)\n",
+              opt.dt, static_cast<long long>(sim.step_count()), sim.time(), wall,
+              wall > 0.0 ? sim.time() / wall : 0.0);
+  std::printf("phase timeline:\n");
+  for (const TimelineEntry& entry : sink.timeline) {
+    std::printf("  %10.4f s  %s\n", entry.t, entry.what.c_str());
+  }
+  const double alpha = std::min(scene.corner1.critical_angle, scene.corner2.critical_angle);
+  std::printf("outcome:    %s at t = %.4f s; peak |theta| %.4g rad (%.3g of alpha), peak |u| %.4g m;"
+              " %ld impacts, %ld base stop hits\n",
+              plinth::host::outcome_name(outcome), sim.time(), peak_theta, peak_theta / alpha,
+              peak_u, sink.impacts, sink.base_stop_hits);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"plinth-sim: simulate a block on an isolated base (or the ground) under a "
+               "record, an impulse or a pulse"};
+  Options opt;
+  app.add_option("--scene", opt.scene_path, "scene file (TOML)")->required();
+  auto* record = app.add_option("--record", opt.record_path, "horizontal record (.AT2 or .csv)");
+  app.add_option("--vertical", opt.vertical_path, "vertical record (same dt)")->needs(record);
+  auto* pga = app.add_option("--pga", opt.pga, "scale the record to this PGA, e.g. 0.3g")->needs(record);
+  app.add_option("--scale", opt.scale, "scale factor gamma of the record")
+      ->needs(record)
+      ->excludes(pga)
+      ->check(CLI::Number);
+  auto* impulse = app.add_option("--impulse", opt.impulse, "impulse I, m/s (Eq 34)")->excludes(record);
+  auto* pulse = app.add_option("--pulse", opt.pulse, "one-period pulse: sine or cosine")
+                    ->check(CLI::IsMember({"sine", "cosine"}))
+                    ->excludes(record)
+                    ->excludes(impulse);
+  app.add_option("--amplitude", opt.amplitude, "pulse amplitude, e.g. 0.5g")->needs(pulse);
+  app.add_option("--period", opt.period, "pulse period, s")->needs(pulse)->check(CLI::PositiveNumber);
+  app.add_option("--dt", opt.dt, "solver step, s")->check(CLI::PositiveNumber);
+  app.add_option("--t-end", opt.t_end, "end time, s (default: the input's length + 5 s, at least 10 s)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--out", opt.out_path, "CSV time history");
+  app.add_option("--out-interval", opt.out_interval, "time between CSV rows, s (whole steps)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--events", opt.events_path, "JSON Lines event log");
+  CLI11_PARSE(app, argc, argv);
+  if (!opt.pulse.empty() && (opt.amplitude.empty() || !opt.period)) {
+    std::fprintf(stderr, "plinth-sim: --pulse needs --amplitude and --period\n");
+    return 2;
+  }
+  try {
+    return run(opt);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "plinth-sim: %s\n", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "plinth-sim: error: %s\n", e.what());
+    return 1;
+  }
+}
