@@ -113,14 +113,13 @@ struct Stepper {
     return guard_value(id, *sim.scene_, mode, y, ag, accelerations(*sim.scene_, mode, y, ag));
   }
 
-  // Time tau in (0, h] at which guard `id` first reaches 0 on the RK4 solution from (t0, y0):
-  // the witness tau -> g(t0 + tau, rk4(y0, tau)) is bracketed by g(0) < 0 <= g(h) and its root
+  // Time tau in (a, b] at which guard `id` reaches 0 on the RK4 solution from (t0, y0):
+  // the witness tau -> g(t0 + tau, rk4(y0, tau)) is bracketed by g(a) < 0 <= g(b) and its root
   // found by the Illinois variant of regula falsi, with a bisection whenever an update fails
   // to halve the bracket. Returns the bracket's upper end, where the guard holds.
   static double locate(const Simulator& sim, const Mode& mode, GuardId id, double t0,
-                       const State& y0, double h, double g_start, double g_end) {
+                       const State& y0, double a, double fa, double b, double fb) {
     const double tolerance = sim.settings_.event_time_tolerance * sim.settings_.step;
-    double a = 0.0, fa = g_start, b = h, fb = g_end;
     int last_side = 0;
     bool bisect = false;
     for (int iteration = 0; iteration < 200 && b - a > tolerance; ++iteration) {
@@ -142,6 +141,23 @@ struct Stepper {
       bisect = (b - a) > 0.5 * width;
     }
     return b;
+  }
+
+  // Crossing time of a guard that is negative or exactly zero at the start and non-negative
+  // at the end. Exactly zero means a reset has just put the state on the guard's surface
+  // (theta = 0 after an impact, u = +-u_max after a stop hit): the motion leaves the surface
+  // and may come back within the same step, so the step is probed for the excursion below 0
+  // and the return is located from there. An excursion too small to see is taken as an event
+  // at the end of the interval.
+  static double first_crossing(const Simulator& sim, const Mode& mode, GuardId id, double t0,
+                               const State& y0, double h, double g_start, double g_end) {
+    if (g_start < 0.0) return locate(sim, mode, id, t0, y0, 0.0, g_start, h, g_end);
+    for (const double fraction : {0.0625, 0.25, 0.5, 0.75}) {
+      const double tau = fraction * h;
+      const double g = guard_at(sim, mode, id, t0 + tau, rk4(sim, mode, t0, y0, tau));
+      if (g < 0.0) return locate(sim, mode, id, t0, y0, tau, g, h, g_end);
+    }
+    return h;
   }
 
   // Eq 16 on entering (or starting in) full contact: if it already holds, rocking starts now
@@ -319,10 +335,10 @@ struct Stepper {
       for (int i = 0; i < guards.count; ++i) {
         const GuardId id = guards.ids[static_cast<std::size_t>(i)];
         const double g_start = guard_at(sim, mode, id, t0, y0);
-        if (g_start >= 0.0) continue;
+        if (g_start > 0.0) continue;
         const double g_end = guard_at(sim, mode, id, t_end, y1);
         if (g_end < 0.0) continue;
-        const double tau = locate(sim, mode, id, t0, y0, h, g_start, g_end);
+        const double tau = first_crossing(sim, mode, id, t0, y0, h, g_start, g_end);
         if (tau < first_tau) {
           first_tau = tau;
           first = id;

@@ -10,7 +10,7 @@ namespace plinth::host {
 
 // A uniformly sampled ground acceleration record, owned, in m/s2.
 struct Record {
-  std::string name;                // e.g. "IRPINIA 11/23/80, BRIENZA, 000" or the file stem
+  std::string name;                // AT2 line 2, e.g. "Irpinia Italy-01, 11/23/1980, Brienza, 0"; CSV: file stem
   double dt = 0.0;                 // s, > 0
   std::vector<double> horizontal;  // m/s2, finite, first sample at t = 0
   std::vector<double> vertical;    // m/s2, empty when the file has none

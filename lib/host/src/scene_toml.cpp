@@ -1,0 +1,386 @@
+#include "plinth/host/scene_toml.h"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <ios>
+#include <initializer_list>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <system_error>
+#include <utility>
+
+#include <toml++/toml.h>
+
+#include "plinth/host/input_error.h"
+
+namespace plinth::host {
+namespace {
+
+// Shortest text that reads back as `value` ("2000", "0.3", "nan", "-inf").
+std::string format_number(double value) {
+  std::array<char, 64> buffer{};
+  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+  if (result.ec != std::errc{}) return "?";
+  return std::string(buffer.data(), result.ptr);
+}
+
+std::string_view type_name(toml::node_type type) {
+  switch (type) {
+    case toml::node_type::none: return "nothing";
+    case toml::node_type::table: return "a table";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a float";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::date: return "a date";
+    case toml::node_type::time: return "a time";
+    case toml::node_type::date_time: return "a date-time";
+  }
+  return "an unknown type";
+}
+
+std::string join(std::initializer_list<std::string_view> words) {
+  std::string out;
+  for (std::string_view word : words) {
+    if (!out.empty()) out += ", ";
+    out += word;
+  }
+  return out;
+}
+
+// A number read from the file: its value, its full dotted key and its line (0: unknown).
+struct Number {
+  double value = 0.0;
+  std::string key;
+  std::uint32_t line = 0;
+};
+
+// Where the value the core checks under one of its field names came from in the file.
+struct Provenance {
+  std::string key;  // the file's dotted key (or table name)
+  std::uint32_t line = 0;
+  std::optional<double> file_value;  // as written in the file
+  // Set when the core's value was computed from the file's (e.g. eccentricity from
+  // eccentricity_ratio): the core's value, shown next to the file's.
+  std::optional<double> core_value;
+};
+
+class Loader {
+ public:
+  explicit Loader(std::string origin) : origin_(std::move(origin)) {}
+
+  Scene load(const std::string& text) {
+    toml::table doc;
+    try {
+      doc = toml::parse(text, origin_);
+    } catch (const toml::parse_error& error) {
+      const toml::source_position where = error.source().begin;
+      throw InputError(origin_ + ":" + std::to_string(where.line) + ":" +
+                       std::to_string(where.column) +
+                       ": TOML syntax error: " + std::string(error.description()));
+    }
+    SceneParams params;
+    check_keys(doc, "", {"gravity", "block", "base", "friction", "base_stops", "support",
+                         "sliding_stops"});
+    if (std::optional<Number> g = number(doc, "", "gravity")) {
+      params.gravity = g->value;
+      record("gravity", *g);
+    }
+    const toml::table* block = table(doc, "block");
+    if (block == nullptr) fail(0, "block", "required table missing");
+    read_block(*block, params);
+    if (const toml::table* base = table(doc, "base")) read_base(*base, params);
+    if (const toml::table* friction = table(doc, "friction")) read_friction(*friction, params);
+    if (const toml::table* stops = table(doc, "base_stops")) read_base_stops(*stops, params);
+    if (const toml::table* support = table(doc, "support")) read_support(*support, params);
+    if (const toml::table* stops = table(doc, "sliding_stops")) read_sliding_stops(*stops, params);
+
+    Scene scene;
+    if (const Error error = make_scene(params, scene); !error.ok()) report(error);
+    return scene;
+  }
+
+ private:
+  [[noreturn]] void fail(std::uint32_t line, std::string_view key, std::string_view what) const {
+    std::string message = origin_;
+    if (line > 0) message += ":" + std::to_string(line);
+    message += ": ";
+    message += key;
+    message += ": ";
+    message += what;
+    throw InputError(message);
+  }
+
+  static std::string dotted(std::string_view prefix, std::string_view key) {
+    std::string out(prefix);
+    if (!out.empty()) out += '.';
+    out += key;
+    return out;
+  }
+
+  // Rejects every key of `tbl` not in `known`, naming it with its full dotted name.
+  void check_keys(const toml::table& tbl, std::string_view prefix,
+                  std::initializer_list<std::string_view> known) const {
+    for (auto&& [key, node] : tbl) {
+      bool found = false;
+      for (std::string_view k : known) found = found || k == key.str();
+      if (found) continue;
+      const std::string name = dotted(prefix, key.str());
+      const char* kind = node.is_table() ? "unknown table" : "unknown key";
+      const std::string where = prefix.empty() ? std::string("at the top level")
+                                               : "in [" + std::string(prefix) + "]";
+      fail(key.source().begin.line, name,
+           std::string(kind) + " (allowed " + where + ": " + join(known) + ")");
+    }
+  }
+
+  // The sub-table `name` of the document, nullptr when absent; anything else is a type error.
+  const toml::table* table(const toml::table& doc, std::string_view name) const {
+    const toml::node* node = doc.get(name);
+    if (node == nullptr) return nullptr;
+    if (const toml::table* tbl = node->as_table()) return tbl;
+    fail(node->source().begin.line, name,
+         "expected a table, got " + std::string(type_name(node->type())));
+  }
+
+  // The number under `key`, nullopt when absent. Integers are accepted; other types and
+  // non-finite values are rejected.
+  std::optional<Number> number(const toml::table& tbl, std::string_view prefix,
+                               std::string_view key) const {
+    const toml::node* node = tbl.get(key);
+    if (node == nullptr) return std::nullopt;
+    Number out;
+    out.key = dotted(prefix, key);
+    out.line = node->source().begin.line;
+    if (const toml::value<std::int64_t>* i = node->as_integer()) {
+      out.value = static_cast<double>(i->get());
+    } else if (const toml::value<double>* f = node->as_floating_point()) {
+      out.value = f->get();
+    } else {
+      fail(out.line, out.key, "expected a number, got " + std::string(type_name(node->type())));
+    }
+    if (!std::isfinite(out.value)) {
+      fail(out.line, out.key, "must be a finite number (got " + format_number(out.value) + ")");
+    }
+    return out;
+  }
+
+  Number required(const toml::table& tbl, std::string_view prefix, std::string_view key) const {
+    std::optional<Number> n = number(tbl, prefix, key);
+    if (!n) fail(tbl.source().begin.line, dotted(prefix, key), "required key missing");
+    return *n;
+  }
+
+  // At most one of the keys `a` and `b`; `first` tells which one was given.
+  struct Choice {
+    Number number;
+    bool first = true;
+  };
+  std::optional<Choice> either(const toml::table& tbl, std::string_view prefix, std::string_view a,
+                               std::string_view b, bool needed) const {
+    std::optional<Number> na = number(tbl, prefix, a);
+    std::optional<Number> nb = number(tbl, prefix, b);
+    if (na && nb) {
+      fail(std::max(na->line, nb->line), nb->key,
+           "give either " + na->key + " or " + nb->key + ", not both");
+    }
+    if (na) return Choice{*na, true};
+    if (nb) return Choice{*nb, false};
+    if (needed) {
+      fail(tbl.source().begin.line, dotted(prefix, a),
+           "required key missing (give " + dotted(prefix, a) + " or " + dotted(prefix, b) + ")");
+    }
+    return std::nullopt;
+  }
+
+  // `core_field` holds the file's number as it is.
+  void record(const std::string& core_field, const Number& n) {
+    provenance_[core_field] = Provenance{n.key, n.line, n.value, std::nullopt};
+  }
+  // `core_field` holds `core_value`, computed from the file's number.
+  void record(const std::string& core_field, const Number& n, double core_value) {
+    if (n.key == core_field) {
+      record(core_field, n);
+    } else {
+      provenance_[core_field] = Provenance{n.key, n.line, n.value, core_value};
+    }
+  }
+
+  void read_block(const toml::table& tbl, SceneParams& params) {
+    check_keys(tbl, "block",
+               {"half_width", "slenderness", "com_height", "eccentricity_ratio", "eccentricity",
+                "density", "depth", "mass", "inertia"});
+    BlockParams& blk = params.block;
+
+    const Number b = required(tbl, "block", "half_width");
+    blk.half_width = b.value;
+    record("block.half_width", b);
+
+    const Choice height = *either(tbl, "block", "slenderness", "com_height", true);
+    blk.com_height = height.first ? height.number.value * blk.half_width : height.number.value;
+    record("block.com_height", height.number, blk.com_height);
+
+    if (std::optional<Choice> ecc =
+            either(tbl, "block", "eccentricity_ratio", "eccentricity", false)) {
+      blk.eccentricity = ecc->first ? ecc->number.value * blk.half_width : ecc->number.value;
+      record("block.eccentricity", ecc->number, blk.eccentricity);
+    }
+
+    const Choice mass = *either(tbl, "block", "density", "mass", true);
+    std::optional<Number> depth = number(tbl, "block", "depth");
+    if (mass.first) {
+      double d = 1.0;
+      if (depth) {
+        if (depth->value <= 0.0) {
+          fail(depth->line, depth->key,
+               "must be greater than zero (got " + format_number(depth->value) + ")");
+        }
+        d = depth->value;
+      }
+      blk.mass = mass.number.value * (2.0 * blk.half_width) * (2.0 * blk.com_height) * d;
+    } else {
+      if (depth) {
+        fail(depth->line, depth->key,
+             "is used only with block.density; with block.mass it has no meaning");
+      }
+      blk.mass = mass.number.value;
+    }
+    record("block.mass", mass.number, blk.mass);
+
+    if (std::optional<Number> inertia = number(tbl, "block", "inertia")) {
+      blk.inertia = inertia->value;
+      record("block.inertia", *inertia);
+    } else {
+      blk.inertia = homogeneous_rectangle_inertia(blk.mass, blk.half_width, blk.com_height);
+    }
+  }
+
+  void read_base(const toml::table& tbl, SceneParams& params) {
+    check_keys(tbl, "base",
+               {"mass_ratio", "mass", "period", "stiffness", "damping_ratio", "damping"});
+    params.has_base = true;
+    BaseParams& base = params.base;
+    const double m = params.block.mass;
+
+    const Choice mass = *either(tbl, "base", "mass_ratio", "mass", true);
+    base.mass = mass.first ? mass.number.value * m : mass.number.value;
+    record("base.mass", mass.number, base.mass);
+
+    const Choice period = *either(tbl, "base", "period", "stiffness", true);
+    if (period.first) {
+      base.period = period.number.value;
+    } else {
+      const double k = period.number.value;
+      if (k <= 0.0) {
+        fail(period.number.line, period.number.key,
+             "must be greater than zero (got " + format_number(k) + ")");
+      }
+      base.period = 2.0 * std::numbers::pi * std::sqrt((m + base.mass) / k);
+    }
+    record("base.period", period.number, base.period);
+
+    const Choice damping = *either(tbl, "base", "damping_ratio", "damping", true);
+    if (damping.first) {
+      base.damping_ratio = damping.number.value;
+    } else {
+      const double omega = 2.0 * std::numbers::pi / base.period;
+      base.damping_ratio = damping.number.value / (2.0 * (m + base.mass) * omega);
+    }
+    record("base.damping_ratio", damping.number, base.damping_ratio);
+  }
+
+  void read_friction(const toml::table& tbl, SceneParams& params) {
+    check_keys(tbl, "friction", {"static", "kinetic"});
+    params.has_friction = true;
+    const Number mu_s = required(tbl, "friction", "static");
+    params.friction.static_coefficient = mu_s.value;
+    record("friction.static", mu_s);
+    if (std::optional<Number> mu_k = number(tbl, "friction", "kinetic")) {
+      params.friction.kinetic_coefficient = mu_k->value;
+      record("friction.kinetic", *mu_k);
+    } else {
+      params.friction.kinetic_coefficient = 0.8 * mu_s.value;
+    }
+  }
+
+  void read_base_stops(const toml::table& tbl, SceneParams& params) {
+    check_keys(tbl, "base_stops", {"max_displacement", "restitution"});
+    params.has_base_stops = true;
+    provenance_["base_stops"] = Provenance{"base_stops", tbl.source().begin.line, {}, {}};
+    const Number u_max = required(tbl, "base_stops", "max_displacement");
+    params.base_stops.max_displacement = u_max.value;
+    record("base_stops.max_displacement", u_max);
+    const Number eta = required(tbl, "base_stops", "restitution");
+    params.base_stops.restitution = eta.value;
+    record("base_stops.restitution", eta);
+  }
+
+  void read_support(const toml::table& tbl, SceneParams& params) {
+    check_keys(tbl, "support", {"clearance"});
+    params.has_support = true;
+    const Number clearance = required(tbl, "support", "clearance");
+    params.support.clearance = clearance.value;
+    record("support.clearance", clearance);
+  }
+
+  void read_sliding_stops(const toml::table& tbl, SceneParams& params) {
+    check_keys(tbl, "sliding_stops", {"restitution"});
+    params.has_sliding_stops = true;
+    provenance_["sliding_stops"] = Provenance{"sliding_stops", tbl.source().begin.line, {}, {}};
+    const Number eta = required(tbl, "sliding_stops", "restitution");
+    params.sliding_stops.restitution = eta.value;
+    record("sliding_stops.restitution", eta);
+  }
+
+  // Throws the core's complaint, under the key the file used for the field at fault.
+  [[noreturn]] void report(const Error& error) const {
+    const std::string field = error.field;
+    const auto it = provenance_.find(field);
+    if (it == provenance_.end()) fail(0, field, error.reason);
+    const Provenance& p = it->second;
+    std::string what = error.reason;
+    if (p.file_value) {
+      what += " (got " + format_number(*p.file_value);
+      if (p.core_value) what += ", giving " + field + " = " + format_number(*p.core_value);
+      what += ")";
+    }
+    fail(p.line, p.key, what);
+  }
+
+  std::string origin_;
+  std::map<std::string, Provenance, std::less<>> provenance_;
+};
+
+}  // namespace
+
+Scene load_scene_text(const std::string& text, const std::string& origin) {
+  return Loader(origin).load(text);
+}
+
+Scene load_scene_file(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw InputError(path + ": cannot open scene file (it is a directory)");
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path + ": cannot open scene file");
+  std::string text;
+  std::array<char, 4096> chunk{};
+  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
+    text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
+  }
+  if (in.bad()) throw InputError(path + ": cannot open scene file (read error)");
+  return load_scene_text(text, path);
+}
+
+}  // namespace plinth::host

@@ -1,0 +1,77 @@
+// Shared helpers of the core test suites: scenes built in code and a recording event sink.
+#pragma once
+
+#include <vector>
+
+#include "plinth/core/scene.h"
+#include "plinth/core/simulator.h"
+
+namespace plinth::testing {
+
+// The paper's block (b = 0.3 m, lambda = 3, rho = 2000 kg/m3, 1 m deep, homogeneous I_C),
+// with eccentricity ratio `epsilon`, on the ground.
+inline SceneParams paper_block(double epsilon = 0.0) {
+  SceneParams p;
+  p.block.half_width = 0.3;
+  p.block.com_height = 0.9;
+  p.block.eccentricity = epsilon * 0.3;
+  p.block.mass = 2000.0 * 0.6 * 1.8;
+  p.block.inertia = homogeneous_rectangle_inertia(p.block.mass, 0.3, 0.9);
+  return p;
+}
+
+// The same block on the paper's base: m_b = m, T = 2 s, xi = 0.2.
+inline SceneParams paper_isolated(double epsilon = 0.0, double period = 2.0, double xi = 0.2) {
+  SceneParams p = paper_block(epsilon);
+  p.has_base = true;
+  p.base.mass = p.block.mass;
+  p.base.period = period;
+  p.base.damping_ratio = xi;
+  return p;
+}
+
+inline Scene make(const SceneParams& p) {
+  Scene s;
+  const Error e = make_scene(p, s);
+  if (!e.ok()) __builtin_trap();
+  return s;
+}
+
+class RecordingSink final : public EventSink {
+ public:
+  void on_event(const Event& e) override { events.push_back(e); }
+
+  [[nodiscard]] const Event* first(EventKind kind) const {
+    for (const Event& e : events) {
+      if (e.kind == kind) return &e;
+    }
+    return nullptr;
+  }
+  [[nodiscard]] int count(EventKind kind) const {
+    int n = 0;
+    for (const Event& e : events) n += e.kind == kind ? 1 : 0;
+    return n;
+  }
+
+  std::vector<Event> events;
+};
+
+// Runs a simulation from rest (or from an impulse when `impulse` != 0) until `t_end` or a
+// terminal phase; returns the simulator in its final state.
+inline Simulator run(const Scene& scene, const Excitation& excitation, double t_end,
+                     double dt, EventSink* sink, double impulse = 0.0,
+                     SolverSettings settings = {}) {
+  settings.step = dt;
+  Simulator sim;
+  if (!Simulator::create(scene, excitation, settings, sim).ok()) __builtin_trap();
+  sim.set_event_sink(sink);
+  if (impulse != 0.0) {
+    sim.start_with_impulse(impulse);
+  } else {
+    sim.start_at_rest();
+  }
+  while (sim.time() < t_end - 0.5 * dt && !sim.mode().terminal()) sim.step();
+  return sim;
+}
+
+}  // namespace plinth::testing
