@@ -63,11 +63,21 @@ class RunSink final : public plinth::EventSink {
         ++impacts;
         timeline.push_back({e.t, "full_contact"});
         break;
-      case plinth::EventKind::kBaseStopHit:
+      case plinth::EventKind::kBaseStopHit: {
         ++base_stop_hits;
+        char text[96];
+        std::snprintf(text, sizeof text, "  base hits the %s stop (u' %.3g -> %.3g m/s)",
+                      e.side > 0 ? "right" : "left", e.before, e.after);
+        timeline.push_back({e.t, text});
         break;
+      }
       case plinth::EventKind::kBaseStopHeld:
+        timeline.push_back({e.t, std::string("  base rests on the ") +
+                                     (e.side > 0 ? "right" : "left") + " stop"});
+        break;
       case plinth::EventKind::kBaseStopReleased:
+        timeline.push_back({e.t, std::string("  base leaves the ") +
+                                     (e.side > 0 ? "right" : "left") + " stop"});
         break;
       case plinth::EventKind::kOverturned:
         timeline.push_back({e.t, std::string("overturned about the ") +
@@ -203,7 +213,7 @@ int run(const Options& opt) {
   std::printf("solver:     RK4, dt %g s, %lld steps to t = %.3f s in %.3f s (%.0fx real time)\n",
               opt.dt, static_cast<long long>(sim.step_count()), sim.time(), wall,
               wall > 0.0 ? sim.time() / wall : 0.0);
-  std::printf("phase timeline:\n");
+  std::printf("phase timeline (and base stop events):\n");
   for (const TimelineEntry& entry : sink.timeline) {
     std::printf("  %10.4f s  %s\n", entry.t, entry.what.c_str());
   }

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# The README's second command, and what CI runs: install what is missing, then build and run
+# every test twice, optimised (warnings as errors) and under ASan + UBSan.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+tools/install-deps.sh
+for preset in release sanitize; do
+  echo "== $preset: configure and build"
+  cmake --preset "$preset" >/dev/null
+  cmake --build --preset "$preset"
+  echo "== $preset: test"
+  ctest --preset "$preset"
+done
