@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
@@ -142,7 +143,12 @@ int run(const Options& opt) {
     double gamma = 1.0;
     if (!opt.pga.empty()) {
       if (peak <= 0.0) throw InputError(opt.record_path + ": record is all zeros, cannot scale to --pga");
-      gamma = plinth::host::parse_acceleration(opt.pga, g, "--pga") / peak;
+      const double pga = plinth::host::parse_acceleration(opt.pga, g, "--pga");
+      if (pga <= 0.0) {
+        throw InputError("--pga: must be greater than zero (use --scale with a negative factor "
+                         "to mirror the record)");
+      }
+      gamma = pga / peak;
     } else if (opt.scale) {
       gamma = *opt.scale;
     }
@@ -176,7 +182,14 @@ int run(const Options& opt) {
 
   const double t_end = opt.t_end ? *opt.t_end : std::max(10.0, excitation.duration() + 5.0);
   auto csv_file = open_output(opt.out_path, "the time history");
-  auto events_file = open_output(opt.events_path, "the event log");
+  std::unique_ptr<std::ofstream> events_file;
+  try {
+    events_file = open_output(opt.events_path, "the event log");
+  } catch (const InputError&) {
+    csv_file.reset();
+    std::filesystem::remove(opt.out_path);  // leave no half-made outputs behind
+    throw;
+  }
   std::optional<plinth::host::TimeHistoryCsv> csv;
   if (csv_file) csv.emplace(*csv_file);
   RunSink sink(events_file.get());
@@ -196,10 +209,11 @@ int run(const Options& opt) {
     const plinth::State& y = sim.state();
     peak_theta = std::max(peak_theta, std::fabs(y[plinth::kTheta]));
     peak_u = std::max(peak_u, std::fabs(y[plinth::kU]));
-    if (csv && i % out_every == 0) {
+    const bool last = sim.mode().terminal() || i == steps;
+    if (csv && (i % out_every == 0 || last)) {
       csv->write_row(sim.time(), excitation.at(sim.time()).horizontal, y, sim.mode().phase);
     }
-    if (sim.mode().terminal() || i == steps) break;
+    if (last) break;
     sim.step();
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
@@ -227,6 +241,26 @@ int run(const Options& opt) {
 
 }  // namespace
 
+// CLI11's PositiveNumber lets NaN through and prints DBL_MAX in its message.
+const CLI::Validator kFinite(
+    [](const std::string& text) -> std::string {
+      double value = 0.0;
+      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) {
+        return "must be a finite number, got '" + text + "'";
+      }
+      return {};
+    },
+    "FINITE");
+const CLI::Validator kFinitePositive(
+    [](const std::string& text) -> std::string {
+      double value = 0.0;
+      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || value <= 0.0) {
+        return "must be a finite number greater than zero, got '" + text + "'";
+      }
+      return {};
+    },
+    "POSITIVE");
+
 int main(int argc, char** argv) {
   CLI::App app{"plinth-sim: simulate a block on an isolated base (or the ground) under a "
                "record, an impulse or a pulse"};
@@ -238,22 +272,29 @@ int main(int argc, char** argv) {
   app.add_option("--scale", opt.scale, "scale factor gamma of the record")
       ->needs(record)
       ->excludes(pga)
-      ->check(CLI::Number);
-  auto* impulse = app.add_option("--impulse", opt.impulse, "impulse I, m/s (Eq 34)")->excludes(record);
+      ->check(kFinite);
+  auto* impulse = app.add_option("--impulse", opt.impulse, "impulse I, m/s (Eq 34)")
+                      ->excludes(record)
+                      ->check(kFinite);
   auto* pulse = app.add_option("--pulse", opt.pulse, "one-period pulse: sine or cosine")
                     ->check(CLI::IsMember({"sine", "cosine"}))
                     ->excludes(record)
                     ->excludes(impulse);
   app.add_option("--amplitude", opt.amplitude, "pulse amplitude, e.g. 0.5g")->needs(pulse);
-  app.add_option("--period", opt.period, "pulse period, s")->needs(pulse)->check(CLI::PositiveNumber);
-  app.add_option("--dt", opt.dt, "solver step, s")->check(CLI::PositiveNumber);
+  app.add_option("--period", opt.period, "pulse period, s")->needs(pulse)->check(kFinitePositive);
+  app.add_option("--dt", opt.dt, "solver step, s")->check(kFinitePositive);
   app.add_option("--t-end", opt.t_end, "end time, s (default: the input's length + 5 s, at least 10 s)")
-      ->check(CLI::PositiveNumber);
+      ->check(kFinitePositive);
   app.add_option("--out", opt.out_path, "CSV time history");
   app.add_option("--out-interval", opt.out_interval, "time between CSV rows, s (whole steps)")
-      ->check(CLI::PositiveNumber);
+      ->check(kFinitePositive);
   app.add_option("--events", opt.events_path, "JSON Lines event log");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and --version end here with 0; every usage error exits with 2.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
   if (!opt.pulse.empty() && (opt.amplitude.empty() || !opt.period)) {
     std::fprintf(stderr, "plinth-sim: --pulse needs --amplitude and --period\n");
     return 2;

@@ -1,0 +1,142 @@
+// Solver benchmarks: cost per step in each phase and scene, the flows alone, a whole record.
+#include <benchmark/benchmark.h>
+
+#include <cstdint>
+#include <exception>
+#include <string>
+
+#include "plinth/core/flows.h"
+#include "plinth/core/simulator.h"
+#include "plinth/host/record_io.h"
+#include "test_support.h"
+
+namespace {
+
+using namespace plinth;
+
+SceneParams with_stops(SceneParams p) {
+  p.has_base_stops = true;
+  p.base_stops = {0.2, 0.7};  // u_max = 0.2 m, eta_i = 0.7 (sim/scenes/paper-isolated-stops.toml)
+  return p;
+}
+
+struct Setup {
+  SceneParams params;
+  Mode mode;
+  State y = State::Zero();
+};
+
+// Free rocking about the left corner from theta = 0.05 rad, at rest otherwise.
+Setup rocking(const SceneParams& p) {
+  Setup s{p, {Phase::kRocking, Corner::kLeft, 0}};
+  s.y[kTheta] = 0.05;
+  return s;
+}
+
+// ns per step with no excitation; whenever the phase measured ends, the run starts again
+// outside the timed region.
+void BM_Step(benchmark::State& state, const Setup& setup) {
+  const Scene scene = testing::make(setup.params);
+  Simulator sim;
+  if (!Simulator::create(scene, Excitation::none(), SolverSettings{}, sim).ok()) {
+    state.SkipWithError("Simulator::create failed");
+    return;
+  }
+  sim.start_from(setup.mode, setup.y);
+  std::int64_t restarts = 0;
+  for (auto _ : state) {
+    sim.step();
+    if (sim.mode().phase != setup.mode.phase) {
+      state.PauseTiming();
+      sim.start_from(setup.mode, setup.y);
+      ++restarts;
+      state.ResumeTiming();
+    }
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.counters["ns_per_step"] = benchmark::Counter(
+      1.0, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+  state.counters["restarts"] = static_cast<double>(restarts);
+}
+BENCHMARK_CAPTURE(BM_Step, full_contact_base, Setup{testing::paper_isolated(), {}});
+BENCHMARK_CAPTURE(BM_Step, rocking_base, rocking(testing::paper_isolated()));
+BENCHMARK_CAPTURE(BM_Step, rocking_ground, rocking(testing::paper_block()));
+BENCHMARK_CAPTURE(BM_Step, full_contact_base_stops, Setup{with_stops(testing::paper_isolated()), {}});
+
+void BM_FullContactFlow(benchmark::State& state) {
+  const Scene scene = testing::make(testing::paper_isolated());
+  State y = State::Zero();
+  y[kU] = 0.05;
+  y[kUDot] = 0.1;
+  GroundAcceleration ag{1.0, 0.0};
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(y);
+    benchmark::DoNotOptimize(ag);
+    Accelerations a = full_contact_flow(scene, y, ag);
+    benchmark::DoNotOptimize(a);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_FullContactFlow);
+
+// Coupled to a moving base (2x2 solve) or on fixed ground.
+void BM_RockingFlow(benchmark::State& state, bool on_base) {
+  const Scene scene =
+      testing::make(on_base ? testing::paper_isolated() : testing::paper_block());
+  State y = State::Zero();
+  y[kU] = 0.05;
+  y[kTheta] = 0.05;
+  y[kUDot] = 0.1;
+  y[kThetaDot] = -0.2;
+  GroundAcceleration ag{1.0, 0.0};
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(y);
+    benchmark::DoNotOptimize(ag);
+    Accelerations a = rocking_flow(scene, scene.corner1, y, ag, on_base);
+    benchmark::DoNotOptimize(a);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK_CAPTURE(BM_RockingFlow, on_base, true);
+BENCHMARK_CAPTURE(BM_RockingFlow, on_ground, false);
+
+// Brienza 000 at PGA 1 g on the isolated scene with stops, dt = 1e-4 s, 40 s.
+void BM_Record(benchmark::State& state) {
+  host::Record record;
+  try {
+    record = host::read_at2(
+        std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
+        kStandardGravity);
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  const Scene scene = testing::make(with_stops(testing::paper_isolated()));
+  const Excitation ex = Excitation::record(record.horizontal_signal(), {},
+                                           kStandardGravity / record.peak_horizontal());
+  SolverSettings settings;
+  settings.step = 1e-4;
+  Simulator sim;
+  if (!Simulator::create(scene, ex, settings, sim).ok()) {
+    state.SkipWithError("Simulator::create failed");
+    return;
+  }
+  constexpr std::int64_t kSteps = 400'000;  // 40 s
+  double simulated = 0.0;
+  std::int64_t steps = 0;
+  for (auto _ : state) {
+    sim.start_at_rest();
+    while (sim.step_count() < kSteps && !sim.mode().terminal()) sim.step();
+    simulated += sim.time();
+    steps += sim.step_count();
+  }
+  state.SetItemsProcessed(steps);
+  // Simulated seconds per wall second (the benchmark uses real time).
+  state.counters["x_real_time"] = benchmark::Counter(simulated, benchmark::Counter::kIsRate);
+  state.counters["steps"] = static_cast<double>(sim.step_count());
+}
+BENCHMARK(BM_Record)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+
+BENCHMARK_MAIN();
