@@ -6,10 +6,10 @@
 #include <charconv>
 #include <cmath>
 #include <cstddef>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <optional>
-#include <regex>
 #include <string>
 #include <string_view>
 #include <system_error>
@@ -123,17 +123,14 @@ NumberStatus parse_number(std::string_view token, double& value) {
 // Parses a finite number or fails on the reader's current line.
 double parse_finite(const LineReader& reader, std::string_view token) {
   double value = 0.0;
-  const std::string quoted = "'" + std::string(token) + "'";
-  switch (parse_number(token, value)) {
-    case NumberStatus::kNotANumber:
-      reader.fail(quoted + " is not a number");
-    case NumberStatus::kOutOfRange:
-      reader.fail("value " + quoted + " is out of the range of double");
-    case NumberStatus::kOk:
-      break;
-  }
-  if (!std::isfinite(value)) reader.fail("value " + quoted + " is not finite");
-  return value;
+  const NumberStatus status = parse_number(token, value);
+  if (status == NumberStatus::kOk && std::isfinite(value)) return value;
+  std::string quoted(1, '\'');  // built only on failure: this runs for every sample
+  quoted.append(token);
+  quoted.push_back('\'');
+  if (status == NumberStatus::kNotANumber) reader.fail(quoted + " is not a number");
+  if (status == NumberStatus::kOutOfRange) reader.fail("value " + quoted + " is out of the range of double");
+  reader.fail("value " + quoted + " is not finite");
 }
 
 // ---- AT2 ---------------------------------------------------------------------------------------
@@ -146,27 +143,38 @@ struct At2Header {
   double dt = 0.0;  // s
 };
 
+// Where the text after `key` starts in `line`, spaces skipped; npos when `key` is absent.
+// (Hand-parsed: GCC 12's <regex> trips -Wmaybe-uninitialized in sanitizer builds.)
+std::size_t value_start(std::string_view line, std::string_view key) {
+  std::size_t at = line.find(key);
+  if (at == std::string_view::npos) return at;
+  at += key.size();
+  while (at < line.size() && is_space(line[at])) ++at;
+  return at;
+}
+
 void check_at2_units(const LineReader& reader, const std::string& line) {
-  static const std::regex units_pattern(R"(UNITS\s+OF\s+(\S+))", std::regex::icase);
-  std::smatch match;
-  if (!std::regex_search(line, match, units_pattern)) {
+  const std::string lower = lowercase(line);
+  const std::size_t units = value_start(lower, "units");
+  const std::size_t at = units == std::string::npos ? units : value_start(lower.substr(units), "of");
+  if (at == std::string::npos || units + at >= lower.size()) {
     reader.fail("cannot find 'UNITS OF G' in the header line");
   }
-  if (lowercase(match[1].str()) != "g") {
-    reader.fail("units are '" + match[1].str() + "', expected G (acceleration in g)");
-  }
+  const std::vector<std::string_view> words = split_whitespace(std::string_view(line).substr(units + at));
+  const std::string unit(words.front());
+  if (lowercase(unit) != "g") reader.fail("units are '" + unit + "', expected G (acceleration in g)");
 }
 
 std::size_t parse_npts(const LineReader& reader, const std::string& line) {
-  static const std::regex npts_pattern(R"(NPTS=\s*(\d+))");
-  std::smatch match;
-  if (!std::regex_search(line, match, npts_pattern)) {
+  const std::size_t at = value_start(line, "NPTS=");
+  if (at == std::string::npos || at >= line.size() || !std::isdigit(static_cast<unsigned char>(line[at]))) {
     reader.fail("cannot find NPTS= in the header line");
   }
-  const std::string digits = match[1].str();
   std::size_t npts = 0;
-  const auto [stop, error] = std::from_chars(digits.data(), digits.data() + digits.size(), npts);
-  if (error != std::errc{} || stop != digits.data() + digits.size()) {
+  const char* first = line.data() + at;
+  const auto [stop, error] = std::from_chars(first, line.data() + line.size(), npts);
+  if (error != std::errc{}) {
+    const std::string digits(first, static_cast<std::size_t>(stop - first));
     reader.fail("NPTS=" + digits + " is out of range");
   }
   if (npts == 0) reader.fail("NPTS must be positive, found NPTS=0");
@@ -174,13 +182,16 @@ std::size_t parse_npts(const LineReader& reader, const std::string& line) {
 }
 
 double parse_dt(const LineReader& reader, const std::string& line) {
-  static const std::regex dt_pattern(R"(DT=\s*([0-9]*\.?[0-9]+(?:[eE][-+]?\d+)?))");
-  std::smatch match;
-  if (!std::regex_search(line, match, dt_pattern)) {
-    reader.fail("cannot find DT= in the header line");
-  }
-  const double dt = parse_finite(reader, match[1].str());
-  if (dt <= 0.0) reader.fail("DT must be positive, found DT=" + match[1].str());
+  const std::size_t at = value_start(line, "DT=");
+  if (at == std::string::npos || at >= line.size()) reader.fail("cannot find DT= in the header line");
+  // The number may have its unit glued on (".00244SEC"): take the longest numeric prefix.
+  const char* first = line.c_str() + at;
+  char* stop = nullptr;
+  const double dt = std::strtod(first, &stop);
+  const std::string text(first, static_cast<std::size_t>(stop - first));
+  if (stop == first) reader.fail("cannot find DT= in the header line");
+  if (!std::isfinite(dt)) reader.fail("DT=" + text + " is not a finite number");
+  if (dt <= 0.0) reader.fail("DT must be positive, found DT=" + text);
   return dt;
 }
 
