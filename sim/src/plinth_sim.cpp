@@ -51,40 +51,55 @@ class RunSink final : public plinth::EventSink {
   explicit RunSink(std::ostream* events_out) : events_out_(events_out) {}
 
   void on_event(const plinth::Event& e) override {
+    using plinth::EventKind;
     if (events_out_ != nullptr) *events_out_ << plinth::host::event_json(e) << '\n';
+    if (e.kind == EventKind::kImpact || e.kind == EventKind::kRockingStop) ++impacts;
+    if (e.kind == EventKind::kBaseStopHit) ++base_stop_hits;
+    const char* side = e.side > 0 ? "right" : "left";
+    char text[128];
     switch (e.kind) {
-      case plinth::EventKind::kRockingStart:
-        timeline.push_back({e.t, std::string("rocking about the ") +
-                                     plinth::corner_name(e.corner) + " corner"});
-        break;
-      case plinth::EventKind::kImpact:
-        ++impacts;
-        break;
-      case plinth::EventKind::kRockingStop:
-        ++impacts;
-        timeline.push_back({e.t, "full_contact"});
-        break;
-      case plinth::EventKind::kBaseStopHit: {
-        ++base_stop_hits;
-        char text[96];
-        std::snprintf(text, sizeof text, "  base hits the %s stop (u' %.3g -> %.3g m/s)",
-                      e.side > 0 ? "right" : "left", e.before, e.after);
+      case EventKind::kBaseStopHit:
+        std::snprintf(text, sizeof text, "  base hits the %s stop (u' %.3g -> %.3g m/s)", side,
+                      e.before, e.after);
         timeline.push_back({e.t, text});
         break;
-      }
-      case plinth::EventKind::kBaseStopHeld:
-        timeline.push_back({e.t, std::string("  base rests on the ") +
-                                     (e.side > 0 ? "right" : "left") + " stop"});
+      case EventKind::kBaseStopHeld:
+        timeline.push_back({e.t, std::string("  base rests on the ") + side + " stop"});
         break;
-      case plinth::EventKind::kBaseStopReleased:
-        timeline.push_back({e.t, std::string("  base leaves the ") +
-                                     (e.side > 0 ? "right" : "left") + " stop"});
+      case EventKind::kBaseStopReleased:
+        timeline.push_back({e.t, std::string("  base leaves the ") + side + " stop"});
         break;
-      case plinth::EventKind::kOverturned:
-        timeline.push_back({e.t, std::string("overturned about the ") +
-                                     plinth::corner_name(e.corner) + " corner"});
+      case EventKind::kSlideStopHit:
+        std::snprintf(text, sizeof text, "  block hits the %s sliding stop (x' %.3g m/s)", side,
+                      e.before);
+        timeline.push_back({e.t, text});
+        break;
+      case EventKind::kOutOfBase:
+        timeline.push_back({e.t, std::string("  block overhangs the support's ") + side + " edge"});
+        break;
+      case EventKind::kBackOnBase:
+        timeline.push_back({e.t, std::string("  block back on the support (") + side + " edge)"});
+        break;
+      default:
         break;
     }
+    // One line per change of phase (and of rocking corner or sliding direction at its start).
+    std::string phase = plinth::phase_name(e.phase);
+    if (e.phase == plinth::Phase::kRocking || e.phase == plinth::Phase::kSlideRocking ||
+        e.phase == plinth::Phase::kOverturned) {
+      phase += std::string(" about the ") + plinth::corner_name(e.corner) + " corner";
+    }
+    if (e.kind == EventKind::kSlidingStart) {
+      phase += e.phase == plinth::Phase::kSliding ? std::string(" ") + side
+                                                   : std::string(", sliding ") + side;
+    }
+    if (e.phase == plinth::Phase::kFell) phase += std::string(" off the ") + side + " edge";
+    const bool starts = e.kind == EventKind::kRockingStart || e.kind == EventKind::kSlidingStart;
+    if (e.phase != last_phase_ || starts) {
+      if (phase != last_text_) timeline.push_back({e.t, phase});
+      last_text_ = phase;
+    }
+    last_phase_ = e.phase;
   }
 
   std::vector<TimelineEntry> timeline{{0.0, "full_contact"}};
@@ -93,6 +108,8 @@ class RunSink final : public plinth::EventSink {
 
  private:
   std::ostream* events_out_;
+  plinth::Phase last_phase_ = plinth::Phase::kFullContact;
+  std::string last_text_ = "full_contact";
 };
 
 std::unique_ptr<std::ofstream> open_output(const std::string& path, const char* what) {
@@ -204,11 +221,13 @@ int run(const Options& opt) {
   const std::int64_t out_every = std::max<std::int64_t>(1, std::llround(opt.out_interval / opt.dt));
   double peak_theta = 0.0;
   double peak_u = 0.0;
+  double peak_x = 0.0;
   const auto wall_start = std::chrono::steady_clock::now();
   for (std::int64_t i = 0; i <= steps; ++i) {
     const plinth::State& y = sim.state();
     peak_theta = std::max(peak_theta, std::fabs(y[plinth::kTheta]));
     peak_u = std::max(peak_u, std::fabs(y[plinth::kU]));
+    peak_x = std::max(peak_x, std::fabs(y[plinth::kX]));
     const bool last = sim.mode().terminal() || i == steps;
     if (csv && (i % out_every == 0 || last)) {
       csv->write_row(sim.time(), excitation.at(sim.time()).horizontal, y, sim.mode().phase);
@@ -227,15 +246,15 @@ int run(const Options& opt) {
   std::printf("solver:     RK4, dt %g s, %lld steps to t = %.3f s in %.3f s (%.0fx real time)\n",
               opt.dt, static_cast<long long>(sim.step_count()), sim.time(), wall,
               wall > 0.0 ? sim.time() / wall : 0.0);
-  std::printf("phase timeline (and base stop events):\n");
+  std::printf("phase timeline (and stop and support events):\n");
   for (const TimelineEntry& entry : sink.timeline) {
     std::printf("  %10.4f s  %s\n", entry.t, entry.what.c_str());
   }
   const double alpha = std::min(scene.corner1.critical_angle, scene.corner2.critical_angle);
-  std::printf("outcome:    %s at t = %.4f s; peak |theta| %.4g rad (%.3g of alpha), peak |u| %.4g m;"
-              " %ld impacts, %ld base stop hits\n",
+  std::printf("outcome:    %s at t = %.4f s; peak |theta| %.4g rad (%.3g of alpha), peak |u| %.4g m,"
+              " peak |x| %.4g m; %ld impacts, %ld base stop hits\n",
               plinth::host::outcome_name(outcome), sim.time(), peak_theta, peak_theta / alpha,
-              peak_u, sink.impacts, sink.base_stop_hits);
+              peak_u, peak_x, sink.impacts, sink.base_stop_hits);
   return 0;
 }
 

@@ -300,8 +300,12 @@ sed 's/^damping_ratio = 0.2/damping_ratio = 1.0/' "$ISOLATED" >"$TMP/damped.toml
 sed 's/^half_width = 0.3/half_width = -0.3/' "$ISOLATED" >"$TMP/negative.toml"
 {
   cat "$ISOLATED"
-  printf '\n[friction]\nstatic = 0.6\nkinetic = 0.5\n'
+  printf '\n[friction]\nstatic = 0.6\nkinetic = 0.7\n'
 } >"$TMP/friction.toml"
+{
+  cat "$ISOLATED"
+  printf '\n[friction]\nstatic = 0.1\n'
+} >"$TMP/slides.toml"
 
 # The scenes above must differ from the bundled one, or the checks below prove nothing.
 for f in unknown-key eccentric damped negative; do
@@ -335,9 +339,16 @@ expect_failure "damping_ratio = 1.0" 'damped\.toml' 'damping_ratio' -- \
   --scene "$TMP/damped.toml" --record "$AT2" --pga 0.3g
 expect_failure "negative half_width" 'negative\.toml' 'half_width' -- \
   --scene "$TMP/negative.toml" --record "$AT2" --pga 0.3g
-expect_failure "[friction] (sliding not modelled)" 'friction' \
-  'sliding.*not (yet )?(modell?ed|supported|implemented)' -- \
+expect_failure "[friction] kinetic above static" 'friction\.kinetic' 'static' -- \
   --scene "$TMP/friction.toml" --record "$AT2" --pga 0.3g
+if expect_success "a low-friction block slides" --scene "$TMP/slides.toml" --record "$AT2" \
+  --pga 1g --events "$TMP/slides.jsonl"; then
+  if grep -q '"event": "sliding_start"' "$TMP/slides.jsonl"; then
+    pass "sliding shows in the event log"
+  else
+    fail "sliding shows in the event log" "no sliding_start event"
+  fi
+fi
 
 expect_failure "--pga without a unit" '--pga' 'unit' -- \
   --scene "$ISOLATED" --record "$AT2" --pga 0.3

@@ -154,6 +154,8 @@ const Rule kRules[] = {
 
     {"sliding_stops_without_support", [](SceneParams& p) { p.has_support = false; },
      "sliding_stops", kInconsistent},
+    {"support_without_friction", [](SceneParams& p) { p.has_friction = false; }, "support",
+     kInconsistent},
     {"sliding_stops_restitution_above_one",
      [](SceneParams& p) { p.sliding_stops.restitution = 2.0; }, "sliding_stops.restitution",
      kOutOfRange},

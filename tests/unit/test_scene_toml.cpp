@@ -436,8 +436,8 @@ TEST(SceneTomlErrors, CoreErrorsAreMappedToTheKeysUsed) {
   EXPECT_HAS(error_of_text(isolated("", "[base_stops]\nmax_displacement = 0.2\nrestitution = "
                                         "1.5\n")),
              "test.toml:11: base_stops.restitution: must lie in [0, 1] (got 1.5)");
-  EXPECT_HAS(error_of_text(isolated("", "[support]\nclearance = 0\n")),
-             "test.toml:10: support.clearance: must be greater than zero (got 0)");
+  EXPECT_HAS(error_of_text(isolated("", "[friction]\nstatic = 0.5\n[support]\nclearance = 0\n")),
+             "test.toml:12: support.clearance: must be greater than zero (got 0)");
 }
 
 TEST(SceneTomlErrors, PartsThatNeedOthers) {
@@ -446,6 +446,9 @@ TEST(SceneTomlErrors, PartsThatNeedOthers) {
              "test.toml:5: base_stops: base stops need a [base]");
   EXPECT_HAS(error_of_text(isolated("", "[sliding_stops]\nrestitution = 0.7\n")),
              "test.toml:9: sliding_stops: sliding stops sit at the support's clearance");
+  EXPECT_HAS(error_of_text(isolated("", "[support]\nclearance = 0.1\n")),
+             "test.toml:9: support: a block that never slides (no [friction]) cannot leave the "
+             "support");
 }
 
 TEST(SceneTomlErrors, StiffnessAndDepthMustBePositive) {

@@ -81,6 +81,10 @@ Error validate(const SceneParams& p) {
     }
   }
   if (p.has_support) {
+    if (!p.has_friction) {
+      return fail(ErrorCode::kInconsistent, "support",
+                  "a block that never slides (no [friction]) cannot leave the support");
+    }
     if (Error e = check_positive(p.support.clearance, "support.clearance"); !e.ok()) return e;
   }
   if (p.has_sliding_stops) {
@@ -108,6 +112,10 @@ CornerGeometry make_corner(double distance, double sign, double h, double m, dou
 }
 
 }  // namespace
+
+CornerGeometry corner_geometry(const Scene& s, double distance, double sign) {
+  return make_corner(distance, sign, s.h, s.m, s.inertia_c);
+}
 
 Error make_scene(const SceneParams& params, Scene& out) {
   if (Error e = validate(params); !e.ok()) return e;

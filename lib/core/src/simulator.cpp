@@ -47,6 +47,18 @@ const char* event_name(EventKind kind) {
       return "base_stop_released";
     case EventKind::kOverturned:
       return "overturned";
+    case EventKind::kSlidingStart:
+      return "sliding_start";
+    case EventKind::kSlidingStop:
+      return "sliding_stop";
+    case EventKind::kSlideStopHit:
+      return "slide_stop_hit";
+    case EventKind::kOutOfBase:
+      return "out_of_base";
+    case EventKind::kBackOnBase:
+      return "back_on_base";
+    case EventKind::kFell:
+      return "fell";
   }
   return "unknown";
 }
@@ -85,10 +97,27 @@ struct Stepper {
 
   static Accelerations accelerations(const Scene& s, const Mode& mode, const State& y,
                                      GroundAcceleration ag) {
-    if (mode.terminal()) return {};
-    if (mode.rocking()) return rocking_flow(s, s.corner(mode.corner), y, ag, base_moves(mode));
-    if (!base_moves(mode)) return {};
-    return full_contact_flow(s, y, ag);
+    const bool moves = base_moves(mode);
+    switch (mode.phase) {
+      case Phase::kFullContact:
+        return moves ? full_contact_flow(s, y, ag) : Accelerations{};
+      case Phase::kSliding:
+        if constexpr (F.sliding) return sliding_flow(s, mode.slide_direction, y, ag, moves);
+        return {};
+      case Phase::kRocking:
+        return rocking_flow(s, pivot_of(s, mode, y).geometry, y, ag, moves);
+      case Phase::kSlideRocking:
+        if constexpr (F.sliding) {
+          const Pivot pivot = pivot_of(s, mode, y);
+          return slide_rocking_flow(s, pivot.geometry, pivot.overhanging, mode.slide_direction, y,
+                                    ag, moves);
+        }
+        return {};
+      case Phase::kOverturned:
+      case Phase::kFell:
+        return {};
+    }
+    return {};
   }
 
   static State derivative(const Simulator& sim, const Mode& mode, double t, const State& y) {
@@ -160,78 +189,132 @@ struct Stepper {
     return h;
   }
 
-  // Eq 16 on entering (or starting in) full contact: if it already holds, rocking starts now
-  // in the favoured direction.
-  static void enter_full_contact(Simulator& sim, double t) {
-    if (sim.mode_.phase != Phase::kFullContact) return;
+  static void emit(Simulator& sim, double t, EventKind kind, int side = 0, double before = 0.0,
+                   double after = 0.0) {
+    Event e;
+    e.t = t;
+    e.kind = kind;
+    e.corner = sim.mode_.corner;
+    e.side = static_cast<std::int8_t>(side);
+    e.before = before;
+    e.after = after;
+    e.phase = sim.mode_.phase;
+    e.state = sim.y_;
+    sim.emit(e);
+  }
+
+  // On entering a mode (at the start or after a reset), the onset conditions that already hold
+  // start their phase at once: Eq 16/17 (rocking) and Eq 15/18 (sliding), in the favoured
+  // direction. At most one of each.
+  static void enter(Simulator& sim, double t) {
     const Scene& s = *sim.scene_;
     const GroundAcceleration ag = sim.excitation_.at(t);
-    const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
-    const double left = rocking_onset_guard(s, Corner::kLeft, acc, ag);
-    const double right = rocking_onset_guard(s, Corner::kRight, acc, ag);
-    if (left < 0.0 && right < 0.0) return;
-    start_rocking(sim, t, left >= right ? Corner::kLeft : Corner::kRight);
+    for (int pass = 0; pass < 2 && !sim.mode_.terminal(); ++pass) {
+      const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
+      if (!sim.mode_.rocking()) {
+        const double left = guard_value(GuardId::kRockingOnsetLeft, s, sim.mode_, sim.y_, ag, acc);
+        const double right = guard_value(GuardId::kRockingOnsetRight, s, sim.mode_, sim.y_, ag, acc);
+        if (left >= 0.0 || right >= 0.0) {
+          start_rocking(sim, t, left >= right ? Corner::kLeft : Corner::kRight);
+          continue;
+        }
+      }
+      if constexpr (F.sliding) {
+        if (!sim.mode_.sliding()) {
+          const double left = guard_value(GuardId::kSlidingOnsetLeft, s, sim.mode_, sim.y_, ag, acc);
+          const double right =
+              guard_value(GuardId::kSlidingOnsetRight, s, sim.mode_, sim.y_, ag, acc);
+          if (left >= 0.0 || right >= 0.0) {
+            start_sliding(sim, t, left >= right ? -1 : 1);
+            continue;
+          }
+        }
+      }
+      return;
+    }
   }
 
   static void start_rocking(Simulator& sim, double t, Corner corner) {
     rocking_onset_reset(corner, sim.mode_, sim.y_);
-    Event e;
-    e.t = t;
-    e.kind = EventKind::kRockingStart;
-    e.corner = corner;
-    e.state = sim.y_;
-    sim.emit(e);
+    emit(sim, t, EventKind::kRockingStart);
+  }
+
+  static void start_sliding(Simulator& sim, double t, int direction) {
+    sliding_onset_reset(direction, sim.mode_);
+    emit(sim, t, EventKind::kSlidingStart, direction);
   }
 
   static void stop_rocking(Simulator& sim, double t, double theta_dot_before) {
     rocking_stop_reset(*sim.scene_, base_moves(sim.mode_), sim.mode_, sim.y_);
-    Event e;
-    e.t = t;
-    e.kind = EventKind::kRockingStop;
-    e.corner = sim.mode_.corner;
-    e.before = theta_dot_before;
-    e.state = sim.y_;
-    sim.emit(e);
+    emit(sim, t, EventKind::kRockingStop, 0, theta_dot_before);
   }
 
   static void rocking_impact(Simulator& sim, double t) {
     const Scene& s = *sim.scene_;
     const double before = sim.y_[kThetaDot];
     const Corner to = opposite(sim.mode_.corner);
-    const double after = impact_velocity_ratio(s, to, base_moves(sim.mode_)) * before;
-    const double energy_after = 0.5 * s.corner(to).inertia * after * after;
+    const CornerGeometry to_pivot = pivot_of(s, to, sim.mode_.overhang, sim.y_[kX]).geometry;
+    const double after =
+        impact_velocity_ratio(s, pivot_of(s, sim.mode_, sim.y_).geometry, to_pivot,
+                              base_moves(sim.mode_)) *
+        before;
+    const double energy_after = 0.5 * to_pivot.inertia * after * after;
+    const double barrier = s.m * s.g * (to_pivot.radius - s.h);
     const bool spent = after * before <= 0.0 ||
-                       energy_after < sim.settings_.rest_energy_ratio * overturning_energy(s, to);
+                       energy_after < sim.settings_.rest_energy_ratio * barrier;
     if (spent) {
       stop_rocking(sim, t, before);
-      enter_full_contact(sim, t);
+      enter(sim, t);
       return;
     }
     rocking_impact_reset(s, base_moves(sim.mode_), sim.mode_, sim.y_);
-    Event e;
-    e.t = t;
-    e.kind = EventKind::kImpact;
-    e.corner = to;
-    e.before = before;
-    e.after = sim.y_[kThetaDot];
-    e.state = sim.y_;
-    sim.emit(e);
+    emit(sim, t, EventKind::kImpact, 0, before, sim.y_[kThetaDot]);
+  }
+
+  // x' reached 0: the block sticks if static friction can hold it (Eq 15 or 18 not met in the
+  // sticking phase), otherwise it slides back the other way.
+  static void sliding_stopped(Simulator& sim, double t) {
+    const Scene& s = *sim.scene_;
+    sliding_stop_reset(sim.mode_, sim.y_);
+    const GroundAcceleration ag = sim.excitation_.at(t);
+    const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
+    const ContactForce f = sticking_contact_force(s, sim.mode_, sim.y_, ag, acc);
+    const int direction = f.tangential > 0.0 ? -1 : 1;
+    if (sliding_onset_guard(s, sim.y_, direction, f) >= 0.0) {
+      sliding_onset_reset(direction, sim.mode_);
+      emit(sim, t, EventKind::kSlidingStart, direction);
+      return;
+    }
+    emit(sim, t, EventKind::kSlidingStop);
+    enter(sim, t);
+  }
+
+  static void sliding_stop_hit(Simulator& sim, double t, int side) {
+    const double before = sim.y_[kXDot];
+    sliding_stop_hit_reset(*sim.scene_, side, base_moves(sim.mode_), sim.mode_, sim.y_);
+    emit(sim, t, EventKind::kSlideStopHit, side, before, sim.y_[kUDot]);
+    enter(sim, t);
   }
 
   static void base_stop_hit(Simulator& sim, double t, int side) {
     const Scene& s = *sim.scene_;
     const double before = sim.y_[kUDot];
     base_stop_reset(s, side, sim.mode_, sim.y_);
-    Event e;
-    e.t = t;
-    e.kind = EventKind::kBaseStopHit;
-    e.corner = sim.mode_.corner;
-    e.side = static_cast<std::int8_t>(side);
-    e.before = before;
-    e.after = sim.y_[kUDot];
-    e.state = sim.y_;
-    sim.emit(e);
+    emit(sim, t, EventKind::kBaseStopHit, side, before, sim.y_[kUDot]);
+    if (sim.mode_.sliding()) keep_sliding_consistent(sim, t);
     if (std::fabs(sim.y_[kUDot]) < sim.settings_.base_rest_speed) hold_if_pushed(sim, t, side);
+  }
+
+  // An impulse on the base changes x' while sliding: the phase follows its new sign.
+  static void keep_sliding_consistent(Simulator& sim, double t) {
+    const double x_dot = sim.y_[kXDot];
+    if (x_dot * sim.mode_.slide_direction > 0.0) return;
+    if (x_dot == 0.0) {
+      sliding_stopped(sim, t);
+      return;
+    }
+    sim.mode_.slide_direction = static_cast<std::int8_t>(x_dot > 0.0 ? 1 : -1);
+    emit(sim, t, EventKind::kSlidingStart, sim.mode_.slide_direction);
   }
 
   // The base's rebound is too slow to matter: if the stop pushes back, the base rests on it.
@@ -244,53 +327,77 @@ struct Stepper {
         base_stop_reaction(s, held, sim.y_, ag, accelerations(s, held, sim.y_, ag));
     if (side * reaction > 0.0) return;  // the stop would have to pull: the base moves away
     base_stop_hold_reset(s, side, sim.mode_, sim.y_);
-    Event e;
-    e.t = t;
-    e.kind = EventKind::kBaseStopHeld;
-    e.corner = sim.mode_.corner;
-    e.side = static_cast<std::int8_t>(side);
-    e.state = sim.y_;
-    sim.emit(e);
-    enter_full_contact(sim, t);
+    emit(sim, t, EventKind::kBaseStopHeld, side);
+    enter(sim, t);
   }
 
   static void release_base(Simulator& sim, double t) {
-    Event e;
-    e.t = t;
-    e.kind = EventKind::kBaseStopReleased;
-    e.corner = sim.mode_.corner;
-    e.side = sim.mode_.held_stop;
+    const int side = sim.mode_.held_stop;
     sim.mode_.held_stop = 0;
-    e.state = sim.y_;
-    sim.emit(e);
-    enter_full_contact(sim, t);
+    emit(sim, t, EventKind::kBaseStopReleased, side);
+    enter(sim, t);
   }
 
   static void overturn(Simulator& sim, double t) {
-    const CornerGeometry& c = sim.scene_->corner(sim.mode_.corner);
+    const CornerGeometry c = pivot_of(*sim.scene_, sim.mode_, sim.y_).geometry;
     sim.y_[kTheta] = c.sign * c.critical_angle;
     sim.mode_.phase = Phase::kOverturned;
-    Event e;
-    e.t = t;
-    e.kind = EventKind::kOverturned;
-    e.corner = sim.mode_.corner;
-    e.state = sim.y_;
-    sim.emit(e);
+    emit(sim, t, EventKind::kOverturned);
   }
 
   static void apply(Simulator& sim, GuardId id, double t) {
+    const double x_hat = sim.scene_->params.support.clearance;
     switch (id) {
       case GuardId::kRockingOnsetLeft:
         start_rocking(sim, t, Corner::kLeft);
+        enter(sim, t);
         return;
       case GuardId::kRockingOnsetRight:
         start_rocking(sim, t, Corner::kRight);
+        enter(sim, t);
         return;
       case GuardId::kRockingImpact:
         rocking_impact(sim, t);
         return;
       case GuardId::kOverturning:
         overturn(sim, t);
+        return;
+      case GuardId::kSlidingOnsetLeft:
+        start_sliding(sim, t, -1);
+        enter(sim, t);
+        return;
+      case GuardId::kSlidingOnsetRight:
+        start_sliding(sim, t, 1);
+        enter(sim, t);
+        return;
+      case GuardId::kSlidingStop:
+        sliding_stopped(sim, t);
+        return;
+      case GuardId::kOutOfBaseLeft:
+      case GuardId::kOutOfBaseRight: {
+        const int side = id == GuardId::kOutOfBaseLeft ? -1 : 1;
+        sim.y_[kX] = side * x_hat;
+        sim.mode_.overhang = static_cast<std::int8_t>(side);
+        emit(sim, t, EventKind::kOutOfBase, side);
+        if (!sim.mode_.rocking()) enter(sim, t);
+        return;
+      }
+      case GuardId::kBackOnBase: {
+        const int side = sim.mode_.overhang;
+        sim.y_[kX] = side * x_hat;
+        sim.mode_.overhang = 0;
+        emit(sim, t, EventKind::kBackOnBase, side);
+        return;
+      }
+      case GuardId::kFall:
+        sim.mode_.phase = Phase::kFell;
+        emit(sim, t, EventKind::kFell, sim.mode_.overhang);
+        return;
+      case GuardId::kSlidingStopLeft:
+        sliding_stop_hit(sim, t, -1);
+        return;
+      case GuardId::kSlidingStopRight:
+        sliding_stop_hit(sim, t, 1);
         return;
       case GuardId::kBaseStopRight:
         base_stop_hit(sim, t, +1);
@@ -360,41 +467,49 @@ struct Stepper {
     ++sim.step_count_;
   }
 
+  static void bind(Simulator& sim) {
+    sim.step_fn_ = &step;
+    sim.enter_fn_ = &enter;
+    sim.acc_fn_ = &current;
+  }
+
   static Accelerations current(const Simulator& sim, double t, const State& y) {
     return accelerations(*sim.scene_, sim.mode_, y, sim.excitation_.at(t));
   }
 };
 
+namespace {
+
+// Binds the solver compiled for exactly the features the scene has.
+template <bool kBase, bool kBaseStops>
+void bind_for_friction(Simulator& sim, const Features& f) {
+  if (!f.sliding) {
+    Stepper<Features{kBase, kBaseStops, false, false, false}>::bind(sim);
+  } else if (f.support_edge) {
+    Stepper<Features{kBase, kBaseStops, true, true, false}>::bind(sim);
+  } else if (f.sliding_stops) {
+    Stepper<Features{kBase, kBaseStops, true, false, true}>::bind(sim);
+  } else {
+    Stepper<Features{kBase, kBaseStops, true, false, false}>::bind(sim);
+  }
+}
+
+}  // namespace
+
 Error Simulator::create(const Scene& scene, const Excitation& excitation,
                         const SolverSettings& settings, Simulator& out) {
   if (Error e = validate(settings); !e.ok()) return e;
-  const SceneParams& p = scene.params;
-  if (p.has_friction) {
-    return {ErrorCode::kUnsupported, "friction",
-            "sliding is not modelled by this version: remove [friction] (the block never slides)"};
-  }
-  if (p.has_support || p.has_sliding_stops) {
-    return {ErrorCode::kUnsupported, p.has_support ? "support" : "sliding_stops",
-            "sliding is not modelled by this version, so the support's edge and sliding stops "
-            "cannot be reached: remove the table"};
-  }
   Simulator sim;
   sim.scene_ = &scene;
   sim.excitation_ = excitation;
   sim.settings_ = settings;
   const Features f = features_of(scene);
   if (!f.base) {
-    sim.step_fn_ = &Stepper<Features{false, false}>::step;
-    sim.enter_fn_ = &Stepper<Features{false, false}>::enter_full_contact;
-    sim.acc_fn_ = &Stepper<Features{false, false}>::current;
+    bind_for_friction<false, false>(sim, f);
   } else if (!f.base_stops) {
-    sim.step_fn_ = &Stepper<Features{true, false}>::step;
-    sim.enter_fn_ = &Stepper<Features{true, false}>::enter_full_contact;
-    sim.acc_fn_ = &Stepper<Features{true, false}>::current;
+    bind_for_friction<true, false>(sim, f);
   } else {
-    sim.step_fn_ = &Stepper<Features{true, true}>::step;
-    sim.enter_fn_ = &Stepper<Features{true, true}>::enter_full_contact;
-    sim.acc_fn_ = &Stepper<Features{true, true}>::current;
+    bind_for_friction<true, true>(sim, f);
   }
   out = sim;
   return ok_error();
@@ -430,6 +545,7 @@ void Simulator::start_with_impulse(double impulse) {
   e.t = 0.0;
   e.kind = EventKind::kRockingStart;
   e.corner = corner;
+  e.phase = mode_.phase;
   e.state = y_;
   emit(e);
 }

@@ -46,7 +46,7 @@ const char* outcome_name(Outcome outcome) {
 
 Outcome outcome_of(Phase final_phase) {
   if (final_phase == Phase::kOverturned) return Outcome::kOverturned;
-  if (final_phase == Phase::kFell) return Outcome::kFell;
+  if (final_phase == Phase::kFell) return Outcome::kFell;  // fell off the base
   return Outcome::kSurvived;
 }
 
@@ -72,10 +72,24 @@ std::string event_json(const Event& e) {
       break;
     case EventKind::kBaseStopHeld:
     case EventKind::kBaseStopReleased:
+    case EventKind::kOutOfBase:
+    case EventKind::kBackOnBase:
+    case EventKind::kFell:
       line += field("side", quoted(e.side > 0 ? "right" : "left"));
+      break;
+    case EventKind::kSlidingStart:
+      line += field("direction", quoted(e.side > 0 ? "right" : "left"));
+      break;
+    case EventKind::kSlidingStop:
+      break;
+    case EventKind::kSlideStopHit:
+      line += field("side", quoted(e.side > 0 ? "right" : "left"));
+      line += field("x_dot_before", number(e.before));
+      line += field("u_dot_after", number(e.after));
       break;
   }
   line += field("u", number(e.state[kU]));
+  line += field("x", number(e.state[kX]));
   line += field("theta", number(e.state[kTheta]));
   line += "}";
   return line;

@@ -328,6 +328,7 @@ class Loader {
   void read_support(const toml::table& tbl, SceneParams& params) {
     check_keys(tbl, "support", {"clearance"});
     params.has_support = true;
+    provenance_["support"] = Provenance{"support", tbl.source().begin.line, {}, {}};
     const Number clearance = required(tbl, "support", "clearance");
     params.support.clearance = clearance.value;
     record("support.clearance", clearance);

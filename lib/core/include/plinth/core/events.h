@@ -16,6 +16,12 @@ enum class EventKind : std::uint8_t {
   kBaseStopHeld,       // the base came to rest against stop `side`
   kBaseStopReleased,   // the held base leaves stop `side`
   kOverturned,         // |theta| passed the critical angle of `corner`
+  kSlidingStart,       // Eq 15 or 18 met (or x' changed sign); `side` is the sign of x'
+  kSlidingStop,        // x' returned to 0 and static friction holds
+  kSlideStopHit,       // Eq 30; `side` +1 right; before: x', after: u' (Eq 32)
+  kOutOfBase,          // |x| passed x_hat: the block overhangs the support's `side` edge
+  kBackOnBase,         // the overhanging block slid back onto the support
+  kFell,               // C passed the support's `side` edge: the block fell off the base
 };
 
 struct Event {
@@ -25,7 +31,8 @@ struct Event {
   std::int8_t side = 0;
   double before = 0.0;
   double after = 0.0;
-  State state = State::Zero();  // just after the reset
+  Phase phase = Phase::kFullContact;  // the phase just after the event
+  State state = State::Zero();        // just after the reset
 };
 
 // Names used in plinth-sim's JSON Lines event log.

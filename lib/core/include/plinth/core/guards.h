@@ -14,16 +14,25 @@
 namespace plinth {
 
 enum class GuardId : std::uint8_t {
-  kRockingOnsetLeft,   // Eq 16 about corner 1
-  kRockingOnsetRight,  // Eq 16 mirrored, about corner 2
-  kRockingImpact,      // theta returns to 0 (Section 3.3)
-  kOverturning,        // |theta| passes the active corner's critical angle alpha_i
-  kBaseStopRight,      // Eq 28, u = +u_max
-  kBaseStopLeft,       // Eq 28, u = -u_max
-  kBaseStopRelease,    // the held base's stop would have to pull: it leaves the stop
+  kRockingOnsetLeft,     // Eq 16 (from rest or full contact) or Eq 17 (while sliding), corner 1
+  kRockingOnsetRight,    // the same about corner 2
+  kRockingImpact,        // theta returns to 0 (Section 3.3)
+  kOverturning,          // |theta| passes the active pivot's critical angle
+  kSlidingOnsetLeft,     // Eq 15 (full contact) or Eq 18 (rocking): the block slides with x' < 0
+  kSlidingOnsetRight,    // ... with x' > 0
+  kSlidingStop,          // x' returns to 0 (Section 3.2.1)
+  kOutOfBaseLeft,        // x passes -x_hat: the block overhangs the support's left edge
+  kOutOfBaseRight,       // x passes +x_hat
+  kBackOnBase,           // the overhanging block slides back onto the support
+  kFall,                 // C passes the support's edge (b_hat = 0): the block falls off
+  kSlidingStopLeft,      // Eq 30, x = -x_hat with sliding stops
+  kSlidingStopRight,     // Eq 30, x = +x_hat
+  kBaseStopRight,        // Eq 28, u = +u_max
+  kBaseStopLeft,         // Eq 28, u = -u_max
+  kBaseStopRelease,      // the held base's stop would have to pull: it leaves the stop
 };
 
-inline constexpr int kMaxActiveGuards = 4;
+inline constexpr int kMaxActiveGuards = 12;
 
 struct ActiveGuards {
   std::array<GuardId, kMaxActiveGuards> ids{};
@@ -34,12 +43,18 @@ struct ActiveGuards {
 
 // What the model of a scene carries, fixed once when the scene is loaded.
 struct Features {
-  bool base = false;        // an isolated base (u is a degree of freedom)
-  bool base_stops = false;  // security stops on the base (Eqs 28-29)
+  bool base = false;           // an isolated base (u is a degree of freedom)
+  bool base_stops = false;     // security stops on the base (Eqs 28-29)
+  bool sliding = false;        // friction is finite: sliding phases exist (Eqs 2-5, 10-15, 17-20)
+  bool support_edge = false;   // the block can overhang the support and fall (Eqs 13-14)
+  bool sliding_stops = false;  // sliding stops at |x| = x_hat (Eqs 30-32)
 };
 
 [[nodiscard]] constexpr Features features_of(const Scene& s) {
-  return {s.params.has_base, s.params.has_base_stops};
+  const SceneParams& p = s.params;
+  return {p.has_base, p.has_base_stops, p.has_friction,
+          p.has_friction && p.has_support && !p.has_sliding_stops,
+          p.has_friction && p.has_sliding_stops};
 }
 
 template <Features F>
@@ -53,6 +68,27 @@ template <Features F>
     g.add(GuardId::kRockingOnsetLeft);
     g.add(GuardId::kRockingOnsetRight);
   }
+  if constexpr (F.sliding) {
+    if (mode.sliding()) {
+      g.add(GuardId::kSlidingStop);
+      if constexpr (F.support_edge) {
+        if (mode.overhang == 0) {
+          g.add(GuardId::kOutOfBaseLeft);
+          g.add(GuardId::kOutOfBaseRight);
+        } else {
+          g.add(GuardId::kBackOnBase);
+          g.add(GuardId::kFall);
+        }
+      }
+      if constexpr (F.sliding_stops) {
+        g.add(GuardId::kSlidingStopLeft);
+        g.add(GuardId::kSlidingStopRight);
+      }
+    } else {
+      g.add(GuardId::kSlidingOnsetLeft);
+      g.add(GuardId::kSlidingOnsetRight);
+    }
+  }
   if constexpr (F.base_stops) {
     if (mode.held_stop != 0) {
       g.add(GuardId::kBaseStopRelease);
@@ -64,35 +100,70 @@ template <Features F>
   return g;
 }
 
-// Absolute horizontal acceleration of the base, u'' + u_G'' (the ground's when it is fixed).
-[[nodiscard]] inline double base_absolute_acceleration(const Accelerations& acc,
-                                                       GroundAcceleration ag) {
-  return acc.u + ag.horizontal;
+// Eqs 16-17: rocking about corner i starts when the block's absolute horizontal acceleration
+// u'' + u_G'' + x'' reaches (b_hat_i / h)(g + v_G'') towards that corner's side (corner 1:
+// positive). b_hat_i is the pivot's distance from C (b_i on the support).
+[[nodiscard]] inline double rocking_onset_guard(const Scene& s, const Pivot& pivot,
+                                                const Accelerations& acc, GroundAcceleration ag) {
+  const double block = acc.u + acc.x + ag.horizontal;
+  return pivot.geometry.sign * block - pivot.geometry.onset_ratio * (s.g + ag.vertical);
 }
 
-// Eq 16: rocking about corner 1 starts when u'' + u_G'' >= (b_1 / h)(g + v_G''); about
-// corner 2 when -(u'' + u_G'') >= (b_2 / h)(g + v_G''). Full-contact accelerations.
-[[nodiscard]] inline double rocking_onset_guard(const Scene& s, Corner corner,
-                                                const Accelerations& acc, GroundAcceleration ag) {
-  const CornerGeometry& c = s.corner(corner);
-  return c.sign * base_absolute_acceleration(acc, ag) - c.onset_ratio * (s.g + ag.vertical);
+// Contact force on the block while it sticks (full contact or rocking), for Eqs 15 and 18.
+[[nodiscard]] inline ContactForce sticking_contact_force(const Scene& s, const Mode& mode,
+                                                         const State& y, GroundAcceleration ag,
+                                                         const Accelerations& acc) {
+  if (!mode.rocking()) {  // full contact, Eq 15: X = m (u'' + u_G''), Y = m (g + v_G'')
+    return {s.m * (acc.u + ag.horizontal), s.m * (s.g + ag.vertical)};
+  }
+  const Pivot pivot = pivot_of(s, mode, y);
+  return contact_force(s, contact_kinematics(s, pivot.geometry, pivot.overhanging, y), acc, ag);
+}
+
+// Eqs 15 and 18: sliding starts when static friction cannot hold, mu_s Y <= |X|. The block
+// slides against X (direction -1 when X > 0). A block pressed against a sliding stop cannot
+// slide into it.
+[[nodiscard]] inline double sliding_onset_guard(const Scene& s, const State& y, int direction,
+                                                const ContactForce& f) {
+  if (s.params.has_sliding_stops &&
+      direction * y[kX] >= s.params.support.clearance * (1.0 - 1e-12)) {
+    return -1.0;
+  }
+  return -direction * f.tangential - s.params.friction.static_coefficient * f.normal;
 }
 
 // Value of guard `id` at (y, ag) with the mode's accelerations `acc`.
 [[nodiscard]] inline double guard_value(GuardId id, const Scene& s, const Mode& mode,
                                         const State& y, GroundAcceleration ag,
                                         const Accelerations& acc) {
+  const double x_hat = s.params.support.clearance;
   switch (id) {
     case GuardId::kRockingOnsetLeft:
-      return rocking_onset_guard(s, Corner::kLeft, acc, ag);
+      return rocking_onset_guard(s, pivot_of(s, Corner::kLeft, mode.overhang, y[kX]), acc, ag);
     case GuardId::kRockingOnsetRight:
-      return rocking_onset_guard(s, Corner::kRight, acc, ag);
+      return rocking_onset_guard(s, pivot_of(s, Corner::kRight, mode.overhang, y[kX]), acc, ag);
     case GuardId::kRockingImpact:
       return -s.corner(mode.corner).sign * y[kTheta];
     case GuardId::kOverturning: {
-      const CornerGeometry& c = s.corner(mode.corner);
+      const CornerGeometry c = pivot_of(s, mode, y).geometry;
       return c.sign * y[kTheta] - c.critical_angle;
     }
+    case GuardId::kSlidingOnsetLeft:
+    case GuardId::kSlidingOnsetRight:
+      return sliding_onset_guard(s, y, id == GuardId::kSlidingOnsetLeft ? -1 : 1,
+                                 sticking_contact_force(s, mode, y, ag, acc));
+    case GuardId::kSlidingStop:
+      return -mode.slide_direction * y[kXDot];
+    case GuardId::kOutOfBaseLeft:
+    case GuardId::kSlidingStopLeft:
+      return -y[kX] - x_hat;
+    case GuardId::kOutOfBaseRight:
+    case GuardId::kSlidingStopRight:
+      return y[kX] - x_hat;
+    case GuardId::kBackOnBase:
+      return x_hat - mode.overhang * y[kX];
+    case GuardId::kFall:  // b_hat of the overhanging side reaches 0
+      return mode.overhang * y[kX] - x_hat - (mode.overhang < 0 ? s.b1 : s.b2);
     case GuardId::kBaseStopRight:
       return y[kU] - s.params.base_stops.max_displacement;
     case GuardId::kBaseStopLeft:

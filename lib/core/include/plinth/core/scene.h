@@ -93,6 +93,10 @@ struct Scene {
   [[nodiscard]] bool has_base() const { return params.has_base; }
 };
 
+// Geometry of rocking about a pivot `distance` (b_i or b_hat_i, m) from C's vertical, on the
+// side `sign` (+1: corner 1, -1: corner 2).
+[[nodiscard]] CornerGeometry corner_geometry(const Scene& s, double distance, double sign);
+
 // Validates `params` and fills `out`. On error, `out` is left unchanged and the Error names the
 // first field at fault.
 [[nodiscard]] Error make_scene(const SceneParams& params, Scene& out);

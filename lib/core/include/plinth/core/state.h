@@ -38,6 +38,15 @@ struct Mode {
   // +1 / -1: the base rests against the right / left base stop (u = +-u_max, u' = 0) after
   // its rebounds died out; 0: the base moves freely. See resets.h, base_stop_reset.
   std::int8_t held_stop = 0;
+  // Sliding phases: sign of x' (+1: the block slides right on the base), fixed for the phase.
+  std::int8_t slide_direction = 0;
+  // -1 / +1: the block overhangs the support's left / right edge (x < -x_hat / x > x_hat), so
+  // rocking about that side turns about the support's corner (Eqs 13-14); 0: on the support.
+  std::int8_t overhang = 0;
+
+  [[nodiscard]] bool sliding() const {
+    return phase == Phase::kSliding || phase == Phase::kSlideRocking;
+  }
 
   [[nodiscard]] bool rocking() const {
     return phase == Phase::kRocking || phase == Phase::kSlideRocking;
