@@ -338,9 +338,17 @@ struct Stepper {
     enter(sim, t);
   }
 
+  // |theta| passed the pivot's critical angle: C is over the pivot. About the support's corner
+  // that is C passing the support's edge, so the block falls off the base; about its own corner
+  // it overturns.
   static void overturn(Simulator& sim, double t) {
-    const CornerGeometry c = pivot_of(*sim.scene_, sim.mode_, sim.y_).geometry;
-    sim.y_[kTheta] = c.sign * c.critical_angle;
+    const Pivot pivot = pivot_of(*sim.scene_, sim.mode_, sim.y_);
+    sim.y_[kTheta] = pivot.geometry.sign * pivot.geometry.critical_angle;
+    if (pivot.overhanging) {
+      sim.mode_.phase = Phase::kFell;
+      emit(sim, t, EventKind::kFell, sim.mode_.overhang);
+      return;
+    }
     sim.mode_.phase = Phase::kOverturned;
     emit(sim, t, EventKind::kOverturned);
   }
