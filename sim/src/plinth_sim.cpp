@@ -87,7 +87,9 @@ class RunSink final : public plinth::EventSink {
     std::string phase = plinth::phase_name(e.phase);
     if (e.phase == plinth::Phase::kRocking || e.phase == plinth::Phase::kSlideRocking ||
         e.phase == plinth::Phase::kOverturned) {
-      phase += std::string(" about the ") + plinth::corner_name(e.corner) + " corner";
+      phase += std::string(" about the ") +
+               (plinth::pivots_on_support(e.corner, e.overhang) ? "support's " : "") +
+               plinth::corner_name(e.corner) + " corner";
     }
     if (e.kind == EventKind::kSlidingStart) {
       phase += e.phase == plinth::Phase::kSliding ? std::string(" ") + side

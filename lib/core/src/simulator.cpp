@@ -199,6 +199,7 @@ struct Stepper {
     e.before = before;
     e.after = after;
     e.phase = sim.mode_.phase;
+    e.overhang = sim.mode_.overhang;
     e.state = sim.y_;
     sim.emit(e);
   }

@@ -56,9 +56,11 @@ std::string event_json(const Event& e) {
     case EventKind::kRockingStart:
     case EventKind::kOverturned:
       line += field("corner", quoted(corner_name(e.corner)));
+      line += field("pivot", quoted(pivots_on_support(e.corner, e.overhang) ? "support" : "body"));
       break;
     case EventKind::kImpact:
       line += field("corner", quoted(corner_name(e.corner)));
+      line += field("pivot", quoted(pivots_on_support(e.corner, e.overhang) ? "support" : "body"));
       line += field("theta_dot_before", number(e.before));
       line += field("theta_dot_after", number(e.after));
       break;

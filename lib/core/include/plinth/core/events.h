@@ -32,11 +32,17 @@ struct Event {
   double before = 0.0;
   double after = 0.0;
   Phase phase = Phase::kFullContact;  // the phase just after the event
+  std::int8_t overhang = 0;           // Mode::overhang just after the event
   State state = State::Zero();        // just after the reset
 };
 
 // Names used in plinth-sim's JSON Lines event log.
 [[nodiscard]] const char* event_name(EventKind kind);
+
+// True when `corner` turns about the support's corner rather than the body's own.
+[[nodiscard]] constexpr bool pivots_on_support(Corner corner, int overhang) {
+  return overhang == (corner == Corner::kLeft ? -1 : 1);
+}
 
 // Receives events as the solver finds them, on the stepping path: must not block.
 class EventSink {

@@ -96,9 +96,10 @@ inline void sliding_stop_hit_reset(const Scene& s, int side, bool base_moves, Mo
   sliding_stop_reset(mode, y);
 }
 
-// Rocking onset (Eq 16 met): the block starts turning about `corner` from theta = 0.
+// Rocking onset (Eq 16, or Eq 17 while sliding): the block starts turning about `corner` from
+// theta = 0; a sliding block goes on sliding (slide-rocking).
 inline void rocking_onset_reset(Corner corner, Mode& mode, State& y) {
-  mode.phase = Phase::kRocking;
+  mode.phase = mode.sliding() ? Phase::kSlideRocking : Phase::kRocking;
   mode.corner = corner;
   y[kTheta] = 0.0;
   y[kThetaDot] = 0.0;
