@@ -369,3 +369,47 @@ TEST(SlidingStops, PrintedEq32WithEtaBelowOneCanAddEnergy) {
 
 }  // namespace
 }  // namespace plinth
+
+namespace plinth {
+namespace {
+
+// The whole model is mirror-symmetric: (epsilon, input) mirrored gives the response mirrored,
+// through sliding, slide-rocking, the support's edge and base stops.
+TEST(WholeModel, MirroredSceneAndInputGiveTheMirroredResponse) {
+  for (const bool sliding_stops : {false, true}) {
+    SceneParams p = testing::paper_isolated(0.3, 1.0);
+    p.has_friction = true;
+    p.friction = {0.25, 0.2};
+    p.has_support = true;
+    p.support = {0.05};
+    p.has_sliding_stops = sliding_stops;
+    p.sliding_stops = {1.0};
+    p.has_base_stops = true;
+    p.base_stops = {0.06, 0.7};
+    SceneParams q = p;
+    q.block.eccentricity = -p.block.eccentricity;
+    const Scene s = testing::make(p);
+    const Scene mirrored = testing::make(q);
+    const Excitation pulse = Excitation::sine_pulse(0.9 * kStandardGravity, 0.8);
+    const Excitation mirrored_pulse = Excitation::sine_pulse(-0.9 * kStandardGravity, 0.8);
+    testing::RecordingSink a;
+    testing::RecordingSink b;
+    const Simulator sa = testing::run(s, pulse, 4.0, 1e-4, &a);
+    const Simulator sb = testing::run(mirrored, mirrored_pulse, 4.0, 1e-4, &b);
+    ASSERT_GT(a.count(EventKind::kSlidingStart), 0);
+    ASSERT_EQ(a.events.size(), b.events.size());
+    for (std::size_t i = 0; i < a.events.size(); ++i) {
+      EXPECT_EQ(a.events[i].kind, b.events[i].kind) << "event " << i;
+      EXPECT_NEAR(a.events[i].t, b.events[i].t, 1e-9) << "event " << i;
+      EXPECT_EQ(a.events[i].side, -b.events[i].side) << "event " << i;
+      EXPECT_EQ(a.events[i].phase, b.events[i].phase) << "event " << i;
+    }
+    EXPECT_EQ(sa.mode().phase, sb.mode().phase);
+    for (const StateIndex i : {kU, kX, kTheta, kUDot, kXDot, kThetaDot}) {
+      EXPECT_NEAR(sa.state()[i], -sb.state()[i], 1e-8) << "component " << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace plinth
