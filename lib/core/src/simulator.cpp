@@ -281,7 +281,9 @@ struct Stepper {
     const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
     const ContactForce f = sticking_contact_force(s, sim.mode_, sim.y_, ag, acc);
     const int direction = f.tangential > 0.0 ? -1 : 1;
-    if (sliding_onset_guard(s, sim.y_, direction, f) >= 0.0) {
+    // Strictly: with mu_s = 0 and no force at all the block stays put rather than "sliding" at
+    // zero speed, re-stopping every step.
+    if (sliding_onset_guard(s, sim.y_, direction, f) > 0.0) {
       sliding_onset_reset(direction, sim.mode_);
       emit(sim, t, EventKind::kSlidingStart, direction);
       return;
@@ -453,7 +455,7 @@ struct Stepper {
         const double g_start = guard_at(sim, mode, id, t0, y0);
         if (g_start > 0.0) continue;
         const double g_end = guard_at(sim, mode, id, t_end, y1);
-        if (g_end < 0.0) continue;
+        if (g_end < 0.0 || (g_start == 0.0 && g_end == 0.0)) continue;  // nothing crossed
         const double tau = first_crossing(sim, mode, id, t0, y0, h, g_start, g_end);
         if (tau < first_tau) {
           first_tau = tau;
