@@ -205,21 +205,16 @@ struct Stepper {
   }
 
   // On entering a mode (at the start or after a reset), the onset conditions that already hold
-  // start their phase at once: Eq 16/17 (rocking) and Eq 15/18 (sliding), in the favoured
-  // direction. At most one of each.
+  // start their phase at once, in the favoured direction: Eq 15/18 (sliding) first, since a
+  // block that cannot be held by friction slides and its acceleration drops to what kinetic
+  // friction gives it; then Eq 16/17 (rocking) with the accelerations of the new phase. (When
+  // both hold at once in full contact, e.g. right after an impulse whose damper force jumps
+  // past both thresholds, the block slides, and rocks too only if Eq 17 holds while sliding.)
   static void enter(Simulator& sim, double t) {
     const Scene& s = *sim.scene_;
     const GroundAcceleration ag = sim.excitation_.at(t);
     for (int pass = 0; pass < 2 && !sim.mode_.terminal(); ++pass) {
       const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
-      if (!sim.mode_.rocking()) {
-        const double left = guard_value(GuardId::kRockingOnsetLeft, s, sim.mode_, sim.y_, ag, acc);
-        const double right = guard_value(GuardId::kRockingOnsetRight, s, sim.mode_, sim.y_, ag, acc);
-        if (left >= 0.0 || right >= 0.0) {
-          start_rocking(sim, t, left >= right ? Corner::kLeft : Corner::kRight);
-          continue;
-        }
-      }
       if constexpr (F.sliding) {
         if (!sim.mode_.sliding()) {
           const double left = guard_value(GuardId::kSlidingOnsetLeft, s, sim.mode_, sim.y_, ag, acc);
@@ -229,6 +224,14 @@ struct Stepper {
             start_sliding(sim, t, left >= right ? -1 : 1);
             continue;
           }
+        }
+      }
+      if (!sim.mode_.rocking()) {
+        const double left = guard_value(GuardId::kRockingOnsetLeft, s, sim.mode_, sim.y_, ag, acc);
+        const double right = guard_value(GuardId::kRockingOnsetRight, s, sim.mode_, sim.y_, ag, acc);
+        if (left >= 0.0 || right >= 0.0) {
+          start_rocking(sim, t, left >= right ? Corner::kLeft : Corner::kRight);
+          continue;
         }
       }
       return;
