@@ -63,6 +63,33 @@ BENCHMARK_CAPTURE(BM_Step, rocking_base, rocking(testing::paper_isolated()));
 BENCHMARK_CAPTURE(BM_Step, rocking_ground, rocking(testing::paper_block()));
 BENCHMARK_CAPTURE(BM_Step, full_contact_base_stops, Setup{with_stops(testing::paper_isolated()), {}});
 
+// mu_k = 0.4 > b/h: a sliding block decelerates enough to tip (slide-rocking); mu_k = 0.2 does
+// not (pure sliding).
+SceneParams with_friction(SceneParams p, double mu_s = 0.5, double mu_k = 0.4) {
+  p.has_friction = true;
+  p.friction = {mu_s, mu_k};
+  p.has_support = true;
+  p.support = {0.1};  // the block may overhang the support
+  return p;
+}
+
+// Sliding right at 0.5 m/s, or slide-rocking (theta = 0.05 rad) on the support or overhanging
+// its left edge; kinetic friction brings it to rest within about 0.1 s.
+Setup sliding(const SceneParams& p, bool rocking_too, int overhang) {
+  Setup s{rocking_too ? with_friction(p) : with_friction(p, 0.25, 0.2),
+          {rocking_too ? Phase::kSlideRocking : Phase::kSliding, Corner::kLeft, 0}};
+  s.mode.slide_direction = 1;
+  s.mode.overhang = static_cast<std::int8_t>(overhang);
+  s.y[kX] = overhang < 0 ? -0.15 : 0.0;
+  s.y[kXDot] = 0.5;
+  if (rocking_too) s.y[kTheta] = 0.05;
+  return s;
+}
+BENCHMARK_CAPTURE(BM_Step, sliding_base, sliding(testing::paper_isolated(), false, 0));
+BENCHMARK_CAPTURE(BM_Step, slide_rocking_base, sliding(testing::paper_isolated(), true, 0));
+BENCHMARK_CAPTURE(BM_Step, slide_rocking_overhanging_base,
+                  sliding(testing::paper_isolated(), true, -1));
+
 void BM_FullContactFlow(benchmark::State& state) {
   const Scene scene = testing::make(testing::paper_isolated());
   State y = State::Zero();
@@ -98,6 +125,24 @@ void BM_RockingFlow(benchmark::State& state, bool on_base) {
   state.SetItemsProcessed(state.iterations());
 }
 BENCHMARK_CAPTURE(BM_RockingFlow, on_base, true);
+
+// Eqs 10-12 (on the support) or 13-14 (overhanging): a 3x3 solve.
+void BM_SlideRockingFlow(benchmark::State& state, bool overhanging) {
+  const Scene scene = testing::make(with_friction(testing::paper_isolated()));
+  State y;
+  y << 0.05, overhanging ? -0.15 : 0.0, 0.05, 0.1, 0.3, -0.2;
+  const Pivot pivot = pivot_of(scene, Corner::kLeft, overhanging ? -1 : 0, y[kX]);
+  GroundAcceleration ag{1.0, 0.0};
+  for (auto _ : state) {
+    benchmark::DoNotOptimize(y);
+    benchmark::DoNotOptimize(ag);
+    Accelerations a = slide_rocking_flow(scene, pivot.geometry, overhanging, 1, y, ag, true);
+    benchmark::DoNotOptimize(a);
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK_CAPTURE(BM_SlideRockingFlow, on_support, false);
+BENCHMARK_CAPTURE(BM_SlideRockingFlow, overhanging, true);
 BENCHMARK_CAPTURE(BM_RockingFlow, on_ground, false);
 
 // Brienza 000 at PGA 1 g on the isolated scene with stops, dt = 1e-4 s, 40 s.

@@ -136,6 +136,16 @@ struct Stepper {
     return y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
   }
 
+  static void evaluate_guards(const Simulator& sim, const Mode& mode, const ActiveGuards& guards,
+                              double t, const State& y, GuardValues& out) {
+    const GroundAcceleration ag = sim.excitation_.at(t);
+    const Accelerations acc = accelerations(*sim.scene_, mode, y, ag);
+    for (int i = 0; i < guards.count; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      out[k] = guard_value(guards.ids[k], *sim.scene_, mode, y, ag, acc);
+    }
+  }
+
   static double guard_at(const Simulator& sim, const Mode& mode, GuardId id, double t,
                          const State& y) {
     const GroundAcceleration ag = sim.excitation_.at(t);
@@ -451,24 +461,36 @@ struct Stepper {
       const State y0 = sim.y_;
       const State y1 = rk4(sim, mode, t0, y0, h);
       const ActiveGuards guards = guards_live ? active_guards<F>(mode) : ActiveGuards{};
+      // The guards at the interval's start: from the cache when the last step ended here in
+      // this mode with no event; one flow evaluation serves every guard.
+      GuardValues start;
+      if (sim.guard_cache_valid_ && events == 0) {
+        start = sim.guard_cache_;
+      } else {
+        evaluate_guards(sim, mode, guards, t0, y0, start);
+      }
+      GuardValues end;
+      evaluate_guards(sim, mode, guards, t_end, y1, end);
       GuardId first = GuardId::kRockingImpact;
       double first_tau = std::numeric_limits<double>::infinity();
       for (int i = 0; i < guards.count; ++i) {
-        const GuardId id = guards.ids[static_cast<std::size_t>(i)];
-        const double g_start = guard_at(sim, mode, id, t0, y0);
-        if (g_start > 0.0) continue;
-        const double g_end = guard_at(sim, mode, id, t_end, y1);
-        if (g_end < 0.0 || (g_start == 0.0 && g_end == 0.0)) continue;  // nothing crossed
-        const double tau = first_crossing(sim, mode, id, t0, y0, h, g_start, g_end);
+        const auto k = static_cast<std::size_t>(i);
+        const double g_start = start[k];
+        const double g_end = end[k];
+        if (g_start > 0.0 || g_end < 0.0 || (g_start == 0.0 && g_end == 0.0)) continue;
+        const double tau = first_crossing(sim, mode, guards.ids[k], t0, y0, h, g_start, g_end);
         if (tau < first_tau) {
           first_tau = tau;
-          first = id;
+          first = guards.ids[k];
         }
       }
       if (!std::isfinite(first_tau)) {
         sim.y_ = y1;
+        sim.guard_cache_ = end;
+        sim.guard_cache_valid_ = guards_live;
         break;
       }
+      sim.guard_cache_valid_ = false;
       t0 += first_tau;
       sim.y_ = rk4(sim, mode, t0 - first_tau, y0, first_tau);
       apply(sim, first, t0);
@@ -531,6 +553,7 @@ Error Simulator::create(const Scene& scene, const Excitation& excitation,
 
 void Simulator::start_from(const Mode& mode, const State& state) {
   step_count_ = 0;
+  guard_cache_valid_ = false;
   chatter_steps_ = 0;
   mode_ = mode;
   y_ = state;

@@ -34,6 +34,8 @@ enum class GuardId : std::uint8_t {
 
 inline constexpr int kMaxActiveGuards = 12;
 
+using GuardValues = std::array<double, kMaxActiveGuards>;
+
 struct ActiveGuards {
   std::array<GuardId, kMaxActiveGuards> ids{};
   int count = 0;

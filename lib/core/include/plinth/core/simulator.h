@@ -84,6 +84,10 @@ class Simulator {
   Accelerations (*acc_fn_)(const Simulator&, double, const State&) = nullptr;
   Mode mode_;
   State y_ = State::Zero();
+  // Guard values at the end of the last step, valid when it had no event (the next step's
+  // start is the same time, state and mode).
+  GuardValues guard_cache_{};
+  bool guard_cache_valid_ = false;
   std::int64_t step_count_ = 0;
   std::int64_t chatter_steps_ = 0;
 };
