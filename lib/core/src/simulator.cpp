@@ -435,9 +435,18 @@ struct Stepper {
     }
   }
 
-  // Chatter within one step (Zeno): bring rocking to rest and hold a base that sits on a stop.
+  // Chatter within one step (Zeno): bring rocking to rest, stop sliding, and hold a base that
+  // sits on a stop.
   static void settle(Simulator& sim, double t) {
     if (sim.mode_.rocking()) stop_rocking(sim, t, sim.y_[kThetaDot]);
+    if constexpr (F.sliding) {
+      // Stick-slip chatter: the block sticks for the rest of the step; the next step's guards
+      // start it sliding again if friction cannot hold it.
+      if (sim.mode_.sliding()) {
+        sliding_stop_reset(sim.mode_, sim.y_);
+        emit(sim, t, EventKind::kSlidingStop);
+      }
+    }
     if constexpr (F.base_stops) {
       const double u_max = sim.scene_->params.base_stops.max_displacement;
       if (sim.mode_.held_stop == 0 && std::fabs(sim.y_[kU]) >= u_max * (1.0 - 1e-9)) {

@@ -10,7 +10,6 @@ enum class ErrorCode : std::uint8_t {
   kNotFinite,     // NaN or infinity where a number is required
   kOutOfRange,    // a finite value outside its physical range
   kInconsistent,  // values that are each fine but do not fit together
-  kUnsupported,   // asks for a part of the model this build does not have
 };
 
 // `field` names the scene or setting field at fault with its canonical key (for example

@@ -22,7 +22,8 @@ struct SolverSettings {
   // The base is held at a stop when it rebounds slower than this while the stop pushes, m/s.
   double base_rest_speed = 1e-5;
   // Events located within one step before the remaining ones are treated as chatter (Zeno):
-  // rocking is brought to rest and the base held, and the step finishes without further events.
+  // rocking is brought to rest, sliding stopped and the base held, and the step finishes
+  // without further events.
   int max_events_per_step = 64;
   // Events are located in time to within this fraction of the step.
   double event_time_tolerance = 1e-10;
@@ -35,13 +36,12 @@ class Simulator {
  public:
   Simulator() = default;
 
-  // `scene` and the signals `excitation` refers to must outlive the simulator. Fails with
-  // kUnsupported for parts of the model this build does not have (sliding, support edge,
-  // sliding stops).
+  // `scene` and the signals `excitation` refers to must outlive the simulator. Fails only on
+  // invalid settings (the Error names the field).
   [[nodiscard]] static Error create(const Scene& scene, const Excitation& excitation,
                                     const SolverSettings& settings, Simulator& out);
 
-  // t = 0, at rest, full contact (rocking starts at once if Eq 16 already holds).
+  // t = 0, at rest, full contact (sliding or rocking starts at once if Eq 15 or 16 holds).
   void start_at_rest();
   // Impulse I, the initial condition of Eq 34: the ground's velocity jumps by -I, m/s. On a
   // base, u'(0+) = I; on the ground, the block turns about the corner the jump throws it on,
@@ -80,7 +80,7 @@ class Simulator {
   SolverSettings settings_;
   EventSink* sink_ = nullptr;
   void (*step_fn_)(Simulator&) = nullptr;
-  void (*enter_fn_)(Simulator&, double) = nullptr;  // checks Eq 16 on entering full contact
+  void (*enter_fn_)(Simulator&, double) = nullptr;  // starts phases whose onset already holds
   Accelerations (*acc_fn_)(const Simulator&, double, const State&) = nullptr;
   Mode mode_;
   State y_ = State::Zero();
