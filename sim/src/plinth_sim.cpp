@@ -196,7 +196,14 @@ int run(const Options& opt) {
   settings.step = opt.dt;
   plinth::Simulator sim;
   if (plinth::Error e = plinth::Simulator::create(scene, excitation, settings, sim); !e.ok()) {
-    throw InputError(std::string(e.field) + ": " + e.reason);
+    std::string message = std::string(e.field == std::string("solver.step") ? "--dt" : e.field) +
+                          ": " + e.reason;
+    if (e.limit > 0.0) {
+      char limit[64];
+      std::snprintf(limit, sizeof limit, "; the largest stable step is %.3g s", e.limit);
+      message += limit;
+    }
+    throw InputError(message);
   }
 
   const double t_end = opt.t_end ? *opt.t_end : std::max(10.0, excitation.duration() + 5.0);

@@ -413,3 +413,41 @@ TEST(WholeModel, MirroredSceneAndInputGiveTheMirroredResponse) {
 
 }  // namespace
 }  // namespace plinth
+
+namespace plinth {
+namespace {
+
+// A step too large for a stable integration of a stiff, light, heavily damped base is refused
+// with the largest stable step; just below it the run stays bounded.
+TEST(StepCheck, RefusesUnstableStepsAndNamesTheLargestStableOne) {
+  SceneParams p = testing::paper_isolated(0.0, 0.05, 0.99);
+  p.base.mass = 0.01 * p.block.mass;
+  p.has_friction = true;
+  p.friction = {0.3, 0.24};
+  const Scene s = testing::make(p);
+  const double limit = largest_stable_step(s);
+  // Overdamped base alone: c / m_b = 2 xi (m + m_b) omega / m_b sets the rate.
+  EXPECT_LT(limit, 1e-4);
+  SolverSettings settings;
+  settings.step = 1e-3;
+  Simulator sim;
+  const Error e = Simulator::create(s, Excitation::none(), settings, sim);
+  EXPECT_EQ(e.code, ErrorCode::kOutOfRange);
+  EXPECT_STREQ(e.field, "solver.step");
+  EXPECT_DOUBLE_EQ(e.limit, limit);
+  settings.step = 0.9 * limit;
+  ASSERT_TRUE(Simulator::create(s, Excitation::sine_pulse(5.0, 0.3), settings, sim).ok());
+  sim.start_at_rest();
+  double peak = 0.0;
+  while (sim.time() < 1.0) {
+    sim.step();
+    ASSERT_TRUE(sim.state().allFinite()) << "t = " << sim.time();
+    peak = std::max(peak, std::fabs(sim.state()[kU]));
+  }
+  EXPECT_LT(peak, 0.1);
+  // Without a base there is no such limit.
+  EXPECT_TRUE(std::isinf(largest_stable_step(testing::make(testing::paper_block()))));
+}
+
+}  // namespace
+}  // namespace plinth

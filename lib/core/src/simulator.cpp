@@ -84,6 +84,27 @@ Error validate(const SolverSettings& st) {
   return ok_error();
 }
 
+namespace {
+
+// Largest |lambda| of m u'' + c u' + k u = 0, 1/s.
+double largest_rate(double mass, double damping, double stiffness) {
+  const double a = damping / (2.0 * mass);
+  const double w2 = stiffness / mass;
+  if (a * a <= w2) return std::sqrt(w2);  // complex pair, |lambda| = sqrt(k/m)
+  return a + std::sqrt(a * a - w2);       // overdamped: the fast real root
+}
+
+}  // namespace
+
+double largest_stable_step(const Scene& s) {
+  if (!s.has_base()) return std::numeric_limits<double>::infinity();
+  constexpr double kRk4StabilityRadius = 2.5;  // below 2.78 (real axis) and 2.83 (imaginary)
+  const double base_mass = s.total_mass - s.m;
+  const double rate = std::max(largest_rate(s.total_mass, s.damping, s.stiffness),
+                               largest_rate(base_mass, s.damping, s.stiffness));
+  return kRk4StabilityRadius / rate;
+}
+
 // The solver for one set of model features: what a scene does not have is compiled out.
 template <Features F>
 struct Stepper {
@@ -544,6 +565,11 @@ void bind_for_friction(Simulator& sim, const Features& f) {
 Error Simulator::create(const Scene& scene, const Excitation& excitation,
                         const SolverSettings& settings, Simulator& out) {
   if (Error e = validate(settings); !e.ok()) return e;
+  if (const double limit = largest_stable_step(scene); settings.step > limit) {
+    return {ErrorCode::kOutOfRange, "solver.step",
+            "is too large for a stable integration of this scene's base (stiff or light base)",
+            limit};
+  }
   Simulator sim;
   sim.scene_ = &scene;
   sim.excitation_ = excitation;

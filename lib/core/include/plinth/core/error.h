@@ -19,6 +19,7 @@ struct Error {
   ErrorCode code = ErrorCode::kOk;
   const char* field = "";
   const char* reason = "";
+  double limit = 0.0;  // the bound that was passed, in the field's unit, where there is one
 
   [[nodiscard]] constexpr bool ok() const { return code == ErrorCode::kOk; }
 };
