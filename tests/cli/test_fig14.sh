@@ -6,9 +6,7 @@
 #   (b) the block slides out of the base: out_of_base, max |x| > x_hat;
 #   (c) slide-rocking with base stop impacts: base_stop_hit, sliding_start, rocking_start,
 #       out_of_base, and a slide_rocking row in the CSV;
-#   (d) pure rocking: rocking_start and impact, no sliding_start. Its window is narrow (about
-#       2.06g to 2.125g around 2.1g; outside it the block does not rock or overturns in its first
-#       swing), so it is checked at PGA x 0.99 and x 1.01 instead of x 0.95 and x 1.05.
+#   (d) pure rocking: rocking_start and impact, no sliding_start.
 # Prints "ok - <name>" or "not ok - <name>: <why>" per check, then "N passed, M failed".
 #
 # Environment: PLINTH_SIM, the plinth-sim binary; PLINTH_SOURCE_DIR, the repository root.
@@ -134,7 +132,8 @@ check_kind() {
   for factor in "$@"; do
     local g
     g=$(awk -v p="$pga" -v f="$factor" 'BEGIN { printf "%.6g", p * f }')
-    local name="($kind) $title, $(basename "$scene") at ${g}g (PGA x $factor)"
+    local name
+    name="($kind) $title, $(basename "$scene") at ${g}g (PGA x $factor)"
     local events=$TMP/$kind-$factor.jsonl csv=$TMP/$kind-$factor.csv
     "${TIMEOUT[@]}" "$SIM" --scene "$scene" --record "$AT2" --pga "${g}g" --events "$events" \
       --out "$csv" >"$TMP/stdout" 2>"$TMP/stderr"
@@ -156,7 +155,7 @@ check_kind b "the block slides out of the base" \
 check_kind c "slide-rocking with base stop impacts" \
   "$SCENES/fig14c-slide-rocking-base-stops.toml" 2.3 1 0.95 1.05
 check_kind d "pure rocking" \
-  "$SCENES/fig14d-pure-rocking.toml" 2.1 1 0.99 1.01
+  "$SCENES/fig14d-pure-rocking.toml" 1.8 1 0.95 1.05
 
 echo "$PASSED passed, $FAILED failed"
 ((FAILED == 0))
