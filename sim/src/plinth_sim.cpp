@@ -135,9 +135,26 @@ std::string describe_scene(const plinth::Scene& s) {
                     s.params.base_stops.restitution);
     }
   } else {
-    std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n), "; on the ground");
+    n += std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n), "; on the ground");
   }
-  return text;
+  std::string out = text;
+  const plinth::SceneParams& p = s.params;
+  char more[160];
+  if (p.has_friction) {
+    std::snprintf(more, sizeof more, "; friction mu_s=%g, mu_k=%g", p.friction.static_coefficient,
+                  p.friction.kinetic_coefficient);
+    out += more;
+  }
+  if (p.has_support) {
+    std::snprintf(more, sizeof more, "; support x_hat=%g m%s", p.support.clearance,
+                  p.has_sliding_stops ? "" : " (the block may leave it)");
+    out += more;
+  }
+  if (p.has_sliding_stops) {
+    std::snprintf(more, sizeof more, "; sliding stops eta_s=%g", p.sliding_stops.restitution);
+    out += more;
+  }
+  return out;
 }
 
 int run(const Options& opt) {
