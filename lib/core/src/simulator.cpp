@@ -317,7 +317,7 @@ struct Stepper {
     const int direction = f.tangential > 0.0 ? -1 : 1;
     // Strictly: with mu_s = 0 and no force at all the block stays put rather than "sliding" at
     // zero speed, re-stopping every step.
-    if (sliding_onset_guard(s, sim.y_, direction, f) > 0.0) {
+    if (sliding_onset_guard(s, sim.mode_, sim.y_, direction, f) > 0.0) {
       sliding_onset_reset(direction, sim.mode_);
       emit(sim, t, EventKind::kSlidingStart, direction);
       return;
@@ -418,6 +418,13 @@ struct Stepper {
       case GuardId::kSlidingStop:
         sliding_stopped(sim, t);
         return;
+      case GuardId::kSlidingInconsistent: {
+        const double before = sim.y_[kXDot];
+        tangential_impact_reset(*sim.scene_, sim.mode_, sim.y_);
+        emit(sim, t, EventKind::kSlidingStop, 0, before);
+        enter(sim, t);
+        return;
+      }
       case GuardId::kOutOfBaseLeft:
       case GuardId::kOutOfBaseRight: {
         const int side = id == GuardId::kOutOfBaseLeft ? -1 : 1;

@@ -139,6 +139,43 @@ struct ContactForce {
   return {s.m * k.tangent.dot(specific), s.m * k.normal.dot(specific)};
 }
 
+// Mass matrix of the slide-rocking Lagrange equations without friction, and with the friction
+// coupling of sliding in `direction` (the x row gains mu_k s m n.J, Y being linear in q'').
+struct SlideRockingMatrices {
+  Eigen::Matrix3d frictionless;
+  Eigen::Matrix3d with_friction;
+};
+
+[[nodiscard]] inline SlideRockingMatrices slide_rocking_matrices(const Scene& s,
+                                                                const ContactKinematics& k,
+                                                                int direction) {
+  SlideRockingMatrices m;
+  m.frictionless = s.m * (k.jx * k.jx.transpose() + k.jy * k.jy.transpose());
+  m.frictionless(0, 0) += s.total_mass - s.m;
+  m.frictionless(2, 2) += s.inertia_c;
+  const double mu = s.params.friction.kinetic_coefficient * direction;
+  const Eigen::Vector3d normal_row = k.normal.x() * k.jx + k.normal.y() * k.jy;
+  m.with_friction = m.frictionless;
+  m.with_friction.row(1) += mu * s.m * normal_row.transpose();
+  return m;
+}
+
+// Near Painlevé's singularity the normal force and the accelerations grow without bound, beyond
+// what any fixed step resolves: below this consistency ratio the contact is taken as stuck.
+inline constexpr double kPainleveMargin = 0.05;
+
+// det(with friction) / det(frictionless) of slide-rocking in `direction`. Where it is not
+// positive, Coulomb friction makes the equations inconsistent (Painlevé's paradox: the normal
+// force of the solution is negative, and it grows without bound as the ratio nears 0): high
+// friction with the block well tilted. The contact then sticks (a tangential impact,
+// kSlidingInconsistent in guards.h).
+[[nodiscard]] inline double sliding_consistency(const Scene& s, const Pivot& pivot,
+                                                int direction, const State& y) {
+  const ContactKinematics k = contact_kinematics(s, pivot.geometry, pivot.overhanging, y);
+  const SlideRockingMatrices m = slide_rocking_matrices(s, k, direction);
+  return m.with_friction.determinant() / m.frictionless.determinant();
+}
+
 // Slide-rocking, Eqs 10-12 (about a body corner) or Eqs 13-14 (overhanging the support): the
 // Lagrange equations M(q) q'' = f with the kinetic friction -mu_k sign(x') Y on x, Y being linear
 // in q''. Assembled from the kinematics of C; tests/unit/test_sliding.cpp checks every printed
@@ -149,15 +186,11 @@ struct ContactForce {
                                                       bool base_moves) {
   const ContactKinematics k = contact_kinematics(s, c, overhanging, y);
   const Eigen::Vector2d free(k.bias.x() + ag.horizontal, k.bias.y() + ag.vertical + s.g);
-  Eigen::Matrix3d mass = s.m * (k.jx * k.jx.transpose() + k.jy * k.jy.transpose());
-  mass(0, 0) += s.total_mass - s.m;
-  mass(2, 2) += s.inertia_c;
+  Eigen::Matrix3d mass = slide_rocking_matrices(s, k, direction).with_friction;
   Eigen::Vector3d force = -s.m * (k.jx * free.x() + k.jy * free.y());
   force[0] -= (s.total_mass - s.m) * ag.horizontal + s.damping * y[kUDot] + s.stiffness * y[kU];
-  // Friction on x: -mu_k s Y, Y = m n.(J q'' + free).
+  // Friction on x: -mu_k s Y, Y = m n.(J q'' + free); its q'' part is in the mass matrix.
   const double mu = s.params.friction.kinetic_coefficient * direction;
-  const Eigen::Vector3d normal_row = k.normal.x() * k.jx + k.normal.y() * k.jy;
-  mass.row(1) += mu * s.m * normal_row.transpose();
   force[1] -= mu * s.m * k.normal.dot(free);
   if (!base_moves) {
     mass.row(0) << 1.0, 0.0, 0.0;

@@ -21,6 +21,7 @@ enum class GuardId : std::uint8_t {
   kSlidingOnsetLeft,     // Eq 15 (full contact) or Eq 18 (rocking): the block slides with x' < 0
   kSlidingOnsetRight,    // ... with x' > 0
   kSlidingStop,          // x' returns to 0 (Section 3.2.1)
+  kSlidingInconsistent,  // slide-rocking reaches Painlevé's paradox: the contact sticks
   kOutOfBaseLeft,        // x passes -x_hat: the block overhangs the support's left edge
   kOutOfBaseRight,       // x passes +x_hat
   kBackOnBase,           // the overhanging block slides back onto the support
@@ -32,7 +33,7 @@ enum class GuardId : std::uint8_t {
   kBaseStopRelease,      // the held base's stop would have to pull: it leaves the stop
 };
 
-inline constexpr int kMaxActiveGuards = 12;
+inline constexpr int kMaxActiveGuards = 13;
 
 using GuardValues = std::array<double, kMaxActiveGuards>;
 
@@ -73,6 +74,7 @@ template <Features F>
   if constexpr (F.sliding) {
     if (mode.sliding()) {
       g.add(GuardId::kSlidingStop);
+      if (mode.rocking()) g.add(GuardId::kSlidingInconsistent);
       if constexpr (F.support_edge) {
         if (mode.overhang == 0) {
           g.add(GuardId::kOutOfBaseLeft);
@@ -125,10 +127,16 @@ template <Features F>
 // Eqs 15 and 18: sliding starts when static friction cannot hold, mu_s Y <= |X|. The block
 // slides against X (direction -1 when X > 0). A block pressed against a sliding stop cannot
 // slide into it.
-[[nodiscard]] inline double sliding_onset_guard(const Scene& s, const State& y, int direction,
-                                                const ContactForce& f) {
+// While rocking, a direction in which Painlevé's paradox holds (or nearly: kPainleveMargin)
+// cannot start sliding either: the contact sticks.
+[[nodiscard]] inline double sliding_onset_guard(const Scene& s, const Mode& mode, const State& y,
+                                                int direction, const ContactForce& f) {
   if (s.params.has_sliding_stops &&
       direction * y[kX] >= s.params.support.clearance * (1.0 - 1e-12)) {
+    return -1.0;
+  }
+  if (mode.rocking() &&
+      sliding_consistency(s, pivot_of(s, mode, y), direction, y) <= kPainleveMargin) {
     return -1.0;
   }
   return -direction * f.tangential - s.params.friction.static_coefficient * f.normal;
@@ -152,10 +160,12 @@ template <Features F>
     }
     case GuardId::kSlidingOnsetLeft:
     case GuardId::kSlidingOnsetRight:
-      return sliding_onset_guard(s, y, id == GuardId::kSlidingOnsetLeft ? -1 : 1,
+      return sliding_onset_guard(s, mode, y, id == GuardId::kSlidingOnsetLeft ? -1 : 1,
                                  sticking_contact_force(s, mode, y, ag, acc));
     case GuardId::kSlidingStop:
       return -mode.slide_direction * y[kXDot];
+    case GuardId::kSlidingInconsistent:
+      return kPainleveMargin - sliding_consistency(s, pivot_of(s, mode, y), mode.slide_direction, y);
     case GuardId::kOutOfBaseLeft:
     case GuardId::kSlidingStopLeft:
       return -y[kX] - x_hat;

@@ -128,6 +128,26 @@ inline void rocking_onset_reset(Corner corner, Mode& mode, State& y) {
   return response / response[0];
 }
 
+// Painlevé's paradox (flows.h, sliding_consistency): the sliding contact sticks at once. An
+// impulse along x alone brings x' to 0 through the frictionless mass matrix of the phase
+// (a plastic tangential impact: it never adds energy); the block goes on rocking.
+inline void tangential_impact_reset(const Scene& s, Mode& mode, State& y) {
+  const Pivot pivot = pivot_of(s, mode, y);
+  const ContactKinematics k = contact_kinematics(s, pivot.geometry, pivot.overhanging, y);
+  Eigen::Matrix3d mass = slide_rocking_matrices(s, k, 0).frictionless;
+  if (mode.held_stop != 0 || !s.has_base()) {  // u is held: only x and theta respond
+    mass.row(0) << 1.0, 0.0, 0.0;
+    mass.col(0) << 1.0, 0.0, 0.0;
+  }
+  const Eigen::Vector3d response = mass.partialPivLu().solve(Eigen::Vector3d::UnitY());
+  const double impulse = -y[kXDot] / response[1];
+  y[kUDot] += response[0] * impulse;
+  y[kThetaDot] += response[2] * impulse;
+  y[kXDot] = 0.0;
+  mode.phase = Phase::kRocking;
+  mode.slide_direction = 0;
+}
+
 inline void apply_base_impulse(const Scene& s, const Mode& mode, double u_dot_after, State& y) {
   const Eigen::Vector3d response = base_impulse_response(s, mode, y);
   const double change = u_dot_after - y[kUDot];

@@ -1,0 +1,495 @@
+// The plinth CAN codec: table-driven Intel bit packing of the frames in plinth.dbc.
+#include "plinth/hal/can_codec.h"
+
+#include <cmath>
+
+namespace plinth::can {
+
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Signal tables: one row per DBC SG_ line (tests/unit/test_can_codec.cpp compares them).
+
+constexpr std::int64_t kU8Max = 255;
+constexpr std::int64_t kU16Max = 65535;
+constexpr std::int64_t kU32Max = 4294967295;
+
+// SensorAcceleration (0x300 + node)
+enum AccelerationSignal : std::size_t { kAx, kAy, kAz, kAccSequence, kAccStatus };
+constexpr std::array<SignalLayout, 5> kAccelerationSignals{{
+    {"Ax", 0, 16, true, 0.00025, 0.0, -32768, 32767, "g", false},
+    {"Ay", 16, 16, true, 0.00025, 0.0, -32768, 32767, "g", false},
+    {"Az", 32, 16, true, 0.00025, 0.0, -32768, 32767, "g", false},
+    {"Sequence", 48, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+    {"Status", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+}};
+
+// SensorHeartbeat (0x310 + node)
+enum HeartbeatSignal : std::size_t {
+  kUptime,
+  kFirmwareMajor,
+  kFirmwareMinor,
+  kHbStatus,
+  kCanTxErrors,
+  kCanRxErrors
+};
+constexpr std::array<SignalLayout, 6> kHeartbeatSignals{{
+    {"Uptime", 0, 32, false, 1.0, 0.0, 0, kU32Max, "s", false},
+    {"FirmwareMajor", 32, 4, false, 1.0, 0.0, 0, 15, "", false},
+    {"FirmwareMinor", 36, 4, false, 1.0, 0.0, 0, 15, "", false},
+    {"Status", 40, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+    {"CanTxErrors", 48, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+    {"CanRxErrors", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+}};
+
+// MonitorStatus (0x320 + axis)
+enum StatusSignal : std::size_t { kPhase, kCorner, kAlarmLevel, kRisk, kStSequence, kSampleAge };
+constexpr std::array<SignalLayout, 6> kStatusSignals{{
+    {"Phase", 0, 4, false, 1.0, 0.0, 0, 5, "", true},
+    {"Corner", 4, 4, false, 1.0, 0.0, 0, 2, "", true},
+    {"AlarmLevel", 8, 4, false, 1.0, 0.0, 0, 4, "", true},
+    {"Risk", 16, 16, false, 0.0001, 0.0, 0, 10000, "", false},
+    {"Sequence", 32, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+    {"SampleAge", 40, 16, false, 1.0, 0.0, 0, kU16Max, "ms", false},
+}};
+
+// AlarmEvent (0x330)
+enum EventSignal : std::size_t { kLevel, kPreviousLevel, kCause, kLatched, kTime, kEvSequence };
+constexpr std::array<SignalLayout, 6> kEventSignals{{
+    {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true},
+    {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 9, "", true},
+    {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true},
+    {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false},
+    {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+}};
+
+// Acknowledge (0x340)
+enum AcknowledgeSignal : std::size_t { kAckLevel, kSourceId, kEventSequence };
+constexpr std::array<SignalLayout, 3> kAcknowledgeSignals{{
+    {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true},
+    {"SourceId", 8, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+    {"EventSequence", 16, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+}};
+
+// ---------------------------------------------------------------------------------------------
+// Packing with the first error kept.
+
+// |raw| below this converts to int64 exactly and safely (2^53).
+constexpr double kMaxConvertible = 9007199254740992.0;
+
+class Packer {
+ public:
+  void physical(double value, const SignalLayout& signal) {
+    if (!result_.ok()) return;
+    if (!std::isfinite(value)) {
+      fail(CodecError::kNotFinite, signal);
+      return;
+    }
+    const double scaled = (value - signal.offset) / signal.factor;
+    if (!(std::fabs(scaled) < kMaxConvertible)) {
+      fail(CodecError::kOutOfRange, signal);
+      return;
+    }
+    // Round half away from zero, independent of the floating-point environment.
+    const auto raw = static_cast<std::int64_t>(std::llround(scaled));
+    put(raw, signal, CodecError::kOutOfRange);
+  }
+
+  void integer(std::uint64_t value, const SignalLayout& signal) {
+    if (!result_.ok()) return;
+    if (value > static_cast<std::uint64_t>(signal.raw_max)) {
+      fail(CodecError::kOutOfRange, signal);
+      return;
+    }
+    put(static_cast<std::int64_t>(value), signal, CodecError::kOutOfRange);
+  }
+
+  template <typename Enum>
+  void enumeration(Enum value, const SignalLayout& signal) {
+    if (!result_.ok()) return;
+    put(static_cast<std::int64_t>(value), signal, CodecError::kInvalidEnum);
+  }
+
+  void fail(CodecError error, const char* signal) {
+    if (result_.ok()) result_ = CodecResult{error, signal};
+  }
+
+  EncodeResult finish(std::uint32_t id, CanFrame& frame) const {
+    if (!result_.ok()) return result_;
+    frame.id = id;
+    frame.length = kFrameLength;
+    store_le64(word_, frame.data);
+    return result_;
+  }
+
+ private:
+  void fail(CodecError error, const SignalLayout& signal) { fail(error, signal.name); }
+
+  void put(std::int64_t raw, const SignalLayout& signal, CodecError out_of_range) {
+    if (raw < signal.raw_min || raw > signal.raw_max) {
+      fail(out_of_range, signal);
+      return;
+    }
+    word_ = insert_bits(word_, signal.start_bit, signal.length, static_cast<std::uint64_t>(raw));
+  }
+
+  std::uint64_t word_ = 0;
+  CodecResult result_{};
+};
+
+class Unpacker {
+ public:
+  Unpacker(const CanFrame& frame, MessageKind expected, std::span<const SignalLayout> signals)
+      : word_(load_le64(frame.data)) {
+    const MessageKind kind = classify(frame.id);
+    if (kind == MessageKind::kUnknown) {
+      result_ = CodecResult{CodecError::kUnknownIdentifier, ""};
+    } else if (kind != expected) {
+      result_ = CodecResult{CodecError::kWrongMessage, ""};
+    } else if (frame.length != kFrameLength) {
+      result_ = CodecResult{CodecError::kWrongLength, ""};
+    } else {
+      std::uint64_t used = 0;
+      for (const SignalLayout& s : signals) used |= bit_mask(s.start_bit, s.length);
+      if ((word_ & ~used) != 0) result_ = CodecResult{CodecError::kReservedBitsSet, ""};
+    }
+  }
+
+  double physical(const SignalLayout& signal) {
+    return static_cast<double>(raw(signal, CodecError::kOutOfRange)) * signal.factor +
+           signal.offset;
+  }
+
+  template <typename Integer>
+  Integer integer(const SignalLayout& signal) {
+    return static_cast<Integer>(raw(signal, CodecError::kOutOfRange));
+  }
+
+  template <typename Enum>
+  Enum enumeration(const SignalLayout& signal) {
+    return static_cast<Enum>(raw(signal, CodecError::kInvalidEnum));
+  }
+
+  void fail(CodecError error, const char* signal) {
+    if (result_.ok()) result_ = CodecResult{error, signal};
+  }
+
+  [[nodiscard]] const CodecResult& result() const { return result_; }
+
+ private:
+  // The raw value, 0 (and the error recorded) when it lies outside the DBC range.
+  std::int64_t raw(const SignalLayout& signal, CodecError out_of_range) {
+    if (!result_.ok()) return 0;
+    const std::uint64_t bits = extract_bits(word_, signal.start_bit, signal.length);
+    const std::int64_t value =
+        signal.is_signed ? sign_extend(bits, signal.length) : static_cast<std::int64_t>(bits);
+    if (value < signal.raw_min || value > signal.raw_max) {
+      fail(out_of_range, signal.name);
+      return 0;
+    }
+    return value;
+  }
+
+  std::uint64_t word_;
+  CodecResult result_{};
+};
+
+constexpr bool undefined_status_flags(std::uint8_t status) {
+  return (status & static_cast<std::uint8_t>(~sensor_status::kDefinedMask)) != 0;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Identifiers and names
+
+MessageKind classify(std::uint32_t id) {
+  if (id < kFirstPlinthId || id > kLastPlinthId) return MessageKind::kUnknown;
+  const std::uint32_t group = id & 0x7F0U;
+  const std::uint32_t index = id & 0x00FU;
+  switch (group) {
+    case kSensorAccelerationBaseId:
+      return index >= kFirstSensorNode ? MessageKind::kSensorAcceleration : MessageKind::kUnknown;
+    case kSensorHeartbeatBaseId:
+      return index >= kFirstSensorNode ? MessageKind::kSensorHeartbeat : MessageKind::kUnknown;
+    case kMonitorStatusBaseId:
+      return index < kMonitorAxisCount ? MessageKind::kMonitorStatus : MessageKind::kUnknown;
+    case kAlarmEventId:
+      return index == 0 ? MessageKind::kAlarmEvent : MessageKind::kUnknown;
+    case kAcknowledgeId:
+      return index == 0 ? MessageKind::kAcknowledge : MessageKind::kUnknown;
+    default:
+      return MessageKind::kUnknown;
+  }
+}
+
+const char* message_kind_name(MessageKind kind) {
+  switch (kind) {
+    case MessageKind::kSensorAcceleration: return "SensorAcceleration";
+    case MessageKind::kSensorHeartbeat: return "SensorHeartbeat";
+    case MessageKind::kMonitorStatus: return "MonitorStatus";
+    case MessageKind::kAlarmEvent: return "AlarmEvent";
+    case MessageKind::kAcknowledge: return "Acknowledge";
+    case MessageKind::kUnknown: break;
+  }
+  return "unknown";
+}
+
+const char* phase_name(Phase phase) {
+  switch (phase) {
+    case Phase::kFullContact: return "full_contact";
+    case Phase::kSliding: return "sliding";
+    case Phase::kRocking: return "rocking";
+    case Phase::kSlideRocking: return "slide_rocking";
+    case Phase::kOverturned: return "overturned";
+    case Phase::kFell: return "fell";
+  }
+  return "invalid";
+}
+
+const char* corner_name(Corner corner) {
+  switch (corner) {
+    case Corner::kNone: return "none";
+    case Corner::kLeft: return "left";
+    case Corner::kRight: return "right";
+  }
+  return "invalid";
+}
+
+const char* alarm_level_name(AlarmLevel level) {
+  switch (level) {
+    case AlarmLevel::kNormal: return "normal";
+    case AlarmLevel::kAdvisory: return "advisory";
+    case AlarmLevel::kWarning: return "warning";
+    case AlarmLevel::kAlarm: return "alarm";
+    case AlarmLevel::kFault: return "fault";
+  }
+  return "invalid";
+}
+
+const char* alarm_cause_name(AlarmCause cause) {
+  switch (cause) {
+    case AlarmCause::kNone: return "none";
+    case AlarmCause::kRiskThreshold: return "risk_threshold";
+    case AlarmCause::kPhaseChange: return "phase_change";
+    case AlarmCause::kOverturnDetected: return "overturn_detected";
+    case AlarmCause::kSensorTimeout: return "sensor_timeout";
+    case AlarmCause::kSensorFault: return "sensor_fault";
+    case AlarmCause::kSensorDisagreement: return "sensor_disagreement";
+    case AlarmCause::kAcknowledged: return "acknowledged";
+    case AlarmCause::kBusError: return "bus_error";
+    case AlarmCause::kInternalFault: return "internal_fault";
+  }
+  return "invalid";
+}
+
+const char* codec_error_text(CodecError error) {
+  switch (error) {
+    case CodecError::kOk: return "ok";
+    case CodecError::kWrongLength: return "frame length is not 8 bytes";
+    case CodecError::kUnknownIdentifier: return "identifier is not a plinth message";
+    case CodecError::kWrongMessage: return "identifier belongs to another message";
+    case CodecError::kNotFinite: return "value is NaN or infinite";
+    case CodecError::kOutOfRange: return "value outside the signal's range";
+    case CodecError::kInvalidEnum: return "value not in the signal's value table";
+    case CodecError::kReservedBitsSet: return "reserved bits or undefined flags set";
+  }
+  return "unknown error";
+}
+
+std::span<const SignalLayout> signal_layouts(MessageKind kind) {
+  switch (kind) {
+    case MessageKind::kSensorAcceleration: return kAccelerationSignals;
+    case MessageKind::kSensorHeartbeat: return kHeartbeatSignals;
+    case MessageKind::kMonitorStatus: return kStatusSignals;
+    case MessageKind::kAlarmEvent: return kEventSignals;
+    case MessageKind::kAcknowledge: return kAcknowledgeSignals;
+    case MessageKind::kUnknown: break;
+  }
+  return {};
+}
+
+// ---------------------------------------------------------------------------------------------
+// Intel bit packing
+
+std::uint64_t load_le64(const std::array<std::uint8_t, 8>& bytes) {
+  std::uint64_t word = 0;
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    word |= static_cast<std::uint64_t>(bytes[i]) << (8U * i);
+  }
+  return word;
+}
+
+void store_le64(std::uint64_t word, std::array<std::uint8_t, 8>& bytes) {
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    bytes[i] = static_cast<std::uint8_t>(word >> (8U * i));
+  }
+}
+
+std::uint64_t bit_mask(unsigned start_bit, unsigned length) {
+  if (length == 0 || start_bit >= 64) return 0;
+  const std::uint64_t low = length >= 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << length) - 1U;
+  return low << start_bit;
+}
+
+std::uint64_t extract_bits(std::uint64_t word, unsigned start_bit, unsigned length) {
+  if (start_bit >= 64) return 0;
+  return (word & bit_mask(start_bit, length)) >> start_bit;
+}
+
+std::uint64_t insert_bits(std::uint64_t word, unsigned start_bit, unsigned length,
+                          std::uint64_t raw) {
+  if (start_bit >= 64) return word;
+  const std::uint64_t mask = bit_mask(start_bit, length);
+  return (word & ~mask) | ((raw << start_bit) & mask);
+}
+
+std::int64_t sign_extend(std::uint64_t raw, unsigned length) {
+  if (length == 0 || length >= 64) return static_cast<std::int64_t>(raw);
+  const std::uint64_t sign = std::uint64_t{1} << (length - 1U);
+  const std::uint64_t value = raw & ((std::uint64_t{1} << length) - 1U);
+  // (value ^ sign) - sign: two's complement of `length` bits, without signed overflow.
+  return static_cast<std::int64_t>((value ^ sign) - sign);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Messages
+
+EncodeResult encode(const SensorAcceleration& message, CanFrame& frame) {
+  const auto& s = kAccelerationSignals;
+  Packer packer;
+  if (message.node < kFirstSensorNode || message.node > kLastSensorNode) {
+    packer.fail(CodecError::kOutOfRange, "node");
+  }
+  packer.physical(message.ax_g, s[kAx]);
+  packer.physical(message.ay_g, s[kAy]);
+  packer.physical(message.az_g, s[kAz]);
+  packer.integer(message.sequence, s[kAccSequence]);
+  if (undefined_status_flags(message.status)) packer.fail(CodecError::kReservedBitsSet, "Status");
+  packer.integer(message.status, s[kAccStatus]);
+  return packer.finish(kSensorAccelerationBaseId + message.node, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, SensorAcceleration& message) {
+  const auto& s = kAccelerationSignals;
+  Unpacker unpacker(frame, MessageKind::kSensorAcceleration, s);
+  SensorAcceleration m;
+  m.node = static_cast<std::uint8_t>(frame.id - kSensorAccelerationBaseId);
+  m.ax_g = unpacker.physical(s[kAx]);
+  m.ay_g = unpacker.physical(s[kAy]);
+  m.az_g = unpacker.physical(s[kAz]);
+  m.sequence = unpacker.integer<std::uint8_t>(s[kAccSequence]);
+  m.status = unpacker.integer<std::uint8_t>(s[kAccStatus]);
+  if (undefined_status_flags(m.status)) unpacker.fail(CodecError::kReservedBitsSet, "Status");
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+EncodeResult encode(const SensorHeartbeat& message, CanFrame& frame) {
+  const auto& s = kHeartbeatSignals;
+  Packer packer;
+  if (message.node < kFirstSensorNode || message.node > kLastSensorNode) {
+    packer.fail(CodecError::kOutOfRange, "node");
+  }
+  packer.integer(message.uptime_s, s[kUptime]);
+  packer.integer(message.firmware_major, s[kFirmwareMajor]);
+  packer.integer(message.firmware_minor, s[kFirmwareMinor]);
+  if (undefined_status_flags(message.status)) packer.fail(CodecError::kReservedBitsSet, "Status");
+  packer.integer(message.status, s[kHbStatus]);
+  packer.integer(message.can_tx_errors, s[kCanTxErrors]);
+  packer.integer(message.can_rx_errors, s[kCanRxErrors]);
+  return packer.finish(kSensorHeartbeatBaseId + message.node, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, SensorHeartbeat& message) {
+  const auto& s = kHeartbeatSignals;
+  Unpacker unpacker(frame, MessageKind::kSensorHeartbeat, s);
+  SensorHeartbeat m;
+  m.node = static_cast<std::uint8_t>(frame.id - kSensorHeartbeatBaseId);
+  m.uptime_s = unpacker.integer<std::uint32_t>(s[kUptime]);
+  m.firmware_major = unpacker.integer<std::uint8_t>(s[kFirmwareMajor]);
+  m.firmware_minor = unpacker.integer<std::uint8_t>(s[kFirmwareMinor]);
+  m.status = unpacker.integer<std::uint8_t>(s[kHbStatus]);
+  if (undefined_status_flags(m.status)) unpacker.fail(CodecError::kReservedBitsSet, "Status");
+  m.can_tx_errors = unpacker.integer<std::uint8_t>(s[kCanTxErrors]);
+  m.can_rx_errors = unpacker.integer<std::uint8_t>(s[kCanRxErrors]);
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+EncodeResult encode(const MonitorStatus& message, CanFrame& frame) {
+  const auto& s = kStatusSignals;
+  Packer packer;
+  if (message.axis >= kMonitorAxisCount) packer.fail(CodecError::kOutOfRange, "axis");
+  packer.enumeration(message.phase, s[kPhase]);
+  packer.enumeration(message.corner, s[kCorner]);
+  packer.enumeration(message.alarm_level, s[kAlarmLevel]);
+  packer.physical(message.risk, s[kRisk]);
+  packer.integer(message.sequence, s[kStSequence]);
+  packer.integer(message.sample_age_ms, s[kSampleAge]);
+  return packer.finish(kMonitorStatusBaseId + message.axis, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, MonitorStatus& message) {
+  const auto& s = kStatusSignals;
+  Unpacker unpacker(frame, MessageKind::kMonitorStatus, s);
+  MonitorStatus m;
+  m.axis = static_cast<std::uint8_t>(frame.id - kMonitorStatusBaseId);
+  m.phase = unpacker.enumeration<Phase>(s[kPhase]);
+  m.corner = unpacker.enumeration<Corner>(s[kCorner]);
+  m.alarm_level = unpacker.enumeration<AlarmLevel>(s[kAlarmLevel]);
+  m.risk = unpacker.physical(s[kRisk]);
+  m.sequence = unpacker.integer<std::uint8_t>(s[kStSequence]);
+  m.sample_age_ms = unpacker.integer<std::uint16_t>(s[kSampleAge]);
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+EncodeResult encode(const AlarmEvent& message, CanFrame& frame) {
+  const auto& s = kEventSignals;
+  Packer packer;
+  packer.enumeration(message.level, s[kLevel]);
+  packer.enumeration(message.previous_level, s[kPreviousLevel]);
+  packer.enumeration(message.cause, s[kCause]);
+  packer.integer(message.latched ? 1U : 0U, s[kLatched]);
+  packer.integer(message.time_since_start_ms, s[kTime]);
+  packer.integer(message.sequence, s[kEvSequence]);
+  return packer.finish(kAlarmEventId, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, AlarmEvent& message) {
+  const auto& s = kEventSignals;
+  Unpacker unpacker(frame, MessageKind::kAlarmEvent, s);
+  AlarmEvent m;
+  m.level = unpacker.enumeration<AlarmLevel>(s[kLevel]);
+  m.previous_level = unpacker.enumeration<AlarmLevel>(s[kPreviousLevel]);
+  m.cause = unpacker.enumeration<AlarmCause>(s[kCause]);
+  m.latched = unpacker.integer<std::uint8_t>(s[kLatched]) != 0;
+  m.time_since_start_ms = unpacker.integer<std::uint32_t>(s[kTime]);
+  m.sequence = unpacker.integer<std::uint8_t>(s[kEvSequence]);
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+EncodeResult encode(const Acknowledge& message, CanFrame& frame) {
+  const auto& s = kAcknowledgeSignals;
+  Packer packer;
+  packer.enumeration(message.level, s[kAckLevel]);
+  packer.integer(message.source_id, s[kSourceId]);
+  packer.integer(message.event_sequence, s[kEventSequence]);
+  return packer.finish(kAcknowledgeId, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, Acknowledge& message) {
+  const auto& s = kAcknowledgeSignals;
+  Unpacker unpacker(frame, MessageKind::kAcknowledge, s);
+  Acknowledge m;
+  m.level = unpacker.enumeration<AlarmLevel>(s[kAckLevel]);
+  m.source_id = unpacker.integer<std::uint8_t>(s[kSourceId]);
+  m.event_sequence = unpacker.integer<std::uint8_t>(s[kEventSequence]);
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+}  // namespace plinth::can

@@ -1,0 +1,960 @@
+// The plinth CAN codec against hand-written golden frames, over the whole range of every signal,
+// on every rejection, and against hal/can_codec/plinth.dbc itself.
+#include "plinth/hal/can_codec.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <random>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace plinth::can {
+namespace {
+
+using Bytes = std::array<std::uint8_t, 8>;
+
+CanFrame make_frame(std::uint32_t id, const Bytes& data, std::uint8_t length = 8) {
+  CanFrame f;
+  f.id = id;
+  f.length = length;
+  f.data = data;
+  return f;
+}
+
+void expect_frame(const CanFrame& f, std::uint32_t id, const Bytes& data) {
+  EXPECT_EQ(f.id, id);
+  EXPECT_EQ(f.length, 8);
+  for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(f.data[i], data[i]) << "byte " << i;
+}
+
+std::uint64_t raw_at(const CanFrame& f, unsigned start, unsigned length) {
+  return extract_bits(load_le64(f.data), start, length);
+}
+
+constexpr double kG = 0.00025;  // SensorAcceleration factor, g/bit
+constexpr double kRiskStep = 0.0001;
+
+// ---------------------------------------------------------------------------------------------
+// Bit packing helpers
+
+TEST(CanBitPacking, LittleEndianWordAndSignals) {
+  const Bytes bytes{0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF};
+  EXPECT_EQ(load_le64(bytes), 0xEFCDAB8967452301ULL);
+  Bytes back{};
+  store_le64(0xEFCDAB8967452301ULL, back);
+  EXPECT_EQ(back, bytes);
+  EXPECT_EQ(bit_mask(4, 4), 0xF0ULL);
+  EXPECT_EQ(bit_mask(0, 64), ~0ULL);
+  EXPECT_EQ(bit_mask(0, 0), 0ULL);
+  EXPECT_EQ(extract_bits(0xEFCDAB8967452301ULL, 12, 8), 0x52ULL);
+  EXPECT_EQ(insert_bits(0, 12, 8, 0x1FF), 0xFF000ULL);  // excess raw bits dropped
+  EXPECT_EQ(insert_bits(~0ULL, 8, 8, 0), 0xFFFFFFFFFFFF00FFULL);
+  EXPECT_EQ(sign_extend(0x8000, 16), -32768);
+  EXPECT_EQ(sign_extend(0x7FFF, 16), 32767);
+  EXPECT_EQ(sign_extend(0xFFFF, 16), -1);
+  EXPECT_EQ(sign_extend(0x1, 1), -1);
+  EXPECT_EQ(sign_extend(0xF0, 4), 0);  // bits above the length ignored
+}
+
+// ---------------------------------------------------------------------------------------------
+// Golden frames, derived by hand from plinth.dbc (Intel: the 8 bytes are one little-endian
+// 64-bit word; a signal at start bit S of length L is bits S..S+L-1; raw = phys / factor).
+
+TEST(CanGolden, SensorAcceleration) {
+  // Node 3: identifier 0x300 + 3 = 0x303.
+  // Ax  0|16@1- (0.00025,0):  1.0 g   -> raw  4000 = 0x0FA0 -> bytes 0-1: A0 0F
+  // Ay 16|16@1- (0.00025,0): -0.5 g   -> raw -2000 = 0xF830 -> bytes 2-3: 30 F8
+  // Az 32|16@1- (0.00025,0): -8.192 g -> raw -32768 = 0x8000 -> bytes 4-5: 00 80
+  // Sequence 48|8: 0x5A -> byte 6; Status 56|8: saturated|over_temperature = 0x05 -> byte 7
+  const Bytes golden{0xA0, 0x0F, 0x30, 0xF8, 0x00, 0x80, 0x5A, 0x05};
+  SensorAcceleration m;
+  m.node = 3;
+  m.ax_g = 1.0;
+  m.ay_g = -0.5;
+  m.az_g = -8.192;
+  m.sequence = 0x5A;
+  m.status = sensor_status::kSaturated | sensor_status::kOverTemperature;
+  CanFrame f;
+  ASSERT_TRUE(encode(m, f).ok());
+  expect_frame(f, 0x303, golden);
+
+  SensorAcceleration d;
+  ASSERT_TRUE(decode(make_frame(0x303, golden), d).ok());
+  EXPECT_EQ(d.node, 3);
+  EXPECT_DOUBLE_EQ(d.ax_g, 1.0);
+  EXPECT_DOUBLE_EQ(d.ay_g, -0.5);
+  EXPECT_DOUBLE_EQ(d.az_g, -8.192);
+  EXPECT_EQ(d.sequence, 0x5A);
+  EXPECT_EQ(d.status, 0x05);
+}
+
+TEST(CanGolden, SensorHeartbeat) {
+  // Node 15: identifier 0x310 + 15 = 0x31F.
+  // Uptime 0|32 (1,0): 0x12345678 s -> bytes 0-3: 78 56 34 12
+  // FirmwareMajor 32|4 = 2 (low nibble of byte 4), FirmwareMinor 36|4 = 7 (high) -> byte 4: 72
+  // Status 40|8: self_test_failed = 0x02 -> byte 5
+  // CanTxErrors 48|8 = 128 -> byte 6: 80; CanRxErrors 56|8 = 127 -> byte 7: 7F
+  const Bytes golden{0x78, 0x56, 0x34, 0x12, 0x72, 0x02, 0x80, 0x7F};
+  SensorHeartbeat m;
+  m.node = 15;
+  m.uptime_s = 0x12345678;
+  m.firmware_major = 2;
+  m.firmware_minor = 7;
+  m.status = sensor_status::kSelfTestFailed;
+  m.can_tx_errors = 128;
+  m.can_rx_errors = 127;
+  CanFrame f;
+  ASSERT_TRUE(encode(m, f).ok());
+  expect_frame(f, 0x31F, golden);
+
+  SensorHeartbeat d;
+  ASSERT_TRUE(decode(make_frame(0x31F, golden), d).ok());
+  EXPECT_EQ(d.node, 15);
+  EXPECT_EQ(d.uptime_s, 0x12345678U);
+  EXPECT_EQ(d.firmware_major, 2);
+  EXPECT_EQ(d.firmware_minor, 7);
+  EXPECT_EQ(d.status, sensor_status::kSelfTestFailed);
+  EXPECT_EQ(d.can_tx_errors, 128);
+  EXPECT_EQ(d.can_rx_errors, 127);
+}
+
+TEST(CanGolden, MonitorStatus) {
+  // Axis 1: identifier 0x320 + 1 = 0x321.
+  // Phase 0|4 = slide_rocking (3), Corner 4|4 = right (2) -> byte 0: 23
+  // AlarmLevel 8|4 = warning (2), bits 12-15 reserved 0 -> byte 1: 02
+  // Risk 16|16 (0.0001,0): 0.75 -> raw 7500 = 0x1D4C -> bytes 2-3: 4C 1D
+  // Sequence 32|8 = 200 -> byte 4: C8
+  // SampleAge 40|16 (1,0) ms: 1234 = 0x04D2 -> bytes 5-6: D2 04; byte 7 reserved: 00
+  const Bytes golden{0x23, 0x02, 0x4C, 0x1D, 0xC8, 0xD2, 0x04, 0x00};
+  MonitorStatus m;
+  m.axis = 1;
+  m.phase = Phase::kSlideRocking;
+  m.corner = Corner::kRight;
+  m.alarm_level = AlarmLevel::kWarning;
+  m.risk = 0.75;
+  m.sequence = 200;
+  m.sample_age_ms = 1234;
+  CanFrame f;
+  ASSERT_TRUE(encode(m, f).ok());
+  expect_frame(f, 0x321, golden);
+
+  MonitorStatus d;
+  ASSERT_TRUE(decode(make_frame(0x321, golden), d).ok());
+  EXPECT_EQ(d.axis, 1);
+  EXPECT_EQ(d.phase, Phase::kSlideRocking);
+  EXPECT_EQ(d.corner, Corner::kRight);
+  EXPECT_EQ(d.alarm_level, AlarmLevel::kWarning);
+  EXPECT_DOUBLE_EQ(d.risk, 0.75);
+  EXPECT_EQ(d.sequence, 200);
+  EXPECT_EQ(d.sample_age_ms, 1234);
+}
+
+TEST(CanGolden, AlarmEvent) {
+  // Identifier 0x330.
+  // Level 0|4 = alarm (3), PreviousLevel 4|4 = advisory (1) -> byte 0: 13
+  // Cause 8|8 = overturn_detected (3) -> byte 1: 03
+  // Latched 16|1 = 1, bits 17-23 reserved 0 -> byte 2: 01
+  // TimeSinceStart 24|32 (1,0) ms: 0xDEADBEEF -> bytes 3-6: EF BE AD DE
+  // Sequence 56|8 = 0x42 -> byte 7
+  const Bytes golden{0x13, 0x03, 0x01, 0xEF, 0xBE, 0xAD, 0xDE, 0x42};
+  AlarmEvent m;
+  m.level = AlarmLevel::kAlarm;
+  m.previous_level = AlarmLevel::kAdvisory;
+  m.cause = AlarmCause::kOverturnDetected;
+  m.latched = true;
+  m.time_since_start_ms = 0xDEADBEEF;
+  m.sequence = 0x42;
+  CanFrame f;
+  ASSERT_TRUE(encode(m, f).ok());
+  expect_frame(f, 0x330, golden);
+
+  AlarmEvent d;
+  ASSERT_TRUE(decode(make_frame(0x330, golden), d).ok());
+  EXPECT_EQ(d.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(d.previous_level, AlarmLevel::kAdvisory);
+  EXPECT_EQ(d.cause, AlarmCause::kOverturnDetected);
+  EXPECT_TRUE(d.latched);
+  EXPECT_EQ(d.time_since_start_ms, 0xDEADBEEFU);
+  EXPECT_EQ(d.sequence, 0x42);
+}
+
+TEST(CanGolden, Acknowledge) {
+  // Identifier 0x340.
+  // Level 0|4 = alarm (3), bits 4-7 reserved -> byte 0: 03
+  // SourceId 8|8 = 0x21 -> byte 1; EventSequence 16|8 = 0x42 -> byte 2; bytes 3-7 reserved: 00
+  const Bytes golden{0x03, 0x21, 0x42, 0x00, 0x00, 0x00, 0x00, 0x00};
+  Acknowledge m;
+  m.level = AlarmLevel::kAlarm;
+  m.source_id = 0x21;
+  m.event_sequence = 0x42;
+  CanFrame f;
+  ASSERT_TRUE(encode(m, f).ok());
+  expect_frame(f, 0x340, golden);
+
+  Acknowledge d;
+  ASSERT_TRUE(decode(make_frame(0x340, golden), d).ok());
+  EXPECT_EQ(d.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(d.source_id, 0x21);
+  EXPECT_EQ(d.event_sequence, 0x42);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Round trips over every signal's range
+
+TEST(CanRoundTrip, SensorAccelerationEveryRawValueOfEveryAxis) {
+  for (std::uint8_t node = kFirstSensorNode; node <= kLastSensorNode; ++node) {
+    SensorAcceleration m;
+    m.node = node;
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok());
+    EXPECT_EQ(f.id, 0x300U + node);
+    EXPECT_EQ(classify(f.id), MessageKind::kSensorAcceleration);
+    SensorAcceleration d;
+    ASSERT_TRUE(decode(f, d).ok());
+    EXPECT_EQ(d.node, node);
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    for (std::int32_t raw = -32768; raw <= 32767; ++raw) {
+      SensorAcceleration m;
+      const double g = raw * kG;
+      (axis == 0 ? m.ax_g : axis == 1 ? m.ay_g : m.az_g) = g;
+      CanFrame f;
+      ASSERT_TRUE(encode(m, f).ok()) << raw;
+      const auto start = static_cast<unsigned>(16 * axis);
+      ASSERT_EQ(sign_extend(raw_at(f, start, 16), 16), raw);
+      SensorAcceleration d;
+      ASSERT_TRUE(decode(f, d).ok()) << raw;
+      ASSERT_EQ(axis == 0 ? d.ax_g : axis == 1 ? d.ay_g : d.az_g, g) << raw;
+    }
+  }
+}
+
+TEST(CanRoundTrip, SensorAccelerationEverySequenceAndStatus) {
+  for (unsigned v = 0; v <= 255; ++v) {
+    SensorAcceleration m;
+    m.sequence = static_cast<std::uint8_t>(v);
+    m.status = static_cast<std::uint8_t>(v & sensor_status::kDefinedMask);
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok());
+    EXPECT_EQ(f.data[6], v);
+    SensorAcceleration d;
+    ASSERT_TRUE(decode(f, d).ok());
+    EXPECT_EQ(d.sequence, m.sequence);
+    EXPECT_EQ(d.status, m.status);
+  }
+}
+
+TEST(CanRoundTrip, SensorAccelerationRandomValuesWithinHalfAStep) {
+  std::mt19937_64 rng(20240611);
+  std::uniform_real_distribution<double> g(-8.192, 8.19175);
+  for (int i = 0; i < 100000; ++i) {
+    SensorAcceleration m;
+    m.ax_g = g(rng);
+    m.ay_g = g(rng);
+    m.az_g = g(rng);
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok()) << m.ax_g << " " << m.ay_g << " " << m.az_g;
+    SensorAcceleration d;
+    ASSERT_TRUE(decode(f, d).ok());
+    EXPECT_LE(std::fabs(d.ax_g - m.ax_g), 0.5 * kG + 1e-12);
+    EXPECT_LE(std::fabs(d.ay_g - m.ay_g), 0.5 * kG + 1e-12);
+    EXPECT_LE(std::fabs(d.az_g - m.az_g), 0.5 * kG + 1e-12);
+  }
+}
+
+TEST(CanRoundTrip, SensorHeartbeatEverySmallFieldAndUptimeSweep) {
+  for (std::uint8_t node = kFirstSensorNode; node <= kLastSensorNode; ++node) {
+    SensorHeartbeat m;
+    m.node = node;
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok());
+    EXPECT_EQ(f.id, 0x310U + node);
+    SensorHeartbeat d;
+    ASSERT_TRUE(decode(f, d).ok());
+    EXPECT_EQ(d.node, node);
+  }
+  for (unsigned v = 0; v <= 255; ++v) {
+    SensorHeartbeat m;
+    m.firmware_major = static_cast<std::uint8_t>(v & 0x0F);
+    m.firmware_minor = static_cast<std::uint8_t>(v >> 4);
+    m.status = static_cast<std::uint8_t>(v & sensor_status::kDefinedMask);
+    m.can_tx_errors = static_cast<std::uint8_t>(v);
+    m.can_rx_errors = static_cast<std::uint8_t>(255 - v);
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok());
+    EXPECT_EQ(f.data[4], v);  // major in the low nibble, minor in the high one
+    SensorHeartbeat d;
+    ASSERT_TRUE(decode(f, d).ok());
+    EXPECT_EQ(d.firmware_major, m.firmware_major);
+    EXPECT_EQ(d.firmware_minor, m.firmware_minor);
+    EXPECT_EQ(d.status, m.status);
+    EXPECT_EQ(d.can_tx_errors, m.can_tx_errors);
+    EXPECT_EQ(d.can_rx_errors, m.can_rx_errors);
+  }
+  // Uptime: 2^20 values spread over the 32-bit range, plus both ends.
+  std::vector<std::uint32_t> uptimes{0, 1, 0xFFFFFFFEU, 0xFFFFFFFFU};
+  for (std::uint32_t k = 0; k < (1U << 20); ++k) uptimes.push_back(k * 4093U + (k >> 7));
+  for (const std::uint32_t u : uptimes) {
+    SensorHeartbeat m;
+    m.uptime_s = u;
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok());
+    ASSERT_EQ(raw_at(f, 0, 32), u);
+    SensorHeartbeat d;
+    ASSERT_TRUE(decode(f, d).ok());
+    ASSERT_EQ(d.uptime_s, u);
+  }
+}
+
+TEST(CanRoundTrip, MonitorStatusEveryEnumCombinationAndAxis) {
+  for (std::uint8_t axis = 0; axis < kMonitorAxisCount; ++axis) {
+    for (unsigned p = 0; p <= 5; ++p) {
+      for (unsigned c = 0; c <= 2; ++c) {
+        for (unsigned a = 0; a <= 4; ++a) {
+          MonitorStatus m;
+          m.axis = axis;
+          m.phase = static_cast<Phase>(p);
+          m.corner = static_cast<Corner>(c);
+          m.alarm_level = static_cast<AlarmLevel>(a);
+          CanFrame f;
+          ASSERT_TRUE(encode(m, f).ok());
+          EXPECT_EQ(f.id, 0x320U + axis);
+          MonitorStatus d;
+          ASSERT_TRUE(decode(f, d).ok());
+          EXPECT_EQ(d.axis, axis);
+          EXPECT_EQ(d.phase, m.phase);
+          EXPECT_EQ(d.corner, m.corner);
+          EXPECT_EQ(d.alarm_level, m.alarm_level);
+        }
+      }
+    }
+  }
+}
+
+TEST(CanRoundTrip, MonitorStatusEveryRiskSequenceAndAge) {
+  for (std::uint32_t raw = 0; raw <= 10000; ++raw) {
+    MonitorStatus m;
+    m.risk = raw * kRiskStep;
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok()) << raw;
+    ASSERT_EQ(raw_at(f, 16, 16), raw);
+    MonitorStatus d;
+    ASSERT_TRUE(decode(f, d).ok());
+    ASSERT_EQ(d.risk, m.risk);
+    ASSERT_LE(d.risk, 1.0);
+  }
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> risk(0.0, 1.0);
+  for (int i = 0; i < 100000; ++i) {
+    MonitorStatus m;
+    m.risk = risk(rng);
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok()) << m.risk;
+    MonitorStatus d;
+    ASSERT_TRUE(decode(f, d).ok());
+    ASSERT_LE(std::fabs(d.risk - m.risk), 0.5 * kRiskStep + 1e-12);
+  }
+  for (std::uint32_t age = 0; age <= 65535; ++age) {
+    MonitorStatus m;
+    m.sample_age_ms = static_cast<std::uint16_t>(age);
+    m.sequence = static_cast<std::uint8_t>(age & 0xFF);
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok());
+    MonitorStatus d;
+    ASSERT_TRUE(decode(f, d).ok());
+    ASSERT_EQ(d.sample_age_ms, age);
+    ASSERT_EQ(d.sequence, age & 0xFF);
+  }
+}
+
+TEST(CanRoundTrip, AlarmEventEveryEnumCombinationAndTimeSweep) {
+  for (unsigned l = 0; l <= 4; ++l) {
+    for (unsigned p = 0; p <= 4; ++p) {
+      for (unsigned c = 0; c <= 9; ++c) {
+        for (const bool latched : {false, true}) {
+          AlarmEvent m;
+          m.level = static_cast<AlarmLevel>(l);
+          m.previous_level = static_cast<AlarmLevel>(p);
+          m.cause = static_cast<AlarmCause>(c);
+          m.latched = latched;
+          CanFrame f;
+          ASSERT_TRUE(encode(m, f).ok());
+          AlarmEvent d;
+          ASSERT_TRUE(decode(f, d).ok());
+          EXPECT_EQ(d.level, m.level);
+          EXPECT_EQ(d.previous_level, m.previous_level);
+          EXPECT_EQ(d.cause, m.cause);
+          EXPECT_EQ(d.latched, latched);
+        }
+      }
+    }
+  }
+  std::vector<std::uint32_t> times{0, 1, 0xFFFFFFFEU, 0xFFFFFFFFU};
+  for (std::uint32_t k = 0; k < (1U << 20); ++k) times.push_back(k * 4099U + (k >> 5));
+  std::uint32_t n = 0;
+  for (const std::uint32_t t : times) {
+    AlarmEvent m;
+    m.time_since_start_ms = t;
+    m.sequence = static_cast<std::uint8_t>(n++);
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok());
+    ASSERT_EQ(raw_at(f, 24, 32), t);
+    AlarmEvent d;
+    ASSERT_TRUE(decode(f, d).ok());
+    ASSERT_EQ(d.time_since_start_ms, t);
+    ASSERT_EQ(d.sequence, m.sequence);
+  }
+}
+
+TEST(CanRoundTrip, AcknowledgeEveryValue) {
+  for (unsigned l = 0; l <= 4; ++l) {
+    for (unsigned v = 0; v <= 255; ++v) {
+      Acknowledge m;
+      m.level = static_cast<AlarmLevel>(l);
+      m.source_id = static_cast<std::uint8_t>(v);
+      m.event_sequence = static_cast<std::uint8_t>(255 - v);
+      CanFrame f;
+      ASSERT_TRUE(encode(m, f).ok());
+      Acknowledge d;
+      ASSERT_TRUE(decode(f, d).ok());
+      EXPECT_EQ(d.level, m.level);
+      EXPECT_EQ(d.source_id, m.source_id);
+      EXPECT_EQ(d.event_sequence, m.event_sequence);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Rejections
+
+// A valid frame of every message kind.
+std::vector<CanFrame> valid_frames() {
+  std::vector<CanFrame> frames(5);
+  SensorAcceleration a;
+  a.ax_g = 0.1;
+  EXPECT_TRUE(encode(a, frames[0]).ok());
+  SensorHeartbeat h;
+  h.uptime_s = 5;
+  EXPECT_TRUE(encode(h, frames[1]).ok());
+  MonitorStatus s;
+  s.risk = 0.5;
+  EXPECT_TRUE(encode(s, frames[2]).ok());
+  AlarmEvent e;
+  e.level = AlarmLevel::kAlarm;
+  EXPECT_TRUE(encode(e, frames[3]).ok());
+  Acknowledge k;
+  k.level = AlarmLevel::kAlarm;
+  EXPECT_TRUE(encode(k, frames[4]).ok());
+  return frames;
+}
+
+// Decodes `f` as every message type; the result of the one `f.id` classifies as, or of all.
+struct AllDecodes {
+  DecodeResult acceleration, heartbeat, status, event, acknowledge;
+};
+AllDecodes decode_all(const CanFrame& f) {
+  SensorAcceleration a;
+  SensorHeartbeat h;
+  MonitorStatus s;
+  AlarmEvent e;
+  Acknowledge k;
+  return {decode(f, a), decode(f, h), decode(f, s), decode(f, e), decode(f, k)};
+}
+DecodeResult decode_as_own_kind(const CanFrame& f) {
+  const AllDecodes all = decode_all(f);
+  switch (classify(f.id)) {
+    case MessageKind::kSensorAcceleration: return all.acceleration;
+    case MessageKind::kSensorHeartbeat: return all.heartbeat;
+    case MessageKind::kMonitorStatus: return all.status;
+    case MessageKind::kAlarmEvent: return all.event;
+    case MessageKind::kAcknowledge: return all.acknowledge;
+    case MessageKind::kUnknown: break;
+  }
+  ADD_FAILURE() << "unknown identifier " << f.id;
+  return {};
+}
+
+TEST(CanReject, EveryLengthButEight) {
+  for (CanFrame f : valid_frames()) {
+    for (unsigned length = 0; length <= 255; ++length) {
+      f.length = static_cast<std::uint8_t>(length);
+      const DecodeResult r = decode_as_own_kind(f);
+      if (length == 8) {
+        EXPECT_TRUE(r.ok());
+      } else {
+        EXPECT_EQ(r.error, CodecError::kWrongLength) << "id " << f.id << " length " << length;
+      }
+    }
+  }
+}
+
+TEST(CanReject, UnknownIdentifiers) {
+  std::set<std::uint32_t> known;
+  for (std::uint32_t n = 1; n <= 15; ++n) known.insert({0x300 + n, 0x310 + n});
+  known.insert({0x320, 0x321, 0x330, 0x340});
+  std::vector<std::uint32_t> ids;
+  for (std::uint32_t id = 0; id <= 0x7FF; ++id) ids.push_back(id);
+  // Identifiers with flag bits (SocketCAN's extended / RTR flags) or beyond 11 bits.
+  ids.insert(ids.end(), {0x800, 0x1303, 0x80000303U, 0x40000330U, 0xFFFFFFFFU});
+  const Bytes zero{};
+  for (const std::uint32_t id : ids) {
+    if (known.count(id) != 0) {
+      EXPECT_NE(classify(id), MessageKind::kUnknown) << id;
+      continue;
+    }
+    EXPECT_EQ(classify(id), MessageKind::kUnknown) << id;
+    const AllDecodes all = decode_all(make_frame(id, zero));
+    EXPECT_EQ(all.acceleration.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.heartbeat.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.status.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.event.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.acknowledge.error, CodecError::kUnknownIdentifier) << id;
+  }
+  EXPECT_EQ(known.size(), 34U);
+}
+
+TEST(CanReject, AnotherMessagesIdentifier) {
+  for (const CanFrame& f : valid_frames()) {
+    const AllDecodes all = decode_all(f);
+    const MessageKind kind = classify(f.id);
+    EXPECT_EQ(all.acceleration.error == CodecError::kWrongMessage,
+              kind != MessageKind::kSensorAcceleration);
+    EXPECT_EQ(all.heartbeat.error == CodecError::kWrongMessage,
+              kind != MessageKind::kSensorHeartbeat);
+    EXPECT_EQ(all.status.error == CodecError::kWrongMessage, kind != MessageKind::kMonitorStatus);
+    EXPECT_EQ(all.event.error == CodecError::kWrongMessage, kind != MessageKind::kAlarmEvent);
+    EXPECT_EQ(all.acknowledge.error == CodecError::kWrongMessage,
+              kind != MessageKind::kAcknowledge);
+  }
+}
+
+TEST(CanReject, EveryReservedBit) {
+  for (const CanFrame& valid : valid_frames()) {
+    std::uint64_t used = 0;
+    for (const SignalLayout& s : signal_layouts(classify(valid.id))) {
+      used |= bit_mask(s.start_bit, s.length);
+    }
+    for (unsigned bit = 0; bit < 64; ++bit) {
+      if ((used >> bit) & 1U) continue;
+      CanFrame f = valid;
+      store_le64(load_le64(f.data) | (std::uint64_t{1} << bit), f.data);
+      const DecodeResult r = decode_as_own_kind(f);
+      EXPECT_EQ(r.error, CodecError::kReservedBitsSet) << "id " << f.id << " bit " << bit;
+    }
+  }
+}
+
+TEST(CanReject, UndefinedSensorStatusFlags) {
+  for (unsigned flag = 4; flag < 8; ++flag) {
+    const auto status = static_cast<std::uint8_t>(1U << flag);
+    SensorAcceleration a;
+    a.status = status;
+    SensorHeartbeat h;
+    h.status = status;
+    CanFrame f;
+    const EncodeResult ea = encode(a, f);
+    EXPECT_EQ(ea.error, CodecError::kReservedBitsSet);
+    EXPECT_STREQ(ea.signal, "Status");
+    EXPECT_EQ(encode(h, f).error, CodecError::kReservedBitsSet);
+
+    SensorAcceleration da;
+    Bytes bytes{};
+    bytes[7] = status;  // Status 56|8
+    const DecodeResult ra = decode(make_frame(0x301, bytes), da);
+    EXPECT_EQ(ra.error, CodecError::kReservedBitsSet);
+    EXPECT_STREQ(ra.signal, "Status");
+    SensorHeartbeat dh;
+    bytes = Bytes{};
+    bytes[5] = status;  // Status 40|8
+    EXPECT_EQ(decode(make_frame(0x311, bytes), dh).error, CodecError::kReservedBitsSet);
+  }
+}
+
+TEST(CanReject, EnumValuesMissingFromTheValueTables) {
+  // Decode: every raw value above the VAL_ table.
+  for (unsigned v = 6; v <= 15; ++v) {
+    MonitorStatus d;
+    const DecodeResult r = decode(make_frame(0x320, Bytes{static_cast<std::uint8_t>(v)}), d);
+    EXPECT_EQ(r.error, CodecError::kInvalidEnum);
+    EXPECT_STREQ(r.signal, "Phase");
+  }
+  for (unsigned v = 3; v <= 15; ++v) {
+    MonitorStatus d;
+    const DecodeResult r = decode(make_frame(0x320, Bytes{static_cast<std::uint8_t>(v << 4)}), d);
+    EXPECT_EQ(r.error, CodecError::kInvalidEnum);
+    EXPECT_STREQ(r.signal, "Corner");
+  }
+  for (unsigned v = 5; v <= 15; ++v) {
+    const auto raw = static_cast<std::uint8_t>(v);
+    MonitorStatus ds;
+    const DecodeResult rs = decode(make_frame(0x321, Bytes{0, raw}), ds);
+    EXPECT_EQ(rs.error, CodecError::kInvalidEnum);
+    EXPECT_STREQ(rs.signal, "AlarmLevel");
+    AlarmEvent de;
+    EXPECT_STREQ(decode(make_frame(0x330, Bytes{raw}), de).signal, "Level");
+    EXPECT_STREQ(decode(make_frame(0x330, Bytes{static_cast<std::uint8_t>(raw << 4)}), de).signal,
+                 "PreviousLevel");
+    Acknowledge dk;
+    const DecodeResult rk = decode(make_frame(0x340, Bytes{raw}), dk);
+    EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
+    EXPECT_STREQ(rk.signal, "Level");
+  }
+  for (unsigned v = 10; v <= 255; ++v) {
+    AlarmEvent d;
+    const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
+    EXPECT_EQ(r.error, CodecError::kInvalidEnum);
+    EXPECT_STREQ(r.signal, "Cause");
+  }
+  // Encode: values no enumerator names.
+  CanFrame f;
+  MonitorStatus s;
+  s.phase = static_cast<Phase>(6);
+  EXPECT_EQ(encode(s, f).error, CodecError::kInvalidEnum);
+  s = MonitorStatus{};
+  s.corner = static_cast<Corner>(3);
+  EXPECT_STREQ(encode(s, f).signal, "Corner");
+  s = MonitorStatus{};
+  s.alarm_level = static_cast<AlarmLevel>(5);
+  EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
+  AlarmEvent e;
+  e.cause = static_cast<AlarmCause>(10);
+  EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
+  e = AlarmEvent{};
+  e.previous_level = static_cast<AlarmLevel>(255);
+  EXPECT_STREQ(encode(e, f).signal, "PreviousLevel");
+  Acknowledge k;
+  k.level = static_cast<AlarmLevel>(7);
+  EXPECT_EQ(encode(k, f).error, CodecError::kInvalidEnum);
+}
+
+TEST(CanReject, RiskAboveOne) {
+  for (std::uint32_t raw = 10001; raw <= 65535; ++raw) {
+    Bytes bytes{};
+    bytes[2] = static_cast<std::uint8_t>(raw & 0xFF);
+    bytes[3] = static_cast<std::uint8_t>(raw >> 8);
+    MonitorStatus d;
+    const DecodeResult r = decode(make_frame(0x320, bytes), d);
+    ASSERT_EQ(r.error, CodecError::kOutOfRange) << raw;
+    ASSERT_STREQ(r.signal, "Risk");
+  }
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  for (const double risk : {1.0001, 1.5, 2.0, -0.0001, -1.0, 1e300, -1e300}) {
+    MonitorStatus m;
+    m.risk = risk;
+    CanFrame f;
+    const EncodeResult r = encode(m, f);
+    EXPECT_EQ(r.error, CodecError::kOutOfRange) << risk;
+    EXPECT_STREQ(r.signal, "Risk");
+  }
+  for (const double risk : {nan, inf, -inf}) {
+    MonitorStatus m;
+    m.risk = risk;
+    CanFrame f;
+    EXPECT_EQ(encode(m, f).error, CodecError::kNotFinite);
+  }
+  // Values that round into the range are represented, not refused.
+  for (const double risk : {1.0, 1.00004, 0.0, -0.00004, -0.0}) {
+    MonitorStatus m;
+    m.risk = risk;
+    CanFrame f;
+    EXPECT_TRUE(encode(m, f).ok()) << risk;
+  }
+}
+
+TEST(CanReject, AccelerationNotFiniteOrOutOfRange) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const char* names[3] = {"Ax", "Ay", "Az"};
+  for (int axis = 0; axis < 3; ++axis) {
+    auto with = [axis](double g) {
+      SensorAcceleration m;
+      (axis == 0 ? m.ax_g : axis == 1 ? m.ay_g : m.az_g) = g;
+      return m;
+    };
+    CanFrame f;
+    for (const double g : {nan, -nan, inf, -inf}) {
+      const EncodeResult r = encode(with(g), f);
+      EXPECT_EQ(r.error, CodecError::kNotFinite);
+      EXPECT_STREQ(r.signal, names[axis]);
+    }
+    // 8.1919 g is raw 32767.6, rounding to 32768; -8.1922 g is raw -32768.8, rounding to -32769.
+    for (const double g : {8.1919, 8.2, 9.0, -8.1922, -8.2, 1e300, -1e300, 1e20}) {
+      const EncodeResult r = encode(with(g), f);
+      EXPECT_EQ(r.error, CodecError::kOutOfRange) << g;
+      EXPECT_STREQ(r.signal, names[axis]);
+    }
+    for (const double g : {8.19175, 8.19187, -8.192, -8.19212}) {
+      EXPECT_TRUE(encode(with(g), f).ok()) << g;
+    }
+  }
+}
+
+TEST(CanReject, NodeAxisAndNibbleOutOfRange) {
+  CanFrame f;
+  for (const unsigned node : {0U, 16U, 255U}) {
+    SensorAcceleration a;
+    a.node = static_cast<std::uint8_t>(node);
+    const EncodeResult r = encode(a, f);
+    EXPECT_EQ(r.error, CodecError::kOutOfRange);
+    EXPECT_STREQ(r.signal, "node");
+    SensorHeartbeat h;
+    h.node = static_cast<std::uint8_t>(node);
+    EXPECT_EQ(encode(h, f).error, CodecError::kOutOfRange);
+  }
+  MonitorStatus s;
+  s.axis = 2;
+  EXPECT_STREQ(encode(s, f).signal, "axis");
+  SensorHeartbeat h;
+  h.firmware_major = 16;
+  EXPECT_STREQ(encode(h, f).signal, "FirmwareMajor");
+  h = SensorHeartbeat{};
+  h.firmware_minor = 200;
+  EXPECT_STREQ(encode(h, f).signal, "FirmwareMinor");
+}
+
+TEST(CanReject, OutputsUntouchedOnFailure) {
+  CanFrame f = make_frame(0x123, Bytes{1, 2, 3, 4, 5, 6, 7, 8}, 3);
+  const CanFrame before = f;
+  SensorAcceleration a;
+  a.ax_g = std::numeric_limits<double>::quiet_NaN();
+  ASSERT_FALSE(encode(a, f).ok());
+  EXPECT_EQ(f.id, before.id);
+  EXPECT_EQ(f.length, before.length);
+  EXPECT_EQ(f.data, before.data);
+
+  MonitorStatus m;
+  m.risk = 0.25;
+  m.sequence = 9;
+  Bytes bad{0x06};  // Phase 6: not in the table
+  ASSERT_FALSE(decode(make_frame(0x320, bad), m).ok());
+  EXPECT_EQ(m.risk, 0.25);
+  EXPECT_EQ(m.sequence, 9);
+}
+
+TEST(CanReject, ErrorTexts) {
+  for (unsigned e = 0; e <= static_cast<unsigned>(CodecError::kReservedBitsSet); ++e) {
+    const char* text = codec_error_text(static_cast<CodecError>(e));
+    ASSERT_NE(text, nullptr);
+    EXPECT_GT(std::string(text).size(), 1U);
+    EXPECT_NE(std::string(text), "unknown error");
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The codec against plinth.dbc
+
+struct DbcSignal {
+  std::string name;
+  unsigned start = 0, length = 0;
+  char byte_order = '?';  // '1' Intel, '0' Motorola
+  char sign = '?';        // '+' unsigned, '-' signed
+  double factor = 0, offset = 0, minimum = 0, maximum = 0;
+  std::string unit;
+};
+struct DbcMessage {
+  std::string name;
+  unsigned dlc = 0;
+  std::vector<DbcSignal> signals;
+};
+struct Dbc {
+  std::map<std::uint32_t, DbcMessage> messages;
+  std::map<std::pair<std::uint32_t, std::string>, std::map<unsigned, std::string>> values;
+  std::set<std::uint32_t> message_comments;
+  std::set<std::pair<std::uint32_t, std::string>> signal_comments;
+  bool network_comment = false;
+};
+
+// Reads the subset of the DBC grammar plinth.dbc uses (one statement per line).
+Dbc parse_dbc(const std::string& path) {
+  Dbc dbc;
+  std::ifstream in(path);
+  EXPECT_TRUE(in) << "cannot open " << path;
+  std::string line;
+  std::uint32_t current = 0;
+  bool in_symbols = false;  // the NS_ block: one keyword a line, up to a blank line
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::string keyword;
+    ls >> keyword;
+    if (keyword == "NS_") {
+      in_symbols = true;
+      continue;
+    }
+    if (in_symbols) {
+      in_symbols = !keyword.empty();
+      continue;
+    }
+    if (keyword == "BO_") {
+      std::string name, sender;
+      unsigned dlc = 0;
+      ls >> current >> name >> dlc >> sender;
+      EXPECT_FALSE(ls.fail()) << line;
+      EXPECT_EQ(name.back(), ':') << line;
+      name.pop_back();
+      EXPECT_EQ(dbc.messages.count(current), 0U) << "duplicate identifier: " << line;
+      dbc.messages[current] = DbcMessage{name, dlc, {}};
+    } else if (keyword == "SG_") {
+      // SG_ Name : start|length@order sign (factor,offset) [min|max] "unit" receivers
+      DbcSignal s;
+      std::string colon, layout, scaling, range, unit;
+      ls >> s.name >> colon >> layout >> scaling >> range >> unit;
+      EXPECT_EQ(colon, ":") << line;
+      char bar = 0, at = 0, lp = 0, comma = 0, rp = 0, lb = 0, rb = 0;
+      std::istringstream(layout) >> s.start >> bar >> s.length >> at >> s.byte_order >> s.sign;
+      EXPECT_TRUE(bar == '|' && at == '@') << line;
+      std::istringstream(scaling) >> lp >> s.factor >> comma >> s.offset >> rp;
+      EXPECT_TRUE(lp == '(' && comma == ',' && rp == ')') << line;
+      std::istringstream(range) >> lb >> s.minimum >> bar >> s.maximum >> rb;
+      EXPECT_TRUE(lb == '[' && bar == '|' && rb == ']') << line;
+      EXPECT_TRUE(unit.size() >= 2 && unit.front() == '"' && unit.back() == '"') << line;
+      s.unit = unit.substr(1, unit.size() - 2);
+      dbc.messages[current].signals.push_back(s);
+    } else if (keyword == "VAL_") {
+      std::uint32_t id = 0;
+      std::string signal, token;
+      ls >> id >> signal;
+      auto& table = dbc.values[{id, signal}];
+      while (ls >> token && token != ";") {
+        const auto value = static_cast<unsigned>(std::stoul(token));
+        std::string quoted;
+        ls >> quoted;
+        table[value] = quoted.substr(1, quoted.size() - 2);
+      }
+      EXPECT_EQ(token, ";") << line;
+    } else if (keyword == "CM_") {
+      std::string what;
+      ls >> what;
+      if (what == "BO_") {
+        std::uint32_t id = 0;
+        ls >> id;
+        dbc.message_comments.insert(id);
+      } else if (what == "SG_") {
+        std::uint32_t id = 0;
+        std::string signal;
+        ls >> id >> signal;
+        dbc.signal_comments.insert({id, signal});
+      } else if (!what.empty() && what.front() == '"') {
+        dbc.network_comment = true;
+      }
+    }
+  }
+  return dbc;
+}
+
+const Dbc& plinth_dbc() {
+  static const Dbc dbc = parse_dbc(std::string(PLINTH_SOURCE_DIR) + "/hal/can_codec/plinth.dbc");
+  return dbc;
+}
+
+TEST(CanDbc, EveryIdentifierTheCodecKnowsIsAMessageAndNoOther) {
+  const Dbc& dbc = plinth_dbc();
+  ASSERT_EQ(dbc.messages.size(), 34U);
+  for (std::uint32_t id = 0; id <= 0x7FF; ++id) {
+    const MessageKind kind = classify(id);
+    const auto it = dbc.messages.find(id);
+    if (kind == MessageKind::kUnknown) {
+      EXPECT_EQ(it, dbc.messages.end()) << "DBC message " << id << " unknown to the codec";
+      continue;
+    }
+    ASSERT_NE(it, dbc.messages.end()) << "identifier " << id << " missing from the DBC";
+    EXPECT_GE(id, kFirstPlinthId);
+    EXPECT_LE(id, kLastPlinthId);
+    EXPECT_EQ(it->second.dlc, kFrameLength) << it->second.name;
+    EXPECT_EQ(it->second.name.rfind(message_kind_name(kind), 0), 0U)
+        << it->second.name << " is not a " << message_kind_name(kind);
+  }
+}
+
+TEST(CanDbc, EverySignalMatchesTheCodecsLayout) {
+  const Dbc& dbc = plinth_dbc();
+  for (const auto& [id, message] : dbc.messages) {
+    const std::span<const SignalLayout> layouts = signal_layouts(classify(id));
+    ASSERT_EQ(message.signals.size(), layouts.size()) << message.name;
+    for (std::size_t i = 0; i < layouts.size(); ++i) {
+      const SignalLayout& c = layouts[i];
+      const DbcSignal& d = message.signals[i];
+      SCOPED_TRACE(message.name + "." + d.name);
+      EXPECT_EQ(d.name, c.name);
+      EXPECT_EQ(d.start, c.start_bit);
+      EXPECT_EQ(d.length, c.length);
+      EXPECT_EQ(d.byte_order, '1');  // Intel
+      EXPECT_EQ(d.sign, c.is_signed ? '-' : '+');
+      EXPECT_EQ(d.factor, c.factor);
+      EXPECT_EQ(d.offset, c.offset);
+      EXPECT_NEAR(d.minimum, static_cast<double>(c.raw_min) * c.factor + c.offset,
+                  1e-9 * std::fabs(d.minimum) + 1e-12);
+      EXPECT_NEAR(d.maximum, static_cast<double>(c.raw_max) * c.factor + c.offset,
+                  1e-9 * std::fabs(d.maximum) + 1e-12);
+      EXPECT_EQ(d.unit, c.unit);
+      // The raw range fits the bits.
+      if (c.is_signed) {
+        EXPECT_GE(c.raw_min, -(std::int64_t{1} << (c.length - 1)));
+        EXPECT_LE(c.raw_max, (std::int64_t{1} << (c.length - 1)) - 1);
+      } else {
+        EXPECT_GE(c.raw_min, 0);
+        EXPECT_LE(c.raw_max, (std::int64_t{1} << c.length) - 1);
+      }
+      EXPECT_LE(c.start_bit + c.length, 64U);
+    }
+    // Signals do not overlap.
+    std::uint64_t used = 0;
+    for (const SignalLayout& c : layouts) {
+      EXPECT_EQ(used & bit_mask(c.start_bit, c.length), 0U) << message.name << "." << c.name;
+      used |= bit_mask(c.start_bit, c.length);
+    }
+  }
+}
+
+std::string value_name(const std::string& signal, unsigned value) {
+  if (signal == "Phase") return phase_name(static_cast<Phase>(value));
+  if (signal == "Corner") return corner_name(static_cast<Corner>(value));
+  if (signal == "AlarmLevel" || signal == "Level" || signal == "PreviousLevel") {
+    return alarm_level_name(static_cast<AlarmLevel>(value));
+  }
+  if (signal == "Cause") return alarm_cause_name(static_cast<AlarmCause>(value));
+  if (signal == "Latched") return value == 0 ? "not_latched" : "latched";
+  return "?";
+}
+
+TEST(CanDbc, ValueTablesMatchTheCodecsEnumerations) {
+  const Dbc& dbc = plinth_dbc();
+  for (const auto& [id, message] : dbc.messages) {
+    for (const SignalLayout& c : signal_layouts(classify(id))) {
+      SCOPED_TRACE(message.name + "." + c.name);
+      const auto it = dbc.values.find({id, c.name});
+      ASSERT_EQ(it != dbc.values.end(), c.has_value_table);
+      if (!c.has_value_table) continue;
+      const auto& table = it->second;
+      // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names.
+      ASSERT_EQ(table.size(), static_cast<std::size_t>(c.raw_max - c.raw_min + 1));
+      for (const auto& [value, name] : table) {
+        EXPECT_GE(static_cast<std::int64_t>(value), c.raw_min);
+        EXPECT_LE(static_cast<std::int64_t>(value), c.raw_max);
+        EXPECT_EQ(name, value_name(c.name, value)) << value;
+      }
+    }
+  }
+  EXPECT_EQ(phase_name(static_cast<Phase>(6)), std::string("invalid"));
+}
+
+TEST(CanDbc, EveryMessageAndSignalIsDocumented) {
+  const Dbc& dbc = plinth_dbc();
+  EXPECT_TRUE(dbc.network_comment);
+  for (const auto& [id, message] : dbc.messages) {
+    EXPECT_EQ(dbc.message_comments.count(id), 1U) << message.name;
+    for (const DbcSignal& s : message.signals) {
+      EXPECT_EQ(dbc.signal_comments.count({id, s.name}), 1U) << message.name << "." << s.name;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace plinth::can
