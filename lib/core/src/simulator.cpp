@@ -284,26 +284,26 @@ struct Stepper {
     emit(sim, t, EventKind::kRockingStop, 0, theta_dot_before);
   }
 
+  // Impact at theta = 0 (Eqs 21-24), or the end of rocking when it leaves less rocking energy
+  // than the rest criterion's fraction of the new pivot's overturning barrier.
   static void rocking_impact(Simulator& sim, double t) {
     const Scene& s = *sim.scene_;
     const double before = sim.y_[kThetaDot];
-    const Corner to = opposite(sim.mode_.corner);
-    const CornerGeometry to_pivot = pivot_of(s, to, sim.mode_.overhang, sim.y_[kX]).geometry;
-    const double after =
-        impact_velocity_ratio(s, pivot_of(s, sim.mode_, sim.y_).geometry, to_pivot,
-                              base_moves(sim.mode_)) *
-        before;
-    const double energy_after = 0.5 * to_pivot.inertia * after * after;
-    const double barrier = s.m * s.g * (to_pivot.radius - s.h);
-    const bool spent = after * before <= 0.0 ||
-                       energy_after < sim.settings_.rest_energy_ratio * barrier;
-    if (spent) {
+    Mode mode = sim.mode_;
+    State y = sim.y_;
+    rocking_impact_reset(s, base_moves(mode), mode, y);
+    const CornerGeometry to = pivot_of(s, mode, y).geometry;
+    const double after = y[kThetaDot];
+    const double barrier = s.m * s.g * (to.radius - s.h);
+    if (after * before <= 0.0 ||
+        0.5 * to.inertia * after * after < sim.settings_.rest_energy_ratio * barrier) {
       stop_rocking(sim, t, before);
       enter(sim, t);
       return;
     }
-    rocking_impact_reset(s, base_moves(sim.mode_), sim.mode_, sim.y_);
-    emit(sim, t, EventKind::kImpact, 0, before, sim.y_[kThetaDot]);
+    sim.mode_ = mode;
+    sim.y_ = y;
+    emit(sim, t, EventKind::kImpact, 0, before, after);
   }
 
   // x' reached 0: the block sticks if static friction can hold it (Eq 15 or 18 not met in the
