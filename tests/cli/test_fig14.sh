@@ -30,23 +30,8 @@ fi
 SCENES=$SRC/sim/scenes
 AT2=$SRC/sim/data/records/irpinia1980_brienza_000.AT2
 
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-cd "$TMP" || exit 2
-
-PASSED=0
-FAILED=0
-pass() {
-  echo "ok - $1"
-  PASSED=$((PASSED + 1))
-}
-fail() {
-  echo "not ok - $1: $2"
-  FAILED=$((FAILED + 1))
-}
-
-TIMEOUT=()
-if command -v timeout >/dev/null 2>&1; then TIMEOUT=(timeout 120); fi
+# shellcheck source=tests/cli/harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 
 # Prints why the run (EVENTS, CSV) is not of KIND (a, b, c or d) with clearance XHAT; nothing
 # when it is.

@@ -22,23 +22,8 @@ ISOLATED=$SCENES/paper-isolated.toml
 GROUND=$SCENES/non-isolated.toml
 AT2=$SRC/sim/data/records/irpinia1980_brienza_000.AT2
 
-TMP=$(mktemp -d)
-trap 'rm -rf "$TMP"' EXIT
-cd "$TMP" || exit 2
-
-PASSED=0
-FAILED=0
-pass() {
-  echo "ok - $1"
-  PASSED=$((PASSED + 1))
-}
-fail() {
-  echo "not ok - $1: $2"
-  FAILED=$((FAILED + 1))
-}
-
-TIMEOUT=()
-if command -v timeout >/dev/null 2>&1; then TIMEOUT=(timeout 120); fi
+# shellcheck source=tests/cli/harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 
 # run ARGS...: runs plinth-sim; sets RC, and leaves its output in $TMP/stdout and $TMP/stderr.
 RC=0

@@ -83,11 +83,9 @@ TEST(ClosedForms, Eq37RockingImpulseMatchesBisectionOnSimulation) {
       double high = 2.0 * predicted;
       ASSERT_FALSE(impulse_starts_rocking(s, -low));
       ASSERT_TRUE(impulse_starts_rocking(s, -high));
-      while (high - low > 1e-8 * predicted) {
-        const double mid = 0.5 * (low + high);
-        (impulse_starts_rocking(s, -mid) ? high : low) = mid;
-      }
-      EXPECT_NEAR(0.5 * (low + high), predicted, 1e-6 * predicted)
+      const double found = testing::bisect_threshold(
+          [&](double i) { return impulse_starts_rocking(s, -i); }, low, high, 1e-8 * predicted);
+      EXPECT_NEAR(found, predicted, 1e-6 * predicted)
           << "epsilon = " << epsilon << ", xi = " << xi;
       // The paper's form of Eq 37: |I| = T g (1 + epsilon) / (2 pi a(xi) lambda).
       const double printed_form = s.params.base.period * s.g * (1.0 + epsilon) /

@@ -63,11 +63,9 @@ TEST(ImpulsiveCriteria, Eq38SlidingImpulseMatchesBisectionOnSimulation) {
         double high = 1.25 * predicted;
         ASSERT_FALSE(impulse_starts_sliding(s, -low));
         ASSERT_TRUE(impulse_starts_sliding(s, -high));
-        while (high - low > 1e-8 * predicted) {
-          const double mid = 0.5 * (low + high);
-          (impulse_starts_sliding(s, -mid) ? high : low) = mid;
-        }
-        EXPECT_NEAR(0.5 * (low + high), predicted, 1e-6 * predicted)
+        const double found = testing::bisect_threshold(
+            [&](double i) { return impulse_starts_sliding(s, -i); }, low, high, 1e-8 * predicted);
+        EXPECT_NEAR(found, predicted, 1e-6 * predicted)
             << "epsilon = " << epsilon << ", xi = " << xi << ", mu_s = " << mu_s;
       }
     }

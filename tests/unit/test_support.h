@@ -74,4 +74,15 @@ inline Simulator run(const Scene& scene, const Excitation& excitation, double t_
   return sim;
 }
 
+// Bisects on a monotone predicate: `occurs(high)` holds and `occurs(low)` does not; returns the
+// middle of the final bracket, narrower than `width`.
+template <typename Predicate>
+double bisect_threshold(Predicate occurs, double low, double high, double width) {
+  while (high - low > width) {
+    const double mid = 0.5 * (low + high);
+    (occurs(mid) ? high : low) = mid;
+  }
+  return 0.5 * (low + high);
+}
+
 }  // namespace plinth::testing
