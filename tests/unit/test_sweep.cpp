@@ -1,0 +1,300 @@
+// plinth-sweep's library: first-occurrence thresholds, parameters, sharding, the CSV map.
+#include "plinth/host/sweep.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "plinth/host/input_error.h"
+#include "plinth/host/record_io.h"
+#include "plinth/host/scene_toml.h"
+#include "test_support.h"
+
+namespace plinth::host {
+namespace {
+
+using ::testing::HasSubstr;
+
+const Record& brienza() {
+  static const Record record =
+      read_at2(std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
+               kStandardGravity);
+  return record;
+}
+
+// The paper's isolated block with friction, base stops and a support it can leave.
+SceneParams isolated_with_friction(double mu_s = 0.3) {
+  SceneParams p = plinth::testing::paper_isolated();
+  p.has_friction = true;
+  p.friction.static_coefficient = mu_s;
+  p.friction.kinetic_coefficient = 0.8 * mu_s;
+  p.has_base_stops = true;
+  p.base_stops.max_displacement = 0.2;
+  p.base_stops.restitution = 0.7;
+  p.has_support = true;
+  p.support.clearance = 0.1;
+  return p;
+}
+
+SweepSettings coarse() {
+  SweepSettings s;
+  s.scan_points = 12;
+  s.pga_max_g = 2.5;
+  s.tolerance_g = 0.01;
+  s.dt = 1e-3;
+  return s;
+}
+
+template <class F>
+std::string input_error_text(F&& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+TEST(Sweep, Names) {
+  const char* expected[] = {"sliding",       "rocking",        "slide_rocking", "out_of_base",
+                            "base_stop_hit", "slide_stop_hit", "fell",          "overturned"};
+  for (std::size_t i = 0; i < kSweepEventCount; ++i) {
+    EXPECT_STREQ(sweep_event_name(static_cast<SweepEvent>(i)), expected[i]);
+  }
+  for (const char* name : {"mu_s", "epsilon", "lambda", "T", "xi", "u_max", "mass_ratio"}) {
+    EXPECT_STREQ(sweep_parameter_name(parse_sweep_parameter(name)), name);
+  }
+}
+
+// Each reported threshold: the event occurs there and not one tolerance below.
+std::array<std::optional<double>, kSweepEventCount> expect_thresholds_hold(
+    const Scene& scene, std::size_t& found, std::size_t& runs) {
+  const SweepSettings settings = coarse();
+  const auto thresholds = first_occurrence_thresholds(scene, brienza(), settings, &runs);
+  for (std::size_t e = 0; e < kSweepEventCount; ++e) {
+    const auto event = static_cast<SweepEvent>(e);
+    SCOPED_TRACE(sweep_event_name(event));
+    if (!thresholds[e]) continue;
+    ++found;
+    const double thr = *thresholds[e];
+    EXPECT_GT(thr, 0.0);
+    EXPECT_LE(thr, settings.pga_max_g);
+    EXPECT_TRUE(simulate_occurrences(scene, brienza(), thr * scene.g, settings)[event]);
+    if (thr - settings.tolerance_g > 0.0) {
+      EXPECT_FALSE(simulate_occurrences(scene, brienza(), (thr - settings.tolerance_g) * scene.g,
+                                        settings)[event]);
+    }
+  }
+  return thresholds;
+}
+
+TEST(Sweep, ThresholdsAgreeWithDirectSimulation) {
+  const Scene scene = plinth::testing::make(isolated_with_friction());
+  std::size_t found = 0;
+  std::size_t runs = 0;
+  const auto thresholds = expect_thresholds_hold(scene, found, runs);
+  // Sliding, rocking and base stop impacts at least happen below 2.5 g on this scene.
+  EXPECT_GE(found, 3u);
+  EXPECT_GT(runs, static_cast<std::size_t>(coarse().scan_points));
+  EXPECT_TRUE(thresholds[static_cast<std::size_t>(SweepEvent::kSliding)].has_value());
+  EXPECT_TRUE(thresholds[static_cast<std::size_t>(SweepEvent::kBaseStopHit)].has_value());
+  EXPECT_FALSE(thresholds[static_cast<std::size_t>(SweepEvent::kSlideStopHit)].has_value());
+}
+
+// Fig. 14(c)'s scene (lambda = 2, mu_s = 0.3, base stops, a support it can leave): sliding,
+// slide-rocking, leaving the support and falling off, none of them monotonic in the PGA.
+TEST(Sweep, ThresholdsHoldWhereBehaviourIsNotMonotonic) {
+  const Scene scene = load_scene_file(std::string(PLINTH_SOURCE_DIR) +
+                                      "/sim/scenes/fig14c-slide-rocking-base-stops.toml");
+  std::size_t found = 0;
+  std::size_t runs = 0;
+  (void)expect_thresholds_hold(scene, found, runs);
+  EXPECT_GE(found, 5u);
+}
+
+// On the ground without friction, rocking starts as soon as the scaled record reaches
+// g b1 / h (towards corner 1) or -g b2 / h (corner 2): Eq 16 at one sample.
+TEST(Sweep, RockingOnsetOnTheGroundMatchesEq16) {
+  const Record& record = brienza();
+  // epsilon = -0.3: the record's largest positive sample governs (its peak is negative), so the
+  // threshold is neither b1/h nor b2/h in g; epsilon = 0.3: the peak reaches b2/h first.
+  for (const double epsilon : {-0.3, 0.3}) {
+    SCOPED_TRACE(epsilon);
+    const Scene scene = plinth::testing::make(plinth::testing::paper_block(epsilon));
+    double scale = INFINITY;  // smallest record scale at which some sample reaches Eq 16
+    for (const double a : record.horizontal) {
+      if (a > 0.0) scale = std::min(scale, scene.g * scene.b1 / scene.h / a);
+      if (a < 0.0) scale = std::min(scale, scene.g * scene.b2 / scene.h / -a);
+    }
+    const double expected_g = scale * record.peak_horizontal() / scene.g;
+    ASSERT_LT(expected_g, 1.0);
+    ASSERT_GT(expected_g, 0.0);
+    if (epsilon < 0.0) {
+      ASSERT_GT(expected_g, scene.b1 / scene.h + 0.01);
+      ASSERT_LT(expected_g, scene.b2 / scene.h - 0.01);
+    }
+
+    SweepSettings settings;
+    settings.pga_max_g = 1.0;
+    settings.scan_points = 10;
+    settings.tolerance_g = 0.002;
+    settings.dt = record.dt / 3.0;  // every sample lies on the solver's time grid
+    const auto thresholds = first_occurrence_thresholds(scene, record, settings);
+    const auto& rocking = thresholds[static_cast<std::size_t>(SweepEvent::kRocking)];
+    ASSERT_TRUE(rocking.has_value());
+    EXPECT_GE(*rocking, expected_g - 1e-9);
+    EXPECT_LE(*rocking - settings.tolerance_g, expected_g + 1e-9);
+    EXPECT_FALSE(thresholds[static_cast<std::size_t>(SweepEvent::kSliding)].has_value());
+    EXPECT_FALSE(thresholds[static_cast<std::size_t>(SweepEvent::kBaseStopHit)].has_value());
+  }
+}
+
+void expect_same_rows(const std::vector<SweepRow>& a, const std::vector<SweepRow>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].value, b[i].value);
+    for (std::size_t e = 0; e < kSweepEventCount; ++e) {
+      EXPECT_EQ(a[i].thresholds_g[e].has_value(), b[i].thresholds_g[e].has_value());
+      if (a[i].thresholds_g[e] && b[i].thresholds_g[e]) {
+        EXPECT_EQ(*a[i].thresholds_g[e], *b[i].thresholds_g[e]);  // bit-identical
+      }
+    }
+  }
+}
+
+TEST(Sweep, RowsDoNotDependOnJobsOrShards) {
+  const SceneParams base = isolated_with_friction();
+  SweepSettings settings = coarse();
+  settings.scan_points = 8;
+  settings.pga_max_g = 2.0;
+  settings.tolerance_g = 0.02;
+  const std::vector<double> values = sweep_values(0.2, 0.6, 3);
+  SweepStats stats;
+  const auto one = run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 1, 1, 1,
+                             &stats);
+  EXPECT_GT(stats.simulations, 3u * 8u);
+  const auto two = run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 2, 1, 1);
+  expect_same_rows(one, two);
+
+  const auto first = run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 2, 1, 2);
+  const auto second = run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 2, 2, 2);
+  ASSERT_EQ(first.size(), 2u);   // values 0 and 2
+  ASSERT_EQ(second.size(), 1u);  // value 1
+  const std::vector<SweepRow> merged = {first[0], second[0], first[1]};
+  expect_same_rows(one, merged);
+
+  // Each row is the thresholds of its own scene.
+  const Scene scene = plinth::testing::make(with_parameter(base, SweepParameter::kMuS, values[1]));
+  const auto direct = first_occurrence_thresholds(scene, brienza(), settings);
+  expect_same_rows({one[1]}, {SweepRow{values[1], direct}});
+}
+
+TEST(Sweep, ValuesAreEvenlySpacedAndInclusive) {
+  EXPECT_THAT(sweep_values(0.1, 1.5, 1), ::testing::ElementsAre(0.1));
+  const auto v = sweep_values(0.1, 1.5, 8);
+  ASSERT_EQ(v.size(), 8u);
+  EXPECT_EQ(v.front(), 0.1);
+  EXPECT_EQ(v.back(), 1.5);
+  EXPECT_NEAR(v[1] - v[0], 0.2, 1e-12);
+  EXPECT_THAT(sweep_values(2.0, 2.0, 3), ::testing::ElementsAre(2.0, 2.0, 2.0));
+}
+
+TEST(Sweep, WithParameterSetsTheSceneInSI) {
+  const SceneParams ground = plinth::testing::paper_block();
+  const SceneParams mu = with_parameter(ground, SweepParameter::kMuS, 0.5);
+  EXPECT_TRUE(mu.has_friction);
+  EXPECT_DOUBLE_EQ(mu.friction.static_coefficient, 0.5);
+  EXPECT_DOUBLE_EQ(mu.friction.kinetic_coefficient, 0.4);
+  EXPECT_DOUBLE_EQ(with_parameter(ground, SweepParameter::kEpsilon, 0.2).block.eccentricity, 0.06);
+
+  const SceneParams iso = plinth::testing::paper_isolated();
+  const SceneParams tall = with_parameter(iso, SweepParameter::kLambda, 4.0);
+  EXPECT_DOUBLE_EQ(tall.block.com_height, 1.2);
+  EXPECT_DOUBLE_EQ(tall.block.mass, iso.block.mass * 4.0 / 3.0);
+  EXPECT_DOUBLE_EQ(tall.block.inertia, homogeneous_rectangle_inertia(tall.block.mass, 0.3, 1.2));
+  EXPECT_DOUBLE_EQ(tall.base.mass, tall.block.mass);  // the mass ratio is kept
+  EXPECT_DOUBLE_EQ(with_parameter(iso, SweepParameter::kPeriod, 3.0).base.period, 3.0);
+  EXPECT_DOUBLE_EQ(with_parameter(iso, SweepParameter::kXi, 0.1).base.damping_ratio, 0.1);
+  EXPECT_DOUBLE_EQ(with_parameter(iso, SweepParameter::kMassRatio, 0.5).base.mass,
+                   0.5 * iso.block.mass);
+  EXPECT_DOUBLE_EQ(
+      with_parameter(isolated_with_friction(), SweepParameter::kUMax, 0.3).base_stops.max_displacement,
+      0.3);
+}
+
+TEST(Sweep, BadInputsSayWhatIsWrong) {
+  EXPECT_EQ(input_error_text([] { (void)parse_sweep_parameter("mu"); }),
+            "--param: unknown parameter 'mu' (one of mu_s, epsilon, lambda, T, xi, u_max, "
+            "mass_ratio)");
+  EXPECT_THAT(input_error_text([] { (void)sweep_values(0.1, 1.0, 0); }),
+              HasSubstr("--steps: must be at least 1"));
+  EXPECT_THAT(input_error_text([] { (void)sweep_values(1.0, 0.1, 5); }),
+              HasSubstr("--from 1 is greater than --to 0.1"));
+  EXPECT_THAT(input_error_text([] { (void)sweep_values(NAN, 1.0, 5); }), HasSubstr("--from"));
+
+  const SceneParams ground = plinth::testing::paper_block();
+  EXPECT_EQ(input_error_text([&] { (void)with_parameter(ground, SweepParameter::kPeriod, 2.0); }),
+            "--param T = 2: the scene has no [base] (a block on the ground)");
+  EXPECT_THAT(input_error_text([&] { (void)with_parameter(ground, SweepParameter::kXi, 0.1); }),
+              HasSubstr("no [base]"));
+  EXPECT_THAT(
+      input_error_text([&] { (void)with_parameter(ground, SweepParameter::kMassRatio, 1.0); }),
+      HasSubstr("no [base]"));
+  const SceneParams iso = plinth::testing::paper_isolated();
+  EXPECT_THAT(input_error_text([&] { (void)with_parameter(iso, SweepParameter::kUMax, 0.2); }),
+              HasSubstr("--param u_max = 0.2: the scene has no [base_stops]"));
+  // make_scene's refusal names the parameter, the value and the field.
+  const std::string negative =
+      input_error_text([&] { (void)with_parameter(iso, SweepParameter::kMuS, -0.1); });
+  EXPECT_THAT(negative, HasSubstr("--param mu_s = -0.1: friction."));
+  EXPECT_THAT(input_error_text([&] { (void)with_parameter(iso, SweepParameter::kPeriod, 0.0); }),
+              HasSubstr("--param T = 0: base.period"));
+
+  // run_sweep checks every value of its shard before simulating, and its own arguments.
+  const std::vector<double> values = {0.5, -1.0};
+  EXPECT_THAT(input_error_text([&] {
+                (void)run_sweep(iso, SweepParameter::kMuS, values, brienza(), coarse(), 1, 1, 1);
+              }),
+              HasSubstr("--param mu_s = -1"));
+  EXPECT_THAT(input_error_text([&] {
+                (void)run_sweep(iso, SweepParameter::kMuS, {0.5}, brienza(), coarse(), 1, 3, 2);
+              }),
+              HasSubstr("--shard"));
+  EXPECT_THAT(input_error_text([&] {
+                (void)run_sweep(iso, SweepParameter::kMuS, {0.5}, brienza(), coarse(), 0, 1, 1);
+              }),
+              HasSubstr("--jobs"));
+  // A simulation's error names the value it ran for.
+  SweepSettings big_step = coarse();
+  big_step.dt = 0.01;
+  EXPECT_THAT(input_error_text([&] {
+                (void)run_sweep(iso, SweepParameter::kPeriod, {0.01}, brienza(), big_step, 1, 1,
+                                1);
+              }),
+              HasSubstr("--param T = 0.01: --dt: "));
+  SweepSettings bad = coarse();
+  bad.tolerance_g = 0.0;
+  EXPECT_THAT(input_error_text([&] { validate(bad); }), HasSubstr("--tol"));
+}
+
+TEST(Sweep, CsvMap) {
+  std::vector<SweepRow> rows(2);
+  rows[0].value = 0.1;
+  rows[0].thresholds_g[0] = 0.123456789;
+  rows[0].thresholds_g[7] = 2.0;
+  rows[1].value = 0.25;
+  std::ostringstream out;
+  write_sweep_csv(out, SweepParameter::kMuS, rows);
+  EXPECT_EQ(out.str(),
+            "mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,"
+            "overturned\n"
+            "0.1,0.123457,,,,,,,2\n"
+            "0.25,,,,,,,,\n");
+}
+
+}  // namespace
+}  // namespace plinth::host
