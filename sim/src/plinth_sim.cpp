@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_validators.h"
 #include "plinth/core/simulator.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
@@ -212,16 +213,8 @@ int run(const Options& opt) {
   plinth::SolverSettings settings;
   settings.step = opt.dt;
   plinth::Simulator sim;
-  if (plinth::Error e = plinth::Simulator::create(scene, excitation, settings, sim); !e.ok()) {
-    std::string message = std::string(e.field == std::string("solver.step") ? "--dt" : e.field) +
-                          ": " + e.reason;
-    if (e.limit > 0.0) {
-      char limit[64];
-      std::snprintf(limit, sizeof limit, "; the largest stable step is %.3g s", e.limit);
-      message += limit;
-    }
-    throw InputError(message);
-  }
+  plinth::host::throw_if_simulator_error(
+      plinth::Simulator::create(scene, excitation, settings, sim));
 
   const double t_end = opt.t_end ? *opt.t_end : std::max(10.0, excitation.duration() + 5.0);
   auto csv_file = open_output(opt.out_path, "the time history");
@@ -286,26 +279,6 @@ int run(const Options& opt) {
 
 }  // namespace
 
-// CLI11's PositiveNumber lets NaN through and prints DBL_MAX in its message.
-const CLI::Validator kFinite(
-    [](const std::string& text) -> std::string {
-      double value = 0.0;
-      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) {
-        return "must be a finite number, got '" + text + "'";
-      }
-      return {};
-    },
-    "FINITE");
-const CLI::Validator kFinitePositive(
-    [](const std::string& text) -> std::string {
-      double value = 0.0;
-      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || value <= 0.0) {
-        return "must be a finite number greater than zero, got '" + text + "'";
-      }
-      return {};
-    },
-    "POSITIVE");
-
 int main(int argc, char** argv) {
   CLI::App app{"plinth-sim: simulate a block on an isolated base (or the ground) under a "
                "record, an impulse or a pulse"};
@@ -317,22 +290,22 @@ int main(int argc, char** argv) {
   app.add_option("--scale", opt.scale, "scale factor gamma of the record")
       ->needs(record)
       ->excludes(pga)
-      ->check(kFinite);
+      ->check(plinth::cli::kFinite);
   auto* impulse = app.add_option("--impulse", opt.impulse, "impulse I, m/s (Eq 34)")
                       ->excludes(record)
-                      ->check(kFinite);
+                      ->check(plinth::cli::kFinite);
   auto* pulse = app.add_option("--pulse", opt.pulse, "one-period pulse: sine or cosine")
                     ->check(CLI::IsMember({"sine", "cosine"}))
                     ->excludes(record)
                     ->excludes(impulse);
   app.add_option("--amplitude", opt.amplitude, "pulse amplitude, e.g. 0.5g")->needs(pulse);
-  app.add_option("--period", opt.period, "pulse period, s")->needs(pulse)->check(kFinitePositive);
-  app.add_option("--dt", opt.dt, "solver step, s")->check(kFinitePositive);
+  app.add_option("--period", opt.period, "pulse period, s")->needs(pulse)->check(plinth::cli::kFinitePositive);
+  app.add_option("--dt", opt.dt, "solver step, s")->check(plinth::cli::kFinitePositive);
   app.add_option("--t-end", opt.t_end, "end time, s (default: the input's length + 5 s, at least 10 s)")
-      ->check(kFinitePositive);
+      ->check(plinth::cli::kFinitePositive);
   app.add_option("--out", opt.out_path, "CSV time history");
   app.add_option("--out-interval", opt.out_interval, "time between CSV rows, s (whole steps)")
-      ->check(kFinitePositive);
+      ->check(plinth::cli::kFinitePositive);
   app.add_option("--events", opt.events_path, "JSON Lines event log");
   try {
     app.parse(argc, argv);

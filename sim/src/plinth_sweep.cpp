@@ -1,5 +1,6 @@
 // plinth-sweep: for each value of one scene parameter, the smallest PGA at which each kind of
 // event first occurs under a record. Writes a CSV map (--out) and a one-line summary.
+#include "cli_validators.h"
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
@@ -97,26 +98,6 @@ int run(const Options& opt) {
 
 }  // namespace
 
-// CLI11's PositiveNumber lets NaN through and prints DBL_MAX in its message.
-const CLI::Validator kFinite(
-    [](const std::string& text) -> std::string {
-      double value = 0.0;
-      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value)) {
-        return "must be a finite number, got '" + text + "'";
-      }
-      return {};
-    },
-    "FINITE");
-const CLI::Validator kFinitePositive(
-    [](const std::string& text) -> std::string {
-      double value = 0.0;
-      if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || value <= 0.0) {
-        return "must be a finite number greater than zero, got '" + text + "'";
-      }
-      return {};
-    },
-    "POSITIVE");
-
 int main(int argc, char** argv) {
   CLI::App app{"plinth-sweep: for each value of one scene parameter, the smallest PGA at which "
                "each event first occurs under a record"};
@@ -126,14 +107,14 @@ int main(int argc, char** argv) {
   app.add_option("--param", opt.param,
                  "parameter to sweep: mu_s, epsilon, lambda, T, xi, u_max or mass_ratio")
       ->required();
-  app.add_option("--from", opt.from, "first value of the parameter")->required()->check(kFinite);
-  app.add_option("--to", opt.to, "last value of the parameter")->required()->check(kFinite);
+  app.add_option("--from", opt.from, "first value of the parameter")->required()->check(plinth::cli::kFinite);
+  app.add_option("--to", opt.to, "last value of the parameter")->required()->check(plinth::cli::kFinite);
   app.add_option("--steps", opt.steps, "number of values, from..to inclusive")->required();
   app.add_option("--pga-max", opt.pga_max, "largest PGA scanned, e.g. 2g (default 2g)");
   app.add_option("--tol", opt.tol, "PGA tolerance of the thresholds, e.g. 0.001g (default)");
   app.add_option("--jobs", opt.jobs, "threads (default: the hardware's)");
   app.add_option("--shard", opt.shard, "run only part i of N of the values, as i/N (default 1/1)");
-  app.add_option("--dt", opt.dt, "solver step, s (default 5e-4)")->check(kFinitePositive);
+  app.add_option("--dt", opt.dt, "solver step, s (default 5e-4)")->check(plinth::cli::kFinitePositive);
   app.add_option("--out", opt.out_path, "CSV map of the thresholds")->required();
   try {
     app.parse(argc, argv);

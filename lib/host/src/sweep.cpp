@@ -133,16 +133,7 @@ Occurrences simulate_occurrences(const Scene& scene, const Record& record, doubl
   Simulator sim;
   const Excitation excitation =
       Excitation::record(record.horizontal_signal(), {}, pga_mps2 / peak);
-  if (const Error e = Simulator::create(scene, excitation, solver, sim); !e.ok()) {
-    std::string message = std::string(e.field == std::string("solver.step") ? "--dt" : e.field) +
-                          ": " + e.reason;
-    if (e.limit > 0.0) {
-      char limit[96];
-      std::snprintf(limit, sizeof limit, "; the largest stable step is %.3g s", e.limit);
-      message += limit;
-    }
-    throw InputError(message);
-  }
+  throw_if_simulator_error(Simulator::create(scene, excitation, solver, sim));
   OccurrenceSink sink;
   sim.set_event_sink(&sink);
   sim.start_at_rest();
