@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "plinth/core/closed_forms.h"
 #include "plinth/core/energy.h"
@@ -191,6 +192,31 @@ TEST(Housner, OverturnsWhenThetaPassesTheCriticalAngle) {
   testing::run(s, Excitation::none(), 5.0, 1e-4, &survives, -0.5);
   EXPECT_EQ(survives.first(EventKind::kOverturned), nullptr);
   EXPECT_NE(survives.first(EventKind::kRockingStop), nullptr);
+}
+
+}  // namespace
+}  // namespace plinth
+
+namespace plinth {
+namespace {
+
+// Eq 16 with vertical ground motion: rocking starts when u_G'' reaches (b_1/h)(g + v_G'').
+TEST(Housner, VerticalGroundAccelerationShiftsTheOnset) {
+  const Scene s = testing::make(testing::paper_block(0.2));
+  // A horizontal ramp 0 -> 1 g over 2 s, sampled every 10 ms, and a steady vertical -0.4 g.
+  std::vector<double> horizontal(201), vertical(201, -0.4 * s.g);
+  for (std::size_t i = 0; i < horizontal.size(); ++i) {
+    horizontal[i] = s.g * static_cast<double>(i) / 200.0;
+  }
+  const Excitation ground = Excitation::record({horizontal.data(), horizontal.size(), 0.01},
+                                               {vertical.data(), vertical.size(), 0.01});
+  testing::RecordingSink sink;
+  testing::run(s, ground, 2.0, 1e-3, &sink);
+  const Event* onset = sink.first(EventKind::kRockingStart);
+  ASSERT_NE(onset, nullptr);
+  EXPECT_EQ(onset->corner, Corner::kLeft);
+  // u_G''(t) = g t / 2 reaches (b1/h)(g - 0.4 g) at t = 2 (b1/h)(0.6).
+  EXPECT_NEAR(onset->t, 2.0 * s.corner1.onset_ratio * 0.6, 1e-9);
 }
 
 }  // namespace
