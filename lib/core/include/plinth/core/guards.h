@@ -135,11 +135,13 @@ template <Features F>
       direction * y[kX] >= s.params.support.clearance * (1.0 - 1e-12)) {
     return -1.0;
   }
-  if (mode.rocking() &&
+  const double onset = -direction * f.tangential - s.params.friction.static_coefficient * f.normal;
+  // The 3x3 determinants only where the onset would otherwise fire, not every step.
+  if (onset >= 0.0 && mode.rocking() &&
       sliding_consistency(s, pivot_of(s, mode, y), direction, y) <= kPainleveMargin) {
     return -1.0;
   }
-  return -direction * f.tangential - s.params.friction.static_coefficient * f.normal;
+  return onset;
 }
 
 // Value of guard `id` at (y, ag) with the mode's accelerations `acc`.
