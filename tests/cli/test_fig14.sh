@@ -12,26 +12,13 @@
 # Environment: PLINTH_SIM, the plinth-sim binary; PLINTH_SOURCE_DIR, the repository root.
 set -u
 
-if [[ -z "${PLINTH_SIM:-}" || -z "${PLINTH_SOURCE_DIR:-}" ]]; then
-  echo "usage: PLINTH_SIM=path/to/plinth-sim PLINTH_SOURCE_DIR=repo/root bash $0" >&2
-  exit 2
-fi
-SIM=$PLINTH_SIM
-SRC=$PLINTH_SOURCE_DIR
-if [[ ! -x "$SIM" ]]; then
-  echo "$SIM: not an executable" >&2
-  exit 2
-fi
+# shellcheck source=tests/cli/harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
+
 if ! command -v python3 >/dev/null 2>&1; then
   echo "python3 is needed to read the event log and the CSV" >&2
   exit 2
 fi
-
-SCENES=$SRC/sim/scenes
-AT2=$SRC/sim/data/records/irpinia1980_brienza_000.AT2
-
-# shellcheck source=tests/cli/harness.sh
-source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 
 # Prints why the run (EVENTS, CSV) is not of KIND (a, b, c or d) with clearance XHAT; nothing
 # when it is.

@@ -6,24 +6,11 @@
 # Environment: PLINTH_SIM, the plinth-sim binary; PLINTH_SOURCE_DIR, the repository root.
 set -u
 
-if [[ -z "${PLINTH_SIM:-}" || -z "${PLINTH_SOURCE_DIR:-}" ]]; then
-  echo "usage: PLINTH_SIM=path/to/plinth-sim PLINTH_SOURCE_DIR=repo/root bash $0" >&2
-  exit 2
-fi
-SIM=$PLINTH_SIM
-SRC=$PLINTH_SOURCE_DIR
-if [[ ! -x "$SIM" ]]; then
-  echo "$SIM: not an executable" >&2
-  exit 2
-fi
-
-SCENES=$SRC/sim/scenes
-ISOLATED=$SCENES/paper-isolated.toml
-GROUND=$SCENES/non-isolated.toml
-AT2=$SRC/sim/data/records/irpinia1980_brienza_000.AT2
-
 # shellcheck source=tests/cli/harness.sh
 source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
+
+ISOLATED=$SCENES/paper-isolated.toml
+GROUND=$SCENES/non-isolated.toml
 
 # run ARGS...: runs plinth-sim; sets RC, and leaves its output in $TMP/stdout and $TMP/stderr.
 RC=0
