@@ -247,37 +247,218 @@ TEST(Falling, LongPulsePushesTheBlockOffTheBase) {
   EXPECT_LE(std::fabs(safe.state()[kX]), held.params.support.clearance + 1e-12);
 }
 
-// Eq 32 with eta_s = 1 conserves the horizontal momentum of block and base.
-TEST(SlidingStops, ElasticTransferConservesMomentum) {
-  SceneParams p = with_friction(testing::paper_isolated(0.0), 0.3, 0.24);
+// Horizontal momentum of base and block relative to the ground, m_b u' + m v_Cx, N s.
+double horizontal_momentum(const Scene& s, const Mode& mode, const State& y) {
+  const Pivot pivot = pivot_of(s, mode, y);
+  const ContactKinematics k = contact_kinematics(s, pivot.geometry, pivot.overhanging, y);
+  return (s.total_mass - s.m) * y[kUDot] + s.m * k.jx.dot(y.tail<3>());
+}
+
+SceneParams with_sliding_stops(SceneParams p, double restitution) {
   p.has_support = true;
   p.support = {0.1};
   p.has_sliding_stops = true;
-  p.sliding_stops = {1.0};
-  const Scene s = make(p);
+  p.sliding_stops = {restitution};
+  return p;
+}
+
+// Sliding stop hit (Eqs 30-32 with restitution, resets.h): x'+ = -eta_s x'-, the horizontal
+// momentum kept for every eta_s, energy never grows and is kept at eta_s = 1; in sliding and
+// slide-rocking alike.
+TEST(SlidingStops, MomentumKeptEnergyNeverGrows) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
-  for (int i = 0; i < 100; ++i) {
-    Mode mode;
-    mode.phase = Phase::kSliding;
-    mode.slide_direction = 1;
-    State y = State::Zero();
-    y[kX] = 0.1;
-    y[kUDot] = unit(rng);
-    y[kXDot] = std::fabs(unit(rng));
-    const double momentum = s.total_mass * y[kUDot] + s.m * y[kXDot];
-    const double energy = mechanical_energy(s, mode, y);
-    sliding_stop_hit_reset(s, 1, true, mode, y);
-    EXPECT_NEAR(s.total_mass * y[kUDot] + s.m * y[kXDot], momentum, 1e-12 * s.total_mass);
-    EXPECT_EQ(y[kXDot], 0.0);
-    EXPECT_EQ(mode.phase, Phase::kFullContact);
-    EXPECT_LE(mechanical_energy(s, mode, y), energy + 1e-12 * std::fabs(energy));
+  for (const double eta : {0.0, 0.3, 0.7, 1.0}) {
+    const Scene s =
+        make(with_sliding_stops(with_friction(testing::paper_isolated(0.2), 0.3, 0.24), eta));
+    for (int i = 0; i < 200; ++i) {
+      Mode mode;
+      mode.phase = i % 2 == 0 ? Phase::kSliding : Phase::kSlideRocking;
+      mode.corner = unit(rng) > 0 ? Corner::kLeft : Corner::kRight;
+      mode.slide_direction = 1;
+      State y = State::Zero();
+      y[kX] = 0.1;
+      y[kUDot] = unit(rng);
+      y[kXDot] = std::fabs(unit(rng));
+      if (mode.rocking()) {
+        y[kTheta] = s.corner(mode.corner).sign * 0.2 * std::fabs(unit(rng));
+        y[kThetaDot] = unit(rng);
+      }
+      const double momentum = horizontal_momentum(s, mode, y);
+      const double energy = mechanical_energy(s, mode, y);
+      const double x_dot = y[kXDot];
+      sliding_stop_hit_reset(s, 1, true, mode, y);
+      EXPECT_NEAR(horizontal_momentum(s, mode, y), momentum, 1e-12 * s.total_mass);
+      EXPECT_NEAR(y[kXDot], -eta * x_dot, 1e-15);
+      EXPECT_EQ(y[kX], 0.1);
+      EXPECT_EQ(mode.slide_direction, -1);
+      const double after = mechanical_energy(s, mode, y);
+      EXPECT_LE(after, energy + 1e-12 * std::fabs(energy));
+      if (eta == 1.0) {
+        EXPECT_NEAR(after, energy, 1e-12 * std::fabs(energy));
+      } else if (x_dot > 1e-3) {
+        EXPECT_LT(after, energy);
+      }
+    }
   }
 }
 
-// Energy never grows across the resets of the sliding phases: base stops while sliding or
-// slide-rocking (the block keeps its absolute velocity), impacts during slide-rocking.
-TEST(SlidingResets, EnergyNeverGrows) {
+// At eta_s = 0 the stop is plastic: x'+ = 0 and u'+ = u'- + m x'- / (m + m_b), the printed
+// Eq 32 with eta_s = 1.
+TEST(SlidingStops, PlasticStopIsPrintedEq32WithEtaOne) {
+  const Scene s =
+      make(with_sliding_stops(with_friction(testing::paper_isolated(0.0), 0.3, 0.24), 0.0));
+  Mode mode;
+  mode.phase = Phase::kSliding;
+  mode.slide_direction = 1;
+  State y = State::Zero();
+  y[kX] = 0.1;
+  y[kUDot] = -0.4;
+  y[kXDot] = 0.9;
+  sliding_stop_hit_reset(s, 1, true, mode, y);
+  EXPECT_NEAR(y[kUDot], -0.4 + s.m / s.total_mass * 0.9, 1e-14);
+  EXPECT_EQ(y[kXDot], 0.0);
+}
+
+// The printed Eq 32 with eta_s < 1 (x'+ = 0, u'+ = u'- + eta_s m x'- / (m + m_b)) removes
+// momentum and adds energy when the base moves against the slide; the map we use does not.
+TEST(SlidingStops, PrintedEq32WithEtaBelowOneAddsEnergy) {
+  const double eta = 0.5;
+  const Scene s =
+      make(with_sliding_stops(with_friction(testing::paper_isolated(0.0), 0.3, 0.24), eta));
+  Mode mode;
+  mode.phase = Phase::kSliding;
+  mode.slide_direction = 1;
+  State y = State::Zero();
+  y[kX] = 0.1;
+  y[kUDot] = -1.0;
+  y[kXDot] = 1.0;  // the block is still in the ground's frame, the base moves left
+  const double before = mechanical_energy(s, mode, y);
+  State printed = y;
+  printed[kUDot] += eta * s.m / s.total_mass * printed[kXDot];
+  printed[kXDot] = 0.0;
+  Mode stuck = mode;
+  stuck.phase = Phase::kFullContact;
+  EXPECT_GT(mechanical_energy(s, stuck, printed), before);
+  sliding_stop_hit_reset(s, 1, true, mode, y);
+  EXPECT_LE(mechanical_energy(s, mode, y), before);
+}
+
+// Random pre-impact states for the impact at theta = 0: sliding or not, either corner, inside
+// the support or overhanging it.
+struct ImpactCase {
+  Mode mode;
+  State y;
+};
+
+ImpactCase random_impact(const Scene& s, std::mt19937& rng, bool sliding) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  ImpactCase c;
+  c.mode.phase = sliding ? Phase::kSlideRocking : Phase::kRocking;
+  c.mode.corner = unit(rng) > 0 ? Corner::kLeft : Corner::kRight;
+  c.y = State::Zero();
+  c.y[kU] = 0.1 * unit(rng);
+  c.y[kUDot] = unit(rng);
+  if (s.params.has_support && unit(rng) > 0.0) {
+    c.mode.overhang = static_cast<std::int8_t>(unit(rng) > 0 ? 1 : -1);
+    c.y[kX] = c.mode.overhang * (s.params.support.clearance + 0.05 * std::fabs(unit(rng)));
+  }
+  if (sliding) {
+    c.y[kXDot] = 2.0 * unit(rng);
+    c.mode.slide_direction = static_cast<std::int8_t>(c.y[kXDot] > 0.0 ? 1 : -1);
+  }
+  // Returning to theta = 0 about the current corner.
+  c.y[kThetaDot] = -s.corner(c.mode.corner).sign * std::fabs(unit(rng));
+  return c;
+}
+
+// Impacts at theta = 0 with friction (coulomb_impact_reset): energy never grows, the horizontal
+// momentum is kept, friction bounds the tangential impulse, and the outcome is consistent
+// (sticking: x' = 0; sliding: x' has the sliding direction, |Pt| = mu_k Pn).
+TEST(CoulombImpact, EnergyNeverGrowsMomentumKept) {
+  std::mt19937 rng(9);
+  int slid = 0;
+  int stuck = 0;
+  for (const double mu : {0.0, 0.2, 0.5, 1.5}) {
+    SceneParams p = with_friction(testing::paper_isolated(0.25), mu, 0.8 * mu);
+    p.has_support = true;
+    p.support = {0.05};
+    const Scene s = make(p);
+    for (int i = 0; i < 500; ++i) {
+      ImpactCase c = random_impact(s, rng, i % 2 == 0);
+      const double energy = mechanical_energy(s, c.mode, c.y);
+      const double momentum = horizontal_momentum(s, c.mode, c.y);
+      const CoulombImpact r = coulomb_impact_reset(s, true, c.mode, c.y);
+      EXPECT_LE(mechanical_energy(s, c.mode, c.y), energy + 1e-12 * std::fabs(energy));
+      EXPECT_NEAR(horizontal_momentum(s, c.mode, c.y), momentum, 1e-12 * s.total_mass);
+      EXPECT_GE(r.normal_impulse, 0.0);
+      if (r.sticks) {
+        ++stuck;
+        EXPECT_EQ(c.mode.phase, Phase::kRocking);
+        EXPECT_EQ(c.y[kXDot], 0.0);
+        EXPECT_LE(std::fabs(r.tangential_impulse), mu * r.normal_impulse * (1 + 1e-12) + 1e-12);
+      } else {
+        ++slid;
+        EXPECT_EQ(c.mode.phase, Phase::kSlideRocking);
+        EXPECT_GT(c.y[kXDot] * c.mode.slide_direction, 0.0);
+        EXPECT_NEAR(r.tangential_impulse, -c.mode.slide_direction * 0.8 * mu * r.normal_impulse,
+                    1e-9 * r.normal_impulse + 1e-12);
+      }
+    }
+  }
+  EXPECT_GT(slid, 100);
+  EXPECT_GT(stuck, 100);
+}
+
+// Without sliding, and friction enough to hold the new corner, the Coulomb impact is the
+// rocking impact of Eqs 21-24 (corrected; resets.h), on the base and held.
+TEST(CoulombImpact, WithoutSlidingIsEqs21To24) {
+  std::mt19937 rng(3);
+  SceneParams p = with_friction(testing::paper_isolated(0.3), 5.0, 4.0);
+  p.has_support = true;
+  p.support = {0.05};
+  const Scene s = make(p);
+  for (const bool base_moves : {true, false}) {
+    for (int i = 0; i < 200; ++i) {
+      ImpactCase c = random_impact(s, rng, false);
+      if (!base_moves) c.y[kUDot] = 0.0;
+      Mode mode = c.mode;
+      State y = c.y;
+      const CoulombImpact r = coulomb_impact_reset(s, base_moves, c.mode, c.y);
+      rocking_impact_reset(s, base_moves, mode, y);
+      ASSERT_TRUE(r.sticks);
+      EXPECT_EQ(c.mode.corner, mode.corner);
+      EXPECT_EQ(c.mode.phase, Phase::kRocking);
+      for (Eigen::Index k = 0; k < 6; ++k) EXPECT_NEAR(c.y[k], y[k], 1e-12) << k;
+    }
+  }
+}
+
+// Section 3.3 keeps x' through an impact during slide-rocking (Eqs 21-22 with x' unchanged). The
+// block's kinetic energy has the cross term -m h x' theta', so that map adds energy when the
+// block slides fast the way C swings; the Coulomb impact on the same state does not.
+TEST(SlideRocking, PrintedImpactKeepingXDotAddsEnergy) {
+  const Scene s = make(with_friction(testing::paper_isolated(0.0), 0.4, 0.3));
+  Mode mode;
+  mode.phase = Phase::kSlideRocking;
+  mode.corner = Corner::kLeft;
+  mode.slide_direction = -1;
+  State y = State::Zero();
+  y[kThetaDot] = -0.5;  // returning to theta = 0 about corner 1
+  y[kXDot] = -4.0;      // sliding fast the same way C moves
+  const double before = mechanical_energy(s, mode, y);
+  Mode printed_mode = mode;
+  State printed = y;
+  rocking_impact_reset(s, true, printed_mode, printed);
+  printed_mode.phase = Phase::kSlideRocking;
+  EXPECT_GT(mechanical_energy(s, printed_mode, printed), before);
+  (void)coulomb_impact_reset(s, true, mode, y);
+  EXPECT_LE(mechanical_energy(s, mode, y), before);
+}
+
+// Energy never grows across base stops while sliding or slide-rocking (the block keeps its
+// absolute velocity while sliding).
+TEST(SlidingResets, BaseStopEnergyNeverGrows) {
   SceneParams p = with_friction(testing::paper_isolated(0.25), 0.4, 0.3);
   p.has_base_stops = true;
   p.base_stops = {0.2, 0.7};
@@ -289,82 +470,23 @@ TEST(SlidingResets, EnergyNeverGrows) {
     mode.phase = i % 2 == 0 ? Phase::kSliding : Phase::kSlideRocking;
     mode.corner = unit(rng) > 0 ? Corner::kLeft : Corner::kRight;
     mode.slide_direction = 1;
-    const double sign = s.corner(mode.corner).sign;
     State y = State::Zero();
     y[kU] = 0.2;
     y[kUDot] = 2.0 * std::fabs(unit(rng));
     y[kXDot] = unit(rng);
     if (mode.rocking()) {
-      y[kTheta] = sign * 0.2 * std::fabs(unit(rng));
+      y[kTheta] = s.corner(mode.corner).sign * 0.2 * std::fabs(unit(rng));
       y[kThetaDot] = unit(rng);
     }
     const double before = mechanical_energy(s, mode, y);
     State hit = y;
     base_stop_reset(s, 1, mode, hit);
     EXPECT_LE(mechanical_energy(s, mode, hit), before + 1e-12 * std::fabs(before));
-    if (mode.phase == Phase::kSliding) {  // the block's absolute velocity is kept
+    EXPECT_NEAR(hit[kUDot], -0.7 * y[kUDot], 1e-15);
+    if (mode.phase == Phase::kSliding) {
       EXPECT_NEAR(hit[kUDot] + hit[kXDot], y[kUDot] + y[kXDot], 1e-12);
-    } else {
-      State impact = y;
-      impact[kTheta] = 0.0;
-      impact[kThetaDot] = -sign * std::fabs(y[kThetaDot]);
-      Mode impact_mode = mode;
-      const double e = mechanical_energy(s, impact_mode, impact);
-      rocking_impact_reset(s, true, impact_mode, impact);
-      EXPECT_EQ(impact[kXDot], y[kXDot]) << "the impact leaves x' alone (Section 3.3)";
-      // With x' = 0 the impact map never adds energy (see the next test for x' != 0).
-      State still = impact;
-      still[kXDot] = 0.0;
-      State still_before = y;
-      still_before[kTheta] = 0.0;
-      still_before[kThetaDot] = -sign * std::fabs(y[kThetaDot]);
-      still_before[kXDot] = 0.0;
-      Mode still_mode = mode;
-      const double e_still = mechanical_energy(s, still_mode, still_before);
-      rocking_impact_reset(s, true, still_mode, still_before);
-      EXPECT_LE(mechanical_energy(s, still_mode, still_before), e_still + 1e-12 * std::fabs(e_still));
-      (void)still;
-      (void)e;
     }
   }
-}
-
-// Section 3.3 keeps x' through an impact during slide-rocking. The block's kinetic energy has
-// the cross term -m h x' theta', so the map can add energy when the block slides fast the
-// way C swings; an open modelling question (docs/model.md), kept visible here.
-TEST(SlideRocking, ImpactKeepingXDotCanAddEnergy) {
-  const Scene s = make(with_friction(testing::paper_isolated(0.0), 0.4, 0.3));
-  Mode mode;
-  mode.phase = Phase::kSlideRocking;
-  mode.corner = Corner::kLeft;
-  mode.slide_direction = -1;
-  State y = State::Zero();
-  y[kThetaDot] = -0.5;  // returning to theta = 0 about corner 1
-  y[kXDot] = -4.0;      // sliding fast the same way C moves
-  const double before = mechanical_energy(s, mode, y);
-  rocking_impact_reset(s, true, mode, y);
-  EXPECT_GT(mechanical_energy(s, mode, y), before);
-}
-
-// The printed Eq 32 with eta_s < 1 removes momentum: when the base moves against the slide it
-// can add energy. Documented in docs/model.md; this test keeps the fact visible.
-TEST(SlidingStops, PrintedEq32WithEtaBelowOneCanAddEnergy) {
-  SceneParams p = with_friction(testing::paper_isolated(0.0), 0.3, 0.24);
-  p.has_support = true;
-  p.support = {0.1};
-  p.has_sliding_stops = true;
-  p.sliding_stops = {0.0};
-  const Scene s = make(p);
-  Mode mode;
-  mode.phase = Phase::kSliding;
-  mode.slide_direction = 1;
-  State y = State::Zero();
-  y[kX] = 0.1;
-  y[kUDot] = -1.0;
-  y[kXDot] = 1.0;  // the block is still in the ground's frame, the base moves left
-  const double before = mechanical_energy(s, mode, y);
-  sliding_stop_hit_reset(s, 1, true, mode, y);
-  EXPECT_GT(mechanical_energy(s, mode, y), before);
 }
 
 }  // namespace

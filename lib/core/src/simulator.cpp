@@ -74,6 +74,9 @@ Error validate(const SolverSettings& st) {
   if (!std::isfinite(st.base_rest_speed) || st.base_rest_speed < 0.0) {
     return {ErrorCode::kOutOfRange, "solver.base_rest_speed", "must be finite and not negative"};
   }
+  if (!std::isfinite(st.slide_rest_speed) || st.slide_rest_speed < 0.0) {
+    return {ErrorCode::kOutOfRange, "solver.slide_rest_speed", "must be finite and not negative"};
+  }
   if (st.max_events_per_step < 1) {
     return {ErrorCode::kOutOfRange, "solver.max_events_per_step", "must be at least 1"};
   }
@@ -284,26 +287,39 @@ struct Stepper {
     emit(sim, t, EventKind::kRockingStop, 0, theta_dot_before);
   }
 
-  // Impact at theta = 0 (Eqs 21-24), or the end of rocking when it leaves less rocking energy
-  // than the rest criterion's fraction of the new pivot's overturning barrier.
+  // Impact at theta = 0 (Eqs 21-24; with friction, the Coulomb impact of resets.h), or the end
+  // of rocking when it leaves less rocking energy than the rest criterion's fraction of the new
+  // pivot's overturning barrier.
   static void rocking_impact(Simulator& sim, double t) {
     const Scene& s = *sim.scene_;
     const double before = sim.y_[kThetaDot];
+    const bool was_sliding = sim.mode_.sliding();
     Mode mode = sim.mode_;
     State y = sim.y_;
-    rocking_impact_reset(s, base_moves(mode), mode, y);
+    if constexpr (F.sliding) {
+      (void)coulomb_impact_reset(s, base_moves(mode), mode, y);
+    } else {
+      rocking_impact_reset(s, base_moves(mode), mode, y);
+    }
     const CornerGeometry to = pivot_of(s, mode, y).geometry;
     const double after = y[kThetaDot];
     const double barrier = s.m * s.g * (to.radius - s.h);
+    sim.mode_ = mode;
+    sim.y_ = y;
     if (after * before <= 0.0 ||
         0.5 * to.inertia * after * after < sim.settings_.rest_energy_ratio * barrier) {
       stop_rocking(sim, t, before);
-      enter(sim, t);
-      return;
+    } else {
+      emit(sim, t, EventKind::kImpact, 0, before, after);
     }
-    sim.mode_ = mode;
-    sim.y_ = y;
-    emit(sim, t, EventKind::kImpact, 0, before, after);
+    if (was_sliding != sim.mode_.sliding()) {
+      if (sim.mode_.sliding()) {
+        emit(sim, t, EventKind::kSlidingStart, sim.mode_.slide_direction);
+      } else {
+        emit(sim, t, EventKind::kSlidingStop);
+      }
+    }
+    enter(sim, t);
   }
 
   // x' reached 0: the block sticks if static friction can hold it (Eq 15 or 18 not met in the
@@ -326,11 +342,23 @@ struct Stepper {
     enter(sim, t);
   }
 
+  // |x| reached x_hat (Eqs 30-32 with restitution, resets.h): the block rebounds from the stop,
+  // or sticks against it once the rebound is slower than settings.slide_rest_speed (this ends
+  // the Zeno sequence of ever smaller rebounds of a block pressed against the stop).
   static void sliding_stop_hit(Simulator& sim, double t, int side) {
+    const Scene& s = *sim.scene_;
     const double before = sim.y_[kXDot];
-    sliding_stop_hit_reset(*sim.scene_, side, base_moves(sim.mode_), sim.mode_, sim.y_);
+    const double rebound = s.params.sliding_stops.restitution * std::fabs(before);
+    if (rebound < sim.settings_.slide_rest_speed) {
+      coordinate_impulse_reset(s, sim.mode_, base_moves(sim.mode_), kXDot, 0.0, sim.y_);
+      sim.y_[kX] = side * s.params.support.clearance;
+      sliding_stop_reset(sim.mode_, sim.y_);
+      emit(sim, t, EventKind::kSlideStopHit, side, before, sim.y_[kUDot]);
+      enter(sim, t);
+      return;
+    }
+    sliding_stop_hit_reset(s, side, base_moves(sim.mode_), sim.mode_, sim.y_);
     emit(sim, t, EventKind::kSlideStopHit, side, before, sim.y_[kUDot]);
-    enter(sim, t);
   }
 
   static void base_stop_hit(Simulator& sim, double t, int side) {

@@ -21,6 +21,8 @@ struct SolverSettings {
   double rest_energy_ratio = 1e-6;
   // The base is held at a stop when it rebounds slower than this while the stop pushes, m/s.
   double base_rest_speed = 1e-5;
+  // The block sticks against a sliding stop instead of rebounding slower than this, m/s.
+  double slide_rest_speed = 1e-5;
   // Events located within one step before the remaining ones are treated as chatter (Zeno):
   // rocking is brought to rest, sliding stopped and the base held, and the step finishes
   // without further events.
