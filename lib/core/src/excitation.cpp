@@ -28,6 +28,8 @@ GroundAcceleration Excitation::at(double t) const {
     case ExcitationKind::kCosinePulse:
       if (t < 0.0 || t > period) return {};
       return {amplitude * std::cos(2.0 * std::numbers::pi * t / period), 0.0};
+    case ExcitationKind::kStream:
+      return stream->at(t);
   }
   return {};
 }
@@ -42,6 +44,8 @@ double Excitation::duration() const {
     case ExcitationKind::kSinePulse:
     case ExcitationKind::kCosinePulse:
       return period;
+    case ExcitationKind::kStream:  // as far as samples have arrived
+      return stream->start_time + stream->period;
   }
   return 0.0;
 }
@@ -68,6 +72,13 @@ Excitation Excitation::cosine_pulse(double amplitude, double period) {
   e.kind = ExcitationKind::kCosinePulse;
   e.amplitude = amplitude;
   e.period = period;
+  return e;
+}
+
+Excitation Excitation::streamed(const GroundStream& stream) {
+  Excitation e;
+  e.kind = ExcitationKind::kStream;
+  e.stream = &stream;
   return e;
 }
 

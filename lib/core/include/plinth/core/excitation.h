@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 
 namespace plinth {
 
@@ -26,7 +27,40 @@ struct SampledSignal {
   }
 };
 
-enum class ExcitationKind : unsigned char { kNone, kRecord, kSinePulse, kCosinePulse };
+// Ground motion arriving sample by sample (the monitor): the two newest samples, linearly
+// interpolated between them, held at the newer one past it. The owner advances it one sample at
+// a time; an Excitation refers to it and must not outlive it.
+struct GroundStream {
+  double start_time = 0.0;  // s, time of `previous`
+  double period = 1.0;      // s, between the two samples
+  GroundAcceleration previous;
+  GroundAcceleration latest;
+  std::int64_t latest_index = 0;  // `latest` is sample n, at t = n period
+
+  [[nodiscard]] GroundAcceleration at(double t) const {
+    double w = (t - start_time) / period;
+    w = w < 0.0 ? 0.0 : (w > 1.0 ? 1.0 : w);
+    return {previous.horizontal + w * (latest.horizontal - previous.horizontal),
+            previous.vertical + w * (latest.vertical - previous.vertical)};
+  }
+  // The next sample arrives: the interval moves on by one period.
+  void push(GroundAcceleration sample) {
+    start_time = static_cast<double>(latest_index) * period;  // no drift over hours
+    ++latest_index;
+    previous = latest;
+    latest = sample;
+  }
+  // Sample 0 at t = 0: held until the next one arrives.
+  void reset(double sample_period, GroundAcceleration first) {
+    period = sample_period;
+    start_time = -sample_period;
+    latest_index = 0;
+    previous = first;
+    latest = first;
+  }
+};
+
+enum class ExcitationKind : unsigned char { kNone, kRecord, kSinePulse, kCosinePulse, kStream };
 
 struct Excitation {
   ExcitationKind kind = ExcitationKind::kNone;
@@ -35,6 +69,7 @@ struct Excitation {
   double scale = 1.0;        // gamma: multiplies the record (Section 4.2)
   double amplitude = 0.0;    // pulses: peak ground acceleration, m/s2
   double period = 0.0;       // pulses: duration of the single period, s
+  const GroundStream* stream = nullptr;  // kStream only
 
   [[nodiscard]] GroundAcceleration at(double t) const;
   // Time after which the ground is still, s.
@@ -45,6 +80,8 @@ struct Excitation {
   // One period of A sin(2 pi t / Tp) (or A cos(...)), zero outside [0, Tp].
   [[nodiscard]] static Excitation sine_pulse(double amplitude, double period);
   [[nodiscard]] static Excitation cosine_pulse(double amplitude, double period);
+  // Samples as they arrive; `stream` must outlive the excitation and its copies.
+  [[nodiscard]] static Excitation streamed(const GroundStream& stream);
 };
 
 }  // namespace plinth

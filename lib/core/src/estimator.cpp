@@ -1,0 +1,51 @@
+#include "plinth/core/estimator.h"
+
+#include <cmath>
+
+namespace plinth {
+
+Error validate(const EstimatorSettings& st, const Scene& scene) {
+  if (!std::isfinite(st.sample_rate_hz) || st.sample_rate_hz < 100.0 ||
+      st.sample_rate_hz > 1000.0) {
+    return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
+  }
+  if (st.steps_per_sample < 1 || st.steps_per_sample > 64) {
+    return {ErrorCode::kOutOfRange, "estimator.steps_per_sample", "must lie in [1, 64]"};
+  }
+  SolverSettings solver = st.solver;
+  solver.step = st.step();
+  if (Error e = validate(solver); !e.ok()) return e;
+  if (const double limit = largest_stable_step(scene); solver.step > limit) {
+    return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
+            "gives a solver step too large for a stable integration of this scene's base; "
+            "raise it so that 1 / (rate * steps) is below the limit",
+            limit};
+  }
+  return ok_error();
+}
+
+Error PlanarEstimator::start(const Scene& scene, const EstimatorSettings& settings,
+                             GroundAcceleration first) {
+  if (Error e = validate(settings, scene); !e.ok()) return e;
+  if (!std::isfinite(first.horizontal) || !std::isfinite(first.vertical)) {
+    return {ErrorCode::kNotFinite, "sample", "the first ground acceleration is not finite"};
+  }
+  SolverSettings solver = settings.solver;
+  solver.step = settings.step();
+  stream_.reset(settings.sample_period(), first);
+  if (Error e = Simulator::create(scene, Excitation::streamed(stream_), solver, simulator_);
+      !e.ok()) {
+    return e;
+  }
+  steps_per_sample_ = settings.steps_per_sample;
+  simulator_.start_at_rest();
+  started_ = true;
+  return ok_error();
+}
+
+void PlanarEstimator::push(GroundAcceleration sample) {
+  stream_.push(sample);
+  for (int i = 0; i < steps_per_sample_; ++i) simulator_.step();
+}
+
+}  // namespace plinth
