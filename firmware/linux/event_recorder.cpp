@@ -1,0 +1,174 @@
+#include "event_recorder.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "plinth/hal/candump_log.h"
+#include "plinth/host/input_error.h"
+
+namespace plinth::firmware {
+
+namespace {
+
+std::int64_t seconds_to_ns(double s) { return static_cast<std::int64_t>(std::llround(s * 1e9)); }
+
+std::size_t frames_in(double seconds, double rate_hz) {
+  return static_cast<std::size_t>(std::ceil(seconds * rate_hz)) + 16;
+}
+
+}  // namespace
+
+EventRecorder::EventRecorder(EventRecorderSettings settings) : settings_(std::move(settings)) {
+  const auto bad = [](const char* what) {
+    return host::InputError(std::string("event recorder: ") + what);
+  };
+  if (!std::isfinite(settings_.pre_trigger_s) || settings_.pre_trigger_s < 0.0 ||
+      settings_.pre_trigger_s > 3600.0) {
+    throw bad("the pre-trigger window must lie in [0, 3600] s");
+  }
+  if (!std::isfinite(settings_.post_trigger_s) || settings_.post_trigger_s < 0.0 ||
+      settings_.post_trigger_s > 3600.0) {
+    throw bad("the post-trigger window must lie in [0, 3600] s");
+  }
+  if (!std::isfinite(settings_.frame_rate_hz) || settings_.frame_rate_hz <= 0.0 ||
+      settings_.frame_rate_hz > 20000.0) {
+    throw bad("the frame rate bound must lie in (0, 20000] Hz");
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(settings_.directory, ec);
+  if (ec || !std::filesystem::is_directory(settings_.directory)) {
+    throw host::InputError("event recorder: cannot create the directory '" + settings_.directory +
+                           "': " + (ec ? ec.message() : std::string("not a directory")));
+  }
+  pre_ns_ = seconds_to_ns(settings_.pre_trigger_s);
+  post_ns_ = seconds_to_ns(settings_.post_trigger_s);
+  ring_.resize(frames_in(settings_.pre_trigger_s, settings_.frame_rate_hz));
+  const std::size_t capture_frames =
+      frames_in(settings_.pre_trigger_s + settings_.post_trigger_s, settings_.frame_rate_hz);
+  for (Capture& c : buffers_) c.frames.reserve(capture_frames);
+  spare_ = &buffers_[0];
+  writer_ = std::thread([this] { writer_loop(); });
+}
+
+EventRecorder::~EventRecorder() {
+  flush();
+  {
+    const std::lock_guard lock(mutex_);
+    stopping_ = true;
+  }
+  wake_.notify_one();
+  writer_.join();
+}
+
+void EventRecorder::on_frame(const hal::TimedFrame& frame) {
+  ring_[ring_next_] = frame;
+  ring_next_ = (ring_next_ + 1) % ring_.size();
+  if (ring_count_ < ring_.size()) ++ring_count_;
+  if (active_ == nullptr) return;
+  if (frame.timestamp_ns > active_->end_ns) {
+    hand_over();
+    return;
+  }
+  if (active_->frames.size() < active_->frames.capacity()) active_->frames.push_back(frame);
+}
+
+void EventRecorder::trigger(const TriggerInfo& info, std::int64_t time_ns) {
+  if (active_ != nullptr) {  // a later alarm within the capture: keep recording after it
+    active_->end_ns = time_ns + post_ns_;
+    return;
+  }
+  {
+    const std::lock_guard lock(mutex_);
+    active_ = spare_;
+    spare_ = nullptr;
+  }
+  if (active_ == nullptr) {  // both buffers busy: the writer is behind
+    dropped_.fetch_add(1);
+    return;
+  }
+  active_->frames.clear();  // keeps the capacity: no allocation
+  const std::size_t first = (ring_next_ + ring_.size() - ring_count_) % ring_.size();
+  for (std::size_t i = 0; i < ring_count_; ++i) {
+    const hal::TimedFrame& f = ring_[(first + i) % ring_.size()];
+    if (f.timestamp_ns >= time_ns - pre_ns_ && active_->frames.size() < active_->frames.capacity()) {
+      active_->frames.push_back(f);
+    }
+  }
+  active_->info = info;
+  active_->trigger_ns = time_ns;
+  active_->end_ns = time_ns + post_ns_;
+  active_->index = next_index_++;
+}
+
+void EventRecorder::flush() {
+  if (active_ != nullptr) hand_over();
+}
+
+void EventRecorder::hand_over() {
+  {
+    const std::lock_guard lock(mutex_);
+    to_write_ = active_;
+  }
+  active_ = nullptr;
+  wake_.notify_one();
+}
+
+std::vector<std::string> EventRecorder::written_paths() {
+  const std::lock_guard lock(mutex_);
+  return paths_;
+}
+
+void EventRecorder::writer_loop() {
+  for (;;) {
+    Capture* capture = nullptr;
+    {
+      std::unique_lock lock(mutex_);
+      wake_.wait(lock, [this] { return to_write_ != nullptr || stopping_; });
+      if (to_write_ == nullptr) return;  // stopping, nothing left
+      capture = to_write_;
+      to_write_ = nullptr;
+    }
+    write(*capture);
+    const std::lock_guard lock(mutex_);
+    // The other buffer may be active; this one is free again.
+    if (spare_ == nullptr) spare_ = capture;
+  }
+}
+
+void EventRecorder::write(const Capture& c) {
+  char stem[64];
+  std::snprintf(stem, sizeof stem, "event-%03d", c.index);
+  const std::filesystem::path dir(settings_.directory);
+  const std::string log_path = (dir / (std::string(stem) + ".log")).string();
+  const std::string json_path = (dir / (std::string(stem) + ".json")).string();
+  std::ofstream log(log_path);
+  for (const hal::TimedFrame& f : c.frames) {
+    log << hal::format_candump_line(f.timestamp_ns, settings_.interface_name, f.frame) << '\n';
+  }
+  log.flush();
+  std::ofstream json(json_path);
+  const double first = c.frames.empty() ? 0.0 : static_cast<double>(c.frames.front().timestamp_ns) * 1e-9;
+  const double last = c.frames.empty() ? 0.0 : static_cast<double>(c.frames.back().timestamp_ns) * 1e-9;
+  char numbers[256];
+  std::snprintf(numbers, sizeof numbers,
+                "\"t\":%.6f,\"frames\":%zu,\"first_frame_time\":%.6f,\"last_frame_time\":%.6f,"
+                "\"pre_trigger_s\":%g,\"post_trigger_s\":%g",
+                c.info.t, c.frames.size(), first, last, settings_.pre_trigger_s,
+                settings_.post_trigger_s);
+  json << "{\"event\":" << c.index << ",\"level\":\"" << c.info.level << "\",\"cause\":\""
+       << c.info.cause << "\"," << numbers << ",\"log\":\"" << log_path << '"';
+  if (!c.info.detail.empty()) json << ',' << c.info.detail;
+  json << "}\n";
+  json.flush();
+  if (!log || !json) {
+    write_errors_.fetch_add(1);
+    return;
+  }
+  written_.fetch_add(1);
+  const std::lock_guard lock(mutex_);
+  paths_.push_back(log_path);
+}
+
+}  // namespace plinth::firmware

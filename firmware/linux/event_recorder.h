@@ -1,0 +1,93 @@
+// The event recorder: the last pre_trigger_s of raw frames in a ring; on a trigger (an alarm)
+// it keeps that window and the following post_trigger_s, then hands the capture to a writer
+// thread that writes a candump log and a JSON summary. The real-time side (on_frame, trigger)
+// never allocates, blocks or does I/O: the ring and two capture buffers are allocated once at
+// start-up, and captures are handed over through a mutex held only for a pointer swap. When the
+// writer is still busy with an earlier capture, a new trigger extends the capture in progress;
+// a trigger while both buffers are full is counted (captures_dropped), never silently lost.
+#pragma once
+
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "plinth/hal/frame_io.h"
+
+namespace plinth::firmware {
+
+struct EventRecorderSettings {
+  std::string directory;       // where captures go (created if missing)
+  std::string interface_name = "can0";  // written in the candump log's lines
+  double pre_trigger_s = 30.0;   // s of frames kept before the trigger
+  double post_trigger_s = 60.0;  // s of frames kept after the (latest) trigger
+  double frame_rate_hz = 1000.0;  // upper bound of the frame rate, sizes the buffers
+};
+
+// What a capture's JSON summary says about its trigger; filled by the caller.
+struct TriggerInfo {
+  double t = 0.0;  // s, monitor time
+  std::string level;
+  std::string cause;
+  std::string detail;  // a JSON object's members, e.g. "\"risk\":0.82,\"phase\":\"rocking\""
+};
+
+class EventRecorder {
+ public:
+  // Throws plinth::host::InputError when the directory cannot be created or a setting is bad.
+  explicit EventRecorder(EventRecorderSettings settings);
+  ~EventRecorder();  // finishes any capture in progress and joins the writer
+  EventRecorder(const EventRecorder&) = delete;
+  EventRecorder& operator=(const EventRecorder&) = delete;
+
+  // Real-time side.
+  void on_frame(const hal::TimedFrame& frame);
+  void trigger(const TriggerInfo& info, std::int64_t time_ns);
+  // The input ended: the capture in progress is written with what it has.
+  void flush();
+
+  [[nodiscard]] std::uint64_t captures_written() const { return written_.load(); }
+  [[nodiscard]] std::uint64_t captures_dropped() const { return dropped_.load(); }
+  [[nodiscard]] std::uint64_t write_errors() const { return write_errors_.load(); }
+  // Paths of the files written so far (candump logs), for the summary.
+  [[nodiscard]] std::vector<std::string> written_paths();
+
+ private:
+  struct Capture {
+    std::vector<hal::TimedFrame> frames;  // capacity reserved once
+    TriggerInfo info;
+    std::int64_t trigger_ns = 0;
+    std::int64_t end_ns = 0;  // frames up to this receive time belong to the capture
+    int index = 0;
+  };
+
+  void hand_over();  // the active capture is complete
+  void writer_loop();
+  void write(const Capture& capture);
+
+  EventRecorderSettings settings_;
+  std::int64_t pre_ns_ = 0;
+  std::int64_t post_ns_ = 0;
+  std::vector<hal::TimedFrame> ring_;
+  std::size_t ring_next_ = 0;
+  std::size_t ring_count_ = 0;
+  Capture buffers_[2];
+  Capture* active_ = nullptr;  // the capture being filled, or none
+  Capture* spare_ = nullptr;   // free for the next capture, or none (the writer has it)
+  int next_index_ = 1;
+
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  Capture* to_write_ = nullptr;
+  bool stopping_ = false;
+  std::thread writer_;
+  std::vector<std::string> paths_;
+  std::atomic<std::uint64_t> written_{0};
+  std::atomic<std::uint64_t> dropped_{0};
+  std::atomic<std::uint64_t> write_errors_{0};
+};
+
+}  // namespace plinth::firmware
