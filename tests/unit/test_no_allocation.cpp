@@ -7,6 +7,8 @@
 #include <new>
 #include <string>
 
+#include "monitor_input.h"
+#include "plinth/firmware/monitor.h"
 #include "plinth/host/record_io.h"
 #include "test_support.h"
 
@@ -39,7 +41,7 @@ namespace {
 class CountingSink final : public EventSink {
  public:
   void on_event(const Event& e) override { ++counts[static_cast<int>(e.kind)]; }
-  long counts[8] = {};
+  long counts[32] = {};  // indexed by EventKind
 };
 
 TEST(NoAllocation, CounterSeesAllocations) {
@@ -80,6 +82,54 @@ TEST(NoAllocation, LongRunsWithEventsAllocateNothing) {
       EXPECT_GT(sink.counts[static_cast<int>(EventKind::kBaseStopHit)], 0);
     }
   }
+}
+
+// The box's loop over an hour of input at 200 Hz (quiet noise with a drifting sensor bias,
+// then Brienza scaled to overturn the block): nothing allocated after start-up, no alarm while
+// quiet, the block at rest and the bias followed, the alarm in the earthquake.
+TEST(NoAllocation, MonitorRunsAnHourWithoutAllocating) {
+  const Scene scene = testing::make(testing::paper_isolated(0.0));
+  const host::Record record = host::read_at2(
+      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
+      kStandardGravity);
+  const double quiet_s = 3600.0;
+  testing::QuietThenQuake input(200.0, quiet_s, record, 20.0);
+  firmware::MonitorConfig config;
+  config.estimator.sample_rate_hz = 200.0;
+  firmware::Monitor monitor;
+  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
+  CountingSink sink;
+  monitor.set_event_sink(0, &sink);
+  const long before = g_allocations.load();
+  long quiet_alarms = 0;
+  double peak_quiet_u = 0.0;
+  double alarm_t = -1.0;
+  for (long n = 0; n < input.size() && !monitor.status().axes[0].mode.terminal(); ++n) {
+    const firmware::MonitorUpdate u = monitor.on_sample(input.sample(n));
+    if (n % 2 == 0) (void)monitor.on_tick(input.sample(n).receive_time_ns);
+    const bool quiet = n < input.quiet_samples();
+    for (std::size_t i = 0; i < u.event_count; ++i) {
+      const can::AlarmLevel level = u.events[i].level;
+      if (quiet && level != can::AlarmLevel::kNormal && level != can::AlarmLevel::kFault) {
+        ++quiet_alarms;
+      }
+      if (!quiet && level == can::AlarmLevel::kAlarm && alarm_t < 0.0) alarm_t = input.time(n);
+    }
+    if (quiet) peak_quiet_u = std::fmax(peak_quiet_u, std::fabs(monitor.status().axes[0].state[kU]));
+    if (n == input.quiet_samples() - 1) {
+      const Eigen::Vector3d error =
+          monitor.conditioning().offset_m_s2 - input.bias_g(n) * kStandardGravity;
+      EXPECT_LT(error.cwiseAbs().maxCoeff(), 1e-3 * kStandardGravity);
+      EXPECT_EQ(monitor.status().axes[0].mode.phase, Phase::kFullContact);
+    }
+  }
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_EQ(quiet_alarms, 0);
+  EXPECT_LT(peak_quiet_u, 1e-3);
+  EXPECT_GT(alarm_t, quiet_s);
+  EXPECT_EQ(monitor.status().axes[0].mode.phase, Phase::kOverturned);
+  EXPECT_GT(sink.counts[static_cast<int>(EventKind::kRockingStart)], 0);
+  EXPECT_EQ(monitor.status().sensor.counters.faults, 0U);  // (the start-up state is not an entry)
 }
 
 }  // namespace

@@ -17,7 +17,8 @@ Error validate(const MonitorConfig& c) {
   if (Error e = validate(c.risk); !e.ok()) return e;
   if (Error e = monitor::validate(c.alarm); !e.ok()) return e;
   // The sensor's period is the estimator's sample period: checked with the values start() uses.
-  if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz <= 0.0) {
+  if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz < 100.0 ||
+      c.estimator.sample_rate_hz > 1000.0) {
     return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
   }
   monitor::ConditioningSettings conditioning = c.conditioning;

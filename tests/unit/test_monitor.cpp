@@ -1,0 +1,274 @@
+// The box's loop (firmware/monitor): frames and samples in, phase, risk and alarms out.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "monitor_input.h"
+#include "plinth/firmware/monitor.h"
+#include "plinth/host/record_io.h"
+#include "test_support.h"
+
+namespace plinth {
+namespace {
+
+namespace fw = firmware;
+using testing::RecordingSink;
+
+const std::string kSource = PLINTH_SOURCE_DIR;
+
+host::Record brienza() {
+  return host::read_at2(kSource + "/sim/data/records/irpinia1980_brienza_000.AT2",
+                        kStandardGravity);
+}
+
+std::int64_t ns(double seconds) { return std::llround(seconds * 1e9); }
+
+// A record replayed as exact samples (m/s2, z reads g): after the lead-in the estimator starts
+// at the record's first sample and gives the simulator's events at the simulator's times.
+TEST(Monitor, RecordReplayGivesTheSimulatorsEvents) {
+  const Scene scene = testing::make(testing::paper_isolated(0.0));
+  const host::Record record = brienza();
+  const double gamma = 20.0;
+  fw::MonitorConfig config;
+  config.estimator.sample_rate_hz = 1.0 / record.dt;
+  config.estimator.steps_per_sample = 4;
+  config.conditioning.unit = monitor::AccelerationUnit::kMetresPerSecondSquared;
+  config.conditioning.startup_window_s = 1.0;
+  config.conditioning.tracking_time_constant_s = 1e6;
+  config.sensor_health.stuck_samples = 0;
+  config.sensor_health.full_scale_g = 1e6;  // the samples are in m/s2, not g
+  config.sensor_health.max_valid_g = 1e6;
+  fw::Monitor monitor;
+  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
+  RecordingSink estimated;
+  monitor.set_event_sink(0, &estimated);
+  const long lead_in = std::lround(config.conditioning.startup_window_s / record.dt) +
+                       config.sensor_health.recovery_samples - 1;
+  const long total = lead_in + static_cast<long>(record.horizontal.size());
+  for (long n = 0; n < total && !monitor.status().axes[0].mode.terminal(); ++n) {
+    monitor::SensorSample s;
+    s.receive_time_ns = ns(static_cast<double>(n) * record.dt);
+    s.sequence = static_cast<std::uint8_t>(n & 0xFF);
+    const double a = n < lead_in ? 0.0 : gamma * record.horizontal[static_cast<std::size_t>(n - lead_in)];
+    s.acceleration_g = Eigen::Vector3d(a, 0.0, kStandardGravity);
+    (void)monitor.on_sample(s);
+  }
+  EXPECT_EQ(monitor.status().estimator_start_ns, ns(static_cast<double>(lead_in) * record.dt));
+  EXPECT_EQ(monitor.status().estimator_restarts, 1U);
+
+  RecordingSink reference;
+  SolverSettings solver;
+  solver.step = config.estimator.step();
+  (void)testing::run(scene, Excitation::record(record.horizontal_signal(), {}, gamma),
+                     record.duration(), solver.step, &reference);
+  ASSERT_GE(reference.events.size(), 2U);
+  ASSERT_EQ(estimated.events.size(), reference.events.size());
+  for (std::size_t i = 0; i < reference.events.size(); ++i) {
+    EXPECT_EQ(estimated.events[i].kind, reference.events[i].kind);
+    // 1e-8 s: the offset tracking (time constant 1e6 s) still moves by ~1e-9 m/s2 while quiet.
+    EXPECT_NEAR(estimated.events[i].t, reference.events[i].t, 1e-8);
+  }
+  EXPECT_EQ(monitor.status().alarm, can::AlarmLevel::kAlarm);
+}
+
+can::CanFrame sensor_frame(std::uint8_t node, std::uint8_t sequence, double ax_g) {
+  can::SensorAcceleration m;
+  m.node = node;
+  m.ax_g = ax_g;
+  m.az_g = 1.0;
+  m.sequence = sequence;
+  can::CanFrame f;
+  EXPECT_TRUE(can::encode(m, f).ok());
+  return f;
+}
+
+fw::MonitorConfig quick_config() {
+  fw::MonitorConfig config;
+  config.estimator.sample_rate_hz = 200.0;
+  config.conditioning.startup_window_s = 0.5;
+  config.sensor_health.stuck_samples = 0;
+  return config;
+}
+
+// Garbled, foreign and truncated frames are counted and refused; nothing reaches the solver.
+TEST(Monitor, FramesAreDecodedCountedOrRefused) {
+  const Scene scene = testing::make(testing::paper_isolated(0.0));
+  fw::Monitor monitor;
+  ASSERT_TRUE(monitor.start(quick_config(), {&scene, nullptr}).ok());
+  std::int64_t t = 0;
+  const auto feed = [&](const can::CanFrame& f) {
+    t += ns(0.005);
+    return monitor.on_frame({f, t});
+  };
+  for (int n = 0; n < 10; ++n) (void)feed(sensor_frame(1, static_cast<std::uint8_t>(n), 0.0));
+  (void)feed(sensor_frame(2, 0, 0.0));  // another node
+  can::CanFrame short_frame = sensor_frame(1, 10, 0.0);
+  short_frame.length = 3;
+  (void)feed(short_frame);
+  can::CanFrame reserved = sensor_frame(1, 10, 0.0);
+  reserved.data[7] |= 0xF0;  // status bits 4-7 are reserved
+  (void)feed(reserved);
+  can::CanFrame foreign;
+  foreign.id = 0x123;
+  foreign.length = 8;
+  (void)feed(foreign);
+  can::CanFrame heartbeat;
+  ASSERT_TRUE(can::encode(can::SensorHeartbeat{1, 100, 1, 2, 0, 0, 0}, heartbeat).ok());
+  (void)feed(heartbeat);
+  can::CanFrame status;
+  ASSERT_TRUE(can::encode(can::MonitorStatus{}, status).ok());
+  (void)feed(status);
+  const fw::FrameCounters& c = monitor.frames();
+  EXPECT_EQ(c.received, 16U);
+  EXPECT_EQ(c.sensor_samples, 10U);
+  EXPECT_EQ(c.other_nodes, 1U);
+  EXPECT_EQ(c.rejected, 2U);
+  EXPECT_EQ(c.unknown_identifiers, 1U);
+  EXPECT_EQ(c.heartbeats, 1U);
+  EXPECT_EQ(c.monitor_frames, 1U);
+  EXPECT_EQ(c.last_error, can::CodecError::kReservedBitsSet);
+  EXPECT_EQ(monitor.status().sensor.counters.received, 10U);
+}
+
+// The ground sensor goes silent: fault (sensor timeout) within the timeout; when it comes back
+// the estimator starts again at rest and the fault clears.
+TEST(Monitor, SensorSilenceIsAFaultAndTheEstimatorRestartsAfterIt) {
+  const Scene scene = testing::make(testing::paper_isolated(0.0));
+  fw::MonitorConfig config = quick_config();
+  fw::Monitor monitor;
+  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
+  std::uint8_t sequence = 0;
+  std::int64_t t = 0;
+  const auto feed_for = [&](double seconds) {
+    for (int n = 0; n < std::lround(seconds * 200.0); ++n) {
+      (void)monitor.on_frame({sensor_frame(1, sequence++, 0.0), t});
+      t += ns(0.005);
+    }
+  };
+  feed_for(4.0);
+  ASSERT_TRUE(monitor.status().estimating);
+  EXPECT_EQ(monitor.status().alarm, can::AlarmLevel::kNormal);
+  EXPECT_EQ(monitor.status().estimator_restarts, 1U);
+  // Silence: ticks every 10 ms; the fault comes within timeout_s (+ one tick).
+  const std::int64_t last = t - ns(0.005);
+  std::int64_t fault_at = -1;
+  for (int k = 1; k <= 30 && fault_at < 0; ++k) {
+    const fw::MonitorUpdate u = monitor.on_tick(last + ns(0.01 * k));
+    for (std::size_t i = 0; i < u.event_count; ++i) {
+      if (u.events[i].level == can::AlarmLevel::kFault) {
+        EXPECT_EQ(u.events[i].cause, can::AlarmCause::kSensorTimeout);
+        fault_at = last + ns(0.01 * k);
+      }
+    }
+  }
+  ASSERT_GT(fault_at, 0);
+  EXPECT_LE(fault_at - last, ns(config.sensor_health.timeout_s + 0.01));
+  t = fault_at + ns(1.0);
+  feed_for(4.0);
+  EXPECT_EQ(monitor.status().estimator_restarts, 2U);
+  EXPECT_EQ(monitor.status().alarm, can::AlarmLevel::kNormal);
+  EXPECT_EQ(monitor.status().sensor.counters.timeouts, 1U);
+}
+
+// A collapse latches the alarm; an Acknowledge frame quoting the latest event releases the
+// latch, the alarm stays (its condition holds), a stale one changes nothing.
+TEST(Monitor, AcknowledgeFrameReleasesTheLatch) {
+  const Scene scene = testing::make(testing::paper_block(0.0));
+  fw::Monitor monitor;
+  ASSERT_TRUE(monitor.start(quick_config(), {&scene, nullptr}).ok());
+  std::int64_t t = 0;
+  std::uint8_t sequence = 0;
+  std::uint8_t last_event = 0;
+  // Quiet start-up, then a 1 s push of 0.6 g: the non-isolated block (b1/h = 1/3) overturns.
+  for (int n = 0; n < 1400 && !monitor.status().axes[0].mode.terminal(); ++n) {
+    const double a = n >= 400 && n < 600 ? 0.6 : 0.0;
+    const fw::MonitorUpdate u = monitor.on_frame({sensor_frame(1, sequence++, a), t});
+    for (std::size_t i = 0; i < u.event_count; ++i) last_event = u.events[i].sequence;
+    t += ns(0.005);
+  }
+  ASSERT_EQ(monitor.status().axes[0].mode.phase, Phase::kOverturned);
+  ASSERT_EQ(monitor.status().alarm, can::AlarmLevel::kAlarm);
+  ASSERT_EQ(monitor.status().latched, can::AlarmLevel::kAlarm);
+  can::CanFrame ack;
+  ASSERT_TRUE(can::encode(can::Acknowledge{can::AlarmLevel::kAlarm, 7,
+                                           static_cast<std::uint8_t>(last_event + 1)}, ack).ok());
+  EXPECT_EQ(monitor.on_frame({ack, t}).acknowledgement, monitor::AckOutcome::kStale);
+  ASSERT_TRUE(can::encode(can::Acknowledge{can::AlarmLevel::kAlarm, 7, last_event}, ack).ok());
+  EXPECT_EQ(monitor.on_frame({ack, t}).acknowledgement,
+            monitor::AckOutcome::kReleasedConditionHolds);
+  EXPECT_EQ(monitor.status().alarm, can::AlarmLevel::kAlarm);
+  EXPECT_EQ(monitor.frames().acknowledgements, 2U);
+}
+
+TEST(Monitor, RefusesBadConfigurationNamingTheField) {
+  const Scene scene = testing::make(testing::paper_isolated(0.0));
+  fw::Monitor monitor;
+  fw::MonitorConfig c = quick_config();
+  c.axis_count = 3;
+  EXPECT_STREQ(monitor.start(c, {&scene, &scene}).field, "monitor.axis_count");
+  c = quick_config();
+  c.axis_count = 2;
+  EXPECT_STREQ(monitor.start(c, {&scene, nullptr}).field, "monitor.axis_count");
+  c = quick_config();
+  c.ground_node = 0;
+  EXPECT_STREQ(monitor.start(c, {&scene, nullptr}).field, "monitor.ground_node");
+  c = quick_config();
+  c.quiet_risk = std::nan("");
+  EXPECT_STREQ(monitor.start(c, {&scene, nullptr}).field, "monitor.quiet_risk");
+  c = quick_config();
+  c.estimator.sample_rate_hz = 5000.0;
+  EXPECT_STREQ(monitor.start(c, {&scene, nullptr}).field, "estimator.sample_rate_hz");
+  c = quick_config();
+  c.alarm.warning.off = 0.9;
+  EXPECT_FALSE(monitor.start(c, {&scene, nullptr}).ok());
+}
+
+// Quiet noise with a drifting sensor bias, then an earthquake that overturns the block: no
+// alarm in the quiet part (only the start-up fault), the bias followed, the block at rest, and
+// the alarm in the earthquake, ahead of the overturn. (An hour of it, counting allocations, is
+// in test_no_allocation.cpp.)
+void quiet_then_quake(double quiet_s) {
+  const Scene scene = testing::make(testing::paper_isolated(0.0));
+  testing::QuietThenQuake input(200.0, quiet_s, brienza(), 20.0);
+  fw::MonitorConfig config;
+  config.estimator.sample_rate_hz = 200.0;
+  fw::Monitor monitor;
+  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
+  double peak_quiet_u = 0.0;
+  double alarm_t = -1.0;
+  double false_alarm_t = -1.0;
+  for (long n = 0; n < input.size(); ++n) {
+    const fw::MonitorUpdate u = monitor.on_sample(input.sample(n));
+    const bool quiet = n < input.quiet_samples();
+    for (std::size_t i = 0; i < u.event_count; ++i) {
+      const can::AlarmLevel level = u.events[i].level;
+      if (quiet && level != can::AlarmLevel::kNormal && level != can::AlarmLevel::kFault &&
+          false_alarm_t < 0.0) {
+        false_alarm_t = input.time(n);
+      }
+      if (!quiet && level == can::AlarmLevel::kAlarm && alarm_t < 0.0) alarm_t = input.time(n);
+    }
+    if (quiet && monitor.status().estimating) {
+      peak_quiet_u = std::fmax(peak_quiet_u, std::fabs(monitor.status().axes[0].state[kU]));
+      ASSERT_EQ(monitor.status().axes[0].mode.phase, Phase::kFullContact) << input.time(n);
+    }
+    if (n == input.quiet_samples() - 1) {
+      const Eigen::Vector3d bias = input.bias_g(n) * kStandardGravity;
+      const Eigen::Vector3d error = monitor.conditioning().offset_m_s2 - bias;
+      EXPECT_LT(error.cwiseAbs().maxCoeff(), 1e-3 * kStandardGravity) << error.x() << " " << error.y() << " " << error.z();
+    }
+    if (monitor.status().axes[0].mode.terminal()) break;
+  }
+  EXPECT_LT(false_alarm_t, 0.0) << "false alarm at t = " << false_alarm_t;
+  EXPECT_LT(peak_quiet_u, 1e-3);
+  ASSERT_GT(alarm_t, 0.0);
+  EXPECT_EQ(monitor.status().axes[0].mode.phase, Phase::kOverturned);
+  EXPECT_LT(alarm_t, quiet_s + 10.65);  // the overturn, from RecordReplayGivesTheSimulatorsEvents
+}
+
+TEST(Monitor, QuietThenQuakeFiveMinutes) { quiet_then_quake(300.0); }
+
+}  // namespace
+}  // namespace plinth
