@@ -1,0 +1,198 @@
+// Alarm policy: turns the estimator's risk and phase, the collapse detector and the fault
+// state into alarm levels and events for the building's alarm system (CAN AlarmEvent frames,
+// status lines). Levels and causes are the CAN protocol's (plinth::can::AlarmLevel, AlarmCause).
+//
+// Conditions, each with on/off thresholds on the risk (hysteresis: the condition starts at
+// risk >= on and ends at risk < off, off < on) and minimum durations (a condition must hold for
+// raise_hold_s before its level is raised, and be absent for lower_hold_s before it is lowered):
+//   advisory  risk >= advisory.on, or the block is out of full contact (motion started)
+//   warning   risk >= warning.on
+//   alarm     risk >= alarm.on; or a collapse (overturned, fell): alarm at once, no hold, latched
+// The condition level is the highest level whose condition is active.
+//
+// Latching: when the condition level rises to warning (latch_warning) or alarm (latch_alarm,
+// or any collapse), that level latches: the level shown stays at least there until an operator
+// acknowledges it. An acknowledgement names the latched level and quotes the sequence of the
+// latest event; otherwise it changes nothing and the outcome says why (stale sequence, wrong
+// level, nothing latched). An accepted acknowledgement releases the latch: the level then
+// follows its condition, so acknowledging an alarm whose condition still holds keeps the
+// alarm (it lowers later without another acknowledgement), and a condition already active is
+// not latched again until it ends and rises anew.
+//
+// Fault: fault_active (sensor or bus trouble; an invalid risk input counts as an internal
+// fault) raises the fault level at once; it ends lower_hold_s after fault_active clears. The
+// level shown is: alarm if the risk level (condition or latched) is alarm, else fault while a
+// fault is active, else the risk level. A fault never hides an alarm; it does hide a warning or
+// advisory (the risk behind them is stale while the input is not trusted), which show again,
+// with an event, when the fault ends; their conditions and latches keep evolving beneath.
+//
+// Events: one each time the level shown or its latched flag changes (at most two per update:
+// the acknowledgement is applied first, against what the operator saw, then the new input).
+// Sequence numbers start at 0 and increment by one per event, wrapping 255 -> 0. Cause: why the
+// new level holds (kRiskThreshold, kPhaseChange, kOverturnDetected, the fault's cause), kNone
+// back to normal, kAcknowledged for a change an acknowledgement made.
+//
+// Heartbeat: a status is due every heartbeat_period_s, and at once after an event;
+// next_heartbeat_ns() says when, heartbeat_sent() records that one went out.
+//
+// Times are int64 ns of monitor time since start, never decreasing (an update with an earlier
+// time is refused and reported). Freestanding: no heap, no exceptions.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+
+#include "plinth/core/error.h"
+#include "plinth/hal/can_codec.h"
+
+namespace plinth::monitor {
+
+using AlarmLevel = can::AlarmLevel;
+using AlarmCause = can::AlarmCause;
+
+struct RiskThresholds {
+  double on = 0.0;   // risk (dimensionless, 0..1) at or above which the condition starts
+  double off = 0.0;  // risk below which it ends; off < on
+};
+
+struct AlarmPolicySettings {
+  RiskThresholds advisory{0.1, 0.05};  // also active while the block is out of full contact
+  RiskThresholds warning{0.5, 0.4};
+  RiskThresholds alarm{0.8, 0.7};
+  double raise_hold_s = 0.1;  // s, >= 0: a condition holds this long before its level rises
+  double lower_hold_s = 2.0;  // s, >= 0: a condition (or fault) is gone this long before it lowers
+  bool latch_warning = true;  // a raised warning holds until acknowledged
+  bool latch_alarm = true;    // a raised alarm holds until acknowledged (a collapse always does)
+  double heartbeat_period_s = 1.0;  // s, > 0: longest time between two status messages
+};
+
+// Checks the settings; the Error names the field at fault ("alarm_policy.warning.off", ...).
+// Thresholds: finite, in [0, 1], off < on per level, and ordered across levels (advisory <=
+// warning <= alarm, for on and for off).
+[[nodiscard]] Error validate(const AlarmPolicySettings& settings);
+
+// An operator's acknowledgement (the CAN Acknowledge frame without its source id).
+struct Acknowledgement {
+  AlarmLevel level = AlarmLevel::kNormal;  // the latched level acknowledged
+  std::uint8_t event_sequence = 0;         // the sequence of the latest event the operator saw
+};
+
+struct AlarmInput {
+  std::int64_t time_ns = 0;          // monitor time since start, ns
+  double risk = 0.0;                 // overturning risk, dimensionless, [0, 1]
+  bool out_of_full_contact = false;  // the block slides or rocks (motion started)
+  bool collapse_detected = false;    // the block overturned or fell
+  bool fault_active = false;         // sensor or bus trouble
+  AlarmCause fault_cause = AlarmCause::kSensorFault;  // reported while fault_active
+  bool acknowledged = false;  // `acknowledgement` arrived since the last update
+  Acknowledgement acknowledgement;
+};
+
+enum class AckOutcome : std::uint8_t {
+  kNone = 0,                // no acknowledgement in this update
+  kReleased,                // latch released; the level follows its (lower) condition
+  kReleasedConditionHolds,  // latch released; the condition still holds, so does the level
+  kStale,                   // the sequence is not the latest event's: nothing changed
+  kWrongLevel,              // the level is not the latched one: nothing changed
+  kNothingLatched,          // no level is latched: nothing changed
+};
+
+enum class InputProblem : std::uint8_t {
+  kNone = 0,
+  kRiskInvalid,   // risk not finite or outside [0, 1]: taken as an internal fault
+  kTimeWentBack,  // time earlier than the last update's: the update was refused
+};
+
+[[nodiscard]] const char* ack_outcome_name(AckOutcome outcome);
+[[nodiscard]] const char* input_problem_name(InputProblem problem);
+
+struct AlarmEventRecord {
+  AlarmLevel level = AlarmLevel::kNormal;
+  AlarmLevel previous_level = AlarmLevel::kNormal;
+  AlarmCause cause = AlarmCause::kNone;
+  bool latched = false;      // a level is latched, awaiting acknowledgement
+  std::int64_t time_ns = 0;  // the update's time
+  std::uint8_t sequence = 0;
+};
+
+// The CAN AlarmEvent of a record: time in whole ms since start, wrapping after 2^32 ms.
+[[nodiscard]] can::AlarmEvent to_can_event(const AlarmEventRecord& record);
+
+inline constexpr std::size_t kMaxEventsPerUpdate = 2;
+
+struct AlarmOutput {
+  std::array<AlarmEventRecord, kMaxEventsPerUpdate> events{};  // events[0 .. event_count)
+  std::size_t event_count = 0;
+  AlarmLevel level = AlarmLevel::kNormal;          // the level shown after this update
+  AlarmLevel latched_level = AlarmLevel::kNormal;  // kNormal when nothing is latched
+  AckOutcome acknowledgement = AckOutcome::kNone;
+  InputProblem input_problem = InputProblem::kNone;
+};
+
+namespace detail {
+// A boolean that changes only after the wanted value has differed for a hold time.
+struct HeldCondition {
+  bool active = false;
+  bool changing = false;       // the wanted value differs from `active`
+  std::int64_t since_ns = 0;   // since when it differs
+  void update(bool wanted, std::int64_t now_ns, std::int64_t raise_hold_ns,
+              std::int64_t lower_hold_ns);
+};
+}  // namespace detail
+
+class AlarmPolicy {
+ public:
+  AlarmPolicy() = default;
+
+  // Fails on invalid settings (the Error names the field); `out` is then left untouched.
+  [[nodiscard]] static Error create(const AlarmPolicySettings& settings, AlarmPolicy& out);
+
+  [[nodiscard]] AlarmOutput update(const AlarmInput& input);
+
+  [[nodiscard]] AlarmLevel level() const { return level_; }
+  [[nodiscard]] AlarmLevel latched_level() const { return latched_level_; }
+  // When the next status / heartbeat is due, ns (the lowest int64 before the first one: due).
+  [[nodiscard]] std::int64_t next_heartbeat_ns() const { return next_heartbeat_ns_; }
+  [[nodiscard]] bool heartbeat_due(std::int64_t now_ns) const {
+    return now_ns >= next_heartbeat_ns_;
+  }
+  void heartbeat_sent(std::int64_t now_ns);
+
+  [[nodiscard]] const AlarmPolicySettings& settings() const { return settings_; }
+
+ private:
+  [[nodiscard]] AckOutcome acknowledge(const Acknowledgement& ack);
+  void evaluate_conditions(const AlarmInput& input, bool risk_valid);
+  [[nodiscard]] AlarmLevel shown_level() const;
+  [[nodiscard]] AlarmCause cause_of(AlarmLevel level) const;
+  void emit_if_changed(AlarmOutput& out, std::int64_t time_ns, bool by_acknowledgement);
+
+  AlarmPolicySettings settings_;
+  std::int64_t raise_hold_ns_ = 0;
+  std::int64_t lower_hold_ns_ = 0;
+  std::int64_t heartbeat_period_ns_ = 0;
+
+  detail::HeldCondition advisory_;
+  detail::HeldCondition warning_;
+  detail::HeldCondition alarm_;
+  detail::HeldCondition fault_;
+  bool collapse_ = false;      // the latest input's collapse_detected
+  bool out_of_contact_ = false;  // the latest input's out_of_full_contact
+  AlarmCause fault_cause_ = AlarmCause::kNone;
+  AlarmLevel condition_level_ = AlarmLevel::kNormal;
+  AlarmLevel latched_level_ = AlarmLevel::kNormal;
+  AlarmCause latched_cause_ = AlarmCause::kNone;
+
+  AlarmLevel level_ = AlarmLevel::kNormal;  // shown
+  bool latched_shown_ = false;              // the latched flag of the last event
+  bool any_event_ = false;
+  std::uint8_t next_sequence_ = 0;
+  std::uint8_t last_event_sequence_ = 0;
+  bool started_ = false;
+  std::int64_t last_time_ns_ = 0;
+  std::int64_t next_heartbeat_ns_ = std::numeric_limits<std::int64_t>::min();
+};
+
+}  // namespace plinth::monitor

@@ -1,0 +1,127 @@
+// Conditioning: one per sensor, between sensor health and the estimator. Turns the sensor's
+// samples (its units, its mounting) into the ground acceleration in the statue frame, m/s2:
+// x, y the statue's first and second principal horizontal axes, z up, z relative to gravity
+// (the vertical channel is v_G'' = a_z - g, so g + v_G'' is the normal-force term of the model).
+//
+//   statue = R * (unit_scale * sensor)             R = sensor_to_statue, unit_scale 1 or g0
+//   ground = statue - (0, 0, g0) - offset          g0 = 9.80665 m/s2 (kStandardGravity)
+//
+// Offset: the sensor's bias, in the statue frame. A start-up window of startup_window_s of
+// samples (the monitor should be started while the ground is quiet) gives its estimate, the
+// window's mean of statue - (0, 0, g0); until the window is full the output is not ready. At
+// the end the window is rejected and a new one begins when the standard deviation of an axis
+// exceeds startup_max_std_m_s2 (the ground was not quiet) or an offset component exceeds
+// startup_max_offset_m_s2 (a wrong mounting rotation or unit would put gravity there); each
+// rejection is counted and the last one's reason kept.
+//
+// Slow tracking: once ready, a first-order low-pass with time constant tracking_time_constant_s
+// follows the offset (temperature drift), applied to a sample only when the caller says the
+// block is at rest and the ground quiet, and only when every component of that sample's output
+// stays within tracking_gate_m_s2: an earthquake (even one the caller has not noticed yet)
+// is never averaged into the offset. A persistent jump beyond the gate is not followed either:
+// status().consecutive_gated counts quiet samples refused by the gate, for the caller to judge.
+//
+// Non-finite input is refused (not ready for that sample, counted); the state is unchanged.
+// Freestanding: no heap, no exceptions; Eigen fixed-size types.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+#include "plinth/core/error.h"
+
+namespace plinth::monitor {
+
+// The unit of the sensor's samples. g is standard gravity, 9.80665 m/s2.
+enum class AccelerationUnit : std::uint8_t { kStandardGravity = 0, kMetresPerSecondSquared = 1 };
+
+struct ConditioningSettings {
+  AccelerationUnit unit = AccelerationUnit::kStandardGravity;
+  // Rotation from the sensor frame to the statue frame (statue = R * sensor). Must be
+  // orthonormal (every element of R^T R - I within rotation_tolerance) with det R = +1
+  // (within rotation_tolerance): a reflection means an axis is wired or declared backwards.
+  Eigen::Matrix3d sensor_to_statue = Eigen::Matrix3d::Identity();
+  double rotation_tolerance = 1e-3;  // dimensionless, in (0, 0.1]
+  double sample_period_s = 0.001;    // the stream's sample period, s
+  double startup_window_s = 10.0;    // s, at least 2 samples long
+  double startup_max_std_m_s2 = 0.05;     // m/s2, per axis, over the start-up window
+  double startup_max_offset_m_s2 = 1.0;   // m/s2, per axis of the estimated offset
+  double tracking_time_constant_s = 600.0;  // s, of the offset's low-pass while quiet
+  double tracking_gate_m_s2 = 0.1;  // m/s2: a quiet sample beyond this on an axis is not tracked
+};
+
+// Checks the settings; the Error names the field at fault ("conditioning.sensor_to_statue", ...).
+[[nodiscard]] Error validate(const ConditioningSettings& settings);
+
+enum class StartupRejection : std::uint8_t {
+  kNone = 0,
+  kTooNoisy,        // an axis's standard deviation exceeded startup_max_std_m_s2
+  kOffsetTooLarge,  // an offset component exceeded startup_max_offset_m_s2
+};
+
+// What conditioning did with the offset on one sample.
+enum class OffsetTracking : std::uint8_t {
+  kStartup,       // the start-up window is still collecting (the sample went into it)
+  kNotQuiet,      // the caller said not quiet: offset held
+  kGated,         // quiet, but the sample exceeded tracking_gate_m_s2: offset held
+  kTracked,       // the offset moved toward this sample
+  kInvalidInput,  // non-finite input: refused
+};
+
+[[nodiscard]] const char* startup_rejection_name(StartupRejection rejection);
+[[nodiscard]] const char* offset_tracking_name(OffsetTracking tracking);
+
+struct ConditionedSample {
+  bool ready = false;  // ground_m_s2 holds a conditioned sample (start-up done, input finite)
+  Eigen::Vector3d ground_m_s2 = Eigen::Vector3d::Zero();  // statue frame; z is v_G''
+  OffsetTracking tracking = OffsetTracking::kStartup;
+};
+
+struct ConditioningStatus {
+  bool ready = false;
+  std::int64_t window_samples = 0;  // samples in the current start-up window
+  std::int64_t window_length = 0;   // samples the window needs
+  StartupRejection last_rejection = StartupRejection::kNone;
+  std::uint64_t rejected_noisy = 0;   // windows rejected as too noisy
+  std::uint64_t rejected_offset = 0;  // windows rejected for too large an offset
+  std::uint64_t invalid_inputs = 0;   // non-finite samples refused
+  std::uint64_t tracked = 0;          // samples that moved the offset
+  std::uint64_t gated = 0;            // quiet samples the gate kept out
+  std::uint64_t consecutive_gated = 0;  // quiet samples gated since the last tracked one
+  Eigen::Vector3d offset_m_s2 = Eigen::Vector3d::Zero();  // statue frame (valid when ready)
+  Eigen::Vector3d window_std_m_s2 = Eigen::Vector3d::Zero();  // of the last completed window
+};
+
+class Conditioner {
+ public:
+  Conditioner() = default;
+
+  // Fails on invalid settings (the Error names the field); `out` is then left untouched.
+  [[nodiscard]] static Error create(const ConditioningSettings& settings, Conditioner& out);
+
+  // One sample in the sensor frame and the declared unit. `quiet`: the caller's estimate that
+  // the block is at rest in full contact and the ground quiet (allows offset tracking).
+  [[nodiscard]] ConditionedSample condition(const Eigen::Vector3d& sensor_sample, bool quiet);
+
+  // Forgets the offset and starts a new start-up window (for example after a sensor fault).
+  void restart_startup();
+
+  // Unit and rotation alone, m/s2 in the statue frame (gravity and offset still in).
+  [[nodiscard]] Eigen::Vector3d to_statue_m_s2(const Eigen::Vector3d& sensor_sample) const;
+
+  [[nodiscard]] const ConditioningStatus& status() const { return status_; }
+  [[nodiscard]] const ConditioningSettings& settings() const { return settings_; }
+
+ private:
+  void add_to_window(const Eigen::Vector3d& statue_m_s2);
+
+  ConditioningSettings settings_;
+  double unit_scale_ = 1.0;     // sensor unit to m/s2
+  double tracking_gain_ = 0.0;  // the low-pass's per-sample gain, 1 - exp(-period / tau)
+  ConditioningStatus status_;
+  // Running mean and sum of squared deviations of the window (Welford), statue frame, m/s2.
+  Eigen::Vector3d window_mean_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d window_m2_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace plinth::monitor

@@ -1,0 +1,212 @@
+// Sensor health: one tracker per accelerometer node, between the CAN decoder and conditioning.
+//
+// Input: every SensorAcceleration sample of the node as received (receive time, 8-bit sequence
+// counter, status flags, ax/ay/az in g), and a periodic tick(now). Output per sample: the
+// samples to feed the solver, in order (0 to max_bridge_samples + 1 of them), the health state
+// and its cause, and counters. Nothing bad passes silently: every sample is fed, fed with a
+// mark, bridged, or dropped with a counter and a cause.
+//
+// Per sample, in this order:
+//   - timeout first: if no sample was accepted for timeout_s, the silence is a timeout fault and
+//     the stream is re-synchronised (this sample starts it afresh, no gap is counted across).
+//   - sequence (against the last sample that passed this check; 8-bit serial arithmetic,
+//     d = (seq - last) mod 256): d = 0 duplicate, d >= 128 out of order; both dropped, counted,
+//     degraded. More than max_bridge_samples out-of-order samples in a row mean the node
+//     restarted its counter: fault, and the next sample re-synchronises. 1 < d < 128: d - 1
+//     sequence numbers were missed (counted).
+//   - values: non-finite, |a| > max_valid_g on an axis, or status bits the protocol does not
+//     define: rejected (counted); the sample's slot becomes part of the gap to bridge.
+//   - gap: the slots between the last accepted sample and this one (missed and rejected). Up to
+//     max_bridge_samples slots are bridged by linear interpolation (values and receive times)
+//     between the two accepted samples, each bridged sample marked: degraded. More is a fault
+//     (and a rejected sample that takes the open gap past the limit is a fault at once).
+//   - status flags: self-test failed or calibration invalid: fault (the values cannot be
+//     trusted); over-temperature: degraded, fed. Saturation (the flag, or |a| >= full_scale_g on
+//     an axis): degraded, fed marked `saturated` (the true |a| is at least the value fed).
+//   - stuck: stuck_samples consecutive accepted samples with all three axes bit-identical:
+//     fault. The first stuck_samples - 1 of them were fed (they could not be told from noise).
+//
+// Health state and recovery: every condition above marks the sample unclean and raises the
+// state to the condition's severity (ok < degraded < fault; the cause is the latest condition
+// of the highest severity held). The state returns to ok after recovery_samples consecutive
+// clean samples (accepted, valid, no flags, not saturated, not stuck; a dropped or rejected
+// sample breaks the run). A gap or a timeout belongs to the time before the sample that ends
+// it: that sample, if clean itself, is the first of the run (so with recovery_samples = 1
+// feeding restarts at the very sample that ends a long gap or a timeout).
+//
+// Stream across a fault: while the state is fault nothing is fed (accepted samples are counted
+// as held_in_fault) and nothing is bridged across it. The sample that completes recovery is
+// fed with `restart` set: the stream before it does not connect to it (the estimator restarts
+// its input interpolation there; what happened meanwhile is unknown). A tracker starts in fault
+// (cause no_data), so the first fed sample of all is also a restart.
+//
+// Times are int64 ns on the receive clock (hal::TimedFrame::timestamp_ns); they must not go
+// backwards (a decrease counts as no time elapsed). Freestanding: no heap, no exceptions.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include "plinth/core/error.h"
+#include "plinth/hal/can_codec.h"
+
+namespace plinth::monitor {
+
+// Largest max_bridge_samples; sizes the per-sample output.
+inline constexpr int kMaxBridgeSamples = 15;
+inline constexpr std::size_t kMaxFedPerSample = static_cast<std::size_t>(kMaxBridgeSamples) + 1;
+
+struct SensorHealthSettings {
+  double sample_period_s = 0.001;  // the node's nominal sample period, s
+  // No accepted sample for this long is a timeout fault, s. Must exceed the longest bridgeable
+  // gap, (max_bridge_samples + 1) periods, and stay below 128 periods so that a silence cannot
+  // hide behind the 8-bit sequence counter's wrap.
+  double timeout_s = 0.05;
+  int max_bridge_samples = 3;  // samples, 0..kMaxBridgeSamples: longest gap bridged
+  int recovery_samples = 10;   // samples, >= 1: consecutive clean samples that clear a condition
+  // samples: this many consecutive bit-identical samples is a stuck sensor; 0 turns the check
+  // off (for noise-free synthetic input), else >= 2.
+  int stuck_samples = 50;
+  double full_scale_g = 8.0;   // g: |a| at or above this on an axis is saturated
+  double max_valid_g = 8.192;  // g, >= full_scale_g: |a| above this is impossible (rejected)
+};
+
+// Checks the settings; the Error names the field at fault ("sensor_health.timeout_s", ...).
+[[nodiscard]] Error validate(const SensorHealthSettings& settings);
+
+enum class HealthState : std::uint8_t { kOk = 0, kDegraded = 1, kFault = 2 };
+
+enum class HealthCause : std::uint8_t {
+  kNone = 0,
+  kNoData,              // no sample accepted yet (the initial state)
+  kTimeout,             // no sample accepted for timeout_s
+  kSequenceGap,         // sequence numbers missing (bridged: degraded; longer: fault)
+  kDuplicate,           // a sequence number received again
+  kOutOfOrder,          // a sequence number behind the last one
+  kNonFinite,           // NaN or infinity on an axis
+  kOutOfRange,          // |a| above max_valid_g on an axis
+  kUndefinedStatus,     // status bits the protocol does not define
+  kSaturated,           // at full scale (flag or value)
+  kStuck,               // all axes bit-identical for stuck_samples samples
+  kSelfTestFailed,      // the sensor's self-test flag
+  kOverTemperature,     // the sensor's over-temperature flag
+  kCalibrationInvalid,  // the sensor's calibration-invalid flag
+};
+
+[[nodiscard]] const char* health_state_name(HealthState state);  // "ok", "degraded", "fault"
+[[nodiscard]] const char* health_cause_name(HealthCause cause);  // e.g. "sequence gap"
+// The alarm cause to report for a fault: kSensorTimeout for no_data and timeout, kNone for
+// kNone, kSensorFault otherwise.
+[[nodiscard]] can::AlarmCause to_alarm_cause(HealthCause cause);
+
+// Event counts since the tracker was created (samples where a unit is not said).
+struct SensorCounters {
+  std::uint64_t received = 0;             // on_sample calls
+  std::uint64_t fed = 0;                  // samples passed on, bridged ones included
+  std::uint64_t bridged = 0;              // interpolated samples passed on
+  std::uint64_t held_in_fault = 0;        // accepted samples not passed on: fault or recovering
+  std::uint64_t missing = 0;              // sequence numbers never received
+  std::uint64_t long_gaps = 0;            // gaps longer than max_bridge_samples (faults)
+  std::uint64_t duplicates = 0;
+  std::uint64_t out_of_order = 0;
+  std::uint64_t non_finite = 0;
+  std::uint64_t out_of_range = 0;
+  std::uint64_t undefined_status = 0;
+  std::uint64_t saturated = 0;
+  std::uint64_t stuck_detections = 0;     // stuck runs that reached stuck_samples
+  std::uint64_t self_test_failed = 0;     // samples with the flag
+  std::uint64_t over_temperature = 0;     // samples with the flag
+  std::uint64_t calibration_invalid = 0;  // samples with the flag
+  std::uint64_t timeouts = 0;
+  std::uint64_t faults = 0;               // entries into the fault state
+};
+
+struct SensorHealth {
+  HealthState state = HealthState::kFault;
+  HealthCause cause = HealthCause::kNoData;
+  SensorCounters counters;
+};
+
+// One received sample, as decoded from a SensorAcceleration frame.
+struct SensorSample {
+  std::int64_t receive_time_ns = 0;
+  std::uint8_t sequence = 0;
+  std::uint8_t status = 0;  // can::sensor_status flags
+  Eigen::Vector3d acceleration_g = Eigen::Vector3d::Zero();  // sensor frame, g
+};
+
+// A sample to feed, in order.
+struct FedSample {
+  std::int64_t time_ns = 0;  // receive time; interpolated for a bridged sample
+  std::uint8_t sequence = 0;  // the sensor's number (the missing one's for a bridged sample)
+  Eigen::Vector3d acceleration_g = Eigen::Vector3d::Zero();  // sensor frame, g
+  bool bridged = false;    // interpolated across a gap
+  bool restart = false;    // first sample after a fault: does not connect to the one before
+  bool saturated = false;  // at full scale: the true |a| on some axis is at least this
+};
+
+// What happened to one input sample.
+enum class SampleVerdict : std::uint8_t {
+  kFed,           // passed on (after any bridged samples)
+  kHeldInFault,   // accepted, but the state is fault: not passed on
+  kDuplicate,     // dropped
+  kOutOfOrder,    // dropped
+  kRejected,      // bad values or status bits: dropped, its slot is part of a gap
+};
+
+struct SensorUpdate {
+  std::array<FedSample, kMaxFedPerSample> fed{};  // fed[0 .. fed_count)
+  std::size_t fed_count = 0;
+  SampleVerdict verdict = SampleVerdict::kFed;
+  SensorHealth health;  // after this sample
+};
+
+class SensorHealthTracker {
+ public:
+  SensorHealthTracker() = default;
+
+  // Fails on invalid settings (the Error names the field); `out` is then left untouched.
+  [[nodiscard]] static Error create(const SensorHealthSettings& settings,
+                                    SensorHealthTracker& out);
+
+  // One received sample of this node.
+  [[nodiscard]] SensorUpdate on_sample(const SensorSample& sample);
+  // Call periodically (at least every timeout_s / 2): detects the timeout while no sample
+  // arrives. Returns the health after the check.
+  const SensorHealth& tick(std::int64_t now_ns);
+
+  [[nodiscard]] const SensorHealth& health() const { return health_; }
+  [[nodiscard]] const SensorHealthSettings& settings() const { return settings_; }
+
+ private:
+  void note(HealthState severity, HealthCause cause);
+  void declare_timeout();
+  [[nodiscard]] bool check_sequence(std::uint8_t sequence, SampleVerdict& verdict);
+  [[nodiscard]] HealthCause value_problem(const SensorSample& sample) const;
+  void check_flags_and_stuck(const SensorSample& sample, bool& saturated);
+  void feed(SensorUpdate& update, const SensorSample& sample, bool bridge_first, bool restart,
+            bool saturated);
+
+  SensorHealthSettings settings_;
+  std::int64_t timeout_ns_ = 0;
+  SensorHealth health_;
+
+  // The stream reference: false at start, after a timeout and after a counter restart.
+  bool have_reference_ = false;
+  std::uint8_t last_received_sequence_ = 0;  // last sample past the sequence check
+  // The last accepted sample (valid values): the start of the next gap and of bridging.
+  std::uint8_t last_accepted_sequence_ = 0;
+  std::int64_t last_accepted_time_ns_ = 0;
+  Eigen::Vector3d last_accepted_g_ = Eigen::Vector3d::Zero();
+
+  int rejected_in_gap_ = 0;     // rejected samples since the last accepted one
+  HealthCause last_rejection_ = HealthCause::kNone;  // why the latest of them was rejected
+  int out_of_order_run_ = 0;    // consecutive out-of-order samples
+  int identical_run_ = 0;       // consecutive accepted samples bit-identical, this one included
+  int clean_run_ = 0;           // consecutive clean samples
+  bool sample_clean_ = true;    // the sample being processed has no condition so far
+};
+
+}  // namespace plinth::monitor

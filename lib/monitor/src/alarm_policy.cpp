@@ -1,0 +1,260 @@
+#include "plinth/monitor/alarm_policy.h"
+
+#include <cmath>
+
+#include "settings_checks.h"
+
+namespace plinth::monitor {
+
+namespace {
+
+constexpr int rank(AlarmLevel level) { return static_cast<int>(level); }
+
+constexpr AlarmLevel higher(AlarmLevel a, AlarmLevel b) { return rank(a) >= rank(b) ? a : b; }
+
+constexpr std::int64_t kNanosecondsPerMillisecond = 1'000'000;
+
+Error check_thresholds(const RiskThresholds& t, const char* on_field, const char* off_field) {
+  if (!std::isfinite(t.on)) return {ErrorCode::kNotFinite, on_field, "must be finite"};
+  if (!std::isfinite(t.off)) return {ErrorCode::kNotFinite, off_field, "must be finite"};
+  if (t.on < 0.0 || t.on > 1.0) {
+    return {ErrorCode::kOutOfRange, on_field, "must lie in [0, 1]", 1.0};
+  }
+  if (t.off < 0.0 || t.off > 1.0) {
+    return {ErrorCode::kOutOfRange, off_field, "must lie in [0, 1]", 1.0};
+  }
+  if (t.off >= t.on) {
+    return {ErrorCode::kInconsistent, off_field, "must be below the level's on threshold", t.on};
+  }
+  return ok_error();
+}
+
+// A level's thresholds must not lie below those of the level beneath it.
+Error check_order(const RiskThresholds& lower, const RiskThresholds& upper, const char* on_field,
+                  const char* off_field) {
+  if (upper.on < lower.on) {
+    return {ErrorCode::kInconsistent, on_field, "must not be below the lower level's on",
+            lower.on};
+  }
+  if (upper.off < lower.off) {
+    return {ErrorCode::kInconsistent, off_field, "must not be below the lower level's off",
+            lower.off};
+  }
+  return ok_error();
+}
+
+// The risk condition with hysteresis: start at `on`, hold down to `off`.
+bool risk_condition(const detail::HeldCondition& held, const RiskThresholds& t, double risk) {
+  return risk >= (held.active ? t.off : t.on);
+}
+
+}  // namespace
+
+void detail::HeldCondition::update(bool wanted, std::int64_t now_ns, std::int64_t raise_hold_ns,
+                                   std::int64_t lower_hold_ns) {
+  if (wanted == active) {
+    changing = false;
+    return;
+  }
+  if (!changing) {
+    changing = true;
+    since_ns = now_ns;
+  }
+  if (now_ns - since_ns >= (wanted ? raise_hold_ns : lower_hold_ns)) {
+    active = wanted;
+    changing = false;
+  }
+}
+
+Error validate(const AlarmPolicySettings& s) {
+  return detail::first_error({
+      check_thresholds(s.advisory, "alarm_policy.advisory.on", "alarm_policy.advisory.off"),
+      check_thresholds(s.warning, "alarm_policy.warning.on", "alarm_policy.warning.off"),
+      check_thresholds(s.alarm, "alarm_policy.alarm.on", "alarm_policy.alarm.off"),
+      check_order(s.advisory, s.warning, "alarm_policy.warning.on", "alarm_policy.warning.off"),
+      check_order(s.warning, s.alarm, "alarm_policy.alarm.on", "alarm_policy.alarm.off"),
+      detail::check_duration(s.raise_hold_s, "alarm_policy.raise_hold_s", true),
+      detail::check_duration(s.lower_hold_s, "alarm_policy.lower_hold_s", true),
+      detail::check_duration(s.heartbeat_period_s, "alarm_policy.heartbeat_period_s", false),
+  });
+}
+
+const char* ack_outcome_name(AckOutcome outcome) {
+  switch (outcome) {
+    case AckOutcome::kNone: return "none";
+    case AckOutcome::kReleased: return "released";
+    case AckOutcome::kReleasedConditionHolds: return "released, condition holds";
+    case AckOutcome::kStale: return "stale sequence";
+    case AckOutcome::kWrongLevel: return "wrong level";
+    case AckOutcome::kNothingLatched: return "nothing latched";
+  }
+  return "invalid";
+}
+
+const char* input_problem_name(InputProblem problem) {
+  switch (problem) {
+    case InputProblem::kNone: return "none";
+    case InputProblem::kRiskInvalid: return "risk not finite or outside [0, 1]";
+    case InputProblem::kTimeWentBack: return "time went back";
+  }
+  return "invalid";
+}
+
+can::AlarmEvent to_can_event(const AlarmEventRecord& record) {
+  can::AlarmEvent event;
+  event.level = record.level;
+  event.previous_level = record.previous_level;
+  event.cause = record.cause;
+  event.latched = record.latched;
+  // Modulo 2^32 ms, as the frame's counter wraps.
+  const std::int64_t ms = record.time_ns / kNanosecondsPerMillisecond;
+  event.time_since_start_ms = static_cast<std::uint32_t>(static_cast<std::uint64_t>(ms));
+  event.sequence = record.sequence;
+  return event;
+}
+
+Error AlarmPolicy::create(const AlarmPolicySettings& settings, AlarmPolicy& out) {
+  if (Error e = validate(settings); !e.ok()) return e;
+  out = AlarmPolicy{};
+  out.settings_ = settings;
+  out.raise_hold_ns_ = detail::to_ns(settings.raise_hold_s);
+  out.lower_hold_ns_ = detail::to_ns(settings.lower_hold_s);
+  out.heartbeat_period_ns_ = detail::to_ns(settings.heartbeat_period_s);
+  return ok_error();
+}
+
+void AlarmPolicy::heartbeat_sent(std::int64_t now_ns) {
+  next_heartbeat_ns_ = now_ns + heartbeat_period_ns_;
+}
+
+// Against the state the operator saw: the latest event and the latched level.
+AckOutcome AlarmPolicy::acknowledge(const Acknowledgement& ack) {
+  if (latched_level_ == AlarmLevel::kNormal) return AckOutcome::kNothingLatched;
+  if (!any_event_ || ack.event_sequence != last_event_sequence_) return AckOutcome::kStale;
+  if (ack.level != latched_level_) return AckOutcome::kWrongLevel;
+  latched_level_ = AlarmLevel::kNormal;
+  latched_cause_ = AlarmCause::kNone;
+  return rank(condition_level_) >= rank(ack.level) ? AckOutcome::kReleasedConditionHolds
+                                                   : AckOutcome::kReleased;
+}
+
+void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
+  // An invalid risk leaves the risk conditions as they were (their holds keep running).
+  if (risk_valid) {
+    const bool advisory = risk_condition(advisory_, settings_.advisory, in.risk) ||
+                          in.out_of_full_contact;
+    const bool warning = risk_condition(warning_, settings_.warning, in.risk);
+    const bool alarm = risk_condition(alarm_, settings_.alarm, in.risk);
+    advisory_.update(advisory, in.time_ns, raise_hold_ns_, lower_hold_ns_);
+    warning_.update(warning, in.time_ns, raise_hold_ns_, lower_hold_ns_);
+    alarm_.update(alarm, in.time_ns, raise_hold_ns_, lower_hold_ns_);
+  }
+  const bool collapse_began = in.collapse_detected && !collapse_;
+  collapse_ = in.collapse_detected;
+  out_of_contact_ = in.out_of_full_contact;
+
+  // Trouble is shown at once; it clears only after lower_hold_s without it.
+  const bool fault = in.fault_active || !risk_valid;
+  fault_.update(fault, in.time_ns, 0, lower_hold_ns_);
+  if (fault) fault_cause_ = risk_valid ? in.fault_cause : AlarmCause::kInternalFault;
+
+  const AlarmLevel previous = condition_level_;
+  condition_level_ = collapse_ || alarm_.active ? AlarmLevel::kAlarm
+                     : warning_.active          ? AlarmLevel::kWarning
+                     : advisory_.active         ? AlarmLevel::kAdvisory
+                                                : AlarmLevel::kNormal;
+
+  // Latch on a rise into a latching level (the highest one passed); a collapse latches the
+  // alarm when it begins, whatever came before. A condition that stays up does not latch again.
+  AlarmLevel latch = AlarmLevel::kNormal;
+  if (collapse_began) {
+    latch = AlarmLevel::kAlarm;
+  } else if (rank(condition_level_) > rank(previous)) {
+    if (condition_level_ == AlarmLevel::kAlarm && settings_.latch_alarm) {
+      latch = AlarmLevel::kAlarm;
+    } else if (rank(condition_level_) >= rank(AlarmLevel::kWarning) &&
+               rank(previous) < rank(AlarmLevel::kWarning) && settings_.latch_warning) {
+      latch = AlarmLevel::kWarning;
+    }
+  }
+  if (latch != AlarmLevel::kNormal && rank(latch) >= rank(latched_level_)) {
+    latched_level_ = latch;
+    latched_cause_ = collapse_began ? AlarmCause::kOverturnDetected : AlarmCause::kRiskThreshold;
+  }
+}
+
+// Alarm above all; then fault; then the risk level (condition or latched).
+AlarmLevel AlarmPolicy::shown_level() const {
+  const AlarmLevel risk_level = higher(condition_level_, latched_level_);
+  if (risk_level == AlarmLevel::kAlarm) return AlarmLevel::kAlarm;
+  if (fault_.active) return AlarmLevel::kFault;
+  return risk_level;
+}
+
+// Why `level` holds now.
+AlarmCause AlarmPolicy::cause_of(AlarmLevel level) const {
+  switch (level) {
+    case AlarmLevel::kNormal: return AlarmCause::kNone;
+    case AlarmLevel::kFault: return fault_cause_;
+    case AlarmLevel::kAdvisory:
+      return out_of_contact_ ? AlarmCause::kPhaseChange : AlarmCause::kRiskThreshold;
+    case AlarmLevel::kWarning:
+    case AlarmLevel::kAlarm:
+      if (collapse_) return AlarmCause::kOverturnDetected;
+      // Held by its latch alone: the cause it latched with.
+      if (rank(condition_level_) < rank(level) && latched_level_ == level) return latched_cause_;
+      return AlarmCause::kRiskThreshold;
+  }
+  return AlarmCause::kNone;
+}
+
+void AlarmPolicy::emit_if_changed(AlarmOutput& out, std::int64_t time_ns,
+                                  bool by_acknowledgement) {
+  const AlarmLevel shown = shown_level();
+  const bool latched = latched_level_ != AlarmLevel::kNormal;
+  if (shown == level_ && latched == latched_shown_) return;
+
+  AlarmEventRecord& e = out.events[out.event_count++];
+  e.level = shown;
+  e.previous_level = level_;
+  e.latched = latched;
+  e.time_ns = time_ns;
+  e.sequence = next_sequence_;
+  if (by_acknowledgement) {
+    e.cause = AlarmCause::kAcknowledged;
+  } else if (shown == level_) {
+    e.cause = latched_cause_;  // only the latch changed: a level latched beneath a fault
+  } else {
+    e.cause = cause_of(shown);
+  }
+  last_event_sequence_ = next_sequence_;
+  next_sequence_ = static_cast<std::uint8_t>(next_sequence_ + 1);
+  any_event_ = true;
+  level_ = shown;
+  latched_shown_ = latched;
+  // A change is reported at once: the next status is due now.
+  if (time_ns < next_heartbeat_ns_) next_heartbeat_ns_ = time_ns;
+}
+
+AlarmOutput AlarmPolicy::update(const AlarmInput& in) {
+  AlarmOutput out;
+  if (started_ && in.time_ns < last_time_ns_) {
+    out.input_problem = InputProblem::kTimeWentBack;
+  } else {
+    started_ = true;
+    last_time_ns_ = in.time_ns;
+    if (in.acknowledged) {
+      out.acknowledgement = acknowledge(in.acknowledgement);
+      emit_if_changed(out, in.time_ns, true);
+    }
+    const bool risk_valid = std::isfinite(in.risk) && in.risk >= 0.0 && in.risk <= 1.0;
+    if (!risk_valid) out.input_problem = InputProblem::kRiskInvalid;
+    evaluate_conditions(in, risk_valid);
+    emit_if_changed(out, in.time_ns, false);
+  }
+  out.level = level_;
+  out.latched_level = latched_level_;
+  return out;
+}
+
+}  // namespace plinth::monitor

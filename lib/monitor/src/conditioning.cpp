@@ -1,0 +1,173 @@
+#include "plinth/monitor/conditioning.h"
+
+#include <cmath>
+#include <Eigen/LU>
+
+#include "plinth/core/scene.h"
+#include "settings_checks.h"
+
+namespace plinth::monitor {
+
+namespace {
+
+// What a sensor at rest reads in the statue frame, m/s2 (the support pushes up).
+Eigen::Vector3d gravity_up() { return {0.0, 0.0, kStandardGravity}; }
+
+// Samples in the start-up window; validate() checks it is at least 2.
+std::int64_t window_length(const ConditioningSettings& s) {
+  return static_cast<std::int64_t>(std::llround(s.startup_window_s / s.sample_period_s));
+}
+
+Error validate_rotation(const ConditioningSettings& s) {
+  const double tol = s.rotation_tolerance;
+  if (!std::isfinite(tol) || tol <= 0.0 || tol > 0.1) {
+    return {ErrorCode::kOutOfRange, "conditioning.rotation_tolerance", "must lie in (0, 0.1]",
+            0.1};
+  }
+  const Eigen::Matrix3d& r = s.sensor_to_statue;
+  if (!r.allFinite()) {
+    return {ErrorCode::kNotFinite, "conditioning.sensor_to_statue", "must be finite"};
+  }
+  const double orthonormality =
+      (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (orthonormality > tol) {
+    return {ErrorCode::kInconsistent, "conditioning.sensor_to_statue",
+            "is not orthonormal (R^T R - I exceeds rotation_tolerance)", tol};
+  }
+  const double det = r.determinant();
+  if (std::abs(det - 1.0) > tol) {
+    return {ErrorCode::kInconsistent, "conditioning.sensor_to_statue",
+            det < 0.0 ? "has determinant -1: a reflection (an axis reversed), not a rotation"
+                      : "has a determinant other than +1",
+            1.0};
+  }
+  return ok_error();
+}
+
+}  // namespace
+
+Error validate(const ConditioningSettings& s) {
+  if (s.unit != AccelerationUnit::kStandardGravity &&
+      s.unit != AccelerationUnit::kMetresPerSecondSquared) {
+    return {ErrorCode::kOutOfRange, "conditioning.unit", "must be g or m/s2"};
+  }
+  if (Error e = detail::first_error({
+          validate_rotation(s),
+          detail::check_duration(s.sample_period_s, "conditioning.sample_period_s", false),
+          detail::check_duration(s.startup_window_s, "conditioning.startup_window_s", false),
+          detail::check_positive(s.startup_max_std_m_s2, "conditioning.startup_max_std_m_s2"),
+          detail::check_positive(s.startup_max_offset_m_s2,
+                                 "conditioning.startup_max_offset_m_s2"),
+          detail::check_duration(s.tracking_time_constant_s,
+                                 "conditioning.tracking_time_constant_s", false),
+          detail::check_positive(s.tracking_gate_m_s2, "conditioning.tracking_gate_m_s2"),
+      });
+      !e.ok()) {
+    return e;
+  }
+  // Needs a valid period and window.
+  if (window_length(s) < 2) {
+    return {ErrorCode::kInconsistent, "conditioning.startup_window_s",
+            "must span at least 2 sample periods", 2.0 * s.sample_period_s};
+  }
+  return ok_error();
+}
+
+const char* startup_rejection_name(StartupRejection rejection) {
+  switch (rejection) {
+    case StartupRejection::kNone: return "none";
+    case StartupRejection::kTooNoisy: return "start-up window too noisy";
+    case StartupRejection::kOffsetTooLarge: return "offset too large (mounting or unit?)";
+  }
+  return "invalid";
+}
+
+const char* offset_tracking_name(OffsetTracking tracking) {
+  switch (tracking) {
+    case OffsetTracking::kStartup: return "start-up";
+    case OffsetTracking::kNotQuiet: return "not quiet";
+    case OffsetTracking::kGated: return "gated";
+    case OffsetTracking::kTracked: return "tracked";
+    case OffsetTracking::kInvalidInput: return "invalid input";
+  }
+  return "invalid";
+}
+
+Error Conditioner::create(const ConditioningSettings& settings, Conditioner& out) {
+  if (Error e = validate(settings); !e.ok()) return e;
+  out = Conditioner{};
+  out.settings_ = settings;
+  out.unit_scale_ = settings.unit == AccelerationUnit::kStandardGravity ? kStandardGravity : 1.0;
+  out.tracking_gain_ = -std::expm1(-settings.sample_period_s / settings.tracking_time_constant_s);
+  out.status_.window_length = window_length(settings);
+  return ok_error();
+}
+
+void Conditioner::restart_startup() {
+  status_.ready = false;
+  status_.window_samples = 0;
+  status_.offset_m_s2.setZero();
+  status_.consecutive_gated = 0;
+  window_mean_.setZero();
+  window_m2_.setZero();
+}
+
+Eigen::Vector3d Conditioner::to_statue_m_s2(const Eigen::Vector3d& sensor_sample) const {
+  return settings_.sensor_to_statue * (unit_scale_ * sensor_sample);
+}
+
+void Conditioner::add_to_window(const Eigen::Vector3d& statue_m_s2) {
+  const std::int64_t n = ++status_.window_samples;
+  const Eigen::Vector3d before = statue_m_s2 - window_mean_;
+  window_mean_ += before / static_cast<double>(n);
+  window_m2_ += before.cwiseProduct(statue_m_s2 - window_mean_);
+  if (n < status_.window_length) return;
+
+  status_.window_std_m_s2 = (window_m2_ / static_cast<double>(n - 1)).cwiseSqrt();
+  const Eigen::Vector3d offset = window_mean_ - gravity_up();
+  if (status_.window_std_m_s2.maxCoeff() > settings_.startup_max_std_m_s2) {
+    status_.last_rejection = StartupRejection::kTooNoisy;
+    ++status_.rejected_noisy;
+  } else if (offset.cwiseAbs().maxCoeff() > settings_.startup_max_offset_m_s2) {
+    status_.last_rejection = StartupRejection::kOffsetTooLarge;
+    ++status_.rejected_offset;
+  } else {
+    status_.ready = true;
+    status_.offset_m_s2 = offset;
+    return;
+  }
+  restart_startup();
+}
+
+ConditionedSample Conditioner::condition(const Eigen::Vector3d& sensor_sample, bool quiet) {
+  ConditionedSample out;
+  if (!sensor_sample.allFinite()) {
+    ++status_.invalid_inputs;
+    out.tracking = OffsetTracking::kInvalidInput;
+    return out;
+  }
+  const Eigen::Vector3d statue = to_statue_m_s2(sensor_sample);
+  if (!status_.ready) {
+    add_to_window(statue);
+    out.tracking = OffsetTracking::kStartup;
+    return out;
+  }
+  out.ready = true;
+  out.ground_m_s2 = statue - gravity_up() - status_.offset_m_s2;
+  if (!quiet) {
+    out.tracking = OffsetTracking::kNotQuiet;
+  } else if (out.ground_m_s2.cwiseAbs().maxCoeff() > settings_.tracking_gate_m_s2) {
+    ++status_.gated;
+    ++status_.consecutive_gated;
+    out.tracking = OffsetTracking::kGated;
+  } else {
+    // The residual is what the offset misses: move toward it by the low-pass gain.
+    status_.offset_m_s2 += tracking_gain_ * out.ground_m_s2;
+    ++status_.tracked;
+    status_.consecutive_gated = 0;
+    out.tracking = OffsetTracking::kTracked;
+  }
+  return out;
+}
+
+}  // namespace plinth::monitor

@@ -1,0 +1,55 @@
+// Checks and conversions shared by the monitor components' settings (private to plinth_monitor).
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <initializer_list>
+
+#include "plinth/core/error.h"
+
+namespace plinth::monitor::detail {
+
+// Longest duration a setting may name, s (11.6 days): keeps every duration exact to the
+// nanosecond in an int64 and catches a value typed in the wrong unit.
+inline constexpr double kMaxDurationS = 1e6;
+
+inline constexpr std::int64_t kNanosecondsPerSecond = 1'000'000'000;
+
+// A duration setting: finite, within [0, kMaxDurationS], and above zero unless `zero_allowed`.
+[[nodiscard]] inline Error check_duration(double seconds, const char* field, bool zero_allowed) {
+  if (!std::isfinite(seconds)) {
+    return {ErrorCode::kNotFinite, field, "must be a finite number of seconds"};
+  }
+  if (seconds < 0.0 || (!zero_allowed && seconds <= 0.0)) {
+    return {ErrorCode::kOutOfRange, field,
+            zero_allowed ? "must not be negative" : "must be greater than zero", 0.0};
+  }
+  if (seconds > kMaxDurationS) {
+    return {ErrorCode::kOutOfRange, field, "must not exceed 1e6 s", kMaxDurationS};
+  }
+  return ok_error();
+}
+
+// A positive finite quantity in the field's unit.
+[[nodiscard]] inline Error check_positive(double value, const char* field) {
+  if (!std::isfinite(value)) return {ErrorCode::kNotFinite, field, "must be finite"};
+  if (value <= 0.0) return {ErrorCode::kOutOfRange, field, "must be greater than zero", 0.0};
+  return ok_error();
+}
+
+// The first failed check of a list, in order; ok when all pass. Every check is evaluated, so
+// list only checks that are safe on any input.
+[[nodiscard]] inline Error first_error(std::initializer_list<Error> checks) {
+  for (const Error& e : checks) {
+    if (!e.ok()) return e;
+  }
+  return ok_error();
+}
+
+// Seconds (already checked by check_duration) to the nearest nanosecond.
+[[nodiscard]] inline std::int64_t to_ns(double seconds) {
+  const double ns = seconds * static_cast<double>(kNanosecondsPerSecond);
+  return static_cast<std::int64_t>(std::llround(ns));
+}
+
+}  // namespace plinth::monitor::detail

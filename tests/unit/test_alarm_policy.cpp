@@ -1,0 +1,432 @@
+// Alarm policy: hysteresis, minimum durations, latching and acknowledgement, collapse, faults,
+// event sequence numbers and the heartbeat.
+#include "plinth/monitor/alarm_policy.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace plinth::monitor {
+namespace {
+
+constexpr std::int64_t kMs = 1'000'000;  // ns
+
+// Settings with no holds and no latches: levels follow the thresholds at once.
+AlarmPolicySettings immediate() {
+  AlarmPolicySettings s;
+  s.raise_hold_s = 0.0;
+  s.lower_hold_s = 0.0;
+  s.latch_warning = false;
+  s.latch_alarm = false;
+  return s;
+}
+
+// immediate(), latching the levels asked for.
+AlarmPolicySettings latching(bool warning, bool alarm) {
+  AlarmPolicySettings s = immediate();
+  s.latch_warning = warning;
+  s.latch_alarm = alarm;
+  return s;
+}
+
+class Policy {
+ public:
+  explicit Policy(const AlarmPolicySettings& settings = {}) {
+    const Error e = AlarmPolicy::create(settings, policy);
+    EXPECT_TRUE(e.ok()) << e.field << ": " << e.reason;
+  }
+
+  // One update at time_ms with the given risk; the other inputs from `base`.
+  AlarmOutput at(std::int64_t time_ms, double risk) {
+    AlarmInput in = base;
+    in.time_ns = time_ms * kMs;
+    in.risk = risk;
+    return policy.update(in);
+  }
+  AlarmOutput ack(std::int64_t time_ms, double risk, AlarmLevel level, std::uint8_t sequence) {
+    AlarmInput in = base;
+    in.time_ns = time_ms * kMs;
+    in.risk = risk;
+    in.acknowledged = true;
+    in.acknowledgement = {level, sequence};
+    return policy.update(in);
+  }
+
+  AlarmPolicy policy;
+  AlarmInput base;
+};
+
+void expect_event(const AlarmOutput& out, std::size_t index, AlarmLevel level,
+                  AlarmLevel previous, AlarmCause cause, bool latched) {
+  ASSERT_GT(out.event_count, index);
+  const AlarmEventRecord& e = out.events[index];
+  EXPECT_EQ(e.level, level) << can::alarm_level_name(e.level);
+  EXPECT_EQ(e.previous_level, previous) << can::alarm_level_name(e.previous_level);
+  EXPECT_EQ(e.cause, cause) << can::alarm_cause_name(e.cause);
+  EXPECT_EQ(e.latched, latched);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Settings
+
+// create() validates: the Error names the field.
+void expect_refused(const AlarmPolicySettings& s, const char* field, ErrorCode code) {
+  AlarmPolicy unused;
+  const Error e = AlarmPolicy::create(s, unused);
+  EXPECT_EQ(e.code, code) << field;
+  EXPECT_STREQ(e.field, field);
+}
+
+TEST(AlarmPolicySettings, DefaultsAreValidAndThresholdsAreChecked) {
+  EXPECT_TRUE(validate(AlarmPolicySettings{}).ok());
+  AlarmPolicySettings s;
+  s.warning.off = 0.5;  // equal to on: no hysteresis
+  expect_refused(s, "alarm_policy.warning.off", ErrorCode::kInconsistent);
+  s = {};
+  s.alarm.on = 1.01;
+  expect_refused(s, "alarm_policy.alarm.on", ErrorCode::kOutOfRange);
+  s = {};
+  s.advisory.off = -0.01;
+  expect_refused(s, "alarm_policy.advisory.off", ErrorCode::kOutOfRange);
+  s = {};
+  s.advisory.on = std::numeric_limits<double>::quiet_NaN();
+  expect_refused(s, "alarm_policy.advisory.on", ErrorCode::kNotFinite);
+  s = {};
+  s.warning.on = 0.85;  // above alarm.on 0.8
+  expect_refused(s, "alarm_policy.alarm.on", ErrorCode::kInconsistent);
+  s = {};
+  s.advisory.off = 0.09;  // just below its on, 0.1
+  EXPECT_TRUE(validate(s).ok());
+  s.warning = {0.5, 0.04};  // off below advisory.off 0.09
+  expect_refused(s, "alarm_policy.warning.off", ErrorCode::kInconsistent);
+  s = {};
+  s.alarm.on = 1.0;  // the edges of [0, 1] are allowed
+  s.advisory.off = 0.0;
+  EXPECT_TRUE(validate(s).ok());
+}
+
+TEST(AlarmPolicySettings, DurationsAreChecked) {
+  AlarmPolicySettings s;
+  s.raise_hold_s = -0.001;
+  expect_refused(s, "alarm_policy.raise_hold_s", ErrorCode::kOutOfRange);
+  s = {};
+  s.lower_hold_s = std::numeric_limits<double>::infinity();
+  expect_refused(s, "alarm_policy.lower_hold_s", ErrorCode::kNotFinite);
+  s = {};
+  s.heartbeat_period_s = 0.0;
+  expect_refused(s, "alarm_policy.heartbeat_period_s", ErrorCode::kOutOfRange);
+  s = {};
+  s.raise_hold_s = 0.0;  // zero holds are allowed
+  s.lower_hold_s = 0.0;
+  EXPECT_TRUE(validate(s).ok());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Thresholds and holds
+
+TEST(AlarmPolicy, HysteresisBoundary) {
+  Policy p(immediate());
+  EXPECT_EQ(p.at(0, 0.0999).level, AlarmLevel::kNormal);
+  EXPECT_EQ(p.at(1, 0.1).level, AlarmLevel::kAdvisory);
+  EXPECT_EQ(p.at(2, 0.4999).level, AlarmLevel::kAdvisory);
+  const AlarmOutput on = p.at(3, 0.5);
+  EXPECT_EQ(on.level, AlarmLevel::kWarning);
+  expect_event(on, 0, AlarmLevel::kWarning, AlarmLevel::kAdvisory, AlarmCause::kRiskThreshold,
+               false);
+  EXPECT_EQ(p.at(4, 0.4).level, AlarmLevel::kWarning);  // at off: still on
+  const AlarmOutput off = p.at(5, 0.3999);
+  EXPECT_EQ(off.level, AlarmLevel::kAdvisory);
+  expect_event(off, 0, AlarmLevel::kAdvisory, AlarmLevel::kWarning, AlarmCause::kRiskThreshold,
+               false);
+  EXPECT_EQ(p.at(6, 0.4999).level, AlarmLevel::kAdvisory);  // below on again: stays off
+  EXPECT_EQ(p.at(7, 0.8).level, AlarmLevel::kAlarm);
+  EXPECT_EQ(p.at(8, 0.7).level, AlarmLevel::kAlarm);
+  EXPECT_EQ(p.at(9, 0.6999).level, AlarmLevel::kWarning);
+  const AlarmOutput normal = p.at(10, 0.0499);
+  EXPECT_EQ(normal.level, AlarmLevel::kNormal);
+  expect_event(normal, 0, AlarmLevel::kNormal, AlarmLevel::kWarning, AlarmCause::kNone, false);
+}
+
+TEST(AlarmPolicy, MinimumDurationBeforeRaisingAndLowering) {
+  AlarmPolicySettings s = immediate();
+  s.raise_hold_s = 0.1;
+  s.lower_hold_s = 0.5;
+  Policy p(s);
+  // Warning condition from t = 1000 ms, updates every 10 ms: raised at 1100 ms, not 1090.
+  for (std::int64_t t = 1000; t < 1100; t += 10) {
+    ASSERT_EQ(p.at(t, 0.6).level, AlarmLevel::kNormal) << t;
+  }
+  const AlarmOutput raised = p.at(1100, 0.6);
+  EXPECT_EQ(raised.level, AlarmLevel::kWarning);  // warning and advisory both held 100 ms
+  expect_event(raised, 0, AlarmLevel::kWarning, AlarmLevel::kNormal, AlarmCause::kRiskThreshold,
+               false);
+  EXPECT_EQ(raised.events[0].time_ns, 1100 * kMs);
+  // Gone from t = 2000 ms: lowered at 2500 ms.
+  EXPECT_EQ(p.at(2000, 0.0).level, AlarmLevel::kWarning);
+  EXPECT_EQ(p.at(2499, 0.0).level, AlarmLevel::kWarning);
+  EXPECT_EQ(p.at(2500, 0.0).level, AlarmLevel::kNormal);
+}
+
+TEST(AlarmPolicy, AnInterruptedConditionStartsItsHoldAgain) {
+  AlarmPolicySettings s = immediate();
+  s.raise_hold_s = 0.1;
+  Policy p(s);
+  (void)p.at(0, 0.6);
+  (void)p.at(90, 0.6);
+  (void)p.at(95, 0.45);  // below on (not yet raised, so on applies): the hold restarts
+  EXPECT_EQ(p.at(100, 0.6).level, AlarmLevel::kAdvisory);  // advisory held since 0
+  EXPECT_EQ(p.at(199, 0.6).level, AlarmLevel::kAdvisory);
+  EXPECT_EQ(p.at(200, 0.6).level, AlarmLevel::kWarning);
+}
+
+TEST(AlarmPolicy, AdvisoryWhenTheBlockLeavesFullContact) {
+  AlarmPolicySettings s = immediate();
+  s.raise_hold_s = 0.05;
+  Policy p(s);
+  p.base.out_of_full_contact = true;
+  EXPECT_EQ(p.at(0, 0.0).level, AlarmLevel::kNormal);
+  const AlarmOutput out = p.at(50, 0.0);
+  EXPECT_EQ(out.level, AlarmLevel::kAdvisory);
+  expect_event(out, 0, AlarmLevel::kAdvisory, AlarmLevel::kNormal, AlarmCause::kPhaseChange, false);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Latching and acknowledgement
+
+TEST(AlarmPolicy, WarningLatchesUntilAcknowledged) {
+  Policy p(latching(true, false));
+  const AlarmOutput raised = p.at(0, 0.6);
+  expect_event(raised, 0, AlarmLevel::kWarning, AlarmLevel::kNormal, AlarmCause::kRiskThreshold,
+               true);
+  EXPECT_EQ(raised.events[0].sequence, 0);
+  EXPECT_EQ(raised.latched_level, AlarmLevel::kWarning);
+  const AlarmOutput calm = p.at(10, 0.0);  // the condition is gone, the latch holds
+  EXPECT_EQ(calm.level, AlarmLevel::kWarning);
+  EXPECT_EQ(calm.event_count, 0U);
+  const AlarmOutput acked = p.ack(20, 0.0, AlarmLevel::kWarning, 0);
+  EXPECT_EQ(acked.acknowledgement, AckOutcome::kReleased);
+  EXPECT_EQ(acked.level, AlarmLevel::kNormal);
+  ASSERT_EQ(acked.event_count, 1U);
+  expect_event(acked, 0, AlarmLevel::kNormal, AlarmLevel::kWarning, AlarmCause::kAcknowledged,
+               false);
+  EXPECT_EQ(acked.events[0].sequence, 1);
+}
+
+TEST(AlarmPolicy, AcknowledgingAnAlarmWhoseConditionHoldsKeepsIt) {
+  Policy p(latching(false, true));
+  (void)p.at(0, 0.9);
+  const AlarmOutput acked = p.ack(10, 0.9, AlarmLevel::kAlarm, 0);
+  EXPECT_EQ(acked.acknowledgement, AckOutcome::kReleasedConditionHolds);
+  EXPECT_EQ(acked.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(acked.latched_level, AlarmLevel::kNormal);
+  ASSERT_EQ(acked.event_count, 1U);  // the latch went: reported, level unchanged
+  expect_event(acked, 0, AlarmLevel::kAlarm, AlarmLevel::kAlarm, AlarmCause::kAcknowledged, false);
+  EXPECT_EQ(p.at(20, 0.9).event_count, 0U);  // no new latch while the condition stays up
+  // It lowers with its condition, without another acknowledgement.
+  const AlarmOutput lower = p.at(30, 0.2);
+  EXPECT_EQ(lower.level, AlarmLevel::kAdvisory);
+  // A new rise latches again.
+  const AlarmOutput again = p.at(40, 0.95);
+  expect_event(again, 0, AlarmLevel::kAlarm, AlarmLevel::kAdvisory, AlarmCause::kRiskThreshold,
+               true);
+}
+
+TEST(AlarmPolicy, StaleWrongLevelAndNeedlessAcknowledgementsChangeNothing) {
+  Policy p(latching(true, true));
+  EXPECT_EQ(p.ack(0, 0.0, AlarmLevel::kWarning, 0).acknowledgement, AckOutcome::kNothingLatched);
+  (void)p.at(10, 0.6);  // event 0: warning, latched
+  (void)p.at(20, 0.9);  // event 1: alarm, latched
+  const AlarmOutput stale = p.ack(30, 0.0, AlarmLevel::kAlarm, 0);  // before the alarm was seen
+  EXPECT_EQ(stale.acknowledgement, AckOutcome::kStale);
+  EXPECT_EQ(stale.event_count, 0U);
+  EXPECT_EQ(stale.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(stale.latched_level, AlarmLevel::kAlarm);
+  const AlarmOutput wrong = p.ack(40, 0.0, AlarmLevel::kWarning, 1);
+  EXPECT_EQ(wrong.acknowledgement, AckOutcome::kWrongLevel);
+  EXPECT_EQ(wrong.level, AlarmLevel::kAlarm);
+  const AlarmOutput right = p.ack(50, 0.0, AlarmLevel::kAlarm, 1);
+  EXPECT_EQ(right.acknowledgement, AckOutcome::kReleased);
+  EXPECT_EQ(right.level, AlarmLevel::kNormal);  // the warning latch went with the alarm's
+}
+
+TEST(AlarmPolicy, CollapseGoesStraightToAlarmAndLatches) {
+  AlarmPolicySettings s;  // holds of 0.1 s and 2 s: the collapse does not wait for them
+  s.latch_alarm = false;   // a collapse latches all the same
+  Policy p(s);
+  p.base.collapse_detected = true;
+  const AlarmOutput fell = p.at(0, 0.3);
+  EXPECT_EQ(fell.level, AlarmLevel::kAlarm);
+  expect_event(fell, 0, AlarmLevel::kAlarm, AlarmLevel::kNormal, AlarmCause::kOverturnDetected,
+               true);
+  // Acknowledged while the block lies overturned: the alarm stays, unlatched.
+  const AlarmOutput acked = p.ack(10, 0.3, AlarmLevel::kAlarm, 0);
+  EXPECT_EQ(acked.acknowledgement, AckOutcome::kReleasedConditionHolds);
+  EXPECT_EQ(acked.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(p.at(20, 0.3).latched_level, AlarmLevel::kNormal);  // not latched again
+  // The detector restarts (collapse cleared): the alarm follows at once, no latch left.
+  p.base.collapse_detected = false;
+  EXPECT_EQ(p.at(30, 0.0).level, AlarmLevel::kNormal);
+}
+
+TEST(AlarmPolicy, LatchedCollapseOutlivesItsDetection) {
+  Policy p(immediate());
+  p.base.collapse_detected = true;
+  (void)p.at(0, 0.0);
+  p.base.collapse_detected = false;
+  const AlarmOutput later = p.at(10, 0.0);
+  EXPECT_EQ(later.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(later.latched_level, AlarmLevel::kAlarm);
+  const AlarmOutput acked = p.ack(20, 0.0, AlarmLevel::kAlarm, 0);
+  EXPECT_EQ(acked.acknowledgement, AckOutcome::kReleased);
+  EXPECT_EQ(acked.level, AlarmLevel::kNormal);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Faults
+
+TEST(AlarmPolicy, FaultIsShownAtOnceAndClearsAfterTheLowerHold) {
+  AlarmPolicySettings s = immediate();
+  s.lower_hold_s = 0.5;
+  Policy p(s);
+  p.base.fault_active = true;
+  p.base.fault_cause = AlarmCause::kSensorTimeout;
+  const AlarmOutput fault = p.at(0, 0.0);
+  EXPECT_EQ(fault.level, AlarmLevel::kFault);
+  expect_event(fault, 0, AlarmLevel::kFault, AlarmLevel::kNormal, AlarmCause::kSensorTimeout,
+               false);
+  p.base.fault_active = false;
+  EXPECT_EQ(p.at(100, 0.0).level, AlarmLevel::kFault);
+  EXPECT_EQ(p.at(599, 0.0).level, AlarmLevel::kFault);
+  const AlarmOutput cleared = p.at(600, 0.0);
+  EXPECT_EQ(cleared.level, AlarmLevel::kNormal);
+  expect_event(cleared, 0, AlarmLevel::kNormal, AlarmLevel::kFault, AlarmCause::kNone, false);
+}
+
+TEST(AlarmPolicy, AFaultNeverHidesAnAlarm) {
+  Policy p(latching(false, true));
+  (void)p.at(0, 0.9);  // event 0: alarm
+  p.base.fault_active = true;
+  const AlarmOutput both = p.at(10, 0.9);
+  EXPECT_EQ(both.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(both.event_count, 0U);
+  // The alarm latched, its condition gone, still above the fault...
+  EXPECT_EQ(p.at(20, 0.0).level, AlarmLevel::kAlarm);
+  // ...until acknowledged: then the fault shows.
+  const AlarmOutput acked = p.ack(30, 0.0, AlarmLevel::kAlarm, 0);
+  EXPECT_EQ(acked.level, AlarmLevel::kFault);
+  expect_event(acked, 0, AlarmLevel::kFault, AlarmLevel::kAlarm, AlarmCause::kAcknowledged, false);
+}
+
+TEST(AlarmPolicy, AFaultHidesAWarningWhichShowsAgainAfterIt) {
+  Policy p(latching(true, false));
+  (void)p.at(0, 0.6);  // event 0: warning, latched
+  p.base.fault_active = true;
+  const AlarmOutput fault = p.at(10, 0.0);
+  expect_event(fault, 0, AlarmLevel::kFault, AlarmLevel::kWarning, AlarmCause::kSensorFault, true);
+  p.base.fault_active = false;
+  const AlarmOutput back = p.at(20, 0.0);
+  expect_event(back, 0, AlarmLevel::kWarning, AlarmLevel::kFault, AlarmCause::kRiskThreshold, true);
+  EXPECT_EQ(p.ack(30, 0.0, AlarmLevel::kWarning, 2).level, AlarmLevel::kNormal);
+}
+
+TEST(AlarmPolicy, AWarningLatchedBeneathAFaultIsReported) {
+  Policy p(latching(true, false));
+  p.base.fault_active = true;
+  (void)p.at(0, 0.0);  // event 0: fault
+  const AlarmOutput latched = p.at(10, 0.6);
+  expect_event(latched, 0, AlarmLevel::kFault, AlarmLevel::kFault, AlarmCause::kRiskThreshold,
+               true);
+  EXPECT_EQ(latched.latched_level, AlarmLevel::kWarning);
+}
+
+TEST(AlarmPolicy, AnInvalidRiskIsAnInternalFault) {
+  Policy p(immediate());
+  (void)p.at(0, 0.6);
+  const AlarmOutput nan = p.at(10, std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(nan.input_problem, InputProblem::kRiskInvalid);
+  expect_event(nan, 0, AlarmLevel::kFault, AlarmLevel::kWarning, AlarmCause::kInternalFault, false);
+  EXPECT_EQ(p.at(20, 0.6).level, AlarmLevel::kWarning);  // the warning held beneath
+  EXPECT_EQ(p.at(30, 1.0001).input_problem, InputProblem::kRiskInvalid);
+  EXPECT_EQ(p.at(40, -0.0001).level, AlarmLevel::kFault);
+  EXPECT_EQ(p.at(50, 1.0).input_problem, InputProblem::kNone);
+}
+
+TEST(AlarmPolicy, AnUpdateFromThePastIsRefused) {
+  Policy p(immediate());
+  (void)p.at(100, 0.6);
+  const AlarmOutput past = p.at(99, 0.0);
+  EXPECT_EQ(past.input_problem, InputProblem::kTimeWentBack);
+  EXPECT_EQ(past.level, AlarmLevel::kWarning);
+  EXPECT_EQ(past.event_count, 0U);
+  EXPECT_EQ(p.at(100, 0.0).level, AlarmLevel::kNormal);  // the same time is fine
+}
+
+// ---------------------------------------------------------------------------------------------
+// Events and heartbeat
+
+TEST(AlarmPolicy, EventSequenceIncrementsAndWraps) {
+  Policy p(immediate());
+  for (int i = 0; i < 300; ++i) {
+    const AlarmOutput out = p.at(i, i % 2 == 0 ? 0.6 : 0.0);
+    ASSERT_EQ(out.event_count, 1U) << i;
+    EXPECT_EQ(out.events[0].sequence, static_cast<std::uint8_t>(i % 256)) << i;
+  }
+}
+
+TEST(AlarmPolicy, AnAcknowledgementAndANewRiseGiveTwoEventsInOrder) {
+  Policy p(latching(true, true));
+  (void)p.at(0, 0.6);  // event 0: warning latched
+  (void)p.at(10, 0.0);
+  const AlarmOutput out = p.ack(20, 0.9, AlarmLevel::kWarning, 0);
+  EXPECT_EQ(out.acknowledgement, AckOutcome::kReleased);
+  ASSERT_EQ(out.event_count, 2U);
+  expect_event(out, 0, AlarmLevel::kNormal, AlarmLevel::kWarning, AlarmCause::kAcknowledged, false);
+  expect_event(out, 1, AlarmLevel::kAlarm, AlarmLevel::kNormal, AlarmCause::kRiskThreshold, true);
+  EXPECT_EQ(out.events[0].sequence, 1);
+  EXPECT_EQ(out.events[1].sequence, 2);
+}
+
+TEST(AlarmPolicy, HeartbeatIsDueEveryPeriodAndAtOnceAfterAnEvent) {
+  AlarmPolicySettings s = immediate();
+  s.heartbeat_period_s = 0.5;
+  Policy p(s);
+  EXPECT_TRUE(p.policy.heartbeat_due(0));  // nothing sent yet
+  p.policy.heartbeat_sent(1000 * kMs);
+  EXPECT_EQ(p.policy.next_heartbeat_ns(), 1500 * kMs);
+  EXPECT_FALSE(p.policy.heartbeat_due(1500 * kMs - 1));
+  EXPECT_TRUE(p.policy.heartbeat_due(1500 * kMs));
+  (void)p.at(1200, 0.6);  // an event: the next status goes out now
+  EXPECT_EQ(p.policy.next_heartbeat_ns(), 1200 * kMs);
+  p.policy.heartbeat_sent(1200 * kMs);
+  EXPECT_EQ(p.policy.next_heartbeat_ns(), 1700 * kMs);
+  (void)p.at(1300, 0.6);  // no event: unchanged
+  EXPECT_EQ(p.policy.next_heartbeat_ns(), 1700 * kMs);
+}
+
+TEST(AlarmPolicy, EventsBecomeCanFrames) {
+  AlarmEventRecord r;
+  r.level = AlarmLevel::kAlarm;
+  r.previous_level = AlarmLevel::kWarning;
+  r.cause = AlarmCause::kOverturnDetected;
+  r.latched = true;
+  r.time_ns = 5'000'123'456;
+  r.sequence = 200;
+  const can::AlarmEvent e = to_can_event(r);
+  EXPECT_EQ(e.time_since_start_ms, 5000U);
+  EXPECT_EQ(e.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(e.previous_level, AlarmLevel::kWarning);
+  EXPECT_EQ(e.cause, AlarmCause::kOverturnDetected);
+  EXPECT_TRUE(e.latched);
+  EXPECT_EQ(e.sequence, 200);
+  can::CanFrame frame;
+  EXPECT_TRUE(can::encode(e, frame).ok());
+  r.time_ns = ((std::int64_t{1} << 32) + 7) * kMs;  // the frame's millisecond counter wraps
+  EXPECT_EQ(to_can_event(r).time_since_start_ms, 7U);
+  EXPECT_STREQ(ack_outcome_name(AckOutcome::kStale), "stale sequence");
+  EXPECT_STREQ(input_problem_name(InputProblem::kTimeWentBack), "time went back");
+}
+
+}  // namespace
+}  // namespace plinth::monitor
