@@ -57,6 +57,7 @@ struct Options {
   double pre_trigger = 30.0;
   double post_trigger = 60.0;
   bool quiet_events = false;
+  std::optional<int> stuck_samples;
 };
 
 const char* axis_name(int axis) { return axis == 0 ? "x" : "y"; }
@@ -393,6 +394,7 @@ int run(const Options& opt) {
   config.ground_node = static_cast<std::uint8_t>(opt.node);
   config.estimator.steps_per_sample = opt.steps;
   config.conditioning.startup_window_s = opt.startup_window;
+  if (opt.stuck_samples) config.sensor_health.stuck_samples = *opt.stuck_samples;
   RecordSamples record;
   double t_origin = 0.0;
   if (replay_record) {
@@ -588,7 +590,16 @@ int main(int argc, char** argv) {
   app.add_option("--post-trigger", opt.post_trigger, "s kept after an alarm (default 60)")
       ->check(plinth::cli::kFinite);
   app.add_flag("--no-events", opt.quiet_events, "leave out the phase event lines");
-  CLI11_PARSE(app, argc, argv);
+  app.add_option("--stuck-samples", opt.stuck_samples,
+                 "identical samples that mean a stuck sensor (default 50; 0: off, for noise-free "
+                 "synthetic logs)")
+      ->check(CLI::Range(0, 100000));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help ends here with 0; every usage error exits with 2.
+    return app.exit(e) == 0 ? 0 : 2;
+  }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   try {
