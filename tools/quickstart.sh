@@ -1,14 +1,16 @@
 #!/usr/bin/env bash
 # The README's first command: install what is missing, build (Release), and run the main job
-# on the bundled default: plinth-sim on the paper's Fig. 8 case H (eccentric block, base
-# stops, Buia 1976 record scaled by 6.5).
+# on the bundled default: plinth-monitor replaying the paper's Fig. 8 case H (eccentric block on
+# the isolated base with stops, Buia 1976 record scaled by 6.5), showing the alarm timeline.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tools/install-deps.sh
 cmake --preset release >/dev/null
-cmake --build --preset release --target plinth-sim
+cmake --build --preset release --target plinth-monitor plinth-sim
 echo
-exec build/release/sim/plinth-sim \
+echo "plinth-monitor: alarm changes and phase events (all status lines: build/release/quickstart.jsonl)"
+build/release/firmware/linux/plinth-monitor \
   --scene sim/scenes/paper-eccentric.toml \
-  --record sim/data/records/friuli1976-09-15_buia_000.AT2 --scale 6.5 \
-  --out build/release/quickstart.csv --events build/release/quickstart-events.jsonl
+  --replay sim/data/records/friuli1976-09-15_buia_000.AT2 --scale 6.5 \
+  --record-dir build/release/quickstart-captures >build/release/quickstart.jsonl
+grep -E '"type": "(alarm|event|summary)"' build/release/quickstart.jsonl | cut -c 1-150

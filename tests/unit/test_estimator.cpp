@@ -209,3 +209,103 @@ TEST(Risk, LeadsTheOverturn) {
 
 }  // namespace
 }  // namespace plinth
+
+namespace plinth {
+namespace {
+
+// How long before the collapse the risk crosses each alarm policy's "on" threshold
+// (advisory 0.1, warning 0.5, alarm 0.8; monitor/alarm_policy.h), on every bundled record
+// scaled just past the collapse of three scenes (overturning on the base, overturning on the
+// ground, falling off the base). Printed as the table of docs/monitor.md.
+struct LeadTimes {
+  double gamma = 0.0;
+  double collapse_t = -1.0;
+  Phase collapse = Phase::kFullContact;
+  double crossed[3] = {-1.0, -1.0, -1.0};
+};
+
+LeadTimes lead_times(const Scene& scene, const host::Record& record, double gamma) {
+  LeadTimes r;
+  r.gamma = gamma;
+  SolverSettings solver;
+  solver.step = std::fmin(record.dt / 4.0, 1e-3);
+  Simulator sim;
+  const Excitation ex = Excitation::record(record.horizontal_signal(), {}, gamma);
+  if (!Simulator::create(scene, ex, solver, sim).ok()) return r;
+  sim.start_at_rest();
+  const double thresholds[3] = {0.1, 0.5, 0.8};
+  while (sim.time() < record.duration() && !sim.mode().terminal()) {
+    sim.step();
+    const double risk = overturning_risk(scene, sim.mode(), sim.state()).total;
+    for (int k = 0; k < 3; ++k) {
+      if (r.crossed[k] < 0.0 && risk >= thresholds[k]) r.crossed[k] = sim.time();
+    }
+  }
+  if (sim.mode().terminal()) {
+    r.collapse_t = sim.time();
+    r.collapse = sim.mode().phase;
+  }
+  return r;
+}
+
+TEST(Risk, LeadsTheCollapseOnEveryBundledRecord) {
+  const std::vector<std::string> records = {
+      "irpinia1980_brienza_000", "irpinia1980_brienza_270", "irpinia1980_calitri_000",
+      "irpinia1980_calitri_270", "irpinia1980_bagnoli_000", "irpinia1980_bagnoli_270",
+      "friuli1976-09-15_buia_000", "friuli1976-09-15_buia_270", "friuli1976-09-11_buia_NS",
+      "elcentro1940_180"};
+  const std::vector<std::pair<std::string, std::string>> scenes = {
+      {"paper-isolated", kSource + "/sim/scenes/paper-isolated.toml"},
+      {"non-isolated", kSource + "/sim/scenes/non-isolated.toml"},
+      {"fig14c (falls)", kSource + "/sim/scenes/fig14c-slide-rocking-base-stops.toml"}};
+  std::printf("| scene | record | PGA (g) | collapse | at (s) | lead of risk 0.1 | 0.5 | 0.8 |\n"
+              "|---|---|---|---|---|---|---|---|\n");
+  int collapses = 0;
+  for (const auto& [scene_name, scene_path] : scenes) {
+    const Scene scene = host::load_scene_file(scene_path);
+    for (const std::string& name : records) {
+      const host::Record record =
+          host::read_at2(kSource + "/sim/data/records/" + name + ".AT2", kStandardGravity);
+      // Just past the collapse: a 25 % PGA grid from 0.1 g to 6 g, then four bisections of the
+      // first interval that collapses (to within 1.5 %).
+      const auto at = [&](double pga_g) {
+        return lead_times(scene, record, pga_g * kStandardGravity / record.peak_horizontal());
+      };
+      LeadTimes r;
+      double low = 0.0;
+      double high = 0.1;
+      for (; high <= 6.0; low = high, high *= 1.25) {
+        r = at(high);
+        if (r.collapse_t >= 0.0) break;
+      }
+      if (r.collapse_t < 0.0) continue;
+      for (int i = 0; i < 4 && low > 0.0; ++i) {
+        const double mid = 0.5 * (low + high);
+        const LeadTimes m = at(mid);
+        if (m.collapse_t >= 0.0) {
+          high = mid;
+          r = m;
+        } else {
+          low = mid;
+        }
+      }
+      ++collapses;
+      std::printf("| %s | %s | %.3f | %s | %.3f |", scene_name.c_str(), name.c_str(),
+                  r.gamma * record.peak_horizontal() / kStandardGravity,
+                  phase_name(r.collapse), r.collapse_t);
+      for (int k = 0; k < 3; ++k) {
+        // Every threshold is crossed, and no later than the collapse itself.
+        EXPECT_GE(r.crossed[k], 0.0) << scene_name << " " << name << " threshold " << k;
+        EXPECT_LE(r.crossed[k], r.collapse_t) << scene_name << " " << name;
+        std::printf(" %.3f |", r.collapse_t - r.crossed[k]);
+      }
+      std::printf("\n");
+      // The warning comes before the collapse, not with it.
+      EXPECT_GT(r.collapse_t - r.crossed[1], 0.0) << scene_name << " " << name;
+    }
+  }
+  EXPECT_GE(collapses, 25);
+}
+
+}  // namespace
+}  // namespace plinth
