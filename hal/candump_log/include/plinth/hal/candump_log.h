@@ -1,0 +1,132 @@
+// can-utils' candump log files: read as a FrameSource, written as a FrameSink.
+//
+// One frame per line, exactly as `candump -l` writes and `canplayer -I` reads:
+//
+//     (1700000000.123456) vcan0 301#0011223344556677
+//
+// the timestamp in seconds with exactly six decimals (microseconds; canplayer reads the
+// decimals as an integer count of microseconds, so "1.5" would mean 1 s + 5 us: refused), the
+// interface name, then the frame: the identifier in hex (3 digits: standard, 8 digits:
+// extended or, with 0x20000000 set, an error frame), '#', the data bytes in hex (0 to 8
+// bytes, either case, optionally separated by '.'). Also recognised, as canplayer does:
+// `123#R` / `123#R5` (remote request, optional DLC), `123##1<data>` (CAN FD: flags nibble,
+// up to 64 bytes), `...#<8 bytes>_9` (classic frame with a raw DLC of 9-15) and a trailing
+// direction token `R` or `T` (asc2log writes one). Blank lines and lines starting with '#' are
+// comments. Anything else is malformed and reported with its file and line; canplayer would
+// silently skip a line not starting with '(', this reader refuses it so a wrong file is noticed.
+//
+// Host code: allocates, and the constructors throw plinth::host::InputError.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <fstream>
+#include <functional>
+#include <string>
+#include <string_view>
+
+#include "plinth/hal/can_codec.h"
+#include "plinth/hal/frame_io.h"
+
+namespace plinth::hal {
+
+enum class CandumpFrameKind : std::uint8_t {
+  kComment,     // blank line or '#' comment: no frame
+  kClassic,     // classic data frame, standard (11-bit) identifier
+  kExtended,    // classic data frame, extended (29-bit) identifier
+  kRemote,      // remote transmission request (standard or extended)
+  kFd,          // CAN FD frame ("##")
+  kErrorFrame,  // error frame (8-digit identifier with CAN_ERR_FLAG 0x20000000)
+};
+
+[[nodiscard]] const char* candump_frame_kind_name(CandumpFrameKind kind);
+
+inline constexpr std::size_t kCandumpMaxFdLength = 64;         // bytes
+inline constexpr std::size_t kCandumpMaxInterfaceLength = 15;  // IFNAMSIZ - 1
+inline constexpr std::uint32_t kStandardIdMask = 0x7FF;
+inline constexpr std::uint32_t kExtendedIdMask = 0x1FFFFFFF;
+inline constexpr std::uint32_t kCanErrorFlag = 0x20000000;  // SocketCAN's CAN_ERR_FLAG
+
+// One parsed log line.
+struct CandumpLine {
+  CandumpFrameKind kind = CandumpFrameKind::kComment;
+  std::int64_t timestamp_ns = 0;  // since the epoch, a whole number of microseconds
+  std::string interface_name;
+  std::uint32_t id = 0;      // without flag bits (for error frames: the error class bits)
+  bool extended = false;     // 8-digit identifier
+  std::uint8_t length = 0;   // data bytes (remote request: the requested DLC)
+  std::uint8_t raw_dlc = 0;  // classic frames with 8 bytes and a "_<dlc>" suffix: 9..15, else 0
+  std::uint8_t fd_flags = 0;
+  std::array<std::uint8_t, kCandumpMaxFdLength> data{};
+};
+
+// Parses one line (without its newline; a trailing '\r' is allowed). Returns "" on success,
+// otherwise what is wrong, e.g. "odd number of hex digits in the data (a truncated byte)".
+[[nodiscard]] std::string parse_candump_line(std::string_view line, CandumpLine& out);
+
+// The log line of a classic frame with a standard identifier, as candump -l writes it
+// (uppercase hex, no newline): "(1700000000.123456) vcan0 301#0011223344556677".
+// The timestamp is truncated to whole microseconds; it must not be negative.
+[[nodiscard]] std::string format_candump_line(std::int64_t timestamp_ns,
+                                              std::string_view interface_name,
+                                              const can::CanFrame& frame);
+
+// Reads a candump log file frame by frame. receive() never waits (timeout_ms is ignored) and
+// returns, per non-comment line:
+//   kOk          a classic data frame with a standard identifier (any identifier and length
+//                0..8: whether it is a plinth frame is the codec's business);
+//   kNotPlinth   an extended, remote, CAN FD or raw-DLC frame (only the timestamp is set);
+//   kBusError    a logged error frame (only the timestamp is set);
+//   kIoError     a malformed line or a read error: error() says "file:line: what"; the next
+//                call goes on with the following line;
+//   kEndOfInput  at the end of the file (and on every later call).
+class CandumpLogReader final : public FrameSource {
+ public:
+  // Throws plinth::host::InputError "<path>: cannot open file" when the file cannot be read.
+  explicit CandumpLogReader(std::string path);
+
+  [[nodiscard]] IoStatus receive(TimedFrame& out, int timeout_ms) override;
+
+  [[nodiscard]] const std::string& error() const { return error_; }
+  // The last line read, as parsed (interface, kind, full identifier and data of any frame).
+  [[nodiscard]] const CandumpLine& last_line() const { return line_; }
+  [[nodiscard]] std::size_t line_number() const { return line_number_; }
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::ifstream in_;
+  std::string text_;
+  CandumpLine line_;
+  std::size_t line_number_ = 0;
+  std::string error_;
+};
+
+// Writes a candump log file. Each sent frame becomes one line stamped with `clock()` (ns since
+// the epoch: the caller decides what time a frame carries, e.g. its virtual send time).
+// send() returns kIoError, with error() set, for a frame that is not a classic standard frame
+// of 0..8 bytes, a negative timestamp or a failed write.
+class CandumpLogWriter final : public FrameSink {
+ public:
+  using Clock = std::function<std::int64_t()>;
+
+  // Creates (truncates) `path`. Throws plinth::host::InputError when it cannot, or when the
+  // interface name is empty, longer than 15 characters or contains white space.
+  CandumpLogWriter(std::string path, std::string interface_name, Clock clock);
+
+  [[nodiscard]] IoStatus send(const can::CanFrame& frame) override;
+  // Flushes to the file; false (error() set) when a write failed.
+  [[nodiscard]] bool flush();
+
+  [[nodiscard]] const std::string& error() const { return error_; }
+  [[nodiscard]] const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+  std::string interface_name_;
+  Clock clock_;
+  std::ofstream out_;
+  std::string error_;
+};
+
+}  // namespace plinth::hal

@@ -1,0 +1,346 @@
+#include "plinth/hal/candump_log.h"
+
+#include <cinttypes>
+#include <cstdio>
+#include <initializer_list>
+#include <limits>
+#include <utility>
+
+#include "plinth/host/input_error.h"
+
+namespace plinth::hal {
+namespace {
+
+constexpr std::int64_t kNsPerSecond = 1'000'000'000;
+constexpr std::int64_t kNsPerMicrosecond = 1'000;
+// The largest whole second whose nanoseconds (plus a fraction) still fit an int64.
+constexpr std::int64_t kMaxTimestampSeconds =
+    std::numeric_limits<std::int64_t>::max() / kNsPerSecond - 1;
+constexpr std::size_t kMaxClassicLength = 8;
+constexpr std::size_t kQuoteLength = 40;  // characters of a bad token quoted in a message
+
+bool is_blank(char c) { return c == ' ' || c == '\t'; }
+bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
+// 0..15 for a hex digit (either case), -1 otherwise.
+int hex_value(char c) {
+  if (c >= '0' && c <= '9') return c - '0';
+  if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+  if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+  return -1;
+}
+
+// Message parts joined (GCC 12 warns falsely on `"literal" + std::string` at -O3).
+std::string join(std::initializer_list<std::string_view> parts) {
+  std::string out;
+  for (const std::string_view part : parts) out += part;
+  return out;
+}
+
+std::string quoted(std::string_view text) {
+  if (text.size() <= kQuoteLength) return join({"'", text, "'"});
+  return join({"'", text.substr(0, kQuoteLength), "...'"});
+}
+
+std::string_view next_token(std::string_view& rest) {
+  std::size_t begin = 0;
+  while (begin < rest.size() && is_blank(rest[begin])) ++begin;
+  std::size_t end = begin;
+  while (end < rest.size() && !is_blank(rest[end])) ++end;
+  const std::string_view token = rest.substr(begin, end - begin);
+  rest.remove_prefix(end);
+  return token;
+}
+
+// "(seconds.micro)" with exactly six decimals -> ns; "" or the reason.
+std::string parse_timestamp(std::string_view token, std::int64_t& timestamp_ns) {
+  const std::string bad = join({"bad timestamp ", quoted(token),
+                                ": expected (seconds.microseconds) with six decimals, as "
+                                "candump -l writes"});
+  if (token.size() < 4 || token.front() != '(' || token.back() != ')') return bad;
+  const std::string_view inner = token.substr(1, token.size() - 2);
+  const std::size_t point = inner.find('.');
+  if (point == std::string_view::npos || point == 0) return bad;
+  const std::string_view seconds_text = inner.substr(0, point);
+  const std::string_view micros_text = inner.substr(point + 1);
+  if (micros_text.size() != 6) return bad;
+  std::int64_t seconds = 0;
+  for (const char c : seconds_text) {
+    if (!is_digit(c)) return bad;
+    seconds = seconds * 10 + (c - '0');
+    if (seconds > kMaxTimestampSeconds) {
+      return join({"timestamp ", quoted(token), " is too large (beyond the year 2262)"});
+    }
+  }
+  std::int64_t micros = 0;
+  for (const char c : micros_text) {
+    if (!is_digit(c)) return bad;
+    micros = micros * 10 + (c - '0');
+  }
+  timestamp_ns = seconds * kNsPerSecond + micros * kNsPerMicrosecond;
+  return {};
+}
+
+// Hex bytes, optionally '.'-separated, from `text` into `data` (at most `max_length`); stops at
+// '_' (a raw DLC suffix follows) or the end. "" or the reason.
+std::string parse_data(std::string_view text, std::size_t max_length, std::uint8_t* data,
+                       std::size_t& length, std::size_t& consumed) {
+  length = 0;
+  std::size_t digits = 0;
+  std::size_t i = 0;
+  while (i < text.size() && text[i] != '_') {
+    const char c = text[i];
+    if (c == '.' && digits % 2 == 0) {
+      ++i;
+      continue;
+    }
+    const int nibble = hex_value(c);
+    if (nibble < 0) {
+      if (c == '.') return "separator '.' inside a byte of the data";
+      return join({"'", std::string_view(&c, 1), "' in the data is not a hex digit"});
+    }
+    if (digits % 2 == 0) {
+      if (length < max_length) data[length] = static_cast<std::uint8_t>(nibble << 4);
+    } else {
+      if (length < max_length) data[length] = static_cast<std::uint8_t>(data[length] | nibble);
+      ++length;
+    }
+    ++digits;
+    ++i;
+  }
+  consumed = i;
+  if (digits % 2 != 0) return "odd number of hex digits in the data (a truncated byte)";
+  if (length > max_length) {
+    return join(
+        {std::to_string(length), " data bytes, at most ", std::to_string(max_length),
+         max_length == kMaxClassicLength ? " fit a classic CAN frame" : " fit a CAN FD frame"});
+  }
+  return {};
+}
+
+// The frame after the interface name: "<id>#<data>", "<id>#R[dlc]", "<id>##<flags><data>".
+std::string parse_frame(std::string_view token, CandumpLine& out) {
+  const std::size_t hash = token.find('#');
+  if (hash == std::string_view::npos) {
+    return join({"frame ", quoted(token), " has no '#' between identifier and data"});
+  }
+  const std::string_view id_text = token.substr(0, hash);
+  if (id_text.size() != 3 && id_text.size() != 8) {
+    return join(
+        {"identifier ", quoted(id_text), " must have 3 (standard) or 8 (extended) hex digits"});
+  }
+  std::uint32_t id = 0;
+  for (const char c : id_text) {
+    const int nibble = hex_value(c);
+    if (nibble < 0) return join({"identifier ", quoted(id_text), " is not hexadecimal"});
+    id = (id << 4) | static_cast<std::uint32_t>(nibble);
+  }
+  out.extended = id_text.size() == 8;
+  if (!out.extended && id > kStandardIdMask) {
+    return join({"standard identifier ", quoted(id_text), " is above 7FF"});
+  }
+  bool error_frame = false;
+  if (out.extended && id > kExtendedIdMask) {
+    if ((id & ~(kCanErrorFlag | kExtendedIdMask)) != 0) {
+      return join({"extended identifier ", quoted(id_text), " is above 1FFFFFFF"});
+    }
+    error_frame = true;  // candump logs error frames with CAN_ERR_FLAG in the identifier
+    id &= kExtendedIdMask;
+  }
+  out.id = id;
+
+  std::string_view rest = token.substr(hash + 1);
+  const std::string in_frame = join({" in frame ", quoted(token)});
+  if (!rest.empty() && (rest.front() == 'R' || rest.front() == 'r')) {
+    out.kind = CandumpFrameKind::kRemote;
+    rest.remove_prefix(1);
+    if (!rest.empty()) {
+      const int dlc = hex_value(rest.front());
+      if (dlc < 0 || static_cast<std::size_t>(dlc) > kMaxClassicLength) {
+        return join({"remote request length ", quoted(rest), " is not 0-8", in_frame});
+      }
+      out.length = static_cast<std::uint8_t>(dlc);
+      rest.remove_prefix(1);
+    }
+    if (!rest.empty()) {
+      return join({"unexpected ", quoted(rest), " after the remote request", in_frame});
+    }
+    return {};
+  }
+
+  std::size_t max_length = kMaxClassicLength;
+  if (!rest.empty() && rest.front() == '#') {
+    out.kind = CandumpFrameKind::kFd;
+    max_length = kCandumpMaxFdLength;
+    if (rest.size() < 2 || hex_value(rest[1]) < 0) {
+      return join({"CAN FD frame needs a flags hex digit after '##'", in_frame});
+    }
+    out.fd_flags = static_cast<std::uint8_t>(hex_value(rest[1]));
+    rest.remove_prefix(2);
+  } else if (error_frame) {
+    out.kind = CandumpFrameKind::kErrorFrame;
+  } else {
+    out.kind = out.extended ? CandumpFrameKind::kExtended : CandumpFrameKind::kClassic;
+  }
+  std::size_t length = 0;
+  std::size_t consumed = 0;
+  std::string problem = parse_data(rest, max_length, out.data.data(), length, consumed);
+  if (!problem.empty()) return join({problem, in_frame});
+  out.length = static_cast<std::uint8_t>(length);
+  rest.remove_prefix(consumed);
+  if (!rest.empty()) {
+    // "_<dlc>": a classic 8-byte frame whose DLC on the wire is 9..15.
+    const int dlc = rest.size() == 2 ? hex_value(rest[1]) : -1;
+    if (out.kind == CandumpFrameKind::kFd || length != kMaxClassicLength || dlc <= 8) {
+      return join({"unexpected ", quoted(rest),
+                   " after the data (a raw DLC suffix is _9.._F after 8 bytes)", in_frame});
+    }
+    out.raw_dlc = static_cast<std::uint8_t>(dlc);
+  }
+  return {};
+}
+
+}  // namespace
+
+const char* candump_frame_kind_name(CandumpFrameKind kind) {
+  switch (kind) {
+    case CandumpFrameKind::kComment: return "comment";
+    case CandumpFrameKind::kClassic: return "classic";
+    case CandumpFrameKind::kExtended: return "extended";
+    case CandumpFrameKind::kRemote: return "remote request";
+    case CandumpFrameKind::kFd: return "CAN FD";
+    case CandumpFrameKind::kErrorFrame: return "error frame";
+  }
+  return "invalid";
+}
+
+std::string parse_candump_line(std::string_view line, CandumpLine& out) {
+  out = CandumpLine{};
+  if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+  std::string_view rest = line;
+  const std::string_view timestamp = next_token(rest);
+  if (timestamp.empty() || timestamp.front() == '#') return {};  // blank or comment
+  if (timestamp.front() != '(') {
+    return join({"expected a line '(seconds.microseconds) interface id#data', got ", quoted(line)});
+  }
+  std::string problem = parse_timestamp(timestamp, out.timestamp_ns);
+  if (!problem.empty()) return problem;
+  const std::string_view interface_name = next_token(rest);
+  if (interface_name.empty()) return "missing the interface name after the timestamp";
+  if (interface_name.size() > kCandumpMaxInterfaceLength) {
+    return join({"interface name ", quoted(interface_name), " is longer than 15 characters"});
+  }
+  out.interface_name = std::string(interface_name);
+  const std::string_view frame = next_token(rest);
+  if (frame.empty()) return "missing the frame (id#data) after the interface name";
+  problem = parse_frame(frame, out);
+  if (!problem.empty()) {
+    out.kind = CandumpFrameKind::kComment;
+    return problem;
+  }
+  // Newer candump (-x) and asc2log add the direction: R (received) or T (transmitted).
+  const std::string_view direction = next_token(rest);
+  if (!direction.empty() && direction != "R" && direction != "T") {
+    out.kind = CandumpFrameKind::kComment;
+    return join({"unexpected ", quoted(direction), " after the frame (only R or T may follow)"});
+  }
+  if (!next_token(rest).empty()) {
+    out.kind = CandumpFrameKind::kComment;
+    return "unexpected text after the frame";
+  }
+  return {};
+}
+
+std::string format_candump_line(std::int64_t timestamp_ns, std::string_view interface_name,
+                                const can::CanFrame& frame) {
+  const std::int64_t micros = timestamp_ns / kNsPerMicrosecond;
+  char text[64];
+  int n = std::snprintf(text, sizeof text, "(%010" PRId64 ".%06" PRId64 ") ", micros / 1'000'000,
+                        micros % 1'000'000);
+  std::string line(text, static_cast<std::size_t>(n));
+  line += interface_name;
+  n = std::snprintf(text, sizeof text, " %03" PRIX32 "#", frame.id);
+  line.append(text, static_cast<std::size_t>(n));
+  const std::size_t length = frame.length <= kMaxClassicLength ? frame.length : kMaxClassicLength;
+  for (std::size_t i = 0; i < length; ++i) {
+    n = std::snprintf(text, sizeof text, "%02X", static_cast<unsigned>(frame.data[i]));
+    line.append(text, static_cast<std::size_t>(n));
+  }
+  return line;
+}
+
+CandumpLogReader::CandumpLogReader(std::string path) : path_(std::move(path)), in_(path_) {
+  if (!in_) throw host::InputError(path_ + ": cannot open file");
+}
+
+IoStatus CandumpLogReader::receive(TimedFrame& out, int /*timeout_ms*/) {
+  error_.clear();
+  while (std::getline(in_, text_)) {
+    ++line_number_;
+    const std::string problem = parse_candump_line(text_, line_);
+    if (!problem.empty()) {
+      error_ = join({path_, ":", std::to_string(line_number_), ": ", problem});
+      return IoStatus::kIoError;
+    }
+    if (line_.kind == CandumpFrameKind::kComment) continue;
+    out = TimedFrame{};
+    out.timestamp_ns = line_.timestamp_ns;
+    switch (line_.kind) {
+      case CandumpFrameKind::kClassic:
+        if (line_.raw_dlc != 0) return IoStatus::kNotPlinth;  // plinth frames have DLC 8
+        out.frame.id = line_.id;
+        out.frame.length = line_.length;
+        for (std::size_t i = 0; i < line_.length; ++i) out.frame.data[i] = line_.data[i];
+        return IoStatus::kOk;
+      case CandumpFrameKind::kErrorFrame: return IoStatus::kBusError;
+      default: return IoStatus::kNotPlinth;
+    }
+  }
+  if (in_.bad()) {
+    error_ = join({path_, ":", std::to_string(line_number_ + 1), ": read error"});
+    return IoStatus::kIoError;
+  }
+  return IoStatus::kEndOfInput;
+}
+
+CandumpLogWriter::CandumpLogWriter(std::string path, std::string interface_name, Clock clock)
+    : path_(std::move(path)), interface_name_(std::move(interface_name)), clock_(std::move(clock)) {
+  bool has_blank = false;
+  for (const char c : interface_name_) has_blank = has_blank || is_blank(c) || c == '\n';
+  if (interface_name_.empty() || interface_name_.size() > kCandumpMaxInterfaceLength || has_blank) {
+    throw host::InputError(join({"log interface name ", quoted(interface_name_),
+                                 ": must be 1 to 15 characters without spaces"}));
+  }
+  out_.open(path_, std::ios::out | std::ios::trunc);
+  if (!out_) throw host::InputError(path_ + ": cannot open the log for writing");
+}
+
+IoStatus CandumpLogWriter::send(const can::CanFrame& frame) {
+  if (frame.id > kStandardIdMask || frame.length > kMaxClassicLength) {
+    error_ = join({path_, ": cannot log a frame with identifier ", std::to_string(frame.id),
+                   " and length ", std::to_string(frame.length),
+                   " (classic, standard identifiers only)"});
+    return IoStatus::kIoError;
+  }
+  const std::int64_t timestamp_ns = clock_();
+  if (timestamp_ns < 0) {
+    error_ = join({path_, ": negative timestamp ", std::to_string(timestamp_ns), " ns"});
+    return IoStatus::kIoError;
+  }
+  out_ << format_candump_line(timestamp_ns, interface_name_, frame) << '\n';
+  if (!out_) {
+    error_ = path_ + ": write failed";
+    return IoStatus::kIoError;
+  }
+  return IoStatus::kOk;
+}
+
+bool CandumpLogWriter::flush() {
+  if (!out_.flush()) {
+    error_ = path_ + ": write failed";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace plinth::hal

@@ -1,0 +1,107 @@
+// What plinth-replay sends and when: sensor frames made from records, or the sensor frames of a
+// candump log, each with its virtual send time (time since the replay started, at speed 1).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "plinth/core/excitation.h"
+#include "plinth/hal/can_codec.h"
+
+namespace plinth::replay {
+
+inline constexpr double kStandardGravity = 9.80665;  // m/s2: the DBC's 1 g
+
+enum class FrameKind : std::uint8_t { kAcceleration, kHeartbeat };
+
+struct ScheduledFrame {
+  std::int64_t virtual_ns = 0;  // since the replay started, at speed 1
+  FrameKind kind = FrameKind::kAcceleration;
+  can::CanFrame frame;
+};
+
+class FrameSchedule {
+ public:
+  virtual ~FrameSchedule() = default;
+  // The next frame in send order; false after the last one.
+  [[nodiscard]] virtual bool next(ScheduledFrame& out) = 0;
+};
+
+// The ground motion one sensor node measures, m/s2: x and y horizontal, z vertical (positive
+// up). An empty signal is a still axis; signals end (read zero) after their last sample.
+struct SensorNodeInput {
+  std::uint8_t node = can::kFirstSensorNode;
+  SampledSignal x;
+  SampledSignal y;
+  SampledSignal z;
+};
+
+// A node's samples at the sensor rate, in g, as the accelerometer reads them (specific force:
+// the ground's acceleration, plus +1 g on z from gravity), clamped to the frame's full scale
+// with sensor_status::kSaturated set where a value had to be clamped.
+struct SensorNodeSamples {
+  std::uint8_t node = can::kFirstSensorNode;
+  std::vector<std::array<double, 3>> acceleration_g;  // per sample: ax, ay, az
+  std::vector<std::uint8_t> status;                   // per sample
+};
+
+// Samples at t = k / rate_hz, k = 0 .. floor(duration_s * rate_hz) (the solver's convention:
+// linear interpolation between record samples), each signal multiplied by `scale`.
+[[nodiscard]] SensorNodeSamples resample(const SensorNodeInput& input, double scale, double rate_hz,
+                                         double duration_s);
+
+// SensorAcceleration frames of every node at each sample time (nodes in the given order),
+// preceded at each whole second of virtual time by a SensorHeartbeat of every node; `loops`
+// times over, each loop starting one sample period after the previous one's last sample. The
+// sequence counters run on across loops (wrapping 255 -> 0), and so does the heartbeats'
+// uptime.
+class RecordSchedule final : public FrameSchedule {
+ public:
+  RecordSchedule(std::vector<SensorNodeSamples> nodes, double rate_hz, std::int64_t loops);
+  [[nodiscard]] bool next(ScheduledFrame& out) override;
+
+  [[nodiscard]] std::int64_t samples_per_loop() const { return samples_per_loop_; }
+
+ private:
+  std::vector<SensorNodeSamples> nodes_;
+  double rate_hz_;
+  std::int64_t samples_per_loop_;
+  std::int64_t total_samples_;
+  std::int64_t sample_ = 0;    // global sample index, across loops
+  std::size_t slot_ = 0;       // position within the current sample time's frames
+  bool heartbeat_due_ = true;  // heartbeats lead the frames of this sample time
+  std::int64_t next_heartbeat_s_ = 0;
+  std::vector<std::uint8_t> sequence_;      // per node
+  std::vector<std::uint8_t> status_since_;  // per node: flags since its last heartbeat
+};
+
+// The sensor frames (SensorAcceleration and SensorHeartbeat of any node) of a candump log, sent
+// again as logged, at their logged times relative to the first of them (times that go backwards
+// are held at the previous one). Other lines are skipped and counted.
+struct LoggedFrames {
+  std::vector<ScheduledFrame> frames;  // virtual_ns relative to the first
+  std::int64_t skipped = 0;            // non-sensor, non-plinth, error-frame lines
+};
+
+// Reads the log; throws host::InputError "file:line: what" for a malformed line, and when the
+// log holds no sensor frame. Frames later than `t_end_s` (relative, s; <0: no limit) are left out.
+[[nodiscard]] LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s);
+
+// `loops` times over the logged frames; each loop starts one mean frame interval after the
+// previous loop's last frame (1 s when the log holds a single frame).
+class LogSchedule final : public FrameSchedule {
+ public:
+  LogSchedule(std::vector<ScheduledFrame> frames, std::int64_t loops);
+  [[nodiscard]] bool next(ScheduledFrame& out) override;
+
+ private:
+  std::vector<ScheduledFrame> frames_;
+  std::int64_t loops_;
+  std::int64_t loop_period_ns_;
+  std::int64_t loop_ = 0;
+  std::size_t index_ = 0;
+};
+
+}  // namespace plinth::replay
