@@ -17,6 +17,7 @@
 
 #include "cli_validators.h"
 #include "event_recorder.h"
+#include "monitor_config.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/hal/can_codec.h"
@@ -48,10 +49,11 @@ struct Options {
   std::optional<double> scale;
   std::string speed = "max";
   std::optional<double> rate;
-  int steps = 4;
-  int node = 1;
+  std::string config_path;
+  std::optional<int> steps;
+  std::optional<int> node;
   double status_interval = 0.1;
-  double startup_window = 2.0;
+  std::optional<double> startup_window;
   double duration = 0.0;
   std::string record_dir;
   double pre_trigger = 30.0;
@@ -377,9 +379,25 @@ int run(const Options& opt) {
   const int sources = (opt.replay_path.empty() ? 0 : 1) + (opt.can_interface.empty() ? 0 : 1);
   if (sources != 1) throw InputError("give exactly one input: --replay FILE or --can INTERFACE");
   const double speed = parse_speed(opt.speed);
+  // Defaults, then the configuration file, then the command line.
+  fw::MonitorConfig config;
+  config.conditioning.startup_window_s = 2.0;
+  std::string scene_y_path = opt.scene_y_path;
+  if (!opt.config_path.empty()) {
+    const fw::MonitorFile file = fw::load_monitor_file(opt.config_path, config);
+    config = file.config;
+    if (scene_y_path.empty()) scene_y_path = file.second_scene_path;
+  }
+  if (opt.steps) config.estimator.steps_per_sample = *opt.steps;
+  if (opt.node) config.ground_node = static_cast<std::uint8_t>(*opt.node);
+  if (opt.startup_window) config.conditioning.startup_window_s = *opt.startup_window;
+  if (opt.stuck_samples) config.sensor_health.stuck_samples = *opt.stuck_samples;
+  if (!opt.replay_y_path.empty() && scene_y_path.empty()) {
+    throw InputError("--replay-y needs a second axis: --scene-y or monitor.second_scene");
+  }
   const plinth::Scene scene_x = plinth::host::load_scene_file(opt.scene_path);
   std::optional<plinth::Scene> scene_y;
-  if (!opt.scene_y_path.empty()) scene_y = plinth::host::load_scene_file(opt.scene_y_path);
+  if (!scene_y_path.empty()) scene_y = plinth::host::load_scene_file(scene_y_path);
   const double gravity = plinth::kStandardGravity;
   const std::string extension = std::filesystem::path(opt.replay_path).extension().string();
   const bool replay_log = !opt.replay_path.empty() && (extension == ".log" || extension == ".LOG");
@@ -389,28 +407,25 @@ int run(const Options& opt) {
     throw InputError("--pga, --scale, --replay-y and --vertical apply to an AT2 or CSV record");
   }
 
-  fw::MonitorConfig config;
   config.axis_count = scene_y ? 2 : 1;
-  config.ground_node = static_cast<std::uint8_t>(opt.node);
-  config.estimator.steps_per_sample = opt.steps;
-  config.conditioning.startup_window_s = opt.startup_window;
-  if (opt.stuck_samples) config.sensor_health.stuck_samples = *opt.stuck_samples;
   RecordSamples record;
   double t_origin = 0.0;
   if (replay_record) {
     record = record_samples(opt, gravity);
     config.estimator.sample_rate_hz = record.rate_hz;
-    // The record is the ground's exact motion in m/s2: no bias to track, no sensor noise (the
-    // stuck-value check needs noise), and the quiet lead-in estimates the zero offset.
+    // The record is the ground's exact motion in m/s2, in the statue's frame: no bias to track,
+    // no sensor noise (the stuck-value check needs noise), and the quiet lead-in estimates the
+    // zero offset. The file's sensor settings describe the real sensor, not this one.
     config.conditioning.unit = mon::AccelerationUnit::kMetresPerSecondSquared;
+    config.conditioning.sensor_to_statue.setIdentity();
     config.conditioning.tracking_time_constant_s = 1e6;
     config.sensor_health.stuck_samples = 0;
     config.sensor_health.full_scale_g = 1e6;
     config.sensor_health.max_valid_g = 1e6;
-    t_origin = (std::round(opt.startup_window * record.rate_hz) +
+    t_origin = (std::round(config.conditioning.startup_window_s * record.rate_hz) +
                 config.sensor_health.recovery_samples - 1) / record.rate_hz;
   } else {
-    config.estimator.sample_rate_hz = opt.rate ? *opt.rate : 200.0;
+    if (opt.rate) config.estimator.sample_rate_hz = *opt.rate;
   }
   fw::Monitor monitor;
   const plinth::Error e =
@@ -456,7 +471,7 @@ int run(const Options& opt) {
     // Quiet lead-in: the health tracker's recovery (it starts in fault, no data yet) and the
     // conditioner's start-up window, so that the estimator starts at the record's first sample.
     const auto lead_in =
-        static_cast<std::size_t>(std::llround(opt.startup_window * record.rate_hz)) +
+        static_cast<std::size_t>(std::llround(config.conditioning.startup_window_s * record.rate_hz)) +
         static_cast<std::size_t>(config.sensor_health.recovery_samples) - 1;
     const std::size_t total = lead_in + record.samples.size();
     for (std::size_t n = 0; n < total && !g_stop; ++n) {
@@ -493,8 +508,7 @@ int run(const Options& opt) {
       const plinth::hal::IoStatus status = reader.receive(frame, 0);
       if (status == plinth::hal::IoStatus::kEndOfInput) break;
       if (status == plinth::hal::IoStatus::kIoError) {
-        throw InputError(reader.path() + ":" + std::to_string(reader.line_number()) + ": " +
-                         reader.error());
+        throw InputError(reader.error());  // "file:line: what"
       }
       if (status != plinth::hal::IoStatus::kOk) continue;  // extended, RTR, FD: not ours
       if (!first_ns) {
@@ -565,8 +579,9 @@ int main(int argc, char** argv) {
   Options opt;
   app.add_option("--scene", opt.scene_path, "scene file (TOML), the statue's first axis")->required();
   app.add_option("--scene-y", opt.scene_y_path, "scene of the second axis (two planar models)");
+  app.add_option("--config", opt.config_path, "the box's configuration file (TOML; docs/monitor.md)");
   app.add_option("--replay", opt.replay_path, "replay a record (.AT2, .csv) or a candump log (.log)");
-  app.add_option("--replay-y", opt.replay_y_path, "second horizontal record (axis y)")->needs("--scene-y");
+  app.add_option("--replay-y", opt.replay_y_path, "second horizontal record (axis y)");
   app.add_option("--vertical", opt.vertical_path, "vertical record");
   app.add_option("--can", opt.can_interface, "listen on a SocketCAN interface, e.g. can0");
   app.add_option("--pga", opt.pga, "scale the record to this PGA, e.g. 0.3g")->excludes("--can");

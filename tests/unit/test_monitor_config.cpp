@@ -1,0 +1,91 @@
+// The box's configuration file (firmware/linux/monitor_config.h).
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "monitor_config.h"
+#include "plinth/host/input_error.h"
+
+namespace plinth::firmware {
+namespace {
+
+const std::string kSource = PLINTH_SOURCE_DIR;
+
+std::string error_of(const std::string& text) {
+  try {
+    (void)load_monitor_text(text, "/etc/plinth/box.toml", MonitorConfig{});
+  } catch (const host::InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(MonitorConfigFile, TheExampleSetsEveryField) {
+  const MonitorFile f = load_monitor_file(kSource + "/firmware/monitor.example.toml", MonitorConfig{});
+  EXPECT_EQ(f.config.ground_node, 1);
+  EXPECT_EQ(f.config.estimator.sample_rate_hz, 200.0);
+  EXPECT_EQ(f.config.conditioning.sensor_to_statue(0, 1), -1.0);
+  EXPECT_EQ(f.config.conditioning.sensor_to_statue(1, 0), 1.0);
+  EXPECT_EQ(f.config.conditioning.startup_window_s, 10.0);
+  EXPECT_EQ(f.config.alarm.warning.on, 0.5);
+  EXPECT_EQ(f.config.alarm.alarm.off, 0.7);
+  EXPECT_EQ(f.config.sensor_health.max_valid_g, 8.192);
+  EXPECT_EQ(f.config.axis_count, 1);
+  EXPECT_TRUE(f.second_scene_path.empty());
+}
+
+TEST(MonitorConfigFile, ValuesOverTheDefaults) {
+  const MonitorFile f = load_monitor_text(
+      "[estimator]\nsample_rate_hz = 1000\nsteps_per_sample = 2\n"
+      "[conditioning]\nunit = \"m/s2\"\n"
+      "[alarm_policy]\nwarning.on = 0.6\nlatch_warning = false\n"
+      "[monitor]\nground_node = 7\nsecond_scene = \"y.toml\"\n",
+      "/etc/plinth/box.toml", MonitorConfig{});
+  EXPECT_EQ(f.config.estimator.sample_rate_hz, 1000.0);
+  EXPECT_EQ(f.config.estimator.steps_per_sample, 2);
+  EXPECT_EQ(f.config.conditioning.unit, monitor::AccelerationUnit::kMetresPerSecondSquared);
+  EXPECT_EQ(f.config.alarm.warning.on, 0.6);
+  EXPECT_EQ(f.config.alarm.warning.off, 0.4);  // the default kept
+  EXPECT_FALSE(f.config.alarm.latch_warning);
+  EXPECT_EQ(f.config.ground_node, 7);
+  EXPECT_EQ(f.second_scene_path, "/etc/plinth/y.toml");
+  EXPECT_EQ(f.config.axis_count, 2);
+}
+
+TEST(MonitorConfigFile, BadInputNamesFileLineAndKey) {
+  EXPECT_EQ(error_of("[estimator]\nsteps = 4\n"),
+            "/etc/plinth/box.toml:2: estimator.steps: unknown key (docs/monitor.md lists them)");
+  EXPECT_EQ(error_of("[estimator]\nsample_rate_hz = \"fast\"\n"),
+            "/etc/plinth/box.toml:2: estimator.sample_rate_hz: expected a number");
+  EXPECT_EQ(error_of("[sensor_health]\n\ntimeout_s = 0.001\n").rfind(
+                "/etc/plinth/box.toml:3: sensor_health.timeout_s: ", 0),
+            0U);
+  EXPECT_EQ(error_of("[alarm_policy]\nwarning = { on = 0.5, off = 0.6 }\n").rfind(
+                "/etc/plinth/box.toml:2: alarm_policy.warning.off: ", 0),
+            0U);
+  EXPECT_EQ(error_of("[conditioning]\nsensor_to_statue = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]\n")
+                .rfind("/etc/plinth/box.toml:2: conditioning.sensor_to_statue: ", 0),
+            0U);
+  EXPECT_EQ(error_of("[conditioning]\nsensor_to_statue = [[1, 0], [0, 1]]\n"),
+            "/etc/plinth/box.toml:2: conditioning.sensor_to_statue: expected three rows of three "
+            "numbers (statue = R sensor)");
+  EXPECT_EQ(error_of("[conditioning]\nunit = \"gal\"\n"),
+            "/etc/plinth/box.toml:2: conditioning.unit: expected \"g\" or \"m/s2\", got \"gal\"");
+  EXPECT_EQ(error_of("[monitor]\nground_node = 16\n"),
+            "/etc/plinth/box.toml:2: monitor.ground_node: must lie in [1, 15]");
+  EXPECT_EQ(error_of("[estimator]\nsample_rate_hz = nan\n").rfind(
+                "/etc/plinth/box.toml:2: estimator.sample_rate_hz: ", 0),
+            0U);
+  EXPECT_NE(error_of("[estimator\n").find("TOML syntax error"), std::string::npos);
+  EXPECT_EQ(error_of("[alarm_policy]\nlatch_alarm = 1\n"),
+            "/etc/plinth/box.toml:2: alarm_policy.latch_alarm: expected true or false");
+  try {
+    (void)load_monitor_file("/nowhere/box.toml", MonitorConfig{});
+    ADD_FAILURE();
+  } catch (const host::InputError& e) {
+    EXPECT_STREQ(e.what(), "/nowhere/box.toml: cannot open file");
+  }
+}
+
+}  // namespace
+}  // namespace plinth::firmware
