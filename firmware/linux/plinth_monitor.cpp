@@ -214,7 +214,8 @@ class Outputs {
         recorder_->trigger(info, last_frame_ns);
       }
     }
-    if (u.event_count > 0 || s.time_ns >= next_status_ns_) {
+    // At the status interval, at every alarm change, and at the alarm policy's heartbeat.
+    if (u.event_count > 0 || u.status_due || s.time_ns >= next_status_ns_) {
       print_line(status_json(monitor_, t_origin_));
       send_status();
       monitor_.status_sent();
