@@ -7,7 +7,8 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libcli11-dev libtomlplusplus-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  python3
+  libsocketcan-dev user-mode-linux kmod iproute2 can-utils  # SocketCAN, tested in UML
+  python3 gnuplot-nox
 )
 
 missing=()

@@ -1,39 +1,68 @@
-// plinth-sweep: for each value of one scene parameter, the smallest PGA at which each kind of
-// event first occurs under a record. Writes a CSV map (--out) and a one-line summary.
-#include "cli_validators.h"
+// plinth-sweep: the paper's parametric analyses (section 5) for any scene and record
+// (docs/sweep.md). For each value of one scene parameter, the smallest PGA at which each kind
+// of event first occurs; two-parameter maps of one event; impulse maps and impulse curves;
+// shards and their merge; plots with gnuplot.
 #include <CLI/CLI.hpp>
-#include <chrono>
-#include <cmath>
+#include <algorithm>
 #include <cstdio>
-#include <fstream>
 #include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "cli_validators.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
 #include "plinth/host/sweep.h"
+#include "plinth/host/sweep_impulse.h"
+#include "plinth/host/sweep_table.h"
 #include "plinth/host/units.h"
+#include "sweep_output.h"
+#include "sweep_plot.h"
 
 namespace {
 
 using plinth::host::InputError;
 
+// Exit code of a run stopped by SIGINT or SIGTERM (128 + SIGINT, as shells report it).
+constexpr int kInterruptedExit = 130;
+
 struct Options {
   std::string scene_path;
   std::string record_path;
   std::string param;
-  double from = 0.0;
-  double to = 0.0;
-  int steps = 0;
+  std::optional<double> from, to;
+  std::optional<int> steps;
+  std::string param2;
+  std::optional<double> from2, to2;
+  std::optional<int> steps2;
+  std::string event = "overturned";
   std::string pga_max = "2g";
   std::string tol = "0.001g";
+  bool impulse_map = false;
+  std::optional<double> mu_from, mu_to, impulse_from, impulse_to;
+  std::optional<int> mu_steps, impulse_steps;
+  bool impulse_curve = false;
+  double impulse_max = 10.0;
+  double impulse_tol = 1e-3;
   std::optional<int> jobs;
   std::string shard = "1/1";
   double dt = 5e-4;
   std::string out_path;
+  std::string plot_path;
+  bool fresh = false;
+};
+
+struct MergeOptions {
+  std::string out_path;
+  std::vector<std::string> inputs;
+  std::string plot_path;
+};
+
+struct PlotOptions {
+  std::string csv_path;
+  std::string plot_path;
 };
 
 // "i/N" with 1 <= i <= N.
@@ -46,8 +75,7 @@ void parse_shard(const std::string& text, int& index, int& count) {
   const std::string a = text.substr(0, slash);
   const std::string b = text.substr(slash + 1);
   const auto digits = [](const std::string& s) {
-    return !s.empty() && s.size() <= 6 &&
-           s.find_first_not_of("0123456789") == std::string::npos;
+    return !s.empty() && s.size() <= 6 && s.find_first_not_of("0123456789") == std::string::npos;
   };
   if (!digits(a) || !digits(b)) throw fail();
   index = std::stoi(a);
@@ -55,67 +83,211 @@ void parse_shard(const std::string& text, int& index, int& count) {
   if (count < 1 || index < 1 || index > count) throw fail();
 }
 
-int run(const Options& opt) {
+template <typename T>
+T required(const std::optional<T>& value, const char* option, const char* mode) {
+  if (!value) throw InputError(std::string(option) + " is required " + mode);
+  return *value;
+}
+
+void require_text(const std::string& value, const char* option, const char* mode) {
+  if (value.empty()) throw InputError(std::string(option) + " is required " + mode);
+}
+
+// The grid axis of --<prefix>from/to/steps, checked.
+plinth::host::GridAxis axis_of(const std::string& name, const std::optional<double>& from,
+                               const std::optional<double>& to, const std::optional<int>& steps,
+                               const std::string& prefix, const std::string& suffix,
+                               const char* mode) {
+  const std::string f = "--" + prefix + "from" + suffix;
+  const std::string t = "--" + prefix + "to" + suffix;
+  const std::string s = "--" + prefix + "steps" + suffix;
+  plinth::host::GridAxis axis{name, required(from, f.c_str(), mode), required(to, t.c_str(), mode),
+                              required(steps, s.c_str(), mode)};
+  (void)plinth::host::sweep_values(axis.from, axis.to, axis.steps, "--" + prefix, suffix);
+  return axis;
+}
+
+int run_sweep_mode(const Options& opt) {
   // Cheap checks first, so a usage slip does not wait for files to load.
-  const plinth::host::SweepParameter parameter = plinth::host::parse_sweep_parameter(opt.param);
-  const std::vector<double> values = plinth::host::sweep_values(opt.from, opt.to, opt.steps);
-  int shard_index = 1;
-  int shard_count = 1;
-  parse_shard(opt.shard, shard_index, shard_count);
+  const char* mode = opt.impulse_map     ? "with --impulse-map"
+                     : opt.impulse_curve ? "with --impulse-curve"
+                                         : "for a PGA sweep";
+  require_text(opt.scene_path, "--scene", mode);
+  require_text(opt.out_path, "--out", mode);
+  plinth::host::SweepRun run;
+  parse_shard(opt.shard, run.shard_index, run.shard_count);
+  run.jobs =
+      opt.jobs ? *opt.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  plinth::host::validate(run);
+  if (opt.impulse_map && opt.impulse_curve) {
+    throw InputError("--impulse-map and --impulse-curve: choose one");
+  }
+  std::optional<plinth::host::SweepParameter> parameter;
+  std::optional<plinth::host::GridAxis> axis;
+  if (!opt.impulse_map) {
+    require_text(opt.param, "--param", mode);
+    parameter = plinth::host::parse_sweep_parameter(opt.param);
+    axis = axis_of(opt.param, opt.from, opt.to, opt.steps, "", "", mode);
+  }
+  if (!opt.plot_path.empty()) {
+    (void)plinth::cli::plot_stem(opt.plot_path);
+    (void)plinth::cli::find_gnuplot();  // before hours of simulation, not after
+  }
 
   const plinth::Scene scene = plinth::host::load_scene_file(opt.scene_path);
   const double g = scene.g;
-  const plinth::host::Record record = plinth::host::read_record(opt.record_path, g);
+  plinth::host::SweepPlan plan;
+  if (opt.impulse_map) {
+    const auto mu_axis = axis_of("mu_s", opt.mu_from, opt.mu_to, opt.mu_steps, "mu-", "", mode);
+    const auto impulse_axis = axis_of("impulse", opt.impulse_from, opt.impulse_to,
+                                      opt.impulse_steps, "impulse-", "", mode);
+    plan = plinth::host::plan_impulse_map(scene.params, mu_axis, impulse_axis, opt.dt);
+  } else if (opt.impulse_curve) {
+    plinth::host::ImpulseSearchSettings settings;
+    settings.impulse_max = opt.impulse_max;
+    settings.tolerance = opt.impulse_tol;
+    settings.dt = opt.dt;
+    plan = plinth::host::plan_impulse_curve(scene.params, *parameter, *axis, settings);
+  } else {
+    require_text(opt.record_path, "--record", mode);
+    const plinth::host::Record record = plinth::host::read_record(opt.record_path, g);
+    plinth::host::SweepSettings settings;
+    settings.pga_max_g = plinth::host::parse_acceleration(opt.pga_max, g, "--pga-max") / g;
+    settings.tolerance_g = plinth::host::parse_acceleration(opt.tol, g, "--tol") / g;
+    settings.dt = opt.dt;
+    plinth::host::validate(settings);
+    if (opt.param2.empty()) {
+      plan = plinth::host::plan_thresholds(scene.params, record, *parameter, *axis, settings);
+    } else {
+      const auto parameter2 = plinth::host::parse_sweep_parameter(opt.param2, "--param2");
+      const auto axis2 =
+          axis_of(opt.param2, opt.from2, opt.to2, opt.steps2, "", "2", "with --param2");
+      plan = plinth::host::plan_threshold_map(scene.params, record, *parameter, *axis, parameter2,
+                                              axis2, plinth::host::parse_sweep_event(opt.event),
+                                              settings);
+    }
+  }
 
-  plinth::host::SweepSettings settings;
-  settings.pga_max_g = plinth::host::parse_acceleration(opt.pga_max, g, "--pga-max") / g;
-  settings.tolerance_g = plinth::host::parse_acceleration(opt.tol, g, "--tol") / g;
-  settings.dt = opt.dt;
-  plinth::host::validate(settings);
-  const int jobs =
-      opt.jobs ? *opt.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  run.stop = plinth::cli::install_stop_handlers();
+  const plinth::cli::SweepOutcome outcome =
+      plinth::cli::run_to_file(plan, run, {opt.out_path, opt.fresh});
+  if (outcome.interrupted) {
+    std::fprintf(stderr,
+                 "plinth-sweep: interrupted: %zu of %zu rows kept in %s (%zu found there "
+                 "before); run the same command again to resume\n",
+                 outcome.rows_written, outcome.rows_total, opt.out_path.c_str(),
+                 outcome.rows_resumed);
+    return kInterruptedExit;
+  }
+  std::printf(
+      "plinth-sweep: %zu rows (shard %d/%d of %zu; %zu resumed from %s), %zu "
+      "simulations, %d jobs, wall time %.2f s -> %s\n",
+      outcome.rows_written, run.shard_index, run.shard_count, plan.keys.size(),
+      outcome.rows_resumed, opt.out_path.c_str(), outcome.simulations, run.jobs,
+      outcome.wall_seconds, opt.out_path.c_str());
+  if (!opt.plot_path.empty()) {
+    const std::string images =
+        plinth::cli::plot_sweep(plinth::host::read_sweep_table(opt.out_path), opt.plot_path);
+    std::printf("plinth-sweep: plotted %s\n", images.c_str());
+  }
+  return 0;
+}
 
-  std::ofstream out(opt.out_path);
-  if (!out) throw InputError(opt.out_path + ": cannot open the sweep map for writing");
+int run_merge(const MergeOptions& opt) {
+  if (!opt.plot_path.empty()) {
+    (void)plinth::cli::plot_stem(opt.plot_path);
+    (void)plinth::cli::find_gnuplot();
+  }
+  std::vector<plinth::host::SweepTable> parts;
+  for (const std::string& path : opt.inputs) parts.push_back(plinth::host::read_sweep_table(path));
+  const plinth::host::SweepTable merged = plinth::host::merge_sweep_tables(parts, opt.inputs);
+  plinth::cli::write_table_file(merged, opt.out_path);
+  std::printf("plinth-sweep merge: %zu rows from %zu files -> %s\n", merged.rows.size(),
+              parts.size(), opt.out_path.c_str());
+  if (!opt.plot_path.empty()) {
+    std::printf("plinth-sweep: plotted %s\n",
+                plinth::cli::plot_sweep(merged, opt.plot_path).c_str());
+  }
+  return 0;
+}
 
-  const auto start = std::chrono::steady_clock::now();
-  plinth::host::SweepStats stats;
-  const std::vector<plinth::host::SweepRow> rows =
-      plinth::host::run_sweep(scene.params, parameter, values, record, settings, jobs,
-                              shard_index, shard_count, &stats);
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  plinth::host::write_sweep_csv(out, parameter, rows);
-  out.close();
-  if (!out) throw InputError(opt.out_path + ": cannot write the sweep map");
-
-  std::printf("plinth-sweep: %zu rows of %s (shard %d/%d of %zu values), %zu simulations, "
-              "%d jobs, wall time %.2f s -> %s\n",
-              rows.size(), opt.param.c_str(), shard_index, shard_count, values.size(),
-              stats.simulations, jobs, wall, opt.out_path.c_str());
+int run_plot(const PlotOptions& opt) {
+  (void)plinth::cli::plot_stem(opt.plot_path);
+  const std::string images =
+      plinth::cli::plot_sweep(plinth::host::read_sweep_table(opt.csv_path), opt.plot_path);
+  std::printf("plinth-sweep: plotted %s\n", images.c_str());
   return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"plinth-sweep: for each value of one scene parameter, the smallest PGA at which "
-               "each event first occurs under a record"};
+  using plinth::cli::kFinite;
+  using plinth::cli::kFinitePositive;
+  CLI::App app{
+      "plinth-sweep: the paper's parametric analyses (docs/sweep.md): first-occurrence "
+      "PGA of each event against one parameter, two-parameter maps, impulse maps and "
+      "impulse curves"};
+  app.require_subcommand(0, 1);
   Options opt;
-  app.add_option("--scene", opt.scene_path, "scene file (TOML)")->required();
-  app.add_option("--record", opt.record_path, "horizontal record (.AT2 or .csv)")->required();
+  app.add_option("--scene", opt.scene_path, "scene file (TOML)");
+  app.add_option("--record", opt.record_path, "horizontal record (.AT2 or .csv), PGA modes");
   app.add_option("--param", opt.param,
-                 "parameter to sweep: mu_s, epsilon, lambda, T, xi, u_max or mass_ratio")
-      ->required();
-  app.add_option("--from", opt.from, "first value of the parameter")->required()->check(plinth::cli::kFinite);
-  app.add_option("--to", opt.to, "last value of the parameter")->required()->check(plinth::cli::kFinite);
-  app.add_option("--steps", opt.steps, "number of values, from..to inclusive")->required();
+                 "parameter to sweep: mu_s, epsilon, lambda, T, xi, u_max or mass_ratio");
+  app.add_option("--from", opt.from, "first value of the parameter")->check(kFinite);
+  app.add_option("--to", opt.to, "last value of the parameter")->check(kFinite);
+  app.add_option("--steps", opt.steps, "number of values, from..to inclusive");
+  app.add_option("--param2", opt.param2, "second parameter: a map of one event (--event)");
+  app.add_option("--from2", opt.from2, "first value of --param2")->check(kFinite);
+  app.add_option("--to2", opt.to2, "last value of --param2")->check(kFinite);
+  app.add_option("--steps2", opt.steps2, "number of values of --param2");
+  app.add_option("--event", opt.event, "event of a two-parameter map (default overturned)");
   app.add_option("--pga-max", opt.pga_max, "largest PGA scanned, e.g. 2g (default 2g)");
   app.add_option("--tol", opt.tol, "PGA tolerance of the thresholds, e.g. 0.001g (default)");
+  CLI::Option* impulse_map =
+      app.add_flag("--impulse-map", opt.impulse_map,
+                   "map of the motion an impulse starts with over (|I|, mu_s), with the closed "
+                   "forms of section 5.3.1");
+  app.add_option("--mu-from", opt.mu_from, "impulse map: first mu_s")->check(kFinite);
+  app.add_option("--mu-to", opt.mu_to, "impulse map: last mu_s")->check(kFinite);
+  app.add_option("--mu-steps", opt.mu_steps, "impulse map: number of mu_s values");
+  app.add_option("--impulse-from", opt.impulse_from, "impulse map: first |I|, m/s")
+      ->check(kFinitePositive);
+  app.add_option("--impulse-to", opt.impulse_to, "impulse map: last |I|, m/s")
+      ->check(kFinitePositive);
+  app.add_option("--impulse-steps", opt.impulse_steps, "impulse map: number of |I| values");
+  CLI::Option* impulse_curve =
+      app.add_flag("--impulse-curve", opt.impulse_curve,
+                   "smallest impulses that start rocking and overturn, against --param");
+  app.add_option("--impulse-max", opt.impulse_max,
+                 "impulse curve: largest |I| scanned, m/s (default 10)")
+      ->check(kFinitePositive);
+  app.add_option("--impulse-tol", opt.impulse_tol,
+                 "impulse curve: tolerance of the thresholds, m/s (default 0.001)")
+      ->check(kFinitePositive);
   app.add_option("--jobs", opt.jobs, "threads (default: the hardware's)");
-  app.add_option("--shard", opt.shard, "run only part i of N of the values, as i/N (default 1/1)");
-  app.add_option("--dt", opt.dt, "solver step, s (default 5e-4)")->check(plinth::cli::kFinitePositive);
-  app.add_option("--out", opt.out_path, "CSV map of the thresholds")->required();
+  app.add_option("--shard", opt.shard, "run only part i of N of the rows, as i/N (default 1/1)");
+  app.add_option("--dt", opt.dt, "solver step, s (default 5e-4)")->check(kFinitePositive);
+  app.add_option("--out", opt.out_path, "CSV file (rows already there are resumed)");
+  app.add_option("--plot", opt.plot_path, "also plot: map.png writes map.png and map.svg");
+  app.add_flag("--fresh", opt.fresh, "do not resume from rows already in --out");
+  for (const char* option : {"--record", "--param2", "--pga-max", "--tol"}) {
+    impulse_map->excludes(option);
+    impulse_curve->excludes(option);
+  }
+
+  MergeOptions merge;
+  CLI::App* merge_command =
+      app.add_subcommand("merge", "join the CSVs of the shards of one sweep, in grid order");
+  merge_command->add_option("--out", merge.out_path, "merged CSV")->required();
+  merge_command->add_option("--plot", merge.plot_path, "also plot the merged CSV");
+  merge_command->add_option("inputs", merge.inputs, "the shards' CSV files")->required();
+
+  PlotOptions plot;
+  CLI::App* plot_command = app.add_subcommand("plot", "plot a sweep CSV: PNG and SVG with gnuplot");
+  plot_command->add_option("csv", plot.csv_path, "a plinth-sweep CSV")->required();
+  plot_command->add_option("--out", plot.plot_path, "image: map.png writes map.png and map.svg")
+      ->required();
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -127,7 +299,9 @@ int main(int argc, char** argv) {
     return 2;
   }
   try {
-    return run(opt);
+    if (merge_command->parsed()) return run_merge(merge);
+    if (plot_command->parsed()) return run_plot(plot);
+    return run_sweep_mode(opt);
   } catch (const InputError& e) {
     std::fprintf(stderr, "plinth-sweep: %s\n", e.what());
     return 1;

@@ -1,10 +1,12 @@
-// plinth-sweep's library: first-occurrence thresholds, parameters, sharding, the CSV map.
+// plinth-sweep's library: first-occurrence thresholds, parameters, sharding, cancellation,
+// two-parameter maps, the CSV map.
 #include "plinth/host/sweep.h"
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -13,18 +15,15 @@
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
 #include "test_support.h"
+#include "test_sweep_support.h"
 
 namespace plinth::host {
 namespace {
 
 using ::testing::HasSubstr;
 
-const Record& brienza() {
-  static const Record record =
-      read_at2(std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
-               kStandardGravity);
-  return record;
-}
+using testing::brienza;
+using testing::input_error_text;
 
 // The paper's isolated block with friction, base stops and a support it can leave.
 SceneParams isolated_with_friction(double mu_s = 0.3) {
@@ -49,16 +48,6 @@ SweepSettings coarse() {
   return s;
 }
 
-template <class F>
-std::string input_error_text(F&& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "(no InputError)";
-}
-
 TEST(Sweep, Names) {
   const char* expected[] = {"sliding",       "rocking",        "slide_rocking", "out_of_base",
                             "base_stop_hit", "slide_stop_hit", "fell",          "overturned"};
@@ -71,8 +60,9 @@ TEST(Sweep, Names) {
 }
 
 // Each reported threshold: the event occurs there and not one tolerance below.
-std::array<std::optional<double>, kSweepEventCount> expect_thresholds_hold(
-    const Scene& scene, std::size_t& found, std::size_t& runs) {
+std::array<std::optional<double>, kSweepEventCount> expect_thresholds_hold(const Scene& scene,
+                                                                           std::size_t& found,
+                                                                           std::size_t& runs) {
   const SweepSettings settings = coarse();
   const auto thresholds = first_occurrence_thresholds(scene, brienza(), settings, &runs);
   for (std::size_t e = 0; e < kSweepEventCount; ++e) {
@@ -174,8 +164,8 @@ TEST(Sweep, RowsDoNotDependOnJobsOrShards) {
   settings.tolerance_g = 0.02;
   const std::vector<double> values = sweep_values(0.2, 0.6, 3);
   SweepStats stats;
-  const auto one = run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 1, 1, 1,
-                             &stats);
+  const auto one =
+      run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 1, 1, 1, &stats);
   EXPECT_GT(stats.simulations, 3u * 8u);
   const auto two = run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 2, 1, 1);
   expect_same_rows(one, two);
@@ -221,9 +211,9 @@ TEST(Sweep, WithParameterSetsTheSceneInSI) {
   EXPECT_DOUBLE_EQ(with_parameter(iso, SweepParameter::kXi, 0.1).base.damping_ratio, 0.1);
   EXPECT_DOUBLE_EQ(with_parameter(iso, SweepParameter::kMassRatio, 0.5).base.mass,
                    0.5 * iso.block.mass);
-  EXPECT_DOUBLE_EQ(
-      with_parameter(isolated_with_friction(), SweepParameter::kUMax, 0.3).base_stops.max_displacement,
-      0.3);
+  EXPECT_DOUBLE_EQ(with_parameter(isolated_with_friction(), SweepParameter::kUMax, 0.3)
+                       .base_stops.max_displacement,
+                   0.3);
 }
 
 TEST(Sweep, BadInputsSayWhatIsWrong) {
@@ -272,8 +262,7 @@ TEST(Sweep, BadInputsSayWhatIsWrong) {
   SweepSettings big_step = coarse();
   big_step.dt = 0.01;
   EXPECT_THAT(input_error_text([&] {
-                (void)run_sweep(iso, SweepParameter::kPeriod, {0.01}, brienza(), big_step, 1, 1,
-                                1);
+                (void)run_sweep(iso, SweepParameter::kPeriod, {0.01}, brienza(), big_step, 1, 1, 1);
               }),
               HasSubstr("--param T = 0.01: --dt: "));
   SweepSettings bad = coarse();
@@ -294,6 +283,154 @@ TEST(Sweep, CsvMap) {
             "overturned\n"
             "0.1,0.123457,,,,,,,2\n"
             "0.25,,,,,,,,\n");
+}
+
+// The scan points skipped below quiet_pga_g are points where nothing happens: the thresholds
+// are the same with and without skipping, and fewer simulations run.
+TEST(Sweep, SkippingTheQuietScanChangesNothing) {
+  const Scene fig14c = load_scene_file(std::string(PLINTH_SOURCE_DIR) +
+                                       "/sim/scenes/fig14c-slide-rocking-base-stops.toml");
+  for (const Scene& scene : {plinth::testing::make(isolated_with_friction(0.6)), fig14c}) {
+    SweepSettings settings = coarse();
+    std::size_t skipping = 0;
+    std::size_t all = 0;
+    const auto fast = first_occurrence_thresholds(scene, brienza(), settings, &skipping);
+    settings.skip_quiet_scan = false;
+    const auto slow = first_occurrence_thresholds(scene, brienza(), settings, &all);
+    expect_same_rows({SweepRow{0.0, fast}}, {SweepRow{0.0, slow}});
+    EXPECT_LE(skipping, all);
+    // Below the quiet PGA the block stays in full contact: no event at all.
+    const double quiet = quiet_pga_g(scene, brienza(), settings.dt);
+    ASSERT_GT(quiet, 0.0);
+    const Occurrences below = simulate_occurrences(scene, brienza(), quiet * scene.g, settings);
+    EXPECT_EQ(std::count(below.occurred.begin(), below.occurred.end(), true), 0);
+  }
+  // The paper's block on its base without friction is quiet up to well above 2 g.
+  EXPECT_GT(quiet_pga_g(plinth::testing::make(plinth::testing::paper_isolated()), brienza(), 5e-4),
+            2.0);
+}
+
+// Searching one event gives the threshold it has among all events (the searches are
+// independent), with fewer simulations.
+TEST(Sweep, OneEventAloneHasTheThresholdItHasAmongAll) {
+  const Scene scene = load_scene_file(std::string(PLINTH_SOURCE_DIR) +
+                                      "/sim/scenes/fig14c-slide-rocking-base-stops.toml");
+  SweepSettings settings = coarse();
+  std::size_t all_runs = 0;
+  const auto all = first_occurrence_thresholds(scene, brienza(), settings, &all_runs);
+  for (const SweepEvent event : {SweepEvent::kRocking, SweepEvent::kFell}) {
+    SCOPED_TRACE(sweep_event_name(event));
+    const auto e = static_cast<std::size_t>(event);
+    ASSERT_TRUE(all[e].has_value());
+    settings.events = EventSet{}.set(e);
+    std::size_t runs = 0;
+    const auto alone = first_occurrence_thresholds(scene, brienza(), settings, &runs);
+    ASSERT_TRUE(alone[e].has_value());
+    EXPECT_EQ(*alone[e], *all[e]);
+    EXPECT_EQ(std::count_if(alone.begin(), alone.end(), [](auto& t) { return t.has_value(); }), 1);
+    EXPECT_LT(runs, all_runs);
+  }
+}
+
+TEST(Sweep, PossibleEventsFollowTheSceneFeatures) {
+  const auto names = [](EventSet events) {
+    std::string text;
+    for (std::size_t e = 0; e < kSweepEventCount; ++e) {
+      if (events[e])
+        text += std::string(text.empty() ? "" : " ") + sweep_event_name(static_cast<SweepEvent>(e));
+    }
+    return text;
+  };
+  EXPECT_EQ(names(possible_events(plinth::testing::make(plinth::testing::paper_isolated()))),
+            "rocking overturned");
+  EXPECT_EQ(names(possible_events(plinth::testing::make(isolated_with_friction()))),
+            "sliding rocking slide_rocking out_of_base base_stop_hit fell overturned");
+  SceneParams stops = isolated_with_friction();
+  stops.has_sliding_stops = true;
+  EXPECT_EQ(names(possible_events(plinth::testing::make(stops))),
+            "sliding rocking slide_rocking base_stop_hit slide_stop_hit overturned");
+  EXPECT_EQ(parse_sweep_event("fell"), SweepEvent::kFell);
+  EXPECT_THAT(input_error_text([] { (void)parse_sweep_event("toppled"); }),
+              HasSubstr("--event: unknown event 'toppled' (one of sliding, rocking,"));
+}
+
+// A raised stop flag ends a search (SweepCancelled) and a run (run_plan returns false, and
+// no row is reported).
+TEST(Sweep, AStopFlagEndsTheRunWithoutRows) {
+  const Scene scene = plinth::testing::make(isolated_with_friction());
+  std::atomic<bool> stop{true};
+  EXPECT_THROW((void)first_occurrence_thresholds(scene, brienza(), coarse(), nullptr, &stop),
+               SweepCancelled);
+  const SweepPlan plan = plan_thresholds(isolated_with_friction(), brienza(), SweepParameter::kMuS,
+                                         {"mu_s", 0.2, 0.6, 3}, coarse());
+  SweepRun run;
+  run.jobs = 2;
+  run.stop = &stop;
+  std::size_t reported = 0;
+  run.on_done = [&](std::size_t) { ++reported; };
+  std::vector<std::string> rows;
+  EXPECT_FALSE(run_plan(plan, {0, 1, 2}, run, rows));
+  EXPECT_EQ(reported, 0u);
+  EXPECT_EQ(rows, std::vector<std::string>(3));
+}
+
+// A two-parameter map of one event holds, cell for cell, the thresholds of the one-parameter
+// sweeps at each value of the second parameter.
+TEST(Sweep, TwoParameterMapMatchesOneParameterSweeps) {
+  SweepSettings settings = coarse();
+  settings.pga_max_g = 4.0;
+  settings.tolerance_g = 0.02;
+  const SceneParams base = plinth::testing::paper_isolated();
+  const GridAxis lambda{"lambda", 3.0, 5.0, 2};
+  const GridAxis epsilon{"epsilon", -0.3, 0.3, 2};
+  const SweepPlan map =
+      plan_threshold_map(base, brienza(), SweepParameter::kLambda, lambda, SweepParameter::kEpsilon,
+                         epsilon, SweepEvent::kOverturned, settings);
+  EXPECT_EQ(map.header, "lambda,epsilon,overturned");
+  EXPECT_EQ(map.keys, (std::vector<std::string>{"3,-0.3", "3,0.3", "5,-0.3", "5,0.3"}));
+  const std::vector<std::string> cells = testing::run_whole_plan(map);
+  std::size_t found = 0;
+  for (std::size_t j = 0; j < 2; ++j) {
+    const double eps = j == 0 ? -0.3 : 0.3;
+    const std::vector<SweepRow> rows =
+        run_sweep(with_parameter(base, SweepParameter::kEpsilon, eps), SweepParameter::kLambda,
+                  sweep_values(3.0, 5.0, 2), brienza(), settings, 2, 1, 1);
+    for (std::size_t i = 0; i < 2; ++i) {
+      const auto& t = rows[i].thresholds_g[static_cast<std::size_t>(SweepEvent::kOverturned)];
+      found += t.has_value() ? 1u : 0u;
+      EXPECT_EQ(cells[2 * i + j], map.keys[2 * i + j] + "," + format_result(t));
+    }
+  }
+  EXPECT_GE(found, 2u);
+  EXPECT_THAT(input_error_text([&] {
+                (void)plan_threshold_map(base, brienza(), SweepParameter::kLambda, lambda,
+                                         SweepParameter::kLambda, lambda, SweepEvent::kFell,
+                                         settings);
+              }),
+              HasSubstr("--param2: must differ from --param"));
+  EXPECT_THAT(input_error_text([&] {
+                (void)plan_threshold_map(base, brienza(), SweepParameter::kLambda, lambda,
+                                         SweepParameter::kPeriod, {"T", 2.0, 1.0, 2},
+                                         SweepEvent::kFell, settings);
+              }),
+              HasSubstr("--from2 2 is greater than --to2 1"));
+}
+
+// The plan of a one-parameter sweep writes the rows write_sweep_csv writes.
+TEST(Sweep, ThresholdPlanRowsAreTheCsvMap) {
+  SweepSettings settings = coarse();
+  const SweepPlan plan = plan_thresholds(isolated_with_friction(), brienza(), SweepParameter::kMuS,
+                                         {"mu_s", 0.2, 0.6, 2}, settings);
+  EXPECT_EQ(plan.header, sweep_csv_header(SweepParameter::kMuS));
+  EXPECT_THAT(plan.settings,
+              ::testing::StartsWith("# plinth-sweep thresholds grid=mu_s:0.2:0.6:2 "));
+  SweepRun run;
+  std::vector<std::string> rows;
+  ASSERT_TRUE(run_plan(plan, {1}, run, rows));
+  const auto direct = run_sweep(isolated_with_friction(), SweepParameter::kMuS, {0.6}, brienza(),
+                                settings, 1, 1, 1);
+  EXPECT_EQ(rows[1], sweep_csv_row(direct[0]));
+  EXPECT_TRUE(rows[0].empty());
 }
 
 }  // namespace

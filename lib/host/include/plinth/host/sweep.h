@@ -1,9 +1,15 @@
-// Parameter sweeps: for each value of one scene parameter, the smallest PGA at which each kind
-// of event first occurs under a record (plinth-sweep).
+// Parameter sweeps (plinth-sweep): for each value of one or two scene parameters, the smallest
+// PGA at which each kind of event first occurs under a record; the threads, shards and
+// cancellation every sweep mode shares. Impulse maps and curves: sweep_impulse.h; the CSV
+// files: sweep_table.h.
 #pragma once
 
 #include <array>
+#include <atomic>
+#include <bitset>
 #include <cstddef>
+#include <exception>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -11,31 +17,50 @@
 
 #include "plinth/core/scene.h"
 #include "plinth/host/record_io.h"
+#include "plinth/host/sweep_table.h"
 
 namespace plinth::host {
 
 // The events a sweep looks for, in the order of the CSV columns.
 enum class SweepEvent : unsigned char {
-  kSliding,        // a kSlidingStart event
-  kRocking,        // a kRockingStart event
-  kSlideRocking,   // any event leaving the block in Phase::kSlideRocking
-  kOutOfBase,      // kOutOfBase
-  kBaseStopHit,    // kBaseStopHit
-  kSlideStopHit,   // kSlideStopHit
-  kFell,           // kFell
-  kOverturned,     // kOverturned
+  kSliding,       // a kSlidingStart event
+  kRocking,       // a kRockingStart event
+  kSlideRocking,  // any event leaving the block in Phase::kSlideRocking
+  kOutOfBase,     // kOutOfBase
+  kBaseStopHit,   // kBaseStopHit
+  kSlideStopHit,  // kSlideStopHit
+  kFell,          // kFell
+  kOverturned,    // kOverturned
 };
 inline constexpr std::size_t kSweepEventCount = 8;
+
+// A set of events, indexed by SweepEvent.
+using EventSet = std::bitset<kSweepEventCount>;
+inline const EventSet kAllEvents = EventSet{}.set();
 
 // "sliding", "rocking", "slide_rocking", "out_of_base", "base_stop_hit", "slide_stop_hit",
 // "fell", "overturned".
 [[nodiscard]] const char* sweep_event_name(SweepEvent event);
 
+// Throws InputError("--event: unknown event 'x' (one of sliding, ...)").
+[[nodiscard]] SweepEvent parse_sweep_event(const std::string& text);
+
+// The events the scene's features allow (guards.h, features_of): sliding and slide_rocking
+// need friction, base stop hits base stops, leaving the support and falling a support without
+// sliding stops, sliding stop hits sliding stops.
+[[nodiscard]] EventSet possible_events(const Scene& scene);
+
 struct SweepSettings {
-  double pga_max_g = 2.0;     // largest PGA scanned, in g (the scene's gravity)
-  double tolerance_g = 0.001; // width of the final bisection bracket, in g
-  int scan_points = 40;       // grid PGA = pga_max * k / scan_points, k = 1..scan_points
-  double dt = 5e-4;           // solver step, s
+  double pga_max_g = 2.0;      // largest PGA scanned, in g (the scene's gravity)
+  double tolerance_g = 0.001;  // width of the final bisection bracket, in g
+  int scan_points = 40;        // grid PGA = pga_max * k / scan_points, k = 1..scan_points
+  double dt = 5e-4;            // solver step, s
+  // The events searched; the others are left empty. A threshold does not depend on which
+  // other events are searched with it, so searching fewer only saves simulations.
+  EventSet events = kAllEvents;
+  // Skips the scan points below the PGA at which the block provably stays in full contact
+  // (quiet_pga_g); off only to test that it changes nothing.
+  bool skip_quiet_scan = true;
 };
 
 // Throws InputError when a setting is out of range (non-finite, not positive, no points).
@@ -50,22 +75,51 @@ struct Occurrences {
   }
 };
 
+// Thrown from a search or a sweep when its stop flag turned true: what was running is dropped.
+class SweepCancelled : public std::exception {
+ public:
+  [[nodiscard]] const char* what() const noexcept override { return "sweep cancelled"; }
+};
+
 // One simulation from rest under `record` scaled to a peak of `pga_mps2` (m/s2), with step
-// settings.dt, until the record's end + 2 s or a terminal phase. Throws InputError when the
-// record is all zeros or the step is too large for the scene.
+// settings.dt, until the record's end + 2 s, a terminal phase, or every event of
+// settings.events the scene allows has occurred (the others may then be missing). Throws
+// InputError when the record is all zeros or the step is too large for the scene.
 [[nodiscard]] Occurrences simulate_occurrences(const Scene& scene, const Record& record,
                                                double pga_mps2, const SweepSettings& settings);
 
-// For each event, the smallest PGA (in g) found at which it occurs, or nothing when it does not
-// occur on the scan grid up to settings.pga_max_g. The search does not assume that an event
-// keeps occurring above its threshold: the grid is scanned, the first grid interval where the
-// event appears is bisected to settings.tolerance_g, and the result is checked once more:
-// the event occurs at the reported value thr and does not occur at thr - tolerance (when
-// thr - tolerance > 0); if it does, the search goes on below. No event is assumed at PGA 0.
-// `simulations`, when given, is increased by the number of simulations run.
+// The PGA (in g) below which the block provably stays in full contact under `record`: no
+// event at all. Full contact is linear (Eq 1), so one run of the base alone at unit scale
+// gives the peak absolute acceleration and base displacement per unit PGA; the first of Eq 15
+// (mu_s g), Eq 16 (min(b1, b2) g / h, either direction) and Eq 28 (u_max) bounds it. Infinity
+// when nothing can happen.
+[[nodiscard]] double quiet_pga_g(const Scene& scene, const Record& record, double dt);
+
+// The first-occurrence search shared by the PGA thresholds and the impulse curves. `simulate`
+// runs at a level in (0, level_max] (PGA in g, impulse in m/s) and reports the events of
+// `events`; levels <= `quiet_below` are taken as showing none (not simulated). The grid
+// level_max * k / scan_points is scanned; for each event the first grid interval showing it is
+// bisected to `tolerance`, and the result thr is checked: the event occurs at thr and not at
+// thr - tolerance (when > 0); if it does, the search goes on below. Each event's search uses
+// only the scan and its own bisection (runs are shared as a cache), so its result does not
+// depend on the other events searched. Nothing is assumed at level 0.
+struct SearchGrid {
+  double level_max = 1.0;
+  int scan_points = 40;
+  double tolerance = 1e-3;
+  double quiet_below = 0.0;
+};
+[[nodiscard]] std::array<std::optional<double>, kSweepEventCount> first_occurrences(
+    const std::function<Occurrences(double level)>& simulate, const SearchGrid& grid,
+    EventSet events, const std::atomic<bool>* stop = nullptr, std::size_t* simulations = nullptr);
+
+// For each event of settings.events the scene allows, the smallest PGA (in g) at which it
+// occurs (first_occurrences on PGA), or nothing when it does not occur on the scan grid up to
+// settings.pga_max_g. `simulations`, when given, is increased by the number of simulations
+// run. Throws SweepCancelled when *stop turns true.
 [[nodiscard]] std::array<std::optional<double>, kSweepEventCount> first_occurrence_thresholds(
     const Scene& scene, const Record& record, const SweepSettings& settings,
-    std::size_t* simulations = nullptr);
+    std::size_t* simulations = nullptr, const std::atomic<bool>* stop = nullptr);
 
 // The scene parameters a sweep can vary (dimensionless where the paper's are).
 enum class SweepParameter : unsigned char {
@@ -80,19 +134,71 @@ enum class SweepParameter : unsigned char {
 
 [[nodiscard]] const char* sweep_parameter_name(SweepParameter parameter);
 
-// Throws InputError("--param: unknown parameter 'x' (one of mu_s, epsilon, ...)").
-[[nodiscard]] SweepParameter parse_sweep_parameter(const std::string& text);
+// Throws InputError("<option>: unknown parameter 'x' (one of mu_s, epsilon, ...)").
+[[nodiscard]] SweepParameter parse_sweep_parameter(const std::string& text,
+                                                   const std::string& option = "--param");
 
 // `params` with the parameter set to `value`, in SI. lambda keeps the block's mass per unit of
 // height (m scales with h, I_C = homogeneous_rectangle_inertia) and the base's mass ratio.
 // Throws InputError naming the parameter and the value when the scene has no base (T, xi,
 // mass_ratio) or no base stops (u_max), or when make_scene refuses the result.
-[[nodiscard]] SceneParams with_parameter(SceneParams params, SweepParameter parameter,
-                                         double value);
+[[nodiscard]] SceneParams with_parameter(SceneParams params, SweepParameter parameter, double value,
+                                         const std::string& option = "--param");
 
-// `steps` values from `from` to `to` inclusive, evenly spaced (one value: `from`). Throws
-// InputError on steps < 1, non-finite bounds, or from > to.
-[[nodiscard]] std::vector<double> sweep_values(double from, double to, int steps);
+// Threads, shards and cancellation of a sweep's jobs (one job per CSV row).
+struct SweepRun {
+  int jobs = 1;
+  int shard_index = 1;  // 1-based: the jobs whose index % shard_count == shard_index - 1
+  int shard_count = 1;
+  const std::atomic<bool>* stop = nullptr;  // once true, no job starts and running ones end
+  // Called after each job that finished, one call at a time, from the worker threads.
+  std::function<void(std::size_t index)> on_done;
+};
+
+// Throws InputError on jobs < 1 or a shard i/N outside 1 <= i <= N.
+void validate(const SweepRun& run);
+
+// The job indices of `count` that belong to the run's shard, ascending.
+[[nodiscard]] std::vector<std::size_t> shard_indices(std::size_t count, const SweepRun& run);
+
+// Runs job(i) for each i of `indices` on run.jobs threads. An InputError of a job is
+// rethrown with `describe(i) + ": "` in front, the one of the lowest index first, after every
+// thread has ended. Returns false when the stop flag ended the run (jobs not finished were not
+// reported to on_done).
+bool run_jobs(const std::vector<std::size_t>& indices, const SweepRun& run,
+              const std::function<void(std::size_t)>& job,
+              const std::function<std::string(std::size_t)>& describe);
+
+// A sweep as jobs that each make one CSV row: what plinth-sweep runs, resumes and merges.
+struct SweepPlan {
+  std::string settings;           // the settings line (sweep_table.h)
+  std::string header;             // the CSV header
+  std::size_t key_columns = 1;    // the first fields of a row that name its grid point
+  std::vector<std::string> keys;  // each row's key, in grid order
+  // The CSV row of job i (starting with keys[i]); called from several threads at once. Adds
+  // its simulations to *simulations; throws SweepCancelled when *stop turns true.
+  std::function<std::string(std::size_t i, const std::atomic<bool>* stop, std::size_t* simulations)>
+      row;
+  std::function<std::string(std::size_t i)> describe;  // "--param mu_s = 0.3", for messages
+};
+
+// Runs the jobs of `indices` (rows.size() == plan.keys.size()); rows[i] is set before
+// run.on_done(i). Returns false when the stop flag ended the run. Throws as run_jobs.
+bool run_plan(const SweepPlan& plan, const std::vector<std::size_t>& indices, const SweepRun& run,
+              std::vector<std::string>& rows, std::size_t* simulations = nullptr);
+
+// One parameter: a row of thresholds of every event per value (mode "thresholds", the
+// write_sweep_csv format). Every value is checked before the plan is returned.
+[[nodiscard]] SweepPlan plan_thresholds(const SceneParams& base, const Record& record,
+                                        SweepParameter parameter, const GridAxis& axis,
+                                        const SweepSettings& settings);
+
+// Two parameters (mode "threshold_map"): a row "<p1>,<p2>,<event>" per cell, the first
+// occurrence of `event`, cells in the order p1 then p2. Every cell is checked first.
+[[nodiscard]] SweepPlan plan_threshold_map(const SceneParams& base, const Record& record,
+                                           SweepParameter parameter1, const GridAxis& axis1,
+                                           SweepParameter parameter2, const GridAxis& axis2,
+                                           SweepEvent event, SweepSettings settings);
 
 struct SweepRow {
   double value = 0.0;
@@ -103,20 +209,31 @@ struct SweepStats {
   std::size_t simulations = 0;
 };
 
-// Sweeps `parameter` over the values of shard `shard_index`/`shard_count` (1-based: the values
-// whose index % shard_count == shard_index - 1) on `jobs` threads. Rows come back in value
-// order and do not depend on jobs or sharding. Every value is checked (with_parameter) before
-// any simulation runs. Throws InputError on bad jobs or shard numbers, bad values, and errors
-// of the simulations (the one of the lowest value index).
+// Sweeps `parameter` over the values of the run's shard. Rows come back in value order and do
+// not depend on jobs or sharding. Every value is checked (with_parameter) before any
+// simulation runs. Throws InputError on bad jobs or shard numbers, bad values, and errors of
+// the simulations (the one of the lowest value index), SweepCancelled when stopped.
 [[nodiscard]] std::vector<SweepRow> run_sweep(const SceneParams& base, SweepParameter parameter,
                                               const std::vector<double>& values,
                                               const Record& record, const SweepSettings& settings,
                                               int jobs, int shard_index, int shard_count,
                                               SweepStats* stats = nullptr);
 
+// The scene of each value (with_parameter then make_scene), checked before anything runs.
+[[nodiscard]] std::vector<Scene> sweep_scenes(const SceneParams& base, SweepParameter parameter,
+                                              const std::vector<double>& values);
+
+// "--param mu_s = 0.3" (option "--param"), the prefix of a value's error messages.
+[[nodiscard]] std::string describe_value(const std::string& option, SweepParameter parameter,
+                                         double value);
+
 // CSV: header "<param>,sliding,rocking,...,overturned", one line per row; thresholds in g
 // (%.6g), empty where the event does not occur up to pga_max.
 void write_sweep_csv(std::ostream& out, SweepParameter parameter,
                      const std::vector<SweepRow>& rows);
+
+// "<param>,sliding,rocking,...,overturned" and one row of it.
+[[nodiscard]] std::string sweep_csv_header(SweepParameter parameter);
+[[nodiscard]] std::string sweep_csv_row(const SweepRow& row);
 
 }  // namespace plinth::host

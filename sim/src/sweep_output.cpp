@@ -1,0 +1,213 @@
+#include "sweep_output.h"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <vector>
+
+#include "plinth/host/input_error.h"
+
+namespace plinth::cli {
+namespace {
+
+using plinth::host::InputError;
+using plinth::host::SweepTable;
+
+std::atomic<bool> g_stop_requested{false};
+static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler stores to it");
+
+extern "C" void on_stop_signal(int signal_number) {
+  g_stop_requested.store(true);
+  constexpr char kMessage[] =
+      "\nplinth-sweep: stopping after the simulations under way (again to quit at once)\n";
+  (void)!::write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
+  struct sigaction default_action {};
+  default_action.sa_handler = SIG_DFL;
+  sigaction(signal_number, &default_action, nullptr);
+}
+
+// "[=======>      ] 12/50 rows  6.1 s, about 19 s left" on one terminal line, redrawn at most
+// ten times a second; nothing when stderr is not a terminal.
+class ProgressBar {
+ public:
+  ProgressBar(std::size_t total, std::size_t done)
+      : enabled_(::isatty(STDERR_FILENO) == 1 && total > 0),
+        total_(total),
+        resumed_(done),
+        start_(Clock::now()) {
+    draw(done, true);
+  }
+
+  void update(std::size_t done) { draw(done, done == total_); }
+
+  void finish() {
+    if (enabled_ && drawn_) std::fprintf(stderr, "\r%*s\r", 79, "");
+  }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+
+  void draw(std::size_t done, bool force) {
+    if (!enabled_) return;
+    const auto now = Clock::now();
+    if (!force && drawn_ && now - last_ < std::chrono::milliseconds(100)) return;
+    last_ = now;
+    drawn_ = true;
+    constexpr std::size_t kWidth = 28;
+    const std::size_t filled = kWidth * done / total_;
+    char bar[kWidth + 1];
+    for (std::size_t k = 0; k < kWidth; ++k) bar[k] = k < filled ? '=' : k == filled ? '>' : ' ';
+    bar[kWidth] = '\0';
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const std::size_t run = done - resumed_;
+    char left[48] = "";
+    if (run > 0 && done < total_) {
+      std::snprintf(left, sizeof left, ", about %.0f s left",
+                    elapsed / static_cast<double>(run) * static_cast<double>(total_ - done));
+    }
+    std::fprintf(stderr, "\r[%s] %zu/%zu rows  %.1f s%s   ", bar, done, total_, elapsed, left);
+    std::fflush(stderr);
+  }
+
+  bool enabled_;
+  std::size_t total_;
+  std::size_t resumed_;
+  Clock::time_point start_;
+  Clock::time_point last_{};
+  bool drawn_ = false;
+};
+
+// Rows of `path` that belong to this sweep, placed by key ("" elsewhere); nothing when the
+// file is absent, from another sweep, or not a sweep CSV (a note says so).
+std::vector<std::string> resumable_rows(const std::string& path,
+                                        const plinth::host::SweepPlan& plan,
+                                        const std::vector<bool>& in_shard) {
+  std::vector<std::string> none(plan.keys.size());
+  if (!std::filesystem::exists(path)) return none;
+  SweepTable table;
+  std::size_t dropped = 0;
+  try {
+    table = plinth::host::read_sweep_table(path, &dropped);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "plinth-sweep: note: %s; it will be replaced\n", e.what());
+    return none;
+  }
+  if (table.settings != plan.settings || table.header != plan.header) {
+    std::fprintf(stderr,
+                 "plinth-sweep: note: %s comes from another sweep (other settings); it will be "
+                 "replaced, not resumed\n",
+                 path.c_str());
+    return none;
+  }
+  std::vector<std::string> placed =
+      plinth::host::place_rows(table.rows, plan.keys, plan.key_columns, path);
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    if (!placed[i].empty() && !in_shard[i]) {
+      throw InputError(path + ": holds row '" + plan.keys[i] +
+                       "' of another shard; give the --shard that wrote it, or another --out");
+    }
+  }
+  if (dropped > 0) {
+    std::fprintf(stderr, "plinth-sweep: note: %s: %zu incomplete row(s) dropped\n", path.c_str(),
+                 dropped);
+  }
+  return placed;
+}
+
+}  // namespace
+
+const std::atomic<bool>* install_stop_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_stop_signal;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  return &g_stop_requested;
+}
+
+void write_table_file(const SweepTable& table, const std::string& path) {
+  const std::string temporary = path + ".tmp";
+  {
+    std::ofstream out(temporary);
+    if (!out) throw InputError(path + ": cannot open for writing");
+    plinth::host::write_sweep_table(out, table);
+    out.close();
+    if (!out) throw InputError(path + ": cannot write");
+  }
+  std::error_code error;
+  std::filesystem::rename(temporary, path, error);
+  if (error) throw InputError(path + ": cannot write (" + error.message() + ")");
+}
+
+SweepOutcome run_to_file(const plinth::host::SweepPlan& plan, plinth::host::SweepRun run,
+                         const OutputOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  const std::vector<std::size_t> shard = plinth::host::shard_indices(plan.keys.size(), run);
+  std::vector<bool> in_shard(plan.keys.size(), false);
+  for (const std::size_t i : shard) in_shard[i] = true;
+
+  const std::string partial_path = options.out_path + ".partial";
+  std::vector<std::string> rows(plan.keys.size());
+  if (!options.fresh) {
+    rows = resumable_rows(options.out_path, plan, in_shard);
+    const std::vector<std::string> partial = resumable_rows(partial_path, plan, in_shard);
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      if (rows[i].empty()) rows[i] = partial[i];
+    }
+  }
+  SweepOutcome outcome;
+  outcome.rows_total = shard.size();
+  std::vector<std::size_t> todo;
+  for (const std::size_t i : shard) {
+    if (rows[i].empty()) {
+      todo.push_back(i);
+    } else {
+      ++outcome.rows_resumed;
+    }
+  }
+
+  // Rows are appended here as they finish, so a kill loses none; the file in grid order is
+  // written at the end.
+  std::ofstream partial(partial_path, std::ios::trunc);
+  if (!partial) throw InputError(partial_path + ": cannot open for writing");
+  partial << plan.settings << '\n' << plan.header << '\n';
+  for (const std::string& row : rows) {
+    if (!row.empty()) partial << row << '\n';
+  }
+  partial.flush();
+
+  ProgressBar progress(shard.size(), outcome.rows_resumed);
+  std::size_t done = outcome.rows_resumed;
+  run.on_done = [&](std::size_t i) {
+    partial << rows[i] << '\n' << std::flush;
+    progress.update(++done);
+  };
+  const auto finish = [&] {
+    progress.finish();
+    SweepTable table{plan.settings, plan.header, {}};
+    for (const std::string& row : rows) {
+      if (!row.empty()) table.rows.push_back(row);
+    }
+    partial.close();
+    write_table_file(table, options.out_path);
+    std::filesystem::remove(partial_path);
+    outcome.rows_written = table.rows.size();
+    outcome.wall_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  try {
+    outcome.interrupted = !plinth::host::run_plan(plan, todo, run, rows, &outcome.simulations);
+  } catch (...) {
+    finish();
+    throw;
+  }
+  finish();
+  return outcome;
+}
+
+}  // namespace plinth::cli

@@ -1,0 +1,451 @@
+#include "sweep_plot.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <vector>
+
+#include "plinth/host/input_error.h"
+#include "plinth/host/sweep.h"
+#include "plinth/host/sweep_impulse.h"
+
+extern char** environ;
+
+namespace plinth::cli {
+namespace {
+
+using plinth::host::InputError;
+using plinth::host::SweepTable;
+using Field = std::optional<double>;
+
+constexpr const char* kInstallHint =
+    "gnuplot is needed for --plot and was not found on PATH: install the Debian package "
+    "gnuplot-nox (apt-get install gnuplot-nox, or tools/install-deps.sh)";
+
+// Axis labels in gnuplot's enhanced text.
+std::string axis_label(const std::string& name) {
+  static const std::map<std::string, std::string> labels = {
+      {"mu_s", "μ_s"}, {"epsilon", "ε = e/b"},   {"lambda", "λ = h/b"},   {"T", "T (s)"},
+      {"xi", "ξ"},     {"u_max", "u_{max} (m)"}, {"mass_ratio", "m_b/m"}, {"impulse", "|I| (m/s)"}};
+  const auto it = labels.find(name);
+  return it == labels.end() ? name : it->second;
+}
+
+// "slide_rocking" -> "slide rocking" (an underscore would be a subscript).
+std::string title_of(std::string name) {
+  std::replace(name.begin(), name.end(), '_', ' ');
+  return name;
+}
+
+// A gnuplot single-quoted string.
+std::string quoted(const std::string& text) {
+  std::string out = "'";
+  for (const char c : text) out += c == '\'' ? std::string("''") : std::string(1, c);
+  return out + "'";
+}
+
+std::string number(double value) { return plinth::host::format_value(value); }
+
+std::vector<std::string> fields_of(const std::string& row) {
+  std::vector<std::string> fields;
+  std::string field;
+  std::istringstream in(row);
+  while (std::getline(in, field, ',')) fields.push_back(field);
+  if (!row.empty() && row.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+Field parse_field(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+// The table as numbers (text fields become nothing); columns by header name.
+struct Columns {
+  std::vector<std::string> names;
+  std::vector<std::vector<std::string>> text;  // [row][column]
+
+  [[nodiscard]] std::size_t index(const std::string& name) const {
+    const auto it = std::find(names.begin(), names.end(), name);
+    if (it == names.end()) throw InputError("plot: the CSV has no column '" + name + "'");
+    return static_cast<std::size_t>(it - names.begin());
+  }
+  [[nodiscard]] Field at(std::size_t row, std::size_t column) const {
+    return parse_field(text[row][column]);
+  }
+  // (first column, `column`) of every row; empty when `column` has no value at all.
+  [[nodiscard]] std::vector<std::pair<double, Field>> curve(std::size_t column) const {
+    std::vector<std::pair<double, Field>> points;
+    bool any = false;
+    for (std::size_t r = 0; r < text.size(); ++r) {
+      if (const Field x = at(r, 0)) {
+        points.emplace_back(*x, at(r, column));
+        any = any || points.back().second.has_value();
+      }
+    }
+    if (!any) points.clear();
+    return points;
+  }
+};
+
+Columns columns_of(const SweepTable& table) {
+  Columns c;
+  c.names = fields_of(table.header);
+  for (const std::string& row : table.rows) c.text.push_back(fields_of(row));
+  return c;
+}
+
+// A gnuplot script being built: datablocks first, then the plot, drawn once per terminal.
+class Script {
+ public:
+  // Points (x, y); a missing y ends a line segment (a blank line in the datablock).
+  void block(const std::string& name, const std::vector<std::pair<double, Field>>& points) {
+    head_ << '$' << name << " << EOD\n";
+    bool gap = false;
+    for (const auto& [x, y] : points) {
+      if (!y) {
+        gap = true;
+        continue;
+      }
+      if (gap) head_ << '\n';
+      gap = false;
+      head_ << number(x) << ' ' << number(*y) << '\n';
+    }
+    head_ << "EOD\n";
+  }
+  void raw_block(const std::string& name, const std::string& lines) {
+    head_ << '$' << name << " << EOD\n" << lines << "EOD\n";
+  }
+  void line(const std::string& text) { body_ << text << '\n'; }
+
+  [[nodiscard]] std::string text(const std::string& stem, const std::string& source) const {
+    std::ostringstream out;
+    out << "# Drawn by plinth-sweep from " << source << " (docs/sweep.md); run: gnuplot "
+        << std::filesystem::path(stem).filename().string() << ".gp\n"
+        << "set encoding utf8\n"
+        << head_.str() << "set terminal pngcairo size 960,640 enhanced font 'sans,11'\n"
+        << "set output " << quoted(stem + ".png") << '\n'
+        << body_.str() << "set terminal svg size 960,640 dynamic enhanced font 'sans,11'\n"
+        << "set output " << quoted(stem + ".svg") << '\n'
+        << "replot\nunset output\n";
+    return out.str();
+  }
+
+ private:
+  std::ostringstream head_;
+  std::ostringstream body_;
+};
+
+// A line style per curve: dash type, point type, colour (the paper's maps tell events apart
+// by line style; colour helps on screen).
+constexpr std::array<const char*, 8> kColours = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd",
+                                                 "#8c564b", "#e377c2", "#17becf", "#d62728"};
+std::string style(std::size_t k, std::size_t rows) {
+  const std::size_t every = std::max<std::size_t>(1, rows / 15);  // points that leave dashes seen
+  return "dt " + std::to_string(k % 5 + 1) + " pt " + std::to_string(k + 4) + " pi " +
+         std::to_string(every) + " ps 1 lw 2 lc rgb '" + kColours[k % kColours.size()] + "'";
+}
+
+void common_setup(Script& s, const std::string& title) {
+  s.line("set title " + quoted(title));
+  s.line("set grid lc rgb '#d0d0d0'");
+  s.line("set key below");
+  s.line("set border lw 1.2");
+}
+
+double setting_number(const std::map<std::string, std::string>& settings, const std::string& key,
+                      double fallback) {
+  const auto it = settings.find(key);
+  if (it == settings.end()) return fallback;
+  const Field value = parse_field(it->second);
+  return value ? *value : fallback;
+}
+
+// One parameter: a curve per event, the region above the lowest collapse curve shaded.
+void thresholds_plot(Script& s, const Columns& c,
+                     const std::map<std::string, std::string>& settings) {
+  const double pga_max = setting_number(settings, "pga_max_g", 2.0);
+  std::vector<std::pair<double, Field>> collapse;
+  for (std::size_t r = 0; r < c.text.size(); ++r) {
+    const Field x = c.at(r, 0);
+    if (!x) continue;
+    Field lowest;
+    for (const char* name : {"fell", "overturned"}) {
+      const Field y = c.at(r, c.index(name));
+      if (y && (!lowest || *y < *lowest)) lowest = y;
+    }
+    collapse.emplace_back(*x, lowest);
+  }
+  s.block("collapse", collapse);
+  std::vector<std::string> curves;
+  for (std::size_t e = 0; e < plinth::host::kSweepEventCount; ++e) {
+    const std::string name =
+        plinth::host::sweep_event_name(static_cast<plinth::host::SweepEvent>(e));
+    const auto points = c.curve(c.index(name));
+    if (points.empty()) continue;  // not up to pga_max anywhere: no entry in the key
+    s.block(name, points);
+    curves.push_back("$" + name + " using 1:2 with linespoints " + style(e, c.text.size()) +
+                     " title " + quoted(title_of(name)));
+  }
+  s.line("set xlabel " + quoted(axis_label(c.names[0])));
+  s.line("set ylabel 'first-occurrence PGA (g)'");
+  s.line("set yrange [0:" + number(pga_max) + "]");
+  s.line("set offsets graph 0.02, graph 0.02, 0, 0");
+  std::string plot = "plot $collapse using 1:2:(" + number(pga_max) +
+                     ") with filledcurves fc rgb '#d62728' fs transparent solid 0.12 noborder "
+                     "title 'collapse: above the lowest of fell, overturned'";
+  for (const std::string& curve : curves) plot += ", \\\n     " + curve;
+  if (curves.empty()) plot += ", 1/0 notitle";
+  s.line(plot);
+}
+
+// Two parameters: a heat map of one event's first-occurrence PGA.
+void threshold_map_plot(Script& s, const Columns& c,
+                        const std::map<std::string, std::string>& settings,
+                        const std::vector<plinth::host::GridAxis>& grid) {
+  const double pga_max = setting_number(settings, "pga_max_g", 2.0);
+  std::string cells;
+  std::string previous;
+  for (std::size_t r = 0; r < c.text.size(); ++r) {
+    const Field x = c.at(r, 0);
+    const Field y = c.at(r, 1);
+    if (!x || !y) continue;
+    if (!previous.empty() && c.text[r][0] != previous) cells += '\n';  // a new scan line
+    previous = c.text[r][0];
+    const Field z = c.at(r, 2);
+    cells += number(*x) + ' ' + number(*y) + ' ' + (z ? number(*z) : std::string("NaN")) + '\n';
+  }
+  s.raw_block("cells", cells);
+  s.line("set xlabel " + quoted(axis_label(c.names[0])));
+  s.line("set ylabel " + quoted(axis_label(c.names[1])));
+  s.line("set cblabel " + quoted("first-occurrence PGA of " + title_of(c.names[2]) + " (g)"));
+  s.line("set cbrange [0:" + number(pga_max) + "]");
+  s.line("set palette defined (0 '#fde725', 0.35 '#21918c', 0.7 '#3b528b', 1 '#440154')");
+  s.line(
+      "set object 1 rectangle from graph 0,0 to graph 1,1 behind fc rgb '#e8e8e8' fs solid "
+      "noborder");
+  s.line("set key outside right bottom");
+  s.line("set tics out");
+  s.line("unset grid");
+  s.line("set autoscale fix");
+  const bool image = grid.size() == 2 && grid[0].steps >= 2 && grid[1].steps >= 2;
+  s.line(std::string("plot $cells using 1:2:3 ") +
+         (image ? "with image notitle" : "with points pt 5 ps 4 palette notitle") +
+         ", 1/0 with boxes fs solid 1.0 border lc rgb '#999999' fc rgb '#e8e8e8' title " +
+         quoted("grey: none up to " + number(pga_max) + " g"));
+}
+
+// The (|I|, mu_s) plane: simulated starts as points, the closed-form curves over them.
+void impulse_map_plot(Script& s, const Columns& c) {
+  const std::size_t mu = c.index("mu_s");
+  const std::size_t impulse = c.index("impulse");
+  const std::size_t simulated = c.index("simulated");
+  const std::size_t predicted = c.index("predicted");
+  if (c.text.empty()) throw InputError("plot: the impulse map has no rows");
+  const Field c_r = c.at(0, c.index("c_r"));
+  const Field c_sr = c.at(0, c.index("c_sr"));
+  double i_max = 0.0;
+  double mu_max = 0.0;
+  double slope = 0.0;             // C_S: mu_s per |I| (Eq 38)
+  std::map<double, double> c_rs;  // |I| -> Eq 41
+  for (std::size_t r = 0; r < c.text.size(); ++r) {
+    const Field i = c.at(r, impulse);
+    const Field m = c.at(r, mu);
+    if (!i || !m) continue;
+    i_max = std::max(i_max, *i);
+    mu_max = std::max(mu_max, *m);
+    if (const Field cs = c.at(r, c.index("c_s")); cs && *cs > 0.0) slope = *m / *cs;
+    if (const Field rs = c.at(r, c.index("c_rs")); rs && c_r && *i >= *c_r) c_rs[*i] = *rs;
+  }
+  using plinth::host::ImpulseStart;
+  const std::array<ImpulseStart, 4> starts = {ImpulseStart::kFullContact, ImpulseStart::kSliding,
+                                              ImpulseStart::kRocking, ImpulseStart::kSlideRocking};
+  const std::array<const char*, 4> colours = {"#b0b0b0", "#1f77b4", "#ff7f0e", "#2ca02c"};
+  const std::array<int, 4> points = {1, 5, 7, 9};
+  std::string plot = "plot ";
+  std::string differ;
+  for (std::size_t k = 0; k < starts.size(); ++k) {
+    const std::string name = plinth::host::impulse_start_name(starts[k]);
+    std::string lines;
+    for (std::size_t r = 0; r < c.text.size(); ++r) {
+      if (c.text[r][simulated] != name) continue;
+      lines += c.text[r][impulse] + ' ' + c.text[r][mu] + '\n';
+      if (c.text[r][predicted] != name) differ += c.text[r][impulse] + ' ' + c.text[r][mu] + '\n';
+    }
+    s.raw_block(name, lines.empty() ? "NaN NaN\n" : lines);
+    plot += "$" + name + " using 1:2 with points pt " + std::to_string(points[k]) +
+            " ps 1.1 lc rgb '" + colours[k] + "' title " + quoted("simulated: " + title_of(name)) +
+            ", \\\n     ";
+  }
+  s.raw_block("differ", differ.empty() ? "NaN NaN\n" : differ);
+  plot +=
+      "$differ using 1:2 with points pt 6 ps 2 lw 1.5 lc rgb 'black' title "
+      "'closed forms say otherwise'";
+  if (c_r && c_sr) {
+    // C_S up to C_R, C_R and C_SR from their meeting point, C_RS from it too (Eq 41 = b1/h
+    // at the rocking threshold).
+    const double top = 1.05 * mu_max;
+    const double right = 1.05 * i_max;
+    s.raw_block("c_s", "0 0\n" + number(std::min(*c_r, top / std::max(slope, 1e-12))) + " " +
+                           number(std::min(*c_sr, top)) + "\n");
+    s.raw_block(
+        "c_r", number(*c_r) + " " + number(*c_sr) + "\n" + number(*c_r) + " " + number(top) + "\n");
+    s.raw_block("c_sr", number(*c_r) + " " + number(*c_sr) + "\n" + number(right) + " " +
+                            number(*c_sr) + "\n");
+    std::string rs = number(*c_r) + " " + number(*c_sr) + "\n";
+    for (const auto& [i, m] : c_rs) rs += number(i) + " " + number(m) + "\n";
+    s.raw_block("c_rs", rs);
+    plot += ", \\\n     $c_s with lines dt 1 lw 2.5 lc rgb 'black' title 'C_S (Eq 38)'";
+    plot += ", \\\n     $c_r with lines dt 2 lw 2.5 lc rgb 'black' title 'C_R (Eq 37)'";
+    plot += ", \\\n     $c_sr with lines dt 3 lw 2.5 lc rgb '#555555' title 'C_{SR} (Eq 39)'";
+    plot += ", \\\n     $c_rs with lines dt 4 lw 2.5 lc rgb '#8b0000' title 'C_{RS} (Eq 41)'";
+    s.line("set xrange [0:" + number(right) + "]");
+    s.line("set yrange [0:" + number(top) + "]");
+  }
+  s.line("set xlabel " + quoted(axis_label("impulse")));
+  s.line("set ylabel " + quoted(axis_label("mu_s")));
+  s.line(plot);
+}
+
+// Impulse curves: simulated thresholds and closed forms against the parameter.
+void impulse_curve_plot(Script& s, const Columns& c) {
+  const std::array<const char*, 4> names = {"rocking", "overturned", "rocking_closed_form",
+                                            "overturned_closed_form"};
+  const std::array<const char*, 4> titles = {"rocking (simulated)", "overturned (simulated)",
+                                             "rocking, closed form (Eq 37)",
+                                             "overturned, closed form (energy)"};
+  const std::array<std::string, 4> styles = {
+      "with linespoints dt 1 pt 7 ps 0.8 lw 2 lc rgb '#ff7f0e'",
+      "with linespoints dt 1 pt 5 ps 0.8 lw 2 lc rgb '#d62728'",
+      "with lines dt 2 lw 2 lc rgb 'black'", "with lines dt 4 lw 2 lc rgb '#555555'"};
+  std::string plot = "plot ";
+  bool first = true;
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const auto points = c.curve(c.index(names[k]));
+    if (points.empty()) continue;
+    s.block(names[k], points);
+    plot += std::string(first ? "" : ", \\\n     ") + "$" + names[k] + " using 1:2 " + styles[k] +
+            " title " + quoted(titles[k]);
+    first = false;
+  }
+  if (first) plot += "1/0 notitle";
+  s.line("set xlabel " + quoted(axis_label(c.names[0])));
+  s.line("set ylabel 'smallest impulse |I| (m/s)'");
+  s.line("set yrange [0:*]");
+  s.line("set offsets graph 0.02, graph 0.02, 0, 0");
+  s.line(plot);
+}
+
+}  // namespace
+
+std::string find_gnuplot() {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path != nullptr ? path : "";
+  std::istringstream in(dirs);
+  std::string dir;
+  while (std::getline(in, dir, ':')) {
+    if (dir.empty()) continue;
+    const std::string candidate = dir + "/gnuplot";
+    if (::access(candidate.c_str(), X_OK) == 0) return candidate;
+  }
+  throw InputError(kInstallHint);
+}
+
+std::string plot_stem(const std::string& plot_path) {
+  const std::filesystem::path p(plot_path);
+  const std::string ext = p.extension().string();
+  if (ext != ".png" && ext != ".svg") {
+    throw InputError(
+        "--plot: expected a file name ending in .png or .svg (both are written), "
+        "got '" +
+        plot_path + "'");
+  }
+  return (p.parent_path() / p.stem()).string();
+}
+
+std::string gnuplot_script(const SweepTable& table, const std::string& stem) {
+  const auto settings = plinth::host::parse_settings(table.settings, "plot");
+  const auto grid = plinth::host::parse_grid(table.settings, "plot");
+  const Columns c = columns_of(table);
+  const std::string& mode = settings.at("mode");
+  Script s;
+  if (mode == "thresholds") {
+    common_setup(s, "First occurrence of each event against " + axis_label(c.names[0]));
+    thresholds_plot(s, c, settings);
+  } else if (mode == "threshold_map") {
+    common_setup(s, "First occurrence of " + title_of(c.names[2]) + " against " +
+                        axis_label(c.names[0]) + " and " + axis_label(c.names[1]));
+    threshold_map_plot(s, c, settings, grid);
+  } else if (mode == "impulse_map") {
+    common_setup(s, "Motion an impulse starts with (section 5.3.1): simulation and closed forms");
+    impulse_map_plot(s, c);
+  } else if (mode == "impulse_curve") {
+    common_setup(
+        s, "Smallest impulses that start rocking and overturn, against " + axis_label(c.names[0]));
+    impulse_curve_plot(s, c);
+  } else {
+    throw InputError("plot: unknown sweep mode '" + mode + "'");
+  }
+  return s.text(stem, std::filesystem::path(stem).filename().string() + " data");
+}
+
+std::string plot_sweep(const SweepTable& table, const std::string& plot_path) {
+  const std::string gnuplot = find_gnuplot();
+  const std::string stem = plot_stem(plot_path);
+  const std::string script_path = stem + ".gp";
+  {
+    std::ofstream out(script_path);
+    out << gnuplot_script(table, stem);
+    if (!out) throw InputError(script_path + ": cannot write the gnuplot script");
+  }
+  const std::string error_path = (std::filesystem::temp_directory_path() /
+                                  ("plinth-sweep-gnuplot-" + std::to_string(::getpid()) + ".txt"))
+                                     .string();
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 2, error_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
+                                   0644);
+  std::vector<char*> argv = {const_cast<char*>(gnuplot.c_str()),  // posix_spawn's signature
+                             const_cast<char*>(script_path.c_str()), nullptr};
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, gnuplot.c_str(), &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) throw InputError(kInstallHint);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  std::string errors;
+  {
+    std::ifstream in(error_path);
+    std::ostringstream text;
+    text << in.rdbuf();
+    errors = text.str();
+  }
+  std::filesystem::remove(error_path);
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    throw InputError("gnuplot failed on " + script_path + ":\n" + errors);
+  }
+  for (const char* ext : {".png", ".svg"}) {
+    if (!std::filesystem::exists(stem + ext)) {
+      throw InputError("gnuplot did not write " + stem + ext + ":\n" + errors);
+    }
+  }
+  return stem + ".png and " + stem + ".svg";
+}
+
+}  // namespace plinth::cli

@@ -1,0 +1,187 @@
+#!/usr/bin/env bash
+# plinth-sweep run as a user would (docs/sweep.md): shards merged equal the whole run byte for
+# byte, an interrupted run keeps its rows and a rerun resumes to the same file, plots are
+# written (or a missing gnuplot is named), and bad inputs end with exit code 1 or 2 and a
+# message naming the problem. Prints "ok - <name>" or "not ok - <name>: <why>" per check,
+# then "N passed, M failed".
+#
+# Environment: PLINTH_SWEEP, the plinth-sweep binary; PLINTH_SOURCE_DIR, the repository root.
+set -u
+
+PLINTH_SIM=${PLINTH_SWEEP:-}
+# shellcheck source=tests/cli/harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
+SWEEP=$SIM
+ISOLATED=$SCENES/paper-isolated.toml
+
+# sweep ARGS...: plinth-sweep ARGS with stdout in $TMP/out.txt, stderr in $TMP/err.txt and
+# the exit code in RC.
+sweep() {
+  RC=0
+  "${TIMEOUT[@]}" "$SWEEP" "$@" >"$TMP/out.txt" 2>"$TMP/err.txt" || RC=$?
+}
+
+# check NAME CONDITION...: passes when the command CONDITION succeeds.
+check() {
+  local name=$1
+  shift
+  if "$@"; then pass "$name"; else fail "$name" "$(head -c 300 "$TMP/err.txt")"; fi
+}
+
+# refuses NAME PATTERN ARGS...: plinth-sweep ARGS must exit with 1 or 2 and say PATTERN
+# (extended regex) on stderr.
+refuses() {
+  local name=$1 pattern=$2
+  shift 2
+  sweep "$@"
+  if ((RC != 1 && RC != 2)); then
+    fail "$name" "exit code $RC, expected 1 or 2; stderr: $(head -c 200 "$TMP/err.txt")"
+  elif ! grep -Eq -- "$pattern" "$TMP/err.txt"; then
+    fail "$name" "stderr does not match '$pattern': $(head -c 200 "$TMP/err.txt")"
+  else
+    pass "$name"
+  fi
+}
+
+# A small but real sweep: 4 values of mu_s, coarse search.
+SMALL=(--scene "$ISOLATED" --record "$AT2" --param mu_s --from 0.2 --to 0.5 --steps 4
+       --pga-max 4g --tol 0.05g --dt 4e-3)
+
+sweep "${SMALL[@]}" --jobs 2 --out whole.csv
+check "a sweep writes its map" test "$RC" -eq 0 -a -s whole.csv
+check "the first line records the settings" \
+  grep -q '^# plinth-sweep thresholds grid=mu_s:0.2:0.5:4 scene=' whole.csv
+check "the header names the parameter and the events" grep -qx \
+  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned' whole.csv
+check "one row per value" test "$(grep -c '^0\.' whole.csv)" -eq 4
+check "no progress bar when stderr is not a terminal" test ! -s "$TMP/err.txt"
+
+# Shards on their own, then merged: the same bytes as the whole run.
+sweep "${SMALL[@]}" --jobs 1 --shard 2/3 --out part2.csv
+sweep "${SMALL[@]}" --jobs 1 --shard 1/3 --out part1.csv
+sweep "${SMALL[@]}" --jobs 1 --shard 3/3 --out part3.csv
+sweep merge --out merged.csv part3.csv part1.csv part2.csv
+check "shards merged equal the whole run byte for byte" cmp -s merged.csv whole.csv
+refuses "merge refuses a missing shard" "1 of 4 rows are missing" merge --out m.csv part1.csv part2.csv
+refuses "merge refuses a shard given twice" "is in both part1.csv and part1.csv" \
+  merge --out m.csv part1.csv part1.csv part2.csv part3.csv
+sweep --scene "$ISOLATED" --record "$AT2" --param mu_s --from 0.2 --to 0.5 --steps 4 \
+  --pga-max 4g --tol 0.1g --dt 4e-3 --shard 3/3 --out other.csv
+refuses "merge refuses shards of different sweeps" "come from different sweeps" \
+  merge --out m.csv part1.csv part2.csv other.csv
+printf 'mu_s,sliding\n0.2,1\n' >plain.csv
+refuses "merge refuses a CSV without the settings line" "plain.csv.*not a plinth-sweep CSV" \
+  merge --out m.csv plain.csv
+refuses "merge of a file that is not there" "nothere.csv: cannot open" merge --out m.csv nothere.csv
+refuses "a shard's file is not resumed by another shard" "holds row '0.2' of another shard" \
+  "${SMALL[@]}" --shard 2/3 --out part1.csv
+
+# Rerunning a finished sweep runs nothing and rewrites the same file.
+cp whole.csv again.csv
+sweep "${SMALL[@]}" --out again.csv
+check "a finished sweep is resumed, not rerun" grep -q '4 resumed from again.csv), 0 simulations' "$TMP/out.txt"
+check "and its file is unchanged" cmp -s again.csv whole.csv
+
+# Interrupt: SIGINT once a row is written; the rows so far are kept; a rerun resumes.
+LONG=(--scene "$ISOLATED" --record "$AT2" --param mu_s --from 0.3 --to 1.5 --steps 9
+      --pga-max 4g --tol 0.02g --dt 4e-3 --jobs 1)
+"$SWEEP" "${LONG[@]}" --out cut.csv >"$TMP/out.txt" 2>"$TMP/err.txt" &
+pid=$!
+for _ in $(seq 1 600); do
+  if [[ -f cut.csv.partial ]] && (($(wc -l <cut.csv.partial) >= 3)); then break; fi
+  sleep 0.05
+done
+kill -INT "$pid"
+wait "$pid"
+RC=$?
+check "SIGINT ends the run with exit code 130" test "$RC" -eq 130
+check "and says how many rows it kept and how to resume" \
+  grep -Eq 'interrupted: [0-9]+ of 9 rows kept in cut.csv.*run the same command again to resume' "$TMP/err.txt"
+kept=$(grep -c '^[01]\.' cut.csv)
+check "the rows finished so far are in the file, in order" test "$kept" -ge 1 -a "$kept" -lt 9
+check "the partial file is gone" test ! -e cut.csv.partial
+sweep "${LONG[@]}" --out cut.csv
+check "the rerun resumes from the kept rows" grep -q "$kept resumed from cut.csv" "$TMP/out.txt"
+sweep "${LONG[@]}" --fresh --out uncut.csv
+check "the resumed file equals an uninterrupted run byte for byte" cmp -s cut.csv uncut.csv
+# A kill leaves cut.csv.partial: its rows are resumed too.
+head -n 4 uncut.csv >killed.csv.partial
+sweep "${LONG[@]}" --out killed.csv
+check "rows of a killed run's partial file are resumed" grep -q "2 resumed from killed.csv" "$TMP/out.txt"
+check "and the result is the same" cmp -s killed.csv uncut.csv
+
+# The progress bar on a terminal (script(1) gives the program one).
+if command -v script >/dev/null 2>&1; then
+  script -qec "$SWEEP ${SMALL[*]} --out tty.csv --fresh" /dev/null >"$TMP/tty.txt" 2>&1
+  check "a progress bar on a terminal" grep -q '4/4 rows' "$TMP/tty.txt"
+fi
+
+# The other modes, small.
+sweep --scene "$ISOLATED" --record "$AT2" --param lambda --from 3 --to 4 --steps 2 \
+  --param2 epsilon --from2 -0.3 --to2 0.3 --steps2 2 --event rocking --pga-max 4g --tol 0.05g \
+  --dt 2e-3 --out map2.csv
+check "a two-parameter map has a row per cell" test "$RC" -eq 0 -a "$(tail -n +3 map2.csv | wc -l)" -eq 4
+check "its header is p1,p2,event" grep -qx 'lambda,epsilon,rocking' map2.csv
+sweep --scene "$ISOLATED" --impulse-map --mu-from 0.1 --mu-to 0.6 --mu-steps 3 \
+  --impulse-from 0.5 --impulse-to 2.5 --impulse-steps 3 --out imap.csv
+check "an impulse map has a row per grid point" test "$RC" -eq 0 -a "$(tail -n +3 imap.csv | wc -l)" -eq 9
+check "its header" grep -qx 'mu_s,impulse,simulated,predicted,c_s,c_r,c_sr,c_rs' imap.csv
+sweep --scene "$ISOLATED" --impulse-curve --param T --from 1.5 --to 2.5 --steps 2 \
+  --impulse-max 5 --impulse-tol 0.01 --out icurve.csv
+check "an impulse curve has a row per value" test "$RC" -eq 0 -a "$(tail -n +3 icurve.csv | wc -l)" -eq 2
+
+# Plots: PNG and SVG of the same stem, or a clear error naming the package.
+if command -v gnuplot >/dev/null 2>&1; then
+  for csv in whole map2 imap icurve; do
+    sweep plot "$csv.csv" --out "plot-$csv.png"
+    check "$csv: plot writes a PNG" test "$RC" -eq 0 -a "$(head -c 4 "plot-$csv.png" | tail -c 3)" = PNG
+    check "$csv: and an SVG" grep -q '<svg' "plot-$csv.svg"
+  done
+  bash "$SRC/tools/plot-sweep.sh" whole.csv wrapped.png >"$TMP/out.txt" 2>"$TMP/err.txt"
+  RC=$?
+  check "tools/plot-sweep.sh plots a CSV" test "$RC" -eq 0 -a -s wrapped.png -a -s wrapped.svg
+else
+  echo "# gnuplot not installed: plot checks skipped (apt-get install gnuplot-nox)"
+fi
+mkdir -p nogp
+PATH=$TMP/nogp "$SWEEP" "${SMALL[@]}" --out nogp.csv --plot nogp.png >"$TMP/out.txt" 2>"$TMP/err.txt"
+RC=$?
+check "a missing gnuplot is named, with its package" \
+  test "$RC" -eq 1 -a -n "$(grep 'gnuplot-nox' "$TMP/err.txt")"
+check "and the sweep did not run first" test ! -e nogp.csv
+
+# Bad inputs.
+refuses "unknown parameter" "--param: unknown parameter 'mu' \(one of mu_s" \
+  --scene "$ISOLATED" --record "$AT2" --param mu --from 0.1 --to 1 --steps 3 --out x.csv
+refuses "--from above --to" "--from 1 is greater than --to 0.1" \
+  --scene "$ISOLATED" --record "$AT2" --param mu_s --from 1 --to 0.1 --steps 3 --out x.csv
+refuses "no steps" "--steps: must be at least 1" \
+  --scene "$ISOLATED" --record "$AT2" --param mu_s --from 0.1 --to 1 --steps 0 --out x.csv
+refuses "a missing --param" "--param is required" \
+  --scene "$ISOLATED" --record "$AT2" --from 0.1 --to 1 --steps 3 --out x.csv
+refuses "an unreadable record" "nothere.AT2" \
+  --scene "$ISOLATED" --record nothere.AT2 --param mu_s --from 0.1 --to 1 --steps 3 --out x.csv
+refuses "a parameter the scene lacks" "--param u_max = 0.1: the scene has no \[base_stops\]" \
+  --scene "$ISOLATED" --record "$AT2" --param u_max --from 0.1 --to 0.2 --steps 2 --out x.csv
+refuses "a bad shard" "--shard: expected i/N" "${SMALL[@]}" --shard 3/2 --out x.csv
+refuses "no jobs" "--jobs: must be at least 1" "${SMALL[@]}" --jobs 0 --out x.csv
+refuses "an unknown event" "--event: unknown event 'toppled'" "${SMALL[@]}" --param2 epsilon \
+  --from2 0 --to2 0.2 --steps2 2 --event toppled --out x.csv
+refuses "a second parameter without its range" "--from2 is required" "${SMALL[@]}" \
+  --param2 epsilon --out x.csv
+refuses "a plot name without .png or .svg" "--plot: expected a file name ending in .png or .svg" \
+  "${SMALL[@]}" --out x.csv --plot map.jpg
+refuses "an impulse map on the ground" "needs a scene with a \[base\]" \
+  --scene "$SCENES/non-isolated.toml" --impulse-map --mu-from 0.1 --mu-to 1 --mu-steps 2 \
+  --impulse-from 0.1 --impulse-to 1 --impulse-steps 2 --out x.csv
+refuses "an impulse map with a record" "excludes" --scene "$ISOLATED" --record "$AT2" \
+  --impulse-map --mu-from 0.1 --mu-to 1 --mu-steps 2 --impulse-from 0.1 --impulse-to 1 \
+  --impulse-steps 2 --out x.csv
+refuses "impulse steps from above to" "--mu-from 1 is greater than --mu-to 0.1" \
+  --scene "$ISOLATED" --impulse-map --mu-from 1 --mu-to 0.1 --mu-steps 2 --impulse-from 0.1 \
+  --impulse-to 1 --impulse-steps 2 --out x.csv
+refuses "an output that cannot be written" "cannot open for writing" "${SMALL[@]}" \
+  --out /nonexistent/dir/x.csv
+
+echo "$PASSED passed, $FAILED failed"
+((FAILED == 0))
