@@ -1,0 +1,801 @@
+#!/usr/bin/env python3
+"""End-to-end test on a real CAN bus: the input before, every check and measurement after.
+
+tools/e2e-can.sh runs this twice around the bus runs inside user-mode Linux (its guest part):
+
+    e2e_can.py prepare --work DIR --record R.AT2 --scale 20 ...   # DIR/input.csv, DIR/config.*
+    e2e_can.py check --work DIR                                   # exit 1 on a failed check
+
+prepare writes the sensor input: a quiet lead-in (the monitor's start-up window, with a 1 LSB
+dither as a real sensor's noise, so the stuck-sensor check stays quiet), then the record
+resampled to the sensor rate and scaled, in m/s2 (so that plinth-sim and plinth-replay read the
+same numbers whatever a scene's g). check reads what the guest left in DIR (candump logs of the
+bus, the monitor's JSON lines, plinth-replay's reports), decodes every frame with its own
+decoder built from hal/can_codec/plinth.dbc, runs plinth-sim and plinth-monitor --replay on the
+host, and compares. Python 3 standard library only.
+"""
+import argparse
+import json
+import math
+import re
+import resource
+import statistics
+import subprocess
+import sys
+from pathlib import Path
+
+G0 = 9.80665  # m/s2: the DBC's 1 g
+RESOLUTION_G = 0.00025  # the acceleration signals' factor
+DITHER = (0, 1, 0, -1)  # lead-in, in LSB: zero mean over any 4 samples
+PLINTH_FIRST, PLINTH_LAST = 0x300, 0x37F
+SENSOR_NODE = 1
+ACCEL_ID = 0x300 + SENSOR_NODE
+HEARTBEAT_ID = 0x310 + SENSOR_NODE
+STATUS_IDS = (0x320, 0x321)
+ALARM_ID = 0x330
+PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "fell"]
+LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
+CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
+          "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault"]
+SCENARIOS = ("main", "stop", "garbage", "burst")
+# Sent by canplayer in the garbage case, each one refused by the DBC (or not for the monitor).
+GARBAGE = (
+    "301#", "301#00", "301#00112233445566",  # SensorAcceleration, lengths 0, 1, 7
+    "301#00000000A00F00F0",  # its Status bits 4-7 (reserved)
+    "311#00", "311#0000000010F00000",  # SensorHeartbeat: short; Status bits 4-7
+    "320#00F0000000000000", "320#0600000000000000",  # MonitorStatus: bits 12-15; phase 6
+    "320#0000112700000000", "320#0000000000000001",  # risk 10001 (> 1); bits 56-63
+    "330#0000FE0000000000", "330#0500000000000000",  # AlarmEvent: bits 17-23; level 5
+    "330#000A000000000000",  # cause 10
+    "340#F000000000000000", "340#00",  # Acknowledge: bits 4-7; short
+    "300#0000000000000000", "322#0000000000000000", "35A#11", "37F#", "331#00", "341#00",  # unknown
+    "301#R", "00000301#00000000A00F0000",  # RTR, extended: the kernel filter keeps them away
+)
+
+
+# ---- The record ------------------------------------------------------------------------------
+
+def read_at2(path):
+    """(dt, values in g) of a PEER NGA AT2 file."""
+    lines = Path(path).read_text().splitlines()
+    match = re.search(r"NPTS\s*=\s*(\d+)\s*,\s*DT\s*=\s*([-+.0-9Ee]+)", lines[3])
+    values = [float(x) for line in lines[4:] for x in line.split()]
+    return float(match.group(2)), values[: int(match.group(1))]
+
+
+def value_at(dt, values, t):
+    """lib/core SampledSignal::at: linear interpolation, 0 before 0 and after the last sample."""
+    position = t / dt
+    last = len(values) - 1
+    if abs(position - last) <= 1e-9 * max(1.0, last):
+        return values[-1]
+    if t < 0 or position > last:
+        return 0.0
+    i = math.floor(position)
+    return values[i] + (position - i) * (values[i + 1] - values[i])
+
+
+def write_csv(path, name, rate, values_m_s2):
+    with open(path, "w") as out:
+        out.write(f"t,{name} [m/s2]\n")
+        for k, a in enumerate(values_m_s2):
+            out.write(f"{k / rate:.6f},{a:.10g}\n")
+
+
+def read_csv(path):
+    rows = [line.split(",") for line in Path(path).read_text().splitlines()[1:] if line.strip()]
+    return [float(row[1]) for row in rows]
+
+
+def prepare(args):
+    work = Path(args.work)
+    work.mkdir(parents=True, exist_ok=True)
+    dt, values_g = read_at2(args.record)
+    lead = round(args.lead_in * args.rate)
+    count = math.floor(args.record_end * args.rate + 1e-6) + 1
+    samples = [DITHER[k % 4] * RESOLUTION_G * G0 for k in range(lead)]
+    samples += [args.scale * value_at(dt, values_g, k / args.rate) * G0 for k in range(count)]
+    write_csv(work / "input.csv", Path(args.record).stem, args.rate, samples)
+    # The monitor's estimator starts (t = 0, at rest) with the first sample after its health
+    # tracker's recovery (10 clean samples, the 10th fed) and its start-up window: sample
+    # round(window * rate) + 10 - 1, as plinth-monitor's own file replay counts its lead-in.
+    start_index = round(args.startup_window * args.rate) + 10 - 1
+    if start_index >= lead:
+        sys.exit("e2e_can.py: --lead-in must be longer than the monitor's start-up window")
+    config = {
+        "record": str(Path(args.record).resolve()), "scale": args.scale, "rate": args.rate,
+        "speed": args.speed, "lead_in_samples": lead, "record_samples": count,
+        "record_end_s": args.record_end, "startup_window_s": args.startup_window,
+        "estimator_start_index": start_index, "steps": args.steps,
+        "status_interval_s": args.status_interval, "timeout_s": 0.05,
+        "short_record_s": args.short,
+        "scene": str(Path(args.scene).resolve()), "dbc": str(Path(args.dbc).resolve()),
+        "monitor": args.monitor, "replay": args.replay, "sim": args.sim,
+    }
+    (work / "config.json").write_text(json.dumps(config, indent=1) + "\n")
+    # For the guest (bash): the values it needs, already in its units.
+    env = {
+        "MONITOR": args.monitor, "REPLAY": args.replay, "SCENE": config["scene"],
+        "RATE": f"{args.rate:g}", "SPEED": f"{args.speed:g}", "STEPS": str(args.steps),
+        "STARTUP_WINDOW": f"{args.startup_window:g}",
+        "STATUS_INTERVAL": f"{args.status_interval:g}",
+        # the stop case: plinth-replay is killed this long after the monitor's level is back to
+        # normal (its start-up fault is held 2 s of wall clock)
+        "KILL_AFTER_NORMAL": f"{args.kill_after:g}",
+        # ... waiting for that at most until 1 s before the input ends (10 ms polls)
+        "STOP_WAIT_POLLS": str(max(1, round(((lead + count - 1) / args.rate / args.speed - 1.0)
+                                            * 100))),
+        # the garbage and burst cases send the lead-in and this much of the record
+        "SHORT_T_END": f"{args.lead_in + args.short:.3f}",
+        # the stall and the garbage come once the record is on (the monitor estimating)
+        "GARBAGE_AFTER": f"{(args.lead_in + 0.2) / args.speed:.3f}",
+    }
+    (work / "config.env").write_text("".join(f"{k}='{v}'\n" for k, v in env.items()))
+    (work / "garbage.in.log").write_text("".join(f"(0.000000) vcan0 {frame}\n"
+                                                 for frame in GARBAGE))
+    print(f"e2e_can.py: {work / 'input.csv'}: {lead} lead-in + {count} record samples at "
+          f"{args.rate:g} Hz ({(lead + count - 1) / args.rate:.3f} s), scale {args.scale:g}")
+    return 0
+
+
+# ---- The DBC ---------------------------------------------------------------------------------
+
+class Signal:
+    def __init__(self, name, start, length, signed, factor, offset, minimum, maximum):
+        self.name, self.start, self.length, self.signed = name, start, length, signed
+        self.factor, self.offset = factor, offset
+        self.raw_min = round((minimum - offset) / factor)
+        self.raw_max = round((maximum - offset) / factor)
+        self.values = None  # the VAL_ table's raw values, for an enumeration
+        self.reserved_mask = 0  # flag bits the comment reserves ("bits 4-7 reserved, must be 0")
+
+
+class Dbc:
+    """The messages of plinth.dbc, read from the file itself, and a decoder that refuses what
+    the DBC makes invalid: a length other than the message's, raw values outside [min|max] or
+    missing from a VAL_ table, bits no signal covers, flag bits a comment reserves."""
+
+    def __init__(self, path):
+        self.messages = {}  # id -> (name, length, [Signal])
+        current = None
+        for line in Path(path).read_text().splitlines():
+            m = re.match(r"^BO_ (\d+) (\w+): (\d+) ", line)
+            if m:
+                current = (m.group(2), int(m.group(3)), [])
+                self.messages[int(m.group(1))] = current
+                continue
+            m = re.match(r"^ SG_ (\w+) : (\d+)\|(\d+)@1([+-]) \(([^,]+),([^)]+)\) "
+                         r"\[([^|]+)\|([^\]]+)\]", line)
+            if m and current is not None:
+                current[2].append(Signal(m.group(1), int(m.group(2)), int(m.group(3)),
+                                         m.group(4) == "-", float(m.group(5)), float(m.group(6)),
+                                         float(m.group(7)), float(m.group(8))))
+                continue
+            m = re.match(r"^VAL_ (\d+) (\w+) (.*);", line)
+            if m:
+                self.signal(int(m.group(1)), m.group(2)).values = {
+                    int(v) for v in re.findall(r'(\d+) "[^"]*"', m.group(3))}
+                continue
+            m = re.match(r'^CM_ SG_ (\d+) (\w+) "(.*)";', line)
+            if m:
+                r = re.search(r"bits (\d+)-(\d+) reserved, must be 0", m.group(3))
+                if r:
+                    low, high = int(r.group(1)), int(r.group(2))
+                    self.signal(int(m.group(1)), m.group(2)).reserved_mask = \
+                        ((1 << (high + 1)) - 1) & ~((1 << low) - 1)
+        if ACCEL_ID not in self.messages or ALARM_ID not in self.messages:
+            raise ValueError(f"{path}: not the plinth DBC")
+
+    def signal(self, ident, name):
+        return next(s for s in self.messages[ident][2] if s.name == name)
+
+    def decode(self, ident, data):
+        """({signal: raw}, "") or (None, why not)."""
+        if ident not in self.messages:
+            return None, "unknown identifier"
+        name, length, signals = self.messages[ident]
+        if len(data) != length:
+            return None, f"length {len(data)}"
+        word = int.from_bytes(data, "little")
+        used = 0
+        raw_values = {}
+        for s in signals:
+            mask = (1 << s.length) - 1
+            used |= mask << s.start
+            raw = (word >> s.start) & mask
+            if s.signed and raw >> (s.length - 1):
+                raw -= 1 << s.length
+            if not s.raw_min <= raw <= s.raw_max:
+                return None, f"{s.name} {raw} out of range"
+            if s.values is not None and raw not in s.values:
+                return None, f"{s.name} {raw} not in its VAL_ table"
+            if raw & s.reserved_mask:
+                return None, f"{s.name} reserved flags {raw:#x}"
+            raw_values[s.name] = raw
+        if word & ~used:
+            return None, "reserved bits set"
+        return raw_values, ""
+
+
+# ---- Files the guest wrote -------------------------------------------------------------------
+
+class Frame:
+    __slots__ = ("t_us", "ident", "extended", "rtr", "data")
+
+    def __init__(self, t_us, ident, extended, rtr, data):
+        self.t_us, self.ident, self.extended, self.rtr, self.data = t_us, ident, extended, rtr, data
+
+    def plinth(self):
+        """What plinth-monitor's socket passes: standard data frames 0x300-0x37F."""
+        return not self.extended and not self.rtr and PLINTH_FIRST <= self.ident <= PLINTH_LAST
+
+
+CANDUMP_LINE = re.compile(r"^\((\d+)\.(\d{6})\) (\S+) ([0-9A-Fa-f]{3}|[0-9A-Fa-f]{8})#"
+                          r"(R\d?|(?:[0-9A-Fa-f]{2})*)$")
+
+
+def read_candump(path):
+    """(frames, drop notices) of a candump -L -d log."""
+    frames, drops = [], []
+    for number, line in enumerate(Path(path).read_text().splitlines(), 1):
+        m = CANDUMP_LINE.match(line)
+        if m is None:
+            if line.strip():
+                drops.append(f"{path.name}:{number}: {line.strip()}")
+            continue
+        seconds, micros, _, ident, data = m.groups()
+        rtr = data.startswith("R")
+        frames.append(Frame(int(seconds) * 1_000_000 + int(micros), int(ident, 16), len(ident) == 8,
+                            rtr, b"" if rtr else bytes.fromhex(data)))
+    return frames, drops
+
+
+def read_jsonl(path):
+    out = []
+    for line in Path(path).read_text().splitlines():
+        if line.strip():
+            out.append(json.loads(line))
+    return out
+
+
+def read_keys(path):
+    """key=value lines."""
+    out = {}
+    if path.exists():
+        for line in path.read_text().splitlines():
+            if "=" in line:
+                key, value = line.split("=", 1)
+                out[key.strip()] = value.strip()
+    return out
+
+
+def ms(seconds):
+    return "none" if seconds is None else f"{seconds * 1e3:.1f} ms"
+
+
+def percentile(values, fraction):
+    """Nearest rank, as plinth-replay's report."""
+    ordered = sorted(values)
+    return ordered[max(0, math.ceil(fraction * len(ordered)) - 1)]
+
+
+# ---- Checks ----------------------------------------------------------------------------------
+
+class Checks:
+    def __init__(self):
+        self.failed = 0
+        self.passed = 0
+
+    def __call__(self, ok, what):
+        if ok:
+            self.passed += 1
+            print(f"  ok    {what}")
+        else:
+            self.failed += 1
+            print(f"  FAIL  {what}")
+        return ok
+
+
+class Scenario:
+    """One bus run: what candump logged, what plinth-monitor printed, plinth-replay's report."""
+
+    def __init__(self, work, name, dbc):
+        self.name = name
+        self.dbc = dbc
+        self.frames, self.drops = read_candump(work / f"{name}.bus.log")
+        self.lines = read_jsonl(work / f"{name}.monitor.jsonl")
+        self.monitor_rc = (work / f"{name}.monitor.rc").read_text().strip()
+        self.monitor_err = (work / f"{name}.monitor.err").read_text().strip()
+        self.summary = next((x for x in self.lines if x.get("type") == "summary"), None)
+        self.status_lines = [x for x in self.lines if x.get("type") == "status"]
+        self.alarm_lines = [x for x in self.lines if x.get("type") == "alarm"]
+        self.event_lines = [x for x in self.lines if x.get("type") == "event"]
+        report = (work / f"{name}.replay.json").read_text().strip()
+        self.report = json.loads(report.splitlines()[-1]) if report else None
+        self.replay_rc = (work / f"{name}.replay.rc").read_text().strip()
+        self.extra = read_keys(work / f"{name}.extra")
+        self.decoded = [dbc.decode(f.ident, f.data) if f.plinth() else (None, "not plinth")
+                        for f in self.frames]
+        # The monitor listens from before its first frame (a status, its start-up fault
+        # alarm); every frame on the bus after that one reached its socket, or should have.
+        self.ready = next((i for i in range(len(self.frames)) if self.own(i)), None)
+        self.sensor = [(f, d) for f, (d, _) in zip(self.frames, self.decoded)
+                       if f.plinth() and f.ident == ACCEL_ID and d is not None]
+        self.epoch_us = self.sensor[0][0].t_us if self.sensor else 0
+
+    def own(self, index):
+        """A frame plinth-monitor sent: a valid MonitorStatus or AlarmEvent (the tests never
+        inject valid ones)."""
+        f = self.frames[index]
+        return f.plinth() and (f.ident in STATUS_IDS or f.ident == ALARM_ID) \
+            and self.decoded[index][0] is not None
+
+    def expected_counters(self):
+        """The summary's frame counters, from the bus, as the DBC says (frames after ready)."""
+        c = dict(received=0, sensor_samples=0, other_nodes=0, heartbeats=0, acknowledgements=0,
+                 rejected=0, unknown_identifiers=0)
+        for i in range(self.ready + 1, len(self.frames)):
+            f = self.frames[i]
+            if not f.plinth() or self.own(i):
+                continue
+            c["received"] += 1
+            raw, why = self.decoded[i]
+            if why == "unknown identifier":
+                c["unknown_identifiers"] += 1
+            elif raw is None:
+                c["rejected"] += 1
+            elif f.ident == ACCEL_ID:
+                c["sensor_samples"] += 1
+            elif 0x301 <= f.ident <= 0x30F:
+                c["other_nodes"] += 1
+            elif 0x311 <= f.ident <= 0x31F:
+                c["heartbeats"] += 1
+            elif f.ident == 0x340:
+                c["acknowledgements"] += 1
+        return c
+
+    def streaming(self, index):
+        """Whether frame `index` lies between the first and the last sensor frame."""
+        t = self.frames[index].t_us
+        return bool(self.sensor) and self.sensor[0][0].t_us <= t <= self.sensor[-1][0].t_us
+
+    def latency_us(self):
+        """Each MonitorStatus frame's time minus the newest SensorAcceleration before it, while
+        the sensor sends."""
+        out = []
+        last = None
+        for i, f in enumerate(self.frames):
+            if f.plinth() and f.ident == ACCEL_ID:
+                last = f.t_us
+            elif f.plinth() and f.ident in STATUS_IDS and self.own(i) and last is not None \
+                    and self.streaming(i):
+                out.append(f.t_us - last)
+        return out
+
+
+def common_checks(check, s, config):
+    """What every run must show: the monitor stopped cleanly, nothing lost or dropped."""
+    runs = s.extra.get("attempts", "1")
+    print(f"[{s.name}]" + ("" if runs == "1" else f" (the last of {runs} runs: a starved guest "
+                                                  f"spoiled the others)"))
+    check(s.monitor_rc == "0" and s.summary is not None,
+          f"plinth-monitor stopped cleanly on {s.extra.get('stop_signal', '?')} (exit "
+          f"{s.monitor_rc}, summary line written){': ' + s.monitor_err if s.monitor_err else ''}")
+    check(not s.drops, "candump dropped no frame" + (f": {s.drops[:3]}" if s.drops else ""))
+    check(s.ready is not None, "the monitor's first frames (status, start-up fault) are on the bus")
+    if s.summary is None or s.ready is None:
+        return False
+    sensor = s.summary["sensor"]
+    frames = s.summary["frames"]
+    want = s.expected_counters()
+    got = {k: frames[k] for k in want}
+    check(got == want, f"the summary's frame counters match the bus as the DBC decodes it: {got}"
+          + ("" if got == want else f", expected {want}"))
+    on_bus = sum(1 for i in range(s.ready + 1, len(s.frames))
+                 if s.frames[i].plinth() and s.frames[i].ident == ACCEL_ID
+                 and s.decoded[i][0] is not None)
+    check(frames["sensor_samples"] == on_bus and sensor["missing"] == 0 and
+          sensor["long_gaps"] == 0 and sensor["bridged"] == 0 and sensor["duplicates"] == 0 and
+          sensor["out_of_order"] == 0,
+          f"no sensor frame lost: {frames['sensor_samples']} received of {on_bus} on the bus; "
+          f"missing {sensor['missing']}, long gaps {sensor['long_gaps']}, bridged "
+          f"{sensor['bridged']}, duplicates {sensor['duplicates']}, out of order "
+          f"{sensor['out_of_order']}")
+    check(s.summary["bus_send_errors"] == 0, f"bus send errors {s.summary['bus_send_errors']}")
+    # A sensor timeout is right only where the bus had no sensor frame for longer than the
+    # timeout: between two frames, or after the last one (the monitor runs on 0.2 s at least).
+    timeout_us = config["timeout_s"] * 1e6
+    stream = [f.t_us for i, f in enumerate(s.frames) if i > s.ready and f.plinth()
+              and f.ident == ACCEL_ID and s.decoded[i][0] is not None]
+    gaps = [b - a for a, b in zip(stream, stream[1:])]
+    silent = sum(1 for g in gaps if g > timeout_us)
+    trailing = 1 if stream and s.epoch_us + s.summary["t"] * 1e6 - stream[-1] > timeout_us else 0
+    check(sensor["timeouts"] == silent + trailing,
+          f"sensor timeouts counted {sensor['timeouts']}: the bus was silent for more than "
+          f"{timeout_us / 1e3:.0f} ms {silent} times between sensor frames (longest gap "
+          f"{max(gaps, default=0) / 1e3:.1f} ms) and {trailing} time at the end")
+    bus_faults = [a for a in s.alarm_lines if a["cause"] == "bus_error"]
+    check(not bus_faults, "no bus fault (kernel drop or error frame) reported" +
+          (f": {bus_faults[0]}" if bus_faults else ""))
+    return True
+
+
+def replay_checks(check, s, samples):
+    r = s.report
+    if not check(s.replay_rc == "0" and r is not None and r["send_errors"] == 0 and
+                 r["acceleration_frames"] == samples,
+                 f"plinth-replay sent {r and r['acceleration_frames']} SensorAcceleration + "
+                 f"{r and r['heartbeat_frames']} SensorHeartbeat frames, {samples} expected, "
+                 f"send errors {r and r['send_errors']} (exit {s.replay_rc})"):
+        return
+    sensor_on_bus = sum(1 for f in s.frames if f.plinth() and f.ident == ACCEL_ID
+                        and s.dbc.decode(f.ident, f.data)[0] is not None)
+    # plinth-replay's heartbeats: firmware 0.1, error counters 0 (not the garbage case's
+    # random frames that happen to decode)
+    heartbeats = 0
+    for f in s.frames:
+        raw = s.dbc.decode(f.ident, f.data)[0] if f.plinth() and f.ident == HEARTBEAT_ID else None
+        if raw and (raw["FirmwareMajor"], raw["FirmwareMinor"], raw["CanTxErrors"],
+                    raw["CanRxErrors"]) == (0, 1, 0, 0):
+            heartbeats += 1
+    check(sensor_on_bus == r["acceleration_frames"] and heartbeats == r["heartbeat_frames"],
+          f"candump logged every frame plinth-replay sent ({sensor_on_bus} + {heartbeats})")
+    check(s.summary is not None and
+          s.summary["frames"]["sensor_samples"] == r["acceleration_frames"],
+          f"the monitor received every SensorAcceleration frame plinth-replay sent (sensor_samples "
+          f"{s.summary and s.summary['frames']['sensor_samples']})")
+
+
+def samples_checks(check, s, config, expected_m_s2):
+    """candump's SensorAcceleration frames decode to the input, within the resolution."""
+    rate, speed = config["rate"], config["speed"]
+    worst = 0.0
+    problems = []
+    for k, (f, raw) in enumerate(s.sensor):
+        if k >= len(expected_m_s2):
+            problems.append(f"frame {k}: more frames than samples")
+            break
+        want_g = expected_m_s2[k] / G0
+        ax = raw["Ax"] * RESOLUTION_G
+        worst = max(worst, abs(ax - want_g))
+        if abs(ax - want_g) > RESOLUTION_G / 2 + 1e-9:
+            problems.append(f"frame {k}: ax {ax:.5f} g, expected {want_g:.5f} g")
+        if raw["Ay"] != 0 or raw["Az"] != 4000 or raw["Sequence"] != k % 256 or raw["Status"] != 0:
+            problems.append(f"frame {k}: ay {raw['Ay']}, az {raw['Az']} LSB, sequence "
+                            f"{raw['Sequence']}, status {raw['Status']}; expected 0, 4000, "
+                            f"{k % 256}, 0")
+    if len(s.sensor) != len(expected_m_s2):
+        problems.append(f"{len(s.sensor)} frames, {len(expected_m_s2)} samples")
+    check(not problems, f"candump's {len(s.sensor)} SensorAcceleration frames decode (per the DBC) "
+          f"to the record resampled at {rate:g} Hz: |ax - input| <= {worst * 1e3:.4f} mg (half "
+          f"the resolution: 0.125 mg), ay 0, az 1 g, sequence k mod 256, status 0"
+          + (f": {problems[:3]}" if problems else ""))
+    # Heartbeats: one per whole second of virtual time, uptime 0, 1, 2, ...
+    beats = [(i, s.dbc.decode(f.ident, f.data)[0]) for i, f in enumerate(s.frames)
+             if f.plinth() and f.ident == HEARTBEAT_ID]
+    check(all(raw is not None and raw["Uptime"] == n for n, (_, raw) in enumerate(beats)) and
+          len(beats) == math.floor((len(expected_m_s2) - 1) / rate) + 1,
+          f"{len(beats)} SensorHeartbeat frames decode, uptime 0, 1, 2, ... s")
+    # Send times on the bus (kernel receive times) against k / (rate * speed).
+    t0 = s.sensor[0][0].t_us
+    deviation = [(f.t_us - t0) - k * 1e6 / (rate * speed) for k, (f, _) in enumerate(s.sensor)]
+    return deviation
+
+
+def monitor_frames_checks(check, s, config):
+    """MonitorStatus and AlarmEvent frames on the bus: valid per the DBC, one per JSON line."""
+    status_frames = [(i, f) for i, f in enumerate(s.frames) if f.plinth() and f.ident in STATUS_IDS]
+    alarm_frames = [(i, f) for i, f in enumerate(s.frames) if f.plinth() and f.ident == ALARM_ID]
+    bad = [f"{f.ident:03X}#{f.data.hex()}: {s.decoded[i][1]}"
+           for i, f in status_frames + alarm_frames if s.decoded[i][0] is None]
+    check(not bad, f"{len(status_frames)} MonitorStatus and {len(alarm_frames)} AlarmEvent frames "
+          f"decode per the DBC (phase, corner, level, cause in their VAL_ tables, risk <= 1, "
+          f"reserved bits 0)" + (f": {bad[:3]}" if bad else ""))
+    if bad:
+        return
+    raw_status = [s.decoded[i][0] for i, _ in status_frames]
+    raw_alarm = [s.decoded[i][0] for i, _ in alarm_frames]
+    sequences_ok = all((b["Sequence"] - a["Sequence"]) % 256 == 1
+                       for a, b in zip(raw_status, raw_status[1:]))
+    mismatch = []
+    if len(raw_status) != len(s.status_lines):
+        mismatch.append(f"{len(raw_status)} frames, {len(s.status_lines)} status lines")
+    for n, (raw, line) in enumerate(zip(raw_status, s.status_lines)):
+        if (PHASES[raw["Phase"]] != line["phase"] or LEVELS[raw["AlarmLevel"]] != line["alarm"] or
+                ["none", "left", "right"][raw["Corner"]] != line["corner"] or
+                abs(raw["Risk"] * 1e-4 - line["risk"]) > 1.5e-4):
+            mismatch.append(f"status {n}: frame {raw}, line {line['phase']} {line['corner']} "
+                            f"{line['alarm']} {line['risk']}")
+    check(not mismatch and sequences_ok,
+          "each MonitorStatus frame matches its JSON status line (phase, corner, alarm level, "
+          "risk), sequence +1 per frame" + (f": {mismatch[:3]}" if mismatch else ""))
+    mismatch = []
+    if len(raw_alarm) != len(s.alarm_lines):
+        mismatch.append(f"{len(raw_alarm)} frames, {len(s.alarm_lines)} alarm lines")
+    for raw, line in zip(raw_alarm, s.alarm_lines):
+        if (LEVELS[raw["Level"]] != line["level"]
+                or LEVELS[raw["PreviousLevel"]] != line["previous"]
+                or CAUSES[raw["Cause"]] != line["cause"] or bool(raw["Latched"]) != line["latched"]
+                or raw["Sequence"] != line["sequence"]
+                or abs(raw["TimeSinceStart"] - line["t"] * 1000) > 1.0):
+            mismatch.append(f"frame {raw} vs line {line}")
+    check(not mismatch, "each AlarmEvent frame matches its JSON alarm line (level, previous, "
+          "cause, latched, sequence, time in ms): " +
+          ", ".join(f"{a['level']}/{a['cause']}@{a['t']:.3f}" for a in s.alarm_lines)
+          + (f": {mismatch[:3]}" if mismatch else ""))
+    return raw_status
+
+
+def monitor_events(lines, frames_sensor, start_index, rate):
+    """The monitor's phase events on the record's time axis: an event line's t is monitor time
+    (since the first sample's receive time) = the estimator's time + its start's receive time."""
+    start_s = (frames_sensor[start_index][0].t_us - frames_sensor[0][0].t_us) * 1e-6
+    return [dict(e, t=e["t"] - start_s + start_index / rate) for e in lines
+            if e.get("type", "event") == "event"]
+
+
+def run_tool(command):
+    """A tool's stdout; raises ValueError with its stderr when it fails."""
+    done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise ValueError(f"{Path(command[0]).name} exited with {done.returncode}: "
+                         f"{done.stderr.strip()}")
+    return done.stdout
+
+
+def run_sim(config, csv, out):
+    dt = 1.0 / (config["rate"] * config["steps"])
+    run_tool([config["sim"], "--scene", config["scene"], "--record", str(csv), "--dt", repr(dt),
+              "--events", str(out)])
+    return [e for e in read_jsonl(out) if e["event"] != "end"]
+
+
+def compare_events(check, name, ours, theirs, tolerance_s):
+    worst = 0.0
+    same = len(ours) == len(theirs)
+    for a, b in zip(ours, theirs):
+        if a["event"] != b["event"] or a.get("corner") != b.get("corner"):
+            same = False
+        worst = max(worst, abs(a["t"] - b["t"]))
+    timeline = ", ".join(f"{e['event']} {e.get('corner', '')} {e['t']:.4f} s" for e in ours)
+    check(same and worst <= tolerance_s,
+          f"{name}: same {len(ours)} events in the same order, |dt| <= {worst * 1e6:.1f} us "
+          f"(tolerance {tolerance_s * 1e6:.0f} us)" +
+          ("" if same else f": monitor [{timeline}] vs "
+           f"[{', '.join(e['event'] + ' ' + str(e['t']) for e in theirs)}]"))
+    return worst
+
+
+def check_main(check, work, s, config, figures):
+    expected = read_csv(work / "input.csv")
+    replay_checks(check, s, len(expected))
+    deviation = samples_checks(check, s, config, expected)
+    figures["bus_send_time_deviation_us"] = (min(deviation), max(deviation))
+    raw_status = monitor_frames_checks(check, s, config)
+    rate, start = config["rate"], config["estimator_start_index"]
+    step = 1.0 / (rate * config["steps"])
+    lead_s = config["lead_in_samples"] / rate
+    if len(s.sensor) <= start:
+        check(False, "the monitor's estimator never started")
+        return
+    live = monitor_events(s.event_lines, s.sensor, start, rate)
+    # plinth-sim on the very samples the monitor received (candump's frames, decoded): the
+    # same solver with the same input, so the same events at the same times but for rounding
+    # and the monitor's offset estimate (zero over the dithered lead-in) and its slow offset
+    # tracking while quiet (600 s time constant): 10 us.
+    quantised = [raw["Ax"] * RESOLUTION_G * G0 for _, raw in s.sensor]
+    write_csv(work / "bus-samples.csv", "bus", rate, quantised)
+    sim_bus = run_sim(config, work / "bus-samples.csv", work / "sim-bus.jsonl")
+    compare_events(check, "monitor on the bus vs plinth-sim on the bus's samples", live, sim_bus,
+                   10e-6)
+    # plinth-sim on the input itself (before the codec's 0.25 mg quantisation): one solver step.
+    sim = run_sim(config, work / "input.csv", work / "sim.jsonl")
+    worst = compare_events(check, f"monitor on the bus vs plinth-sim on the record "
+                           f"(--dt {step:g})", live, sim, step)
+    figures["timeline_vs_sim_us"] = worst * 1e6
+    figures["timeline"] = ", ".join(f"{e['event']} {e.get('corner', '')} at {e['t'] - lead_s:.4f} s"
+                                    for e in sim)
+    # plinth-monitor --replay of candump's log: the same frames at the same times.
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    replayed = run_tool(
+        [config["monitor"], "--scene", config["scene"], "--replay", str(work / "main.bus.log"),
+         "--rate", f"{rate:g}", "--startup-window", f"{config['startup_window_s']:g}",
+         "--status-interval", f"{config['status_interval_s']:g}"])
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    cpu_s = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    figures["host_cpu_us_per_frame"] = cpu_s * 1e6 / max(1, len(s.frames))
+    (work / "main.monitor-replay.jsonl").write_text(replayed)
+    lines = [json.loads(x) for x in replayed.splitlines() if x.strip()]
+    compare_events(check, "monitor on the bus vs plinth-monitor --replay main.bus.log",
+                   live, monitor_events(lines, s.sensor, start, rate), 2e-6)
+    phases = [PHASES[r["Phase"]] for r in raw_status or []]
+    check(phases and phases[-1] == "overturned" and "rocking" in phases,
+          "the MonitorStatus frames on the bus show the block rocking, then overturned")
+    check(s.summary["final_phase"] == "overturned" and s.summary["max_alarm"] == "alarm" and
+          s.summary["estimator_restarts"] == 1,
+          f"summary: final phase {s.summary['final_phase']}, max alarm {s.summary['max_alarm']}, "
+          f"estimator started {s.summary['estimator_restarts']} time(s)")
+    latency = s.latency_us()
+    figures["latency_us"] = latency
+    figures["jitter"] = s.report
+    figures["main_wall_s"] = s.report["wall_time_s"]
+    figures["main_attempts"] = s.extra.get("attempts", "?")
+    status_index = [i for i, f in enumerate(s.frames) if f.plinth() and f.ident in STATUS_IDS]
+    ages = [r["SampleAge"] for i, r in zip(status_index, raw_status or [])
+            if s.streaming(i) and s.frames[i].t_us > s.sensor[start][0].t_us]
+    figures["sample_age_ms_max"] = max(ages, default=None)
+
+
+def fault_delay(s):
+    """The first sensor_timeout fault line after the last sensor frame, and its delays after
+    that frame: in monitor time (JSON) and on the bus (its AlarmEvent frame), s."""
+    last = s.sensor[-1][0].t_us
+    line = next((a for a in s.alarm_lines
+                 if a["level"] == "fault" and a["cause"] == "sensor_timeout"
+                 and a["t"] * 1e6 + s.epoch_us > last - 1), None)
+    frame = next((f for i, f in enumerate(s.frames) if f.plinth() and f.ident == ALARM_ID
+                  and f.t_us > last and s.decoded[i][0] is not None
+                  and s.decoded[i][0]["Level"] == 4 and s.decoded[i][0]["Cause"] == 4), None)
+    json_delay = None if line is None else (line["t"] * 1e6 + s.epoch_us - last) * 1e-6
+    bus_delay = None if frame is None else (frame.t_us - last) * 1e-6
+    return line, json_delay, bus_delay
+
+
+def check_stop(check, s, config, figures):
+    rate = config["rate"]
+    killed_at = (len(s.sensor) - 1) / rate - config["lead_in_samples"] / rate
+    check(s.replay_rc == "137" and 0 < killed_at < config["record_end_s"] - 0.5,
+          f"plinth-replay killed (SIGKILL, exit {s.replay_rc}) mid-record, after the sample at "
+          f"{killed_at:.3f} s of the record")
+    timeout = config["timeout_s"]
+    line, json_delay, bus_delay = fault_delay(s)
+    figures["fault_delay_s"] = (json_delay, bus_delay)
+    # The health tracker declares the timeout at the first tick at least timeout_s after the
+    # last sample; plinth-monitor ticks after every receive() (10 ms poll): timeout + 10 ms,
+    # plus scheduling in the guest (bounded at 100 ms in all, so that a loaded host passes).
+    ok = line is not None and bus_delay is not None and \
+        timeout <= json_delay <= bus_delay <= timeout + 0.1 and line["previous"] != "fault"
+    check(ok, f"fault (sensor_timeout) raised {ms(json_delay)} after the last sensor frame "
+          f"(monitor time; from {line and line['previous']}), its AlarmEvent on the bus "
+          f"{ms(bus_delay)} after it (timeout {timeout * 1e3:.0f} ms, allowed up to "
+          f"{(timeout + 0.1) * 1e3:.0f} ms)")
+    check("no_normal_level" not in s.extra, "the monitor's level was back to normal (start-up "
+          "fault over) before the sensor was killed")
+    check(s.summary["sensor"]["timeouts"] == 1 and s.summary["alarm"] == "fault",
+          f"summary: sensor timeouts {s.summary['sensor']['timeouts']}, alarm {s.summary['alarm']}")
+
+
+def check_garbage(check, s, config, expected_samples):
+    replay_checks(check, s, expected_samples)
+    c = s.summary["frames"]
+    check(c["rejected"] > 0 and c["unknown_identifiers"] > 0,
+          f"garbage counted: rejected {c['rejected']} (last error: {c['last_error']}), unknown "
+          f"identifiers {c['unknown_identifiers']}, other nodes {c['other_nodes']}")
+    # A silence longer than the timeout after the estimator started may restart it (the generic
+    # check above counts the silences; two close ones make one restart); nothing else may.
+    start_us = s.sensor[config["estimator_start_index"]][0].t_us if len(s.sensor) > \
+        config["estimator_start_index"] else float("inf")
+    restarts = 1 + sum(1 for (a, _), (b, _) in zip(s.sensor, s.sensor[1:])
+                       if b.t_us - a.t_us > config["timeout_s"] * 1e6 and a.t_us >= start_us)
+    check(s.summary["sensor"]["rejected"] == 0 and s.summary["estimator_restarts"] <= restarts,
+          f"the sensor stream went on undisturbed by the garbage and by the monitor's "
+          f"{s.extra.get('stalled_s', '?')} s stall (SIGSTOP): sensor samples rejected "
+          f"{s.summary['sensor']['rejected']}, estimator started "
+          f"{s.summary['estimator_restarts']} time(s), at most {restarts} expected")
+
+
+def check_burst(check, s, config, expected_samples, figures):
+    replay_checks(check, s, expected_samples)
+    sent = int(s.extra.get("tx_after", 0)) - int(s.extra.get("tx_before", 0))
+    seconds = (int(s.extra.get("flood_stop_ns", 0)) - int(s.extra.get("flood_start_ns", 0))) * 1e-9
+    plinth = sum(1 for f in s.frames if f.plinth())
+    foreign = sent - plinth
+    rate = foreign / seconds if seconds > 0 else 0.0
+    figures["burst"] = (foreign, seconds, rate, s.report, s.latency_us())
+    check(foreign > 1000, f"{foreign} unrelated frames (id 0x2FF, random extended ids) "
+          f"in {seconds:.2f} s ({rate:.0f} frames/s) alongside {plinth} plinth frames")
+
+
+def describe(values, unit="us"):
+    if not values:
+        return "none"
+    return (f"median {statistics.median(values):.0f} {unit}, p99 {percentile(values, 0.99):.0f} "
+            f"{unit}, max {max(values):.0f} {unit} ({len(values)} frames)")
+
+
+def run_checks(args):
+    work = Path(args.work)
+    config = json.loads((work / "config.json").read_text())
+    dbc = Dbc(config["dbc"])
+    checks = Checks()
+    figures = {}
+    timing = read_keys(work / "guest.times")
+    runs = {}
+    for name in SCENARIOS:
+        try:
+            runs[name] = Scenario(work, name, dbc)
+        except (OSError, ValueError) as error:
+            print(f"[{name}]")
+            checks(False, f"the {name} run left no usable output: {error}")
+    short_samples = round((config["lead_in_samples"] / config["rate"] + config["short_record_s"])
+                          * config["rate"]) + 1
+    if "main" in runs and common_checks(checks, runs["main"], config):
+        try:
+            check_main(checks, work, runs["main"], config, figures)
+        except ValueError as error:  # plinth-sim or plinth-monitor --replay failed
+            checks(False, str(error))
+    if "stop" in runs and common_checks(checks, runs["stop"], config):
+        check_stop(checks, runs["stop"], config, figures)
+    if "garbage" in runs and common_checks(checks, runs["garbage"], config):
+        check_garbage(checks, runs["garbage"], config, short_samples)
+    if "burst" in runs and common_checks(checks, runs["burst"], config):
+        check_burst(checks, runs["burst"], config, short_samples, figures)
+
+    print("measured:")
+    if "latency_us" in figures:
+        print(f"  record: {figures['timeline']} (record time; plinth-sim on the same input)")
+        print(f"  sensor frame -> MonitorStatus frame latency on the bus: "
+              f"{describe(figures['latency_us'])}")
+        j = figures["jitter"]
+        print(f"  plinth-replay pacing jitter (send - deadline): median "
+              f"{j['jitter_median_us']:.0f} us, p99 {j['jitter_p99_us']:.0f} us, max "
+              f"{j['jitter_max_us']:.0f} us over {j['frames_sent']} frames at --speed "
+              f"{config['speed']:g} ({config['rate'] * config['speed']:g} frames/s)")
+        print(f"  the record run took {figures['main_wall_s']:.2f} s (run "
+              f"{figures['main_attempts']} of at most 3)")
+        lo, hi = figures["bus_send_time_deviation_us"]
+        print(f"  sensor frames on the bus vs k / (rate x speed): {lo:.0f} to {hi:.0f} us")
+        print(f"  monitor timeline vs plinth-sim: {figures['timeline_vs_sim_us']:.1f} us "
+              f"(solver step {1e6 / (config['rate'] * config['steps']):.0f} us)")
+        print(f"  newest-sample age in the MonitorStatus frames (estimating, sensor sending): at "
+              f"most {figures['sample_age_ms_max']} ms")
+    if "host_cpu_us_per_frame" in figures:
+        print(f"  plinth-monitor's own work: {figures['host_cpu_us_per_frame']:.1f} us of CPU per "
+              f"frame (plinth-monitor --replay main.bus.log on the host, start-up included); "
+              f"inside user-mode Linux add its system calls (poll, recvmsg, clock_gettime, "
+              f"sendmsg) at ~16 us each")
+    if "fault_delay_s" in figures:
+        json_delay, bus_delay = figures["fault_delay_s"]
+        print(f"  sensor stop -> fault: {ms(json_delay)} (monitor time), AlarmEvent on the bus "
+              f"after {ms(bus_delay)}")
+    if "burst" in figures:
+        foreign, seconds, rate, report, latency = figures["burst"]
+        print(f"  burst: {foreign} unrelated frames in {seconds:.2f} s ({rate:.0f} frames/s); "
+              f"latency {describe(latency)}; jitter median {report['jitter_median_us']:.0f} us, "
+              f"p99 {report['jitter_p99_us']:.0f} us, max {report['jitter_max_us']:.0f} us")
+    if timing:
+        print("  guest wall time: " + ", ".join(f"{k} {float(v):.2f} s" for k, v in timing.items()))
+    print(f"e2e-can: {checks.passed} checks passed, {checks.failed} failed")
+    return 1 if checks.failed else 0
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("prepare")
+    p.add_argument("--work", required=True)
+    p.add_argument("--record", required=True)
+    p.add_argument("--scene", required=True)
+    p.add_argument("--dbc", required=True)
+    p.add_argument("--monitor", required=True)
+    p.add_argument("--replay", required=True)
+    p.add_argument("--sim", required=True)
+    p.add_argument("--scale", type=float, default=20.0)
+    p.add_argument("--rate", type=float, default=200.0)
+    p.add_argument("--speed", type=float, default=2.0)
+    p.add_argument("--steps", type=int, default=4)
+    p.add_argument("--lead-in", type=float, default=1.25, help="s of quiet input before the record")
+    p.add_argument("--record-end", type=float, default=11.0, help="s of the record sent")
+    p.add_argument("--startup-window", type=float, default=1.0)
+    p.add_argument("--status-interval", type=float, default=0.02)
+    p.add_argument("--kill-after", type=float, default=0.1,
+                   help="s after the monitor's level is normal again: the stop case")
+    p.add_argument("--short", type=float, default=2.0, help="record s: the garbage and burst cases")
+    c = sub.add_parser("check")
+    c.add_argument("--work", required=True)
+    args = parser.parse_args()
+    return prepare(args) if args.command == "prepare" else run_checks(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

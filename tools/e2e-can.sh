@@ -1,0 +1,317 @@
+#!/usr/bin/env bash
+# End-to-end test on a real CAN bus: plinth-replay sends a bundled record as sensor frames on
+# vcan0 inside user-mode Linux (tools/uml-vcan.sh) while plinth-monitor listens and candump
+# (can-utils, an independent client) logs the bus; then tests/integration/e2e_can.py checks
+# what everyone saw and prints the figures. Four runs: the record (phase timeline against
+# plinth-sim), the sensor node killed mid-record (fault within the timeout), garbage on the
+# plinth identifiers (counted and rejected), a flood of unrelated traffic (no plinth frame
+# lost). See docs/can-e2e.md.
+#
+# Usage: tools/e2e-can.sh [--build DIR] [--work DIR] [--speed S] [--keep]
+#   --build DIR   the build tree with plinth-monitor, plinth-replay, plinth-sim (default
+#                 build/release; or give them as PLINTH_MONITOR, PLINTH_REPLAY, PLINTH_SIM)
+#   --work DIR    keep every file of the run there (bus logs, JSON lines, reports); default a
+#                 temporary folder, removed after a passing run
+#   --keep        keep the temporary folder of a passing run too
+#   --speed S     plinth-replay's speed factor, above 0 and at most 5 (default 2: 400 frames/s
+#                 at 200 Hz; faster, the input ends before the monitor's start-up fault is over)
+# Exit status: 0 all checks passed, 1 a check failed, 77 user-mode Linux cannot start here
+# (ctest's SKIP_RETURN_CODE), 2 usage.
+# shellcheck disable=SC2153,SC2317  # the guest's settings come from config.env; the scenario_*
+#                                   # functions are called through attempt()
+set -euo pipefail
+
+# --- Guest: inside user-mode Linux, vcan0 up, cwd = the work folder ---------------------------
+# Every process started in the guest costs tens of ms (exec through hostfs), so the waits below
+# use bash builtins only: EPOCHREALTIME for the time, read -t for sleeping, reading the new
+# lines of a log for watching the bus.
+if [ "${1:-}" = "--guest" ]; then
+  cd "$2"
+  # shellcheck disable=SC1091
+  . ./config.env
+  fail() { echo "e2e-can (guest): $*" >&2; exit 1; }
+  trap '[ $? -ne 77 ] || exit 1' EXIT  # never 77: uml-vcan's "cannot start", a skip
+  # A FIFO nobody writes to (in the guest's own tmpfs): read -t on it is a sleep.
+  nap_fifo=$(mktemp -u /dev/shm/e2e-can-nap.XXXXXX)
+  mkfifo "$nap_fifo"
+  exec {nap_fd}<>"$nap_fifo"
+  nap() { read -r -t "$1" -u "$nap_fd" || true; }  # sleep S, without a process
+  us() { now=${EPOCHREALTIME/./}; }                 # now: us since the epoch
+  # Waits until a line of FILE matches the glob PATTERN, at most POLLS x 10 ms.
+  wait_line() {  # FILE PATTERN POLLS
+    local fd line rest="" i
+    for ((i = 0; i < $3; i++)); do
+      [ -e "$1" ] && break  # a background job's redirection may not have run yet
+      nap 0.01
+    done
+    exec {fd}<"$1" || return 1
+    for ((; i < $3; i++)); do
+      while IFS= read -r -u "$fd" line; do
+        line=$rest$line
+        rest=""
+        # shellcheck disable=SC2053  # a glob on purpose
+        if [[ $line == $2 ]]; then exec {fd}<&-; return 0; fi
+      done
+      rest=$rest$line
+      nap 0.01
+    done
+    exec {fd}<&-
+    return 1
+  }
+  # candump logs the bus (through FILTER if given); it has bound its socket once a marker
+  # frame (0x37F: a plinth identifier no message uses) shows up in its log.
+  start_capture() {  # NAME [FILTER]
+    : >"$1.bus.log"  # now: a retried run's old log must not satisfy the waits below
+    candump -L -d "vcan0${2:+,$2}" >>"$1.bus.log" 2>"$1.candump.err" &
+    capture_pid=$!
+    local i
+    for ((i = 0; i < 100; i++)); do
+      cansend vcan0 37F#E2
+      wait_line "$1.bus.log" '* 37F#E2' 5 && return 0
+    done
+    fail "candump did not start: $(cat "$1.candump.err")"
+  }
+  stop_capture() { kill -INT "$capture_pid"; wait "$capture_pid" || true; }
+  # plinth-monitor listens once its start-up AlarmEvent (fault: no data yet) is on the bus.
+  start_monitor() {  # NAME
+    "$MONITOR" --scene "$SCENE" --can vcan0 --rate "$RATE" --steps "$STEPS" \
+      --startup-window "$STARTUP_WINDOW" --status-interval "$STATUS_INTERVAL" \
+      >"$1.monitor.jsonl" 2>"$1.monitor.err" &
+    monitor_pid=$!
+    wait_line "$1.bus.log" '* 330#*' 1000 ||
+      fail "plinth-monitor did not start: $(cat "$1.monitor.err")"
+  }
+  stop_monitor() {  # NAME SIGNAL
+    echo "stop_signal=SIG$2" >>"$1.extra"
+    kill "-$2" "$monitor_pid" 2>/dev/null || true  # not if it crashed: wait says how
+    local rc=0
+    wait "$monitor_pid" || rc=$?
+    echo "$rc" >"$1.monitor.rc"
+  }
+  replay() {  # NAME [ARG...]
+    local name=$1 rc=0
+    shift
+    "$REPLAY" --record input.csv --can vcan0 --rate "$RATE" --speed "$SPEED" --report-json "$@" \
+      >"$name.replay.json" 2>"$name.replay.err" || rc=$?
+    echo "$rc" >"$name.replay.rc"
+  }
+  lap() {  # NAME START_US
+    us
+    printf '%s=%d.%06d\n' "$1" $(((now - $2) / 1000000)) $(((now - $2) % 1000000)) >>guest.times
+  }
+  : >guest.times
+  us
+  run_started=$now
+
+  # Runs scenario_NAME until USABLE NAME [ARG] says the run is usable, 3 times at most: a
+  # guest starved by a loaded host (seen: plinth-replay 0.5 s late) makes silences that are the
+  # rig's, not the monitor's. The last run's files stay.
+  attempt() {  # NAME USABLE [ARG]
+    local n
+    for n in 1 2 3; do
+      us; t=$now
+      : >"$1.extra"
+      "scenario_$1"
+      lap "$1$n" "$t"
+      echo "attempts=$n" >>"$1.extra"
+      "$2" "$1" "${3:-}" && return 0
+    done
+    return 0  # the checks say what went wrong
+  }
+  # plinth-replay was at most MAX_US late (from its report).
+  replay_on_time() {  # NAME MAX_US
+    local report="" late=999999999
+    read -r report <"$1.replay.json" || true
+    [[ $report =~ \"jitter_max_us\":\ ([0-9]+) ]] && late=${BASH_REMATCH[1]}
+    ((late < $2)) && return 0
+    echo "e2e-can (guest): $1, run $n: plinth-replay was up to $late us late" >&2
+    return 1
+  }
+  # The monitor's estimator ran from start to end, or plinth-replay kept its deadlines so well
+  # (45 ms) that no silence of the sensor can explain a restart: then the checks judge it.
+  estimated_throughout() {  # NAME
+    local line last=""
+    while IFS= read -r line; do last=$line; done <"$1.monitor.jsonl"
+    [[ $last =~ \"estimator_restarts\":\ 1, ]] && return 0
+    echo "e2e-can (guest): $1, run $n: the estimator restarted" >&2
+    replay_on_time "$1" 45000
+  }
+
+  # 1. The record, clean bus: the monitor's timeline, every frame, latency, jitter. The sensor
+  #    stops at the end of the input: the monitor times out (fault) before it is stopped. The
+  #    timeline can only match plinth-sim's if no silence exceeded the monitor's 50 ms sensor
+  #    timeout (that restarts the estimator, as it must).
+  scenario_main() {
+    start_capture main
+    start_monitor main
+    replay main
+    nap 0.2
+    stop_monitor main INT
+    stop_capture
+  }
+  attempt main estimated_throughout
+
+  # 2. The sensor node dies mid-record (SIGKILL: no goodbye), once the monitor's level is back
+  #    to normal after its start-up (the fault of "no data yet" is held 2 s): the fault must
+  #    come within the sensor timeout.
+  us; t=$now
+  : >stop.extra
+  start_capture stop
+  start_monitor stop
+  "$REPLAY" --record input.csv --can vcan0 --rate "$RATE" --speed "$SPEED" --report-json \
+    >stop.replay.json 2>stop.replay.err &
+  replay_pid=$!
+  wait_line stop.bus.log '* 330#40*' "$STOP_WAIT_POLLS" || echo "no_normal_level=1" >>stop.extra
+  nap "$KILL_AFTER_NORMAL"
+  kill -KILL "$replay_pid" 2>/dev/null || true
+  rc=0
+  wait "$replay_pid" 2>/dev/null || rc=$?
+  echo "$rc" >stop.replay.rc
+  nap 0.3
+  stop_monitor stop TERM
+  stop_capture
+  lap stop "$t"
+
+  # 3. The monitor stalls (SIGSTOP for 150 ms: the frames wait in its socket) while the sensor
+  #    sends, then garbage on the plinth identifiers (garbage.in.log, sent by canplayer: wrong
+  #    lengths, reserved bits, values outside the DBC's ranges, unknown plinth identifiers, and
+  #    RTR and extended frames the kernel filter keeps from the monitor), and random data from
+  #    cangen. Run again only if plinth-replay was so late (300 ms) that its backlog could
+  #    overflow the monitor's socket (278 frames with the kernel's default buffer).
+  scenario_garbage() {
+    start_capture garbage
+    start_monitor garbage
+    replay garbage --t-end "$SHORT_T_END" &
+    replay_pid=$!
+    nap "$GARBAGE_AFTER"
+    kill -STOP "$monitor_pid" 2>/dev/null || true
+    nap 0.15
+    kill -CONT "$monitor_pid" 2>/dev/null || true
+    echo "stalled_s=0.15" >>garbage.extra
+    canplayer -t -g 1 -I garbage.in.log &
+    player=$!
+    cangen vcan0 -I 301 -L 3 -D r -g 1 -n 30 &  # random 3-byte frames on the sensor's id
+    gen1=$!
+    cangen vcan0 -I 311 -L r -D r -g 1 -n 30 &  # random length and data, heartbeat id
+    gen2=$!
+    cangen vcan0 -I 30F -L r -D r -g 1 -n 30 &  # another node: counted, not used
+    gen3=$!
+    wait "$player" "$gen1" "$gen2" "$gen3" || true
+    wait "$replay_pid" || true
+    nap 0.2
+    stop_monitor garbage INT
+    stop_capture
+  }
+  attempt garbage replay_on_time 300000
+
+  # 4. A flood of unrelated traffic (ids outside 0x300-0x37F, as fast as the guest sends) for
+  #    the whole replay: no plinth frame may be lost. candump logs the plinth frames only (it
+  #    could not keep up with the flood, and must not drop what is checked).
+  scenario_burst() {
+    start_capture burst 300:C0000780
+    start_monitor burst
+    local stats=/sys/class/net/vcan0/statistics/tx_packets count
+    read -r count <"$stats"
+    us
+    printf 'tx_before=%s\nflood_start_ns=%s000\n' "$count" "$now" >>burst.extra
+    cangen vcan0 -g 0 -i -I 2FF -L 8 -D r &
+    flood1=$!
+    cangen vcan0 -g 0 -i -e -L r -D r &
+    flood2=$!
+    nap 0.1
+    replay burst --t-end "$SHORT_T_END"
+    kill -INT "$flood1" "$flood2" 2>/dev/null || true
+    wait "$flood1" "$flood2" || true
+    read -r count <"$stats"
+    us
+    printf 'tx_after=%s\nflood_stop_ns=%s000\n' "$count" "$now" >>burst.extra
+    nap 0.2
+    stop_monitor burst TERM
+    stop_capture
+  }
+  attempt burst replay_on_time 300000
+  lap guest "$run_started"
+  exit 0
+fi
+
+# --- Host ---------------------------------------------------------------------------------------
+me=e2e-can
+if [ "${PLINTH_ASAN:-0}" = 1 ]; then  # ctest's entry in a PLINTH_SANITIZE build
+  # ASan needs its shadow memory where user-mode Linux maps the guest's programs (as
+  # socketcan_uml in tests/CMakeLists.txt).
+  echo "$me: skipped: ASan cannot run inside user-mode Linux" >&2
+  exit 77
+fi
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+build="$root/build/release"
+work=""
+speed=2
+keep=0
+usage() { sed -n '/^# Usage:/,/^# (ctest/p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --build) build=${2:?}; shift 2 ;;
+    --work) work=${2:?}; shift 2 ;;
+    --speed) speed=${2:?}; shift 2 ;;
+    --keep) keep=1; shift ;;
+    -h | --help) usage ;;
+    *) echo "$me: unknown argument $1" >&2; usage ;;
+  esac
+done
+awk -v s="$speed" 'BEGIN { exit !(s + 0 > 0 && s + 0 <= 5) }' ||
+  { echo "$me: --speed must be above 0 and at most 5, got '$speed'" >&2; exit 2; }
+monitor=${PLINTH_MONITOR:-$build/firmware/linux/plinth-monitor}
+replay=${PLINTH_REPLAY:-$build/hal/replay/plinth-replay}
+sim=${PLINTH_SIM:-$build/sim/plinth-sim}
+for tool in "$monitor" "$replay" "$sim"; do
+  [ -x "$tool" ] || { echo "$me: $tool not found: build it, or give --build DIR" >&2; exit 1; }
+done
+command -v python3 >/dev/null ||
+  { echo "$me: python3 not found (tools/install-deps.sh)" >&2; exit 1; }
+for tool in candump cansend cangen canplayer; do  # the guest runs the host's programs
+  command -v "$tool" >/dev/null ||
+    { echo "$me: $tool not found: install can-utils (tools/install-deps.sh)" >&2; exit 1; }
+done
+if [ -z "$work" ]; then
+  work=$(mktemp -d /tmp/plinth-e2e-can.XXXXXX)  # /tmp: the guest sees it through hostfs
+else
+  mkdir -p "$work"
+  work=$(cd "$work" && pwd)
+  rm -f "$work"/*.log "$work"/*.jsonl "$work"/*.json "$work"/*.rc "$work"/*.err "$work"/*.extra \
+    "$work"/*.csv "$work"/guest.times "$work"/config.env
+  keep=1
+fi
+case "$work" in
+  /dev/shm/*) echo "$me: the guest cannot see /dev/shm: use another --work" >&2; exit 2 ;;
+esac
+
+python3 "$root/tests/integration/e2e_can.py" prepare --work "$work" \
+  --record "$root/sim/data/records/irpinia1980_brienza_000.AT2" --scale 20 \
+  --scene "$root/sim/scenes/paper-isolated.toml" --dbc "$root/hal/can_codec/plinth.dbc" \
+  --monitor "$(realpath "$monitor")" --replay "$(realpath "$replay")" --sim "$(realpath "$sim")" \
+  --speed "$speed"
+
+started=$(date +%s%N)
+status=0
+bash "$root/tools/uml-vcan.sh" --timeout 80 -- bash "$root/tools/e2e-can.sh" --guest "$work" ||
+  status=$?
+if [ "$status" -eq 77 ]; then
+  echo "$me: SKIPPED: user-mode Linux cannot start here (above: why); the end-to-end test needs" \
+    "the packages user-mode-linux, can-utils, kmod, iproute2 (tools/install-deps.sh)" >&2
+  [ "$keep" -eq 1 ] || rm -rf "$work"
+  exit 77
+fi
+if [ "$status" -ne 0 ]; then
+  echo "$me: the runs on the bus failed (status $status); files in $work" >&2
+  exit 1
+fi
+echo "$me: bus runs in user-mode Linux took $(awk -v s="$started" -v e="$(date +%s%N)" \
+  'BEGIN { printf "%.1f", (e - s) / 1e9 }') s (boot included)"
+status=0
+python3 "$root/tests/integration/e2e_can.py" check --work "$work" || status=$?
+if [ "$status" -ne 0 ]; then
+  echo "$me: FAILED; the run's files are in $work" >&2
+  exit 1
+fi
+[ "$keep" -eq 1 ] || rm -rf "$work"
+exit 0
