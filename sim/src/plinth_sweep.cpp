@@ -52,6 +52,7 @@ struct Options {
   std::string out_path;
   std::string plot_path;
   bool fresh = false;
+  bool compare_ground = false;
 };
 
 struct MergeOptions {
@@ -147,7 +148,8 @@ int run_sweep_mode(const Options& opt) {
     settings.impulse_max = opt.impulse_max;
     settings.tolerance = opt.impulse_tol;
     settings.dt = opt.dt;
-    plan = plinth::host::plan_impulse_curve(scene.params, *parameter, *axis, settings);
+    plan = plinth::host::plan_impulse_curve(scene.params, *parameter, *axis, settings,
+                                            opt.compare_ground);
   } else {
     require_text(opt.record_path, "--record", mode);
     const plinth::host::Record record = plinth::host::read_record(opt.record_path, g);
@@ -157,14 +159,15 @@ int run_sweep_mode(const Options& opt) {
     settings.dt = opt.dt;
     plinth::host::validate(settings);
     if (opt.param2.empty()) {
-      plan = plinth::host::plan_thresholds(scene.params, record, *parameter, *axis, settings);
+      plan = plinth::host::plan_thresholds(scene.params, record, *parameter, *axis, settings,
+                                           opt.compare_ground);
     } else {
       const auto parameter2 = plinth::host::parse_sweep_parameter(opt.param2, "--param2");
       const auto axis2 =
           axis_of(opt.param2, opt.from2, opt.to2, opt.steps2, "", "2", "with --param2");
       plan = plinth::host::plan_threshold_map(scene.params, record, *parameter, *axis, parameter2,
                                               axis2, plinth::host::parse_sweep_event(opt.event),
-                                              settings);
+                                              settings, opt.compare_ground);
     }
   }
 
@@ -271,6 +274,9 @@ int main(int argc, char** argv) {
   app.add_option("--out", opt.out_path, "CSV file (rows already there are resumed)");
   app.add_option("--plot", opt.plot_path, "also plot: map.png writes map.png and map.svg");
   app.add_flag("--fresh", opt.fresh, "do not resume from rows already in --out");
+  app.add_flag("--compare-ground", opt.compare_ground,
+               "also the thresholds of the same block on the ground (no base, no stops), in "
+               "columns <event>_ground");
   for (const char* option : {"--record", "--param2", "--pga-max", "--tol"}) {
     impulse_map->excludes(option);
     impulse_curve->excludes(option);
@@ -293,6 +299,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     // --help and --version end here with 0; every usage error exits with 2.
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (opt.compare_ground && opt.impulse_map) {
+    std::fprintf(stderr,
+                 "plinth-sweep: --compare-ground: not with --impulse-map (its closed forms are "
+                 "for the isolated block; on the ground every impulse starts rocking); use it "
+                 "with --param, --param2 or --impulse-curve\n");
+    return 2;
   }
   if (opt.jobs && *opt.jobs < 1) {
     std::fprintf(stderr, "plinth-sweep: --jobs: must be at least 1, got %d\n", *opt.jobs);

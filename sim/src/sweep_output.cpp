@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "plinth/host/input_error.h"
@@ -98,10 +99,13 @@ std::vector<std::string> resumable_rows(const std::string& path,
     return none;
   }
   if (table.settings != plan.settings || table.header != plan.header) {
+    std::string difference =
+        plinth::host::settings_difference(table.settings, "the file", plan.settings, "this run");
+    if (difference.empty()) difference = "other columns";
     std::fprintf(stderr,
-                 "plinth-sweep: note: %s comes from another sweep (other settings); it will be "
-                 "replaced, not resumed\n",
-                 path.c_str());
+                 "plinth-sweep: note: %s comes from another sweep (%s); it will be replaced, not "
+                 "resumed\n",
+                 path.c_str(), difference.c_str());
     return none;
   }
   std::vector<std::string> placed =

@@ -15,6 +15,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "plinth/host/input_error.h"
@@ -58,15 +59,6 @@ std::string quoted(const std::string& text) {
 
 std::string number(double value) { return plinth::host::format_value(value); }
 
-std::vector<std::string> fields_of(const std::string& row) {
-  std::vector<std::string> fields;
-  std::string field;
-  std::istringstream in(row);
-  while (std::getline(in, field, ',')) fields.push_back(field);
-  if (!row.empty() && row.back() == ',') fields.emplace_back();
-  return fields;
-}
-
 Field parse_field(const std::string& text) {
   if (text.empty()) return std::nullopt;
   char* end = nullptr;
@@ -105,8 +97,8 @@ struct Columns {
 
 Columns columns_of(const SweepTable& table) {
   Columns c;
-  c.names = fields_of(table.header);
-  for (const std::string& row : table.rows) c.text.push_back(fields_of(row));
+  c.names = plinth::host::csv_fields(table.header);
+  for (const std::string& row : table.rows) c.text.push_back(plinth::host::csv_fields(row));
   return c;
 }
 
@@ -132,33 +124,112 @@ class Script {
     head_ << '$' << name << " << EOD\n" << lines << "EOD\n";
   }
   void line(const std::string& text) { body_ << text << '\n'; }
+  // Panels side by side (set multiplot ... unset multiplot in the body): drawn once per
+  // terminal, as replot would redraw the last panel only.
+  void multiplot(const std::string& size) {
+    multiplot_ = true;
+    size_ = size;
+  }
 
   [[nodiscard]] std::string text(const std::string& stem, const std::string& source) const {
     std::ostringstream out;
     out << "# Drawn by plinth-sweep from " << source << " (docs/sweep.md); run: gnuplot "
         << std::filesystem::path(stem).filename().string() << ".gp\n"
         << "set encoding utf8\n"
-        << head_.str() << "set terminal pngcairo size 960,640 enhanced font 'sans,11'\n"
+        << head_.str() << "set terminal pngcairo size " << size_ << " enhanced font 'sans,11'\n"
         << "set output " << quoted(stem + ".png") << '\n'
-        << body_.str() << "set terminal svg size 960,640 dynamic enhanced font 'sans,11'\n"
+        << body_.str() << "set terminal svg size " << size_ << " dynamic enhanced font 'sans,11'\n"
         << "set output " << quoted(stem + ".svg") << '\n'
-        << "replot\nunset output\n";
+        << (multiplot_ ? body_.str() : std::string("replot\n")) << "unset output\n";
     return out.str();
   }
 
  private:
   std::ostringstream head_;
   std::ostringstream body_;
+  bool multiplot_ = false;
+  std::string size_ = "960,640";
 };
 
 // A line style per curve: dash type, point type, colour (the paper's maps tell events apart
 // by line style; colour helps on screen).
 constexpr std::array<const char*, 8> kColours = {"#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd",
                                                  "#8c564b", "#e377c2", "#17becf", "#d62728"};
-std::string style(std::size_t k, std::size_t rows) {
+// `thin`: the same style with thin lines and small points, for the block on the ground (the
+// paper draws the non-isolated system's curves thin).
+std::string style(std::size_t k, std::size_t rows, bool thin = false) {
   const std::size_t every = std::max<std::size_t>(1, rows / 15);  // points that leave dashes seen
   return "dt " + std::to_string(k % 5 + 1) + " pt " + std::to_string(k + 4) + " pi " +
-         std::to_string(every) + " ps 1 lw 2 lc rgb '" + kColours[k % kColours.size()] + "'";
+         std::to_string(every) + (thin ? " ps 0.6 lw 1" : " ps 1 lw 2") + " lc rgb '" +
+         kColours[k % kColours.size()] + "'";
+}
+
+// The column of the block on the ground matching `name` ("rocking" -> "rocking_ground").
+std::string ground_column(const std::string& name) {
+  return name + plinth::host::kGroundSuffix;
+}
+
+bool has_column(const Columns& c, const std::string& name) {
+  return std::find(c.names.begin(), c.names.end(), name) != c.names.end();
+}
+
+// Whether the block on the ground lacks the swept parameter (T, xi, u_max, mass_ratio): its
+// thresholds are then the same for every value and drawn as points on the y axis.
+bool ground_lacks(const std::string& parameter) {
+  try {
+    return plinth::host::parameter_needs_base(plinth::host::parse_sweep_parameter(parameter));
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
+// The x range of the first column, widened a little each side; the left end is where points
+// on the axis go.
+std::pair<double, double> x_range(const Columns& c) {
+  double lo = INFINITY;
+  double hi = -INFINITY;
+  for (std::size_t r = 0; r < c.text.size(); ++r) {
+    if (const Field x = c.at(r, 0)) {
+      lo = std::min(lo, *x);
+      hi = std::max(hi, *x);
+    }
+  }
+  if (!(lo <= hi)) return {0.0, 1.0};
+  const double pad = hi > lo ? 0.04 * (hi - lo) : 0.1 * std::max(std::fabs(lo), 1.0);
+  return {lo - pad, hi + pad};
+}
+
+// A curve of the block on the ground: column "<name>_ground", drawn `thin` ("with lines ...")
+// against a parameter the ground has, else as points on the y axis (`axis`: "pt 5 ps 2 ...").
+struct GroundCurve {
+  std::string name;
+  std::string title;
+  std::string thin;
+  std::string axis;
+};
+
+// Adds the ground curves that have data to `plot` (after the scene's own), against a
+// parameter the ground lacks at x = x_left. Returns whether any was drawn on the axis.
+bool ground_curves(Script& s, const Columns& c, const std::vector<GroundCurve>& curves,
+                   double x_left, std::string& plot) {
+  const bool on_axis = ground_lacks(c.names[0]);
+  bool drawn = false;
+  for (const GroundCurve& curve : curves) {
+    const std::string column = ground_column(curve.name);
+    if (!has_column(c, column)) continue;
+    auto points = c.curve(c.index(column));
+    if (points.empty()) continue;  // never up to the scan's maximum
+    if (on_axis) {
+      for (auto& point : points) point.first = x_left;
+    }
+    s.block(column, points);
+    plot += ", \\\n     $" + column + " using 1:2 " +
+            (on_axis ? "with points " + curve.axis + " title " +
+                           quoted(curve.title + ", on the ground (no base: on the axis)")
+                     : curve.thin + " title " + quoted(curve.title + ", on the ground"));
+    drawn = drawn || on_axis;
+  }
+  return drawn;
 }
 
 void common_setup(Script& s, const std::string& title) {
@@ -202,23 +273,40 @@ void thresholds_plot(Script& s, const Columns& c,
     curves.push_back("$" + name + " using 1:2 with linespoints " + style(e, c.text.size()) +
                      " title " + quoted(title_of(name)));
   }
-  s.line("set xlabel " + quoted(axis_label(c.names[0])));
-  s.line("set ylabel 'first-occurrence PGA (g)'");
-  s.line("set yrange [0:" + number(pga_max) + "]");
-  s.line("set offsets graph 0.02, graph 0.02, 0, 0");
   std::string plot = "plot $collapse using 1:2:(" + number(pga_max) +
                      ") with filledcurves fc rgb '#d62728' fs transparent solid 0.12 noborder "
                      "title 'collapse: above the lowest of fell, overturned'";
   for (const std::string& curve : curves) plot += ", \\\n     " + curve;
   if (curves.empty()) plot += ", 1/0 notitle";
+  // With --compare-ground: the block on the ground, thin (or on the axis).
+  std::vector<GroundCurve> ground;
+  for (std::size_t e = 0; e < plinth::host::kSweepEventCount; ++e) {
+    const std::string name =
+        plinth::host::sweep_event_name(static_cast<plinth::host::SweepEvent>(e));
+    ground.push_back({name, title_of(name), "with linespoints " + style(e, c.text.size(), true),
+                      "pt " + std::to_string(e + 4) + " ps 2 lw 2 lc rgb '" +
+                          kColours[e % kColours.size()] + "'"});
+  }
+  const auto [x_lo, x_hi] = x_range(c);
+  const bool on_axis = ground_curves(s, c, ground, x_lo, plot);
+  s.line("set xlabel " + quoted(axis_label(c.names[0])));
+  s.line("set ylabel 'first-occurrence PGA (g)'");
+  s.line("set yrange [0:" + number(pga_max) + "]");
+  s.line("set offsets graph 0.02, graph 0.02, 0, 0");
+  if (on_axis) {
+    s.line("set xrange [" + number(x_lo) + ":" + number(x_hi) + "]");
+    s.line("unset clip points");
+  }
   s.line(plot);
 }
 
-// Two parameters: a heat map of one event's first-occurrence PGA.
+// Two parameters: a heat map of one event's first-occurrence PGA; with --compare-ground, the
+// block on the ground in a second panel beside it, on the same colour scale.
 void threshold_map_plot(Script& s, const Columns& c,
                         const std::map<std::string, std::string>& settings,
-                        const std::vector<plinth::host::GridAxis>& grid) {
+                        const std::vector<plinth::host::GridAxis>& grid, const std::string& title) {
   const double pga_max = setting_number(settings, "pga_max_g", 2.0);
+  const bool ground = c.names.size() > 3 && c.names[3] == ground_column(c.names[2]);
   std::string cells;
   std::string previous;
   for (std::size_t r = 0; r < c.text.size(); ++r) {
@@ -227,8 +315,12 @@ void threshold_map_plot(Script& s, const Columns& c,
     if (!x || !y) continue;
     if (!previous.empty() && c.text[r][0] != previous) cells += '\n';  // a new scan line
     previous = c.text[r][0];
-    const Field z = c.at(r, 2);
-    cells += number(*x) + ' ' + number(*y) + ' ' + (z ? number(*z) : std::string("NaN")) + '\n';
+    cells += number(*x) + ' ' + number(*y);
+    for (std::size_t column = 2; column < (ground ? 4U : 3U); ++column) {
+      const Field z = c.at(r, column);
+      cells += ' ' + (z ? number(*z) : std::string("NaN"));
+    }
+    cells += '\n';
   }
   s.raw_block("cells", cells);
   s.line("set xlabel " + quoted(axis_label(c.names[0])));
@@ -244,10 +336,28 @@ void threshold_map_plot(Script& s, const Columns& c,
   s.line("unset grid");
   s.line("set autoscale fix");
   const bool image = grid.size() == 2 && grid[0].steps >= 2 && grid[1].steps >= 2;
-  s.line(std::string("plot $cells using 1:2:3 ") +
-         (image ? "with image notitle" : "with points pt 5 ps 4 palette notitle") +
-         ", 1/0 with boxes fs solid 1.0 border lc rgb '#999999' fc rgb '#e8e8e8' title " +
-         quoted("grey: none up to " + number(pga_max) + " g"));
+  const std::string style = image ? "with image" : "with points pt 5 ps 4 palette";
+  const std::string none = ", 1/0 with boxes fs solid 1.0 border lc rgb '#999999' fc rgb "
+                           "'#e8e8e8' title " +
+                           quoted("grey: none up to " + number(pga_max) + " g");
+  if (!ground) {
+    s.line("plot $cells using 1:2:3 " + style + " notitle" + none);
+    return;
+  }
+  s.multiplot("1280,560");
+  // Fixed margins: both panels the same size, the key and the colour box in the margins.
+  s.line("set multiplot layout 1,2 margins 0.06,0.88,0.17,0.88 spacing 0.08 title " +
+         quoted(title));
+  s.line("set key at screen 0.5,0.02 center bottom");
+  s.line("set title 'isolated'");
+  s.line("unset colorbox");  // the same scale as the panel on the right's
+  s.line("plot $cells using 1:2:3 " + style + " notitle");
+  s.line("set colorbox");
+  s.line("set title " + quoted(ground_lacks(c.names[0]) || ground_lacks(c.names[1])
+                                   ? "on the ground (no base: the same along a base parameter)"
+                                   : "on the ground (no base)"));
+  s.line("plot $cells using 1:2:4 " + style + " notitle" + none);
+  s.line("unset multiplot");
 }
 
 // The (|I|, mu_s) plane: simulated starts as points, the closed-form curves over them.
@@ -344,10 +454,22 @@ void impulse_curve_plot(Script& s, const Columns& c) {
     first = false;
   }
   if (first) plot += "1/0 notitle";
+  // With --compare-ground: the block on the ground, thin (or on the axis).
+  const std::vector<GroundCurve> ground = {
+      {"overturned", "overturned (simulated)",
+       "with linespoints dt 1 pt 5 ps 0.5 lw 1 lc rgb '#d62728'", "pt 5 ps 2 lc rgb '#d62728'"},
+      {"overturned_closed_form", "overturned, closed form (energy)",
+       "with lines dt 4 lw 1 lc rgb '#555555'", "pt 6 ps 2 lw 2 lc rgb '#555555'"}};
+  const auto [x_lo, x_hi] = x_range(c);
+  const bool on_axis = ground_curves(s, c, ground, x_lo, plot);
   s.line("set xlabel " + quoted(axis_label(c.names[0])));
   s.line("set ylabel 'smallest impulse |I| (m/s)'");
   s.line("set yrange [0:*]");
   s.line("set offsets graph 0.02, graph 0.02, 0, 0");
+  if (on_axis) {
+    s.line("set xrange [" + number(x_lo) + ":" + number(x_hi) + "]");
+    s.line("unset clip points");
+  }
   s.line(plot);
 }
 
@@ -388,9 +510,10 @@ std::string gnuplot_script(const SweepTable& table, const std::string& stem) {
     common_setup(s, "First occurrence of each event against " + axis_label(c.names[0]));
     thresholds_plot(s, c, settings);
   } else if (mode == "threshold_map") {
-    common_setup(s, "First occurrence of " + title_of(c.names[2]) + " against " +
-                        axis_label(c.names[0]) + " and " + axis_label(c.names[1]));
-    threshold_map_plot(s, c, settings, grid);
+    const std::string title = "First occurrence of " + title_of(c.names[2]) + " against " +
+                              axis_label(c.names[0]) + " and " + axis_label(c.names[1]);
+    common_setup(s, title);
+    threshold_map_plot(s, c, settings, grid, title);
   } else if (mode == "impulse_map") {
     common_setup(s, "Motion an impulse starts with (section 5.3.1): simulation and closed forms");
     impulse_map_plot(s, c);

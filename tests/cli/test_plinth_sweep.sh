@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # plinth-sweep run as a user would (docs/sweep.md): shards merged equal the whole run byte for
-# byte, an interrupted run keeps its rows and a rerun resumes to the same file, plots are
-# written (or a missing gnuplot is named), and bad inputs end with exit code 1 or 2 and a
-# message naming the problem. Prints "ok - <name>" or "not ok - <name>: <why>" per check,
+# byte, an interrupted run keeps its rows and a rerun resumes to the same file, the ground's
+# columns of --compare-ground are a run of the block on the ground, plots are written (or a
+# missing gnuplot is named), and bad inputs end with exit code 1 or 2 and a message naming
+# the problem. Prints "ok - <name>" or "not ok - <name>: <why>" per check,
 # then "N passed, M failed".
 #
 # Environment: PLINTH_SWEEP, the plinth-sweep binary; PLINTH_SOURCE_DIR, the repository root.
@@ -130,13 +131,88 @@ sweep --scene "$ISOLATED" --impulse-curve --param T --from 1.5 --to 2.5 --steps 
   --impulse-max 5 --impulse-tol 0.01 --out icurve.csv
 check "an impulse curve has a row per value" test "$RC" -eq 0 -a "$(tail -n +3 icurve.csv | wc -l)" -eq 2
 
+# The isolated and the non-isolated system side by side (--compare-ground).
+# simulations N: the simulations the last run's summary reports.
+simulations() { grep -o '[0-9]* simulations' "$TMP/out.txt" | cut -d' ' -f1; }
+sweep "${SMALL[@]}" --jobs 2 --compare-ground --out cmp.csv
+check "--compare-ground writes its map" test "$RC" -eq 0 -a -s cmp.csv
+check "its settings line says compare=ground" \
+  grep -q '^# plinth-sweep thresholds grid=mu_s:0.2:0.5:4 scene=.* compare=ground$' cmp.csv
+check "its header adds the ground's events, suffixed _ground" grep -qx \
+  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned,sliding_ground,rocking_ground,slide_rocking_ground,overturned_ground' cmp.csv
+check "the scene's own columns are those of the run without it" \
+  cmp -s <(tail -n +3 cmp.csv | cut -d, -f1-9) <(tail -n +3 whole.csv)
+sweep --scene "$SCENES/non-isolated.toml" --record "$AT2" --param mu_s --from 0.2 --to 0.5 \
+  --steps 4 --pga-max 4g --tol 0.05g --dt 4e-3 --out ground.csv
+check "the ground columns are those of a run of non-isolated.toml" \
+  cmp -s <(tail -n +3 cmp.csv | cut -d, -f10-13) <(tail -n +3 ground.csv | cut -d, -f2-4,9)
+check "and the block on the ground rocks there" test -n "$(tail -n +3 ground.csv | cut -d, -f3 | tr -d '\n')"
+PERIOD=(--scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 3 --steps 3 --pga-max 4g
+        --tol 0.05g --dt 4e-3 --jobs 2)
+sweep "${PERIOD[@]}" --compare-ground --out cmpT.csv
+compared=$(simulations)
+sweep "${PERIOD[@]}" --out plainT.csv
+plain=$(simulations)
+sweep --scene "$SCENES/non-isolated.toml" --record "$AT2" --param epsilon --from 0 --to 0 \
+  --steps 1 --pga-max 4g --tol 0.05g --dt 4e-3 --out ground1.csv
+alone=$(simulations)
+check "against T (the ground has none) every row holds the one ground row" test \
+  "$(tail -n +3 cmpT.csv | cut -d, -f10,11 | sort -u)" = "$(tail -n +3 ground1.csv | cut -d, -f3,9)"
+check "its header has only rocking and overturned (no friction)" grep -q ',overturned,rocking_ground,overturned_ground$' cmpT.csv
+check "and the ground was searched once" test "$compared" -eq $((plain + alone))
+# Shards, merge and resume with the ground's columns (on the T sweep: cheap).
+sweep "${PERIOD[@]}" --compare-ground --shard 2/2 --out cmpT2.csv
+sweep "${PERIOD[@]}" --compare-ground --shard 1/2 --out cmpT1.csv
+sweep merge --out cmpTmerged.csv cmpT2.csv cmpT1.csv
+check "compared shards merged equal the whole run byte for byte" cmp -s cmpTmerged.csv cmpT.csv
+refuses "merge refuses shards with and without --compare-ground" \
+  "different sweeps .*compare: none in plainT.csv, ground in cmpT1.csv" merge --out m.csv cmpT1.csv plainT.csv
+cp cmpT.csv cmpTagain.csv
+sweep "${PERIOD[@]}" --compare-ground --out cmpTagain.csv
+check "a compared sweep is resumed" grep -q '3 resumed from cmpTagain.csv), 0 simulations' "$TMP/out.txt"
+check "and its file is unchanged" cmp -s cmpTagain.csv cmpT.csv
+head -n 3 cmpT.csv >cmpTkilled.csv.partial
+sweep "${PERIOD[@]}" --compare-ground --out cmpTkilled.csv
+check "rows of a killed compared run are resumed" grep -q "1 resumed from cmpTkilled.csv" "$TMP/out.txt"
+check "and the result is the same" cmp -s cmpTkilled.csv cmpT.csv
+cp plainT.csv plainfirst.csv
+sweep "${PERIOD[@]}" --compare-ground --out plainfirst.csv
+check "a map made without --compare-ground is replaced, saying why" \
+  grep -q "another sweep (compare: none in the file, ground in this run)" "$TMP/err.txt"
+check "by the compared map" cmp -s plainfirst.csv cmpT.csv
+sweep --scene "$ISOLATED" --record "$AT2" --param lambda --from 3 --to 4 --steps 2 \
+  --param2 epsilon --from2 -0.3 --to2 0.3 --steps2 2 --event rocking --pga-max 4g --tol 0.05g \
+  --dt 2e-3 --compare-ground --out cmpmap2.csv
+check "a compared two-parameter map adds <event>_ground" grep -qx 'lambda,epsilon,rocking,rocking_ground' cmpmap2.csv
+check "and keeps the map's own column" cmp -s <(tail -n +3 cmpmap2.csv | cut -d, -f1-3) <(tail -n +3 map2.csv)
+sweep --scene "$ISOLATED" --impulse-curve --param T --from 1.5 --to 2.5 --steps 2 \
+  --impulse-max 5 --impulse-tol 0.01 --compare-ground --out cmpicurve.csv
+check "a compared impulse curve adds the ground's overturning" grep -qx \
+  'T,rocking,overturned,rocking_closed_form,overturned_closed_form,overturned_ground,overturned_closed_form_ground' cmpicurve.csv
+check "and keeps the curve's own columns" cmp -s <(tail -n +3 cmpicurve.csv | cut -d, -f1-5) <(tail -n +3 icurve.csv)
+refuses "--compare-ground on a scene without a base" "--compare-ground: the scene has no \[base\]" \
+  --scene "$SCENES/non-isolated.toml" --record "$AT2" --param mu_s --from 0.2 --to 0.5 --steps 2 \
+  --compare-ground --out x.csv
+refuses "--compare-ground with an event the ground cannot have" \
+  "--compare-ground: the block on the ground cannot have base_stop_hit \(it has no base stops\)" \
+  --scene "$SCENES/paper-isolated-stops.toml" --record "$AT2" --param lambda --from 3 --to 4 \
+  --steps 2 --param2 epsilon --from2 0 --to2 0.2 --steps2 2 --event base_stop_hit --compare-ground --out x.csv
+refuses "--compare-ground with --impulse-map" "--compare-ground: not with --impulse-map" \
+  --scene "$ISOLATED" --impulse-map --mu-from 0.1 --mu-to 1 --mu-steps 2 --impulse-from 0.1 \
+  --impulse-to 1 --impulse-steps 2 --compare-ground --out x.csv
+
 # Plots: PNG and SVG of the same stem, or a clear error naming the package.
 if command -v gnuplot >/dev/null 2>&1; then
-  for csv in whole map2 imap icurve; do
+  for csv in whole map2 imap icurve cmp cmpT cmpmap2 cmpicurve; do
     sweep plot "$csv.csv" --out "plot-$csv.png"
     check "$csv: plot writes a PNG" test "$RC" -eq 0 -a "$(head -c 4 "plot-$csv.png" | tail -c 3)" = PNG
     check "$csv: and an SVG" grep -q '<svg' "plot-$csv.svg"
   done
+  check "cmp: the ground's curves are drawn thin" grep -q "rocking_ground using 1:2 with linespoints .* lw 1 .*on the ground'" plot-cmp.gp
+  check "cmpT: against T, on the axis" grep -q "rocking_ground using 1:2 with points .*no base: on the axis" plot-cmpT.gp
+  check "cmpmap2: the ground's map beside the scene's" grep -q "set multiplot layout 1,2" plot-cmpmap2.gp
+  check "cmpmap2: its SVG has both panels" grep -q "on the ground" plot-cmpmap2.svg
+  check "cmpicurve: the ground's overturning on the axis" grep -q "overturned_ground using 1:2 with points" plot-cmpicurve.gp
   bash "$SRC/tools/plot-sweep.sh" whole.csv wrapped.png >"$TMP/out.txt" 2>"$TMP/err.txt"
   RC=$?
   check "tools/plot-sweep.sh plots a CSV" test "$RC" -eq 0 -a -s wrapped.png -a -s wrapped.svg

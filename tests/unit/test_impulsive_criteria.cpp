@@ -10,6 +10,7 @@
 
 #include "plinth/core/closed_forms.h"
 #include "plinth/core/guards.h"
+#include "plinth/host/sweep_impulse.h"
 #include "test_support.h"
 
 namespace plinth {
@@ -145,78 +146,6 @@ TEST(ImpulsiveCriteria, PrintedEq41IsTheGeneralFormWithARodInertia) {
   }
 }
 
-// The motion an impulse starts with, from the simulation's events.
-enum class Start : unsigned char {
-  kFullContact,   // no event within one period
-  kSliding,       // sliding starts first
-  kRocking,       // rocking starts first and the first rocking phase ends without sliding
-  kSlideRocking,  // rocking first, then sliding within the first rocking phase
-};
-
-struct Outcome {
-  Start start = Start::kFullContact;
-  double slide_theta = 0.0;  // theta when sliding started in the first rocking phase, rad
-};
-
-Outcome simulate_start(const Scene& s, double impulse) {
-  RecordingSink sink;
-  Simulator sim = simulator_for(s, 1e-4, &sink);
-  sim.start_with_impulse(impulse);
-  const double period = s.params.base.period;
-  // Stops as soon as the classification is settled (the first rocking phase ended, or sliding
-  // started); otherwise runs for one period.
-  for (;;) {
-    bool rocking = false;
-    for (const Event& e : sink.events) {
-      if (!rocking && e.kind == EventKind::kSlidingStart) return {Start::kSliding};
-      if (!rocking && e.kind == EventKind::kRockingStart) {
-        rocking = true;
-      } else if (rocking && e.kind == EventKind::kSlidingStart) {
-        return {Start::kSlideRocking, e.state[kTheta]};
-      } else if (rocking && (e.kind == EventKind::kImpact || e.kind == EventKind::kRockingStop ||
-                             e.kind == EventKind::kOverturned)) {
-        return {Start::kRocking};
-      }
-    }
-    if (sim.time() >= period - 0.5e-4 || sim.mode().terminal()) {
-      return {rocking ? Start::kRocking : Start::kFullContact};
-    }
-    sim.step();
-  }
-}
-
-// A grid point's neighbourhood: 5 % either way in |I| and in mu_s.
-struct Box {
-  double i_lo, i_hi, mu_lo, mu_hi;
-};
-
-// Whether the curve mu = f(I), non-decreasing for I in [from, to], passes through the box.
-template <typename F>
-bool crosses(const Box& box, double from, double to, F f) {
-  const double lo = std::max(box.i_lo, from);
-  const double hi = std::min(box.i_hi, to);
-  return lo <= hi && f(lo) <= box.mu_hi && f(hi) >= box.mu_lo;
-}
-
-// Whether the vertical line I = at, mu in [from, to], passes through the box.
-bool crosses_vertical(const Box& box, double at, double from, double to) {
-  return at >= box.i_lo && at <= box.i_hi && from <= box.mu_hi && to >= box.mu_lo;
-}
-
-const char* start_name(Start s) {
-  switch (s) {
-    case Start::kFullContact:
-      return "full contact";
-    case Start::kSliding:
-      return "sliding";
-    case Start::kRocking:
-      return "rocking";
-    case Start::kSlideRocking:
-      return "slide-rocking";
-  }
-  return "?";
-}
-
 // Eq 41 against the simulation's own C_RS: with no sliding (no friction modelled; the motion
 // before any sliding does not depend on mu_s), the largest |X1| / Y1 of Eq 18 in the first
 // rocking phase is the mu_s below which the block slide-rocks. Eq 41 evaluates it at
@@ -285,7 +214,9 @@ TEST(ImpulsiveCriteria, Eq41AgainstTheSimulatedFrictionDemand) {
 // The closed forms predict: below C_S (Eq 38) and C_R (Eq 37), full contact; mu_s < b1/h
 // (C_SR, Eq 39) above C_S, sliding first; mu_s > b1/h above C_R, rocking first, and
 // slide-rocking when mu_s lies below C_RS (Eq 41, general I_C). Points within 5 % (in |I| and
-// in mu_s) of a curve are skipped.
+// in mu_s) of a curve are skipped. The classifications, simulated and predicted, and the
+// neighbourhoods of the curves are lib/host's (sweep_impulse.h: simulate_impulse_start,
+// predicted_impulse_start, near_curve), those plinth-sweep --impulse-map writes.
 //
 // Two things the criteria do not describe; the map measures them, reports them as
 // disagreements with the paper's classification, and asserts them on their own terms:
@@ -301,6 +232,8 @@ TEST(ImpulsiveCriteria, Eq41AgainstTheSimulatedFrictionDemand) {
 //    reported rate; the assertion classifies them as rocking (the early part, which Eq 41
 //    describes, is asserted at every point).
 TEST(ImpulsiveCriteria, CriteriaMapMatchesSimulation) {
+  using host::ImpulseStart;
+  using host::impulse_start_name;
   constexpr int kMuPoints = 31;
   constexpr int kImpulsePoints = 30;
   constexpr double kMargin = 0.05;
@@ -314,68 +247,54 @@ TEST(ImpulsiveCriteria, CriteriaMapMatchesSimulation) {
       const double mu_s = 0.05 + 0.75 * im / (kMuPoints - 1);
       const Scene s = make(with_friction(paper_isolated(epsilon, 2.0, 0.2), mu_s));
       const double xi = s.params.base.damping_ratio;
-      const double a_xi = peak_acceleration_factor(xi);
-      const double i_rock = rocking_impulse_threshold(s, Corner::kLeft);    // C_R, Eq 37
-      const double i_slide = sliding_impulse_threshold(s);                  // C_S, Eq 38
-      const double mu_sr = slide_rocking_friction_limit(s, Corner::kLeft);  // C_SR, Eq 39
-      const double alpha = s.corner1.critical_angle;
-      const auto c_s = [&](double i) { return i * s.omega * a_xi / s.g; };  // C_S as mu_s(I)
-      const auto c_sr = [&](double) { return mu_sr; };
-      const auto c_rs = [&](double i) {  // C_RS, Eq 41
-        return rocking_to_sliding_friction(s, Corner::kLeft, i);
-      };
+      const double i_rock = rocking_impulse_threshold(s, Corner::kLeft);  // C_R, Eq 37
       // Sliding at t = 0+ (Eq 15 with the damper's jump): mu_s g <= 2 xi omega |I|.
       const auto c_at_once = [&](double i) { return 2.0 * xi * s.omega * i / s.g; };
       for (int ii = 0; ii < kImpulsePoints; ++ii) {
         const double impulse = i_rock * (0.1 + 2.9 * ii / (kImpulsePoints - 1));
-        const Box box{impulse * (1.0 - kMargin), impulse * (1.0 + kMargin),
-                      mu_s * (1.0 - kMargin), mu_s * (1.0 + kMargin)};
-        const double inf = 1e300;
-        if (crosses(box, 0.0, i_rock, c_s) || crosses_vertical(box, i_rock, mu_sr, inf) ||
-            crosses(box, i_rock, inf, c_sr) || crosses(box, i_rock, inf, c_rs)) {
-          continue;
-        }
-        if (crosses(box, 0.0, inf, c_at_once)) {
+        // Within 5 % (in |I| and in mu_s) of C_S, C_R, C_SR or C_RS; else of the line of
+        // sliding at t = 0+.
+        const host::NearCurve near = host::near_curve(s, impulse, kMargin);
+        if (near == host::NearCurve::kCriteria) continue;
+        if (near == host::NearCurve::kSlidingAtOnce) {
           ++skipped_t0;
           continue;
         }
 
         // The paper's classification, and the expected events.
-        Start paper = Start::kFullContact;
-        if (mu_s < mu_sr && impulse > i_slide) {
-          paper = Start::kSliding;
-        } else if (mu_s > mu_sr && impulse > i_rock) {
-          paper = mu_s < c_rs(impulse) ? Start::kSlideRocking : Start::kRocking;
-        }
+        const ImpulseStart paper = host::predicted_impulse_start(s, impulse);
         const bool at_once = mu_s <= c_at_once(impulse);
-        const Start predicted = at_once ? Start::kSliding : paper;
+        const ImpulseStart predicted = at_once ? ImpulseStart::kSliding : paper;
 
-        const Outcome got = simulate_start(s, -impulse);
-        const bool late =
-            got.start == Start::kSlideRocking && got.slide_theta >= 0.5 * alpha;
+        const host::SimulatedStart got = host::simulate_impulse_start(s, -impulse, 1e-4);
+        // theta / alpha_1 when sliding began (negative: rocking about corner 2).
+        const double slide_theta =
+            got.corner == Corner::kLeft ? got.slide_angle_ratio : -got.slide_angle_ratio;
+        const bool late = got.start == ImpulseStart::kSlideRocking && slide_theta >= 0.5;
         if (late) {
-          late_theta = std::min(late_theta, got.slide_theta / alpha);
-        } else if (got.start == Start::kSlideRocking) {
-          early_theta = std::max(early_theta, got.slide_theta / alpha);
+          late_theta = std::min(late_theta, slide_theta);
+        } else if (got.start == ImpulseStart::kSlideRocking) {
+          early_theta = std::max(early_theta, slide_theta);
         }
-        EXPECT_EQ(late ? Start::kRocking : got.start, predicted)
-            << "epsilon = " << epsilon << ", mu_s = " << mu_s << ", |I| = " << impulse
-            << " (" << impulse / i_rock << " I_R): predicted " << start_name(predicted)
-            << ", simulated " << start_name(got.start) << " (theta " << got.slide_theta << ")";
+        EXPECT_EQ(late ? ImpulseStart::kRocking : got.start, predicted)
+            << "epsilon = " << epsilon << ", mu_s = " << mu_s << ", |I| = " << impulse << " ("
+            << impulse / i_rock << " I_R): predicted " << impulse_start_name(predicted)
+            << ", simulated " << impulse_start_name(got.start) << " (theta / alpha_1 "
+            << slide_theta << ")";
 
         // Against the paper's classification, by the events (both-at-once = slide-rocking).
         ++compared;
-        const Start literal = got.start;
+        const ImpulseStart literal = got.start;
         if (literal != paper) {
           if (at_once) {
             ++disagree_t0;
-          } else if (late && paper == Start::kRocking) {
+          } else if (late && paper == ImpulseStart::kRocking) {
             ++late_slides;
           } else {
             ++other;
           }
         }
-        if (paper == Start::kRocking || paper == Start::kSlideRocking) {
+        if (paper == ImpulseStart::kRocking || paper == ImpulseStart::kSlideRocking) {
           ++crs_compared;
           crs_agree += literal == paper ? 1 : 0;
         }

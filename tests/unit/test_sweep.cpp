@@ -433,5 +433,170 @@ TEST(Sweep, ThresholdPlanRowsAreTheCsvMap) {
   EXPECT_TRUE(rows[0].empty());
 }
 
+// Coarser still: the comparisons below hold at any resolution.
+SweepSettings quick() {
+  SweepSettings s = coarse();
+  s.scan_points = 10;
+  s.tolerance_g = 0.02;
+  s.dt = 2e-3;
+  return s;
+}
+
+SceneParams bundled(const std::string& name) {
+  return load_scene_file(std::string(PLINTH_SOURCE_DIR) + "/sim/scenes/" + name).params;
+}
+
+// The block on the ground keeps the block, gravity and friction, and loses the base and
+// everything on it; the paper's isolated scene's is sim/scenes/non-isolated.toml.
+TEST(SweepGround, CounterpartIsTheSameBlockOnTheGround) {
+  SceneParams p = isolated_with_friction(0.4);
+  p.gravity = 9.81;
+  p.has_sliding_stops = true;
+  p.sliding_stops.restitution = 0.5;
+  const SceneParams g = ground_counterpart(p);
+  EXPECT_FALSE(g.has_base);
+  EXPECT_FALSE(g.has_base_stops);
+  EXPECT_FALSE(g.has_support);
+  EXPECT_FALSE(g.has_sliding_stops);
+  EXPECT_TRUE(g.has_friction);
+  EXPECT_EQ(g.friction.static_coefficient, 0.4);
+  EXPECT_EQ(g.friction.kinetic_coefficient, p.friction.kinetic_coefficient);
+  EXPECT_EQ(g.gravity, 9.81);
+  EXPECT_EQ(g.block.half_width, p.block.half_width);
+  EXPECT_EQ(g.block.com_height, p.block.com_height);
+  EXPECT_EQ(g.block.eccentricity, p.block.eccentricity);
+  EXPECT_EQ(g.block.mass, p.block.mass);
+  EXPECT_EQ(g.block.inertia, p.block.inertia);
+  const EventSet events = possible_events(plinth::testing::make(g));
+  EXPECT_EQ(events, EventSet{}
+                        .set(static_cast<std::size_t>(SweepEvent::kSliding))
+                        .set(static_cast<std::size_t>(SweepEvent::kRocking))
+                        .set(static_cast<std::size_t>(SweepEvent::kSlideRocking))
+                        .set(static_cast<std::size_t>(SweepEvent::kOverturned)));
+  EXPECT_EQ(fingerprint(ground_counterpart(bundled("paper-isolated.toml"))),
+            fingerprint(bundled("non-isolated.toml")));
+  for (const char* name : {"T", "xi", "u_max", "mass_ratio"}) {
+    EXPECT_TRUE(parameter_needs_base(parse_sweep_parameter(name))) << name;
+  }
+  for (const char* name : {"mu_s", "epsilon", "lambda"}) {
+    EXPECT_FALSE(parameter_needs_base(parse_sweep_parameter(name))) << name;
+  }
+}
+
+// --compare-ground: the scene's own columns are those of a run without it, and the columns
+// "<event>_ground" those of a run of sim/scenes/non-isolated.toml, to the bit.
+TEST(SweepGround, ColumnsEqualARunOfTheBlockOnTheGround) {
+  const SweepSettings settings = quick();
+  const GridAxis mu{"mu_s", 0.3, 0.6, 2};
+  const SweepPlan compared = plan_thresholds(bundled("paper-isolated.toml"), brienza(),
+                                             SweepParameter::kMuS, mu, settings, true);
+  const SweepPlan own = plan_thresholds(bundled("paper-isolated.toml"), brienza(),
+                                        SweepParameter::kMuS, mu, settings);
+  const SweepPlan ground =
+      plan_thresholds(bundled("non-isolated.toml"), brienza(), SweepParameter::kMuS, mu, settings);
+  EXPECT_EQ(compared.settings, own.settings + " compare=ground");
+  EXPECT_EQ(compared.header,
+            own.header + ",sliding_ground,rocking_ground,slide_rocking_ground,overturned_ground");
+  const std::vector<std::string> rows = testing::run_whole_plan(compared);
+  const std::vector<std::string> own_rows = testing::run_whole_plan(own);
+  const std::vector<std::string> ground_rows = testing::run_whole_plan(ground);
+  std::size_t found = 0;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    SCOPED_TRACE(rows[i]);
+    const std::vector<std::string> f = csv_fields(rows[i]);
+    const std::vector<std::string> g = csv_fields(ground_rows[i]);
+    ASSERT_EQ(f.size(), 1 + kSweepEventCount + 4);
+    EXPECT_EQ(rows[i].substr(0, own_rows[i].size() + 1), own_rows[i] + ",");
+    std::size_t column = 1 + kSweepEventCount;
+    for (const SweepEvent e : {SweepEvent::kSliding, SweepEvent::kRocking,
+                               SweepEvent::kSlideRocking, SweepEvent::kOverturned}) {
+      const std::string& expected = g[1 + static_cast<std::size_t>(e)];
+      EXPECT_EQ(f[column++], expected) << sweep_event_name(e);
+      found += expected.empty() ? 0U : 1U;
+    }
+  }
+  EXPECT_GE(found, 4u);  // on the ground the block slides, and rocks at 0.33 g
+}
+
+// A parameter the ground lacks (T): one ground search for the whole sweep, the same fields on
+// every row, and only the ground's possible events (no friction here: rocking, overturned).
+TEST(SweepGround, BaseParameterGivesOneGroundRowSearchedOnce) {
+  const SweepSettings settings = quick();
+  const SceneParams base = plinth::testing::paper_isolated();
+  const GridAxis period{"T", 1.0, 3.0, 3};
+  const SweepPlan compared =
+      plan_thresholds(base, brienza(), SweepParameter::kPeriod, period, settings, true);
+  const SweepPlan own = plan_thresholds(base, brienza(), SweepParameter::kPeriod, period, settings);
+  EXPECT_EQ(compared.header, own.header + ",rocking_ground,overturned_ground");
+  std::size_t compared_runs = 0;
+  std::size_t own_runs = 0;
+  SweepRun run;
+  run.jobs = 2;
+  std::vector<std::string> rows;
+  std::vector<std::string> own_rows;
+  ASSERT_TRUE(run_plan(compared, {0, 1, 2}, run, rows, &compared_runs));
+  ASSERT_TRUE(run_plan(own, {0, 1, 2}, run, own_rows, &own_runs));
+  std::size_t ground_runs = 0;
+  const auto ground = first_occurrence_thresholds(plinth::testing::make(ground_counterpart(base)),
+                                                  brienza(), settings, &ground_runs);
+  EXPECT_EQ(compared_runs, own_runs + ground_runs);
+  const std::string fields =
+      "," + format_result(ground[static_cast<std::size_t>(SweepEvent::kRocking)]) + "," +
+      format_result(ground[static_cast<std::size_t>(SweepEvent::kOverturned)]);
+  EXPECT_NE(fields, ",,");
+  for (std::size_t i = 0; i < rows.size(); ++i) EXPECT_EQ(rows[i], own_rows[i] + fields);
+}
+
+// A two-parameter map: the ground column is the map of the block on the ground.
+TEST(SweepGround, TwoParameterMapHasTheGroundColumn) {
+  SweepSettings settings = quick();
+  settings.pga_max_g = 4.0;
+  const GridAxis lambda{"lambda", 3.0, 5.0, 2};
+  const GridAxis epsilon{"epsilon", -0.3, 0.3, 2};
+  const SweepPlan map = plan_threshold_map(
+      plinth::testing::paper_isolated(), brienza(), SweepParameter::kLambda, lambda,
+      SweepParameter::kEpsilon, epsilon, SweepEvent::kOverturned, settings, true);
+  EXPECT_EQ(map.header, "lambda,epsilon,overturned,overturned_ground");
+  EXPECT_THAT(map.settings, ::testing::EndsWith(" event=overturned compare=ground"));
+  const SweepPlan ground = plan_threshold_map(
+      plinth::testing::paper_block(), brienza(), SweepParameter::kLambda, lambda,
+      SweepParameter::kEpsilon, epsilon, SweepEvent::kOverturned, settings);
+  const std::vector<std::string> cells = testing::run_whole_plan(map);
+  const std::vector<std::string> ground_cells = testing::run_whole_plan(ground);
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    const std::vector<std::string> f = csv_fields(cells[i]);
+    ASSERT_EQ(f.size(), 4u);
+    EXPECT_FALSE(f[3].empty());
+    EXPECT_EQ(map.keys[i] + "," + f[3], ground_cells[i]);
+  }
+}
+
+TEST(SweepGround, RefusesWhatCannotBeCompared) {
+  const SweepSettings settings = quick();
+  const GridAxis mu{"mu_s", 0.3, 0.6, 2};
+  EXPECT_THAT(input_error_text([&] {
+                (void)plan_thresholds(plinth::testing::paper_block(), brienza(),
+                                      SweepParameter::kMuS, mu, settings, true);
+              }),
+              HasSubstr("--compare-ground: the scene has no [base]: it is already the block on "
+                        "the ground"));
+  const GridAxis lambda{"lambda", 3.0, 4.0, 2};
+  const GridAxis epsilon{"epsilon", 0.0, 0.2, 2};
+  const auto map_of = [&](const SceneParams& base, SweepEvent event) {
+    return input_error_text([&] {
+      (void)plan_threshold_map(base, brienza(), SweepParameter::kLambda, lambda,
+                               SweepParameter::kEpsilon, epsilon, event, settings, true);
+    });
+  };
+  EXPECT_THAT(map_of(isolated_with_friction(), SweepEvent::kFell),
+              HasSubstr("--compare-ground: the block on the ground cannot have fell (it has no "
+                        "support's edge to leave)"));
+  EXPECT_THAT(map_of(isolated_with_friction(), SweepEvent::kBaseStopHit),
+              HasSubstr("cannot have base_stop_hit (it has no base stops)"));
+  EXPECT_THAT(map_of(plinth::testing::paper_isolated(), SweepEvent::kSliding),
+              HasSubstr("cannot have sliding (the scene has no [friction])"));
+  EXPECT_EQ(map_of(isolated_with_friction(), SweepEvent::kSlideRocking), "(no InputError)");
+}
+
 }  // namespace
 }  // namespace plinth::host

@@ -150,5 +150,61 @@ TEST(SweepImpulse, CurveOnTheGroundMatchesTheEnergyBound) {
               HasSubstr("--impulse-max: must be greater than zero"));
 }
 
+// --compare-ground: the ground's columns are those of the impulse curve of the block on the
+// ground (overturned and its energy bound), to the bit; against T, one ground search for all.
+TEST(SweepImpulse, CurveComparesTheBlockOnTheGround) {
+  ImpulseSearchSettings settings;
+  settings.impulse_max = 4.0;
+  settings.scan_points = 8;
+  settings.tolerance = 5e-3;
+  settings.dt = 1e-3;
+  const GridAxis lambda{"lambda", 2.0, 4.0, 2};
+  const SweepPlan compared = plan_impulse_curve(plinth::testing::paper_isolated(),
+                                                SweepParameter::kLambda, lambda, settings, true);
+  const SweepPlan own = plan_impulse_curve(plinth::testing::paper_isolated(),
+                                           SweepParameter::kLambda, lambda, settings);
+  const SweepPlan ground =
+      plan_impulse_curve(plinth::testing::paper_block(), SweepParameter::kLambda, lambda, settings);
+  EXPECT_EQ(compared.header, own.header + ",overturned_ground,overturned_closed_form_ground");
+  EXPECT_EQ(compared.settings, own.settings + " compare=ground");
+  const std::vector<std::string> rows = testing::run_whole_plan(compared);
+  const std::vector<std::string> own_rows = testing::run_whole_plan(own);
+  const std::vector<std::string> ground_rows = testing::run_whole_plan(ground);
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    // The ground's row: lambda, rocking (0), overturned, 0, the energy bound.
+    const std::vector<std::string> g = csv_fields(ground_rows[i]);
+    ASSERT_EQ(g.size(), 5u);
+    EXPECT_FALSE(g[2].empty());
+    EXPECT_EQ(rows[i], own_rows[i] + "," + g[2] + "," + g[4]);
+  }
+
+  const GridAxis period{"T", 1.0, 3.0, 3};
+  const SweepPlan by_period = plan_impulse_curve(plinth::testing::paper_isolated(),
+                                                 SweepParameter::kPeriod, period, settings, true);
+  SweepRun run;
+  run.jobs = 2;
+  std::vector<std::string> period_rows;
+  std::size_t runs = 0;
+  ASSERT_TRUE(run_plan(by_period, {0, 1, 2}, run, period_rows, &runs));
+  std::size_t own_runs = 0;
+  std::vector<std::string> own_period_rows;
+  ASSERT_TRUE(run_plan(plan_impulse_curve(plinth::testing::paper_isolated(),
+                                          SweepParameter::kPeriod, period, settings),
+                       {0, 1, 2}, run, own_period_rows, &own_runs));
+  std::size_t ground_runs = 0;
+  const Scene on_ground = plinth::testing::make(plinth::testing::paper_block());
+  const ImpulseThresholds found = impulse_thresholds(on_ground, settings, &ground_runs);
+  EXPECT_EQ(runs, own_runs + ground_runs);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(period_rows[i], own_period_rows[i] + "," + format_result(found.overturned) + "," +
+                                  format_result(ground_overturning_impulse(on_ground)));
+  }
+  EXPECT_THAT(testing::input_error_text([&] {
+                (void)plan_impulse_curve(plinth::testing::paper_block(), SweepParameter::kLambda,
+                                         lambda, settings, true);
+              }),
+              HasSubstr("--compare-ground: the scene has no [base]"));
+}
+
 }  // namespace
 }  // namespace plinth::host

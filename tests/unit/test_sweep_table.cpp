@@ -73,6 +73,8 @@ TEST(SweepTable, FormatsAndFingerprints) {
   EXPECT_NE(fingerprint(a), fingerprint(b));
   EXPECT_EQ(row_key("2,-0.5,1.25", 2), "2,-0.5");
   EXPECT_EQ(row_key("0.3,,", 1), "0.3");
+  EXPECT_THAT(csv_fields("0.3,,"), ElementsAre("0.3", "", ""));
+  EXPECT_THAT(csv_fields("mu_s"), ElementsAre("mu_s"));
 }
 
 TEST(SweepTable, FilesReadBackAsWritten) {
@@ -139,6 +141,33 @@ TEST(SweepTable, MergeRefusesWhatDoesNotFit) {
               HasSubstr("p.csv: row '2' appears twice"));
   EXPECT_THAT(testing::input_error_text([] { (void)merge_sweep_tables({}, {}); }),
               HasSubstr("no input files"));
+}
+
+// Messages about settings lines that differ name the settings, not just the lines.
+TEST(SweepTable, SettingsDifferenceNamesTheSettings) {
+  const std::string plain = SettingsLine("thresholds", {{"mu_s", 0.1, 1.5, 50}})
+                                .add("pga_max_g", 2.0)
+                                .add("tol_g", 0.001)
+                                .text();
+  const std::string compared = SettingsLine("thresholds", {{"mu_s", 0.1, 1.5, 50}})
+                                   .add("pga_max_g", 3.0)
+                                   .add("tol_g", 0.001)
+                                   .add("compare", "ground")
+                                   .text();
+  EXPECT_EQ(settings_difference(compared, "a.csv", plain, "b.csv"),
+            "compare: ground in a.csv, none in b.csv; pga_max_g: 3 in a.csv, 2 in b.csv");
+  EXPECT_EQ(settings_difference(plain, "a.csv", plain, "b.csv"), "");
+  EXPECT_EQ(settings_difference("mu_s,sliding", "a.csv", plain, "b.csv"), "");
+
+  SweepTable first = two_by_two({"2,-0.5,1,0.5", "4,-0.5,3,1"});
+  first.header = "lambda,epsilon,overturned,overturned_ground";
+  first.settings += " compare=ground";
+  SweepTable second = two_by_two({"4,0.5,4", "2,0.5,"});
+  EXPECT_THAT(testing::input_error_text([&] {
+                (void)merge_sweep_tables({first, second}, {"a.csv", "b.csv"});
+              }),
+              HasSubstr("merge: b.csv and a.csv come from different sweeps (their settings lines "
+                        "differ: compare: none in b.csv, ground in a.csv)"));
 }
 
 }  // namespace

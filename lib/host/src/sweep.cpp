@@ -285,6 +285,42 @@ std::array<std::optional<double>, kSweepEventCount> first_occurrence_thresholds(
                            simulations);
 }
 
+bool parameter_needs_base(SweepParameter parameter) {
+  return parameter == SweepParameter::kPeriod || parameter == SweepParameter::kXi ||
+         parameter == SweepParameter::kMassRatio || parameter == SweepParameter::kUMax;
+}
+
+SceneParams ground_counterpart(const SceneParams& params) {
+  SceneParams ground;
+  ground.gravity = params.gravity;
+  ground.block = params.block;
+  ground.has_friction = params.has_friction;
+  ground.friction = params.friction;
+  return ground;
+}
+
+GroundScenes ground_scenes(const std::vector<Scene>& scenes) {
+  GroundScenes ground;
+  for (const Scene& scene : scenes) {
+    const SceneParams params = ground_counterpart(scene.params);
+    ground.scenes.emplace_back();
+    if (const Error e = make_scene(params, ground.scenes.back()); !e.ok()) {
+      throw InputError("--compare-ground: the block on the ground: " + std::string(e.field) +
+                       ": " + e.reason);
+    }
+    ground.keys.push_back(fingerprint(params));
+  }
+  return ground;
+}
+
+void require_base_to_compare(const SceneParams& params) {
+  if (!params.has_base) {
+    throw InputError(
+        "--compare-ground: the scene has no [base]: it is already the block on the ground "
+        "(compare needs the isolated scene)");
+  }
+}
+
 SweepParameter parse_sweep_parameter(const std::string& text, const std::string& option) {
   for (std::size_t i = 0; i < kParameterNames.size(); ++i) {
     if (text == kParameterNames[i]) return static_cast<SweepParameter>(i);
@@ -301,10 +337,7 @@ SceneParams with_parameter(SceneParams p, SweepParameter parameter, double value
                            const std::string& option) {
   const std::string what = describe_value(option, parameter, value);
   if (!std::isfinite(value)) throw InputError(what + ": not a finite number");
-  const bool needs_base =
-      parameter == SweepParameter::kPeriod || parameter == SweepParameter::kXi ||
-      parameter == SweepParameter::kMassRatio || parameter == SweepParameter::kUMax;
-  if (needs_base && !p.has_base) {
+  if (parameter_needs_base(parameter) && !p.has_base) {
     throw InputError(what + ": the scene has no [base] (a block on the ground)");
   }
   switch (parameter) {
@@ -472,24 +505,105 @@ SettingsLine pga_settings(const std::string& mode, const std::vector<GridAxis>& 
   return line;
 }
 
+using Thresholds = std::array<std::optional<double>, kSweepEventCount>;
+
+// The counterparts on the ground of the scenes of a plan, the events they can have, and the
+// thresholds of each distinct one, searched once.
+struct GroundPlan {
+  GroundScenes ground;
+  EventSet events;  // the events they can have, of those searched
+  OnceCache<Thresholds> thresholds;
+};
+
+std::shared_ptr<GroundPlan> ground_plan(const std::vector<Scene>& scenes,
+                                        const EventSet& searched) {
+  auto plan = std::make_shared<GroundPlan>();
+  plan->ground = ground_scenes(scenes);
+  // Friction, the only feature of the ground's that may differ, is the same for every value.
+  plan->events = possible_events(plan->ground.scenes.front()) & searched;
+  return plan;
+}
+
+// The thresholds of the ground counterpart of scene i, computed once per distinct one.
+Thresholds ground_thresholds(GroundPlan& plan, std::size_t i, const Record& record,
+                             const SweepSettings& settings, const std::atomic<bool>* stop,
+                             std::size_t* simulations) {
+  return plan.thresholds.get(plan.ground.keys[i], [&] {
+    try {
+      return first_occurrence_thresholds(plan.ground.scenes[i], record, settings, simulations,
+                                         stop);
+    } catch (const InputError& e) {
+      throw InputError(std::string("the block on the ground: ") + e.what());
+    }
+  });
+}
+
+std::string ground_header(const EventSet& events) {
+  std::string header;
+  for (std::size_t e = 0; e < kSweepEventCount; ++e) {
+    if (!events[e]) continue;
+    header += ',';
+    header += kEventNames[e];
+    header += kGroundSuffix;
+  }
+  return header;
+}
+
+std::string ground_fields(const EventSet& events, const Thresholds& thresholds) {
+  std::string fields;
+  for (std::size_t e = 0; e < kSweepEventCount; ++e) {
+    if (!events[e]) continue;
+    fields += ',';
+    fields += format_result(thresholds[e]);
+  }
+  return fields;
+}
+
+// Why the block on the ground cannot have `event`.
+std::string why_ground_lacks(SweepEvent event) {
+  switch (event) {
+    case SweepEvent::kSliding:
+    case SweepEvent::kSlideRocking: return "the scene has no [friction]";
+    case SweepEvent::kOutOfBase:
+    case SweepEvent::kFell: return "it has no support's edge to leave";
+    case SweepEvent::kBaseStopHit: return "it has no base stops";
+    case SweepEvent::kSlideStopHit: return "it has no sliding stops";
+    default: return "it cannot";
+  }
+}
+
 }  // namespace
 
 SweepPlan plan_thresholds(const SceneParams& base, const Record& record, SweepParameter parameter,
-                          const GridAxis& axis, const SweepSettings& settings) {
+                          const GridAxis& axis, const SweepSettings& settings,
+                          bool compare_ground) {
   validate(settings);
   check_record(record);
+  if (compare_ground) require_base_to_compare(base);
   const std::vector<double> values = sweep_values(axis.from, axis.to, axis.steps);
   auto scenes = std::make_shared<const std::vector<Scene>>(sweep_scenes(base, parameter, values));
+  const std::shared_ptr<GroundPlan> ground =
+      compare_ground ? ground_plan(*scenes, settings.events) : nullptr;
   auto shared_record = std::make_shared<const Record>(record);
   SweepPlan plan;
-  plan.settings = pga_settings("thresholds", {axis}, base, record, settings).text();
+  SettingsLine line = pga_settings("thresholds", {axis}, base, record, settings);
   plan.header = sweep_csv_header(parameter);
+  if (ground) {
+    line.add("compare", "ground");
+    plan.header += ground_header(ground->events);
+  }
+  plan.settings = line.text();
   plan.keys = grid_keys({axis});
-  plan.row = [scenes, shared_record, values, settings](std::size_t i, const std::atomic<bool>* stop,
-                                                       std::size_t* simulations) {
+  plan.row = [scenes, ground, shared_record, values, settings](
+                 std::size_t i, const std::atomic<bool>* stop, std::size_t* simulations) {
     const SweepRow row{values[i], first_occurrence_thresholds((*scenes)[i], *shared_record,
                                                               settings, simulations, stop)};
-    return sweep_csv_row(row);
+    std::string text = sweep_csv_row(row);
+    if (ground) {
+      text += ground_fields(ground->events, ground_thresholds(*ground, i, *shared_record, settings,
+                                                              stop, simulations));
+    }
+    return text;
   };
   plan.describe = [parameter, values](std::size_t i) {
     return describe_value("--param", parameter, values[i]);
@@ -500,9 +614,10 @@ SweepPlan plan_thresholds(const SceneParams& base, const Record& record, SweepPa
 SweepPlan plan_threshold_map(const SceneParams& base, const Record& record,
                              SweepParameter parameter1, const GridAxis& axis1,
                              SweepParameter parameter2, const GridAxis& axis2, SweepEvent event,
-                             SweepSettings settings) {
+                             SweepSettings settings, bool compare_ground) {
   validate(settings);
   check_record(record);
+  if (compare_ground) require_base_to_compare(base);
   if (parameter1 == parameter2) {
     throw InputError(std::string("--param2: must differ from --param (both ") +
                      sweep_parameter_name(parameter1) + ")");
@@ -523,21 +638,38 @@ SweepPlan plan_threshold_map(const SceneParams& base, const Record& record,
   }
   settings.events.reset();
   settings.events.set(static_cast<std::size_t>(event));
+  const std::shared_ptr<GroundPlan> ground =
+      compare_ground ? ground_plan(*scenes, settings.events) : nullptr;
+  if (ground && ground->events.none()) {
+    throw InputError(std::string("--compare-ground: the block on the ground cannot have ") +
+                     sweep_event_name(event) + " (" + why_ground_lacks(event) +
+                     "); it can have rocking, overturned, and with friction sliding and "
+                     "slide_rocking");
+  }
   auto shared_record = std::make_shared<const Record>(record);
   SweepPlan plan;
-  plan.settings = pga_settings("threshold_map", {axis1, axis2}, base, record, settings)
-                      .add("event", sweep_event_name(event))
-                      .text();
+  SettingsLine line = pga_settings("threshold_map", {axis1, axis2}, base, record, settings);
+  line.add("event", sweep_event_name(event));
   plan.header = std::string(sweep_parameter_name(parameter1)) + "," +
                 sweep_parameter_name(parameter2) + "," + sweep_event_name(event);
+  if (ground) {
+    line.add("compare", "ground");
+    plan.header += ground_header(ground->events);
+  }
+  plan.settings = line.text();
   plan.key_columns = 2;
   plan.keys = grid_keys({axis1, axis2});
   const std::vector<std::string> keys = plan.keys;
-  plan.row = [scenes, shared_record, settings, event, keys](
+  plan.row = [scenes, ground, shared_record, settings, event, keys](
                  std::size_t i, const std::atomic<bool>* stop, std::size_t* simulations) {
     const auto thresholds =
         first_occurrence_thresholds((*scenes)[i], *shared_record, settings, simulations, stop);
-    return keys[i] + "," + format_result(thresholds[static_cast<std::size_t>(event)]);
+    std::string text = keys[i] + "," + format_result(thresholds[static_cast<std::size_t>(event)]);
+    if (ground) {
+      text += ground_fields(ground->events, ground_thresholds(*ground, i, *shared_record, settings,
+                                                              stop, simulations));
+    }
+    return text;
   };
   const std::size_t columns = values2.size();
   plan.describe = [=](std::size_t i) {

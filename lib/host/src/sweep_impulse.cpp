@@ -45,6 +45,7 @@ class StartSink final : public EventSink {
         settle(ImpulseStart::kSliding);
       } else if (e.kind == EventKind::kRockingStart) {
         rocking_ = true;
+        result.corner = e.corner;
         alpha_ = scene_.corner(e.corner).critical_angle;
       }
     } else if (e.kind == EventKind::kSlidingStart) {
@@ -132,7 +133,11 @@ ImpulseStart predicted_impulse_start(const Scene& scene, double impulse_magnitud
 }
 
 bool near_criteria_curves(const Scene& scene, double impulse_magnitude, double margin) {
-  if (!scene.params.has_friction) return false;
+  return near_curve(scene, impulse_magnitude, margin) != NearCurve::kNone;
+}
+
+NearCurve near_curve(const Scene& scene, double impulse_magnitude, double margin) {
+  if (!scene.params.has_friction) return NearCurve::kNone;
   const ImpulseCriteria c = impulse_criteria(scene, impulse_magnitude);
   const double mu_s = scene.params.friction.static_coefficient;
   const double i_lo = impulse_magnitude * (1.0 - margin);
@@ -149,10 +154,14 @@ bool near_criteria_curves(const Scene& scene, double impulse_magnitude, double m
   const auto at_once = [&](double i) { return 2.0 * xi * scene.omega * i / scene.g; };
   const bool c_r = c.rocking_impulse >= i_lo && c.rocking_impulse <= i_hi &&  // Eq 37, vertical
                    mu_hi >= c.dividing_friction;
-  return c_r || curve_crosses(i_lo, i_hi, mu_lo, mu_hi, 0.0, c.rocking_impulse, c_s) ||
-         curve_crosses(i_lo, i_hi, mu_lo, mu_hi, c.rocking_impulse, kInfinity, c_sr) ||
-         curve_crosses(i_lo, i_hi, mu_lo, mu_hi, c.rocking_impulse, kInfinity, c_rs) ||
-         curve_crosses(i_lo, i_hi, mu_lo, mu_hi, 0.0, kInfinity, at_once);
+  if (c_r || curve_crosses(i_lo, i_hi, mu_lo, mu_hi, 0.0, c.rocking_impulse, c_s) ||
+      curve_crosses(i_lo, i_hi, mu_lo, mu_hi, c.rocking_impulse, kInfinity, c_sr) ||
+      curve_crosses(i_lo, i_hi, mu_lo, mu_hi, c.rocking_impulse, kInfinity, c_rs)) {
+    return NearCurve::kCriteria;
+  }
+  return curve_crosses(i_lo, i_hi, mu_lo, mu_hi, 0.0, kInfinity, at_once)
+             ? NearCurve::kSlidingAtOnce
+             : NearCurve::kNone;
 }
 
 SweepPlan plan_impulse_map(const SceneParams& base, const GridAxis& mu_axis,
@@ -291,25 +300,45 @@ ImpulseThresholds impulse_thresholds(const Scene& scene, const ImpulseSearchSett
 }
 
 SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,
-                             const GridAxis& axis, const ImpulseSearchSettings& settings) {
+                             const GridAxis& axis, const ImpulseSearchSettings& settings,
+                             bool compare_ground) {
   validate(settings);
+  if (compare_ground) require_base_to_compare(base);
   const std::vector<double> values = sweep_values(axis.from, axis.to, axis.steps);
   auto scenes = std::make_shared<const std::vector<Scene>>(sweep_scenes(base, parameter, values));
   for (const Scene& scene : *scenes) (void)impulse_simulator(scene, settings.dt, nullptr);
+  // The counterparts on the ground, and their thresholds, searched once per distinct scene.
+  struct Ground {
+    GroundScenes on_ground;
+    OnceCache<ImpulseThresholds> thresholds;
+  };
+  std::shared_ptr<Ground> ground;
+  if (compare_ground) {
+    ground = std::make_shared<Ground>();
+    ground->on_ground = ground_scenes(*scenes);
+    for (const Scene& scene : ground->on_ground.scenes) {
+      (void)impulse_simulator(scene, settings.dt, nullptr);
+    }
+  }
   SweepPlan plan;
-  plan.settings = SettingsLine("impulse_curve", {axis})
-                      .add("scene", fingerprint(base))
-                      .add("impulse_max", settings.impulse_max)
-                      .add("impulse_tol", settings.tolerance)
-                      .add("scan_points", std::to_string(settings.scan_points))
-                      .add("dt", settings.dt)
-                      .text();
+  SettingsLine line("impulse_curve", {axis});
+  line.add("scene", fingerprint(base))
+      .add("impulse_max", settings.impulse_max)
+      .add("impulse_tol", settings.tolerance)
+      .add("scan_points", std::to_string(settings.scan_points))
+      .add("dt", settings.dt);
   plan.header = std::string(sweep_parameter_name(parameter)) +
                 ",rocking,overturned,rocking_closed_form,overturned_closed_form";
+  if (ground) {
+    line.add("compare", "ground");
+    plan.header += std::string(",overturned") + kGroundSuffix + ",overturned_closed_form" +
+                   kGroundSuffix;
+  }
+  plan.settings = line.text();
   plan.keys = grid_keys({axis});
   const std::vector<std::string> keys = plan.keys;
-  plan.row = [scenes, settings, keys](std::size_t i, const std::atomic<bool>* stop,
-                                      std::size_t* simulations) {
+  plan.row = [scenes, ground, settings, keys](std::size_t i, const std::atomic<bool>* stop,
+                                              std::size_t* simulations) {
     const Scene& scene = (*scenes)[i];
     const ImpulseThresholds found = impulse_thresholds(scene, settings, simulations, stop);
     const bool on_base = scene.has_base();
@@ -317,8 +346,24 @@ SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,
         on_base ? rocking_impulse_threshold(scene, Corner::kLeft) : 0.0;
     const std::optional<double> overturned_closed_form =
         on_base ? std::nullopt : std::optional<double>(ground_overturning_impulse(scene));
-    return keys[i] + "," + format_result(found.rocking) + "," + format_result(found.overturned) +
-           "," + format_result(rocking_closed_form) + "," + format_result(overturned_closed_form);
+    std::string row = keys[i] + "," + format_result(found.rocking) + "," +
+                      format_result(found.overturned) + "," + format_result(rocking_closed_form) +
+                      "," + format_result(overturned_closed_form);
+    if (ground) {
+      const Scene& on_ground = ground->on_ground.scenes[i];
+      const ImpulseThresholds g = ground->thresholds.get(ground->on_ground.keys[i], [&] {
+        try {
+          return impulse_thresholds(on_ground, settings, simulations, stop);
+        } catch (const InputError& e) {
+          throw InputError(std::string("the block on the ground: ") + e.what());
+        }
+      });
+      row += ',';
+      row += format_result(g.overturned);
+      row += ',';
+      row += format_result(ground_overturning_impulse(on_ground));
+    }
+    return row;
   };
   plan.describe = [parameter, values](std::size_t i) {
     return describe_value("--param", parameter, values[i]);

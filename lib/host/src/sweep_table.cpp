@@ -8,6 +8,7 @@
 #include <ostream>
 #include <sstream>
 #include <unordered_map>
+#include <utility>
 
 #include "plinth/host/input_error.h"
 
@@ -160,6 +161,36 @@ std::map<std::string, std::string> parse_settings(const std::string& line,
   return settings;
 }
 
+std::string settings_difference(const std::string& a, const std::string& a_name,
+                                const std::string& b, const std::string& b_name) {
+  std::map<std::string, std::string> first;
+  std::map<std::string, std::string> second;
+  try {
+    first = parse_settings(a, a_name);
+    second = parse_settings(b, b_name);
+  } catch (const InputError&) {
+    return {};
+  }
+  std::map<std::string, std::pair<std::string, std::string>> both;
+  for (const auto& [key, value] : first) both[key].first = value;
+  for (const auto& [key, value] : second) both[key].second = value;
+  std::string text;
+  for (const auto& [key, values] : both) {
+    if (values.first == values.second) continue;
+    if (!text.empty()) text += "; ";
+    text += key;
+    text += ": ";
+    text += values.first.empty() ? std::string("none") : values.first;
+    text += " in ";
+    text += a_name;
+    text += ", ";
+    text += values.second.empty() ? std::string("none") : values.second;
+    text += " in ";
+    text += b_name;
+  }
+  return text;
+}
+
 std::vector<GridAxis> parse_grid(const std::string& line, const std::string& where) {
   const auto settings = parse_settings(line, where);
   const auto it = settings.find("grid");
@@ -207,6 +238,8 @@ std::vector<std::string> grid_keys(const std::vector<GridAxis>& grid) {
   }
   return keys;
 }
+
+std::vector<std::string> csv_fields(const std::string& row) { return split(row, ','); }
 
 std::string row_key(const std::string& row, std::size_t key_columns) {
   std::size_t end = 0;
@@ -275,8 +308,11 @@ SweepTable merge_sweep_tables(const std::vector<SweepTable>& parts,
   const SweepTable& first = parts.front();
   for (std::size_t p = 1; p < parts.size(); ++p) {
     if (parts[p].settings != first.settings) {
+      const std::string difference =
+          settings_difference(parts[p].settings, names[p], first.settings, names[0]);
       throw InputError("merge: " + names[p] + " and " + names[0] +
-                       " come from different sweeps (their settings lines differ):\n  " +
+                       " come from different sweeps (their settings lines differ" +
+                       (difference.empty() ? std::string() : ": " + difference) + "):\n  " +
                        parts[p].settings + "\n  " + first.settings);
     }
     if (parts[p].header != first.header) {

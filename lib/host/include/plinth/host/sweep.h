@@ -11,6 +11,9 @@
 #include <exception>
 #include <functional>
 #include <iosfwd>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -145,6 +148,65 @@ enum class SweepParameter : unsigned char {
 [[nodiscard]] SceneParams with_parameter(SceneParams params, SweepParameter parameter, double value,
                                          const std::string& option = "--param");
 
+// Whether the parameter exists only with a base (T, xi, u_max, mass_ratio): the block on the
+// ground does not have it.
+[[nodiscard]] bool parameter_needs_base(SweepParameter parameter);
+
+// The non-isolated counterpart of a scene (the paper's section 5 comparisons, Figs. 9-10): the
+// same block (geometry, mass, inertia, eccentricity) under the same gravity standing on the
+// ground, with the same friction between block and ground as between block and base (or none,
+// as on the base). It has no base, no base stops, and neither the support's edge nor the sliding
+// stops, which belong to the base plate. Its possible events (possible_events) are rocking,
+// overturned and, with friction, sliding and slide_rocking.
+[[nodiscard]] SceneParams ground_counterpart(const SceneParams& params);
+
+// The CSV columns of the counterpart on the ground carry its event's name with this suffix
+// ("rocking_ground"); they come after the scene's own columns, and only for the events the
+// block on the ground can have.
+inline constexpr const char* kGroundSuffix = "_ground";
+
+// Results computed once per key and shared between the jobs of a plan (the thresholds of a
+// counterpart on the ground that does not depend on the swept parameter: T, xi, ...). The
+// first job asking for a key computes it; others asking meanwhile wait for it. A computation
+// that throws stores nothing (the next job asking tries again). Thread-safe.
+template <class T>
+class OnceCache {
+ public:
+  template <class Compute>
+  T get(const std::string& key, Compute&& compute) {
+    std::shared_ptr<Entry> entry;
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      std::shared_ptr<Entry>& slot = entries_[key];
+      if (!slot) slot = std::make_shared<Entry>();
+      entry = slot;
+    }
+    const std::lock_guard<std::mutex> lock(entry->mutex);
+    if (!entry->value) entry->value = compute();
+    return *entry->value;
+  }
+
+ private:
+  struct Entry {
+    std::mutex mutex;
+    std::optional<T> value;
+  };
+  std::mutex mutex_;
+  std::map<std::string, std::shared_ptr<Entry>> entries_;
+};
+
+// Throws InputError naming --compare-ground when the scene has no base (it is already the
+// block on the ground).
+void require_base_to_compare(const SceneParams& params);
+
+// The counterparts on the ground of the scenes of a plan (ground_counterpart, make_scene), and
+// the fingerprint of each: the key of its results in an OnceCache, equal for equal scenes.
+struct GroundScenes {
+  std::vector<Scene> scenes;
+  std::vector<std::string> keys;
+};
+[[nodiscard]] GroundScenes ground_scenes(const std::vector<Scene>& scenes);
+
 // Threads, shards and cancellation of a sweep's jobs (one job per CSV row).
 struct SweepRun {
   int jobs = 1;
@@ -189,16 +251,24 @@ bool run_plan(const SweepPlan& plan, const std::vector<std::size_t>& indices, co
 
 // One parameter: a row of thresholds of every event per value (mode "thresholds", the
 // write_sweep_csv format). Every value is checked before the plan is returned.
+// With `compare_ground` (the scene must have a base), each row also holds the thresholds of
+// the value's ground_counterpart, in columns "<event>_ground" for the events it can have
+// (possible_events), and the settings line says "compare=ground". Ground scenes that are the
+// same for several values (a parameter the ground lacks) are searched once (OnceCache).
 [[nodiscard]] SweepPlan plan_thresholds(const SceneParams& base, const Record& record,
                                         SweepParameter parameter, const GridAxis& axis,
-                                        const SweepSettings& settings);
+                                        const SweepSettings& settings,
+                                        bool compare_ground = false);
 
 // Two parameters (mode "threshold_map"): a row "<p1>,<p2>,<event>" per cell, the first
-// occurrence of `event`, cells in the order p1 then p2. Every cell is checked first.
+// occurrence of `event`, cells in the order p1 then p2. Every cell is checked first. With
+// `compare_ground`, also "<event>_ground", the cell's ground_counterpart's; refused when the
+// block on the ground cannot have `event`.
 [[nodiscard]] SweepPlan plan_threshold_map(const SceneParams& base, const Record& record,
                                            SweepParameter parameter1, const GridAxis& axis1,
                                            SweepParameter parameter2, const GridAxis& axis2,
-                                           SweepEvent event, SweepSettings settings);
+                                           SweepEvent event, SweepSettings settings,
+                                           bool compare_ground = false);
 
 struct SweepRow {
   double value = 0.0;

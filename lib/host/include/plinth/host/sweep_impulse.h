@@ -30,6 +30,8 @@ enum class ImpulseStart : unsigned char {
 
 struct SimulatedStart {
   ImpulseStart start = ImpulseStart::kFullContact;
+  // kRocking, kSlideRocking: the corner the block first rocked about.
+  Corner corner = Corner::kLeft;
   // kSlideRocking: |theta| / alpha of the pivot when sliding began. Eq 41 describes the onset
   // of rocking; a block on its way to overturning may slide late (docs/model.md).
   double slide_angle_ratio = 0.0;
@@ -59,6 +61,11 @@ struct ImpulseCriteria {
 // forms may disagree.
 [[nodiscard]] bool near_criteria_curves(const Scene& scene, double impulse_magnitude,
                                         double margin);
+
+// What near_criteria_curves found: a curve of the criteria (C_S, C_R, C_SR, C_RS), else the
+// line of sliding at once (mu_s g = 2 xi omega |I|), else none. kNone without friction.
+enum class NearCurve : unsigned char { kNone, kCriteria, kSlidingAtOnce };
+[[nodiscard]] NearCurve near_curve(const Scene& scene, double impulse_magnitude, double margin);
 
 // Fig. 11 kind (mode "impulse_map"): a row per (mu_s, |I|), mu_s slowest:
 // "mu_s,impulse,simulated,predicted,c_s,c_r,c_sr,c_rs" (docs/sweep.md). Needs a base.
@@ -102,8 +109,13 @@ struct ImpulseThresholds {
 // Fig. 7 kind (mode "impulse_curve"): a row per value,
 // "<param>,rocking,overturned,rocking_closed_form,overturned_closed_form": the simulated
 // thresholds and Eq 37 (on a base) or 0 and ground_overturning_impulse (on the ground).
+// With `compare_ground` (the scene must have a base), also the value's ground_counterpart's
+// "overturned_ground,overturned_closed_form_ground" (its rocking impulse is 0 for every
+// value, so it has no column); the same ground scene is searched once (OnceCache), and the
+// settings line says "compare=ground".
 [[nodiscard]] SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,
                                            const GridAxis& axis,
-                                           const ImpulseSearchSettings& settings);
+                                           const ImpulseSearchSettings& settings,
+                                           bool compare_ground = false);
 
 }  // namespace plinth::host

@@ -59,6 +59,13 @@ class SettingsLine {
 [[nodiscard]] std::map<std::string, std::string> parse_settings(const std::string& line,
                                                                 const std::string& where);
 
+// What differs between two settings lines, for messages: "compare: ground in a.csv, none in
+// b.csv; tol_g: 0.05 in a.csv, 0.1 in b.csv" (keys in order; "none" where a line lacks the
+// key; the mode and grid as keys "mode" and "grid"). Empty when they hold the same settings
+// or one is not a settings line.
+[[nodiscard]] std::string settings_difference(const std::string& a, const std::string& a_name,
+                                              const std::string& b, const std::string& b_name);
+
 // The grid of a settings line and the key of each of its rows, in grid order (the first axis
 // varies slowest). Throws InputError naming `where` on a malformed grid.
 [[nodiscard]] std::vector<GridAxis> parse_grid(const std::string& line, const std::string& where);
@@ -70,6 +77,10 @@ struct SweepTable {
   std::string header;             // the CSV header
   std::vector<std::string> rows;  // CSV lines without their newline
 };
+
+// The comma-separated fields of a CSV row or header; an empty last field counts ("0.3,," has
+// three).
+[[nodiscard]] std::vector<std::string> csv_fields(const std::string& row);
 
 // The key of a row: its first `key_columns` comma-separated fields.
 [[nodiscard]] std::string row_key(const std::string& row, std::size_t key_columns);
