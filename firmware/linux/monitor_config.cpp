@@ -59,67 +59,87 @@ std::function<bool(const toml::node&)> flag_into(bool& target) {
   };
 }
 
+std::function<bool(const toml::node&)> string_into(std::string& target) {
+  return [&target](const toml::node& n) {
+    if (!n.is_string()) return false;
+    target = n.value<std::string>().value_or("");
+    return true;
+  };
+}
+
+std::function<bool(const toml::node&)> rotation_into(Eigen::Matrix3d& target) {
+  return [&target](const toml::node& n) {
+    const toml::array* rows = n.as_array();
+    if (rows == nullptr || rows->size() != 3) return false;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const toml::array* row = (*rows)[i].as_array();
+      if (row == nullptr || row->size() != 3) return false;
+      for (std::size_t j = 0; j < 3; ++j) {
+        if (!(*row)[j].is_number()) return false;
+        target(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
+            (*row)[j].value<double>().value_or(0.0);
+      }
+    }
+    return true;
+  };
+}
+
+constexpr const char* kRotationExpected = "three rows of three numbers (statue = R sensor)";
+
+// The keys of a sensor's conditioning and health. `mounting` prefixes unit, sensor_to_statue
+// and rotation_tolerance ("conditioning." at the top, "" in a [[sensor]] table); `prefix` the
+// others ("" at the top, the table's keys then start with conditioning. / sensor_health.).
+void sensor_bindings(std::vector<Binding>& b, const std::string& mounting,
+                     monitor::ConditioningSettings& cond, monitor::SensorHealthSettings& health,
+                     std::string& unit) {
+  b.push_back({cat(mounting, "unit"), string_into(unit), "a string, \"g\" or \"m/s2\""});
+  b.push_back({cat(mounting, "sensor_to_statue"), rotation_into(cond.sensor_to_statue),
+               kRotationExpected});
+  b.push_back({cat(mounting, "rotation_tolerance"), number_into(cond.rotation_tolerance),
+               "a number"});
+  const std::pair<const char*, double*> numbers[] = {
+      {"conditioning.startup_window_s", &cond.startup_window_s},
+      {"conditioning.startup_max_std_m_s2", &cond.startup_max_std_m_s2},
+      {"conditioning.startup_max_offset_m_s2", &cond.startup_max_offset_m_s2},
+      {"conditioning.tracking_time_constant_s", &cond.tracking_time_constant_s},
+      {"conditioning.tracking_gate_m_s2", &cond.tracking_gate_m_s2},
+      {"sensor_health.timeout_s", &health.timeout_s},
+      {"sensor_health.full_scale_g", &health.full_scale_g},
+      {"sensor_health.max_valid_g", &health.max_valid_g},
+  };
+  for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
+  const std::pair<const char*, int*> integers[] = {
+      {"sensor_health.max_bridge_samples", &health.max_bridge_samples},
+      {"sensor_health.recovery_samples", &health.recovery_samples},
+      {"sensor_health.stuck_samples", &health.stuck_samples},
+  };
+  for (const auto& [key, target] : integers) {
+    b.push_back({key, integer_into(*target), "an integer"});
+  }
+}
+
 std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit) {
   MonitorConfig& c = f.config;
-  monitor::ConditioningSettings& cond = c.conditioning;
-  monitor::SensorHealthSettings& health = c.sensor_health;
   monitor::AlarmPolicySettings& alarm = c.alarm;
   std::vector<Binding> b = {
       {"monitor.ground_node", integer_into(node), "an integer"},
       {"monitor.quiet_risk", number_into(c.quiet_risk), "a number"},
-      {"monitor.second_scene",
-       [&f](const toml::node& n) {
-         if (!n.is_string()) return false;
-         f.second_scene_path = n.value<std::string>().value_or("");
-         return true;
-       },
-       "a string (a scene file)"},
+      {"monitor.second_scene", string_into(f.second_scene_path), "a string (a scene file)"},
       {"estimator.sample_rate_hz", number_into(c.estimator.sample_rate_hz), "a number"},
       {"estimator.steps_per_sample", integer_into(c.estimator.steps_per_sample), "an integer"},
       {"risk.base_stop_weight", number_into(c.risk.base_stop_weight), "a number"},
-      {"conditioning.unit",
-       [&unit](const toml::node& n) {
-         if (!n.is_string()) return false;
-         unit = n.value<std::string>().value_or("");
-         return true;
-       },
-       "a string, \"g\" or \"m/s2\""},
-      {"conditioning.sensor_to_statue",
-       [&cond](const toml::node& n) {
-         const toml::array* rows = n.as_array();
-         if (rows == nullptr || rows->size() != 3) return false;
-         for (std::size_t i = 0; i < 3; ++i) {
-           const toml::array* row = (*rows)[i].as_array();
-           if (row == nullptr || row->size() != 3) return false;
-           for (std::size_t j = 0; j < 3; ++j) {
-             if (!(*row)[j].is_number()) return false;
-             cond.sensor_to_statue(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) =
-                 (*row)[j].value<double>().value_or(0.0);
-           }
-         }
-         return true;
-       },
-       "three rows of three numbers (statue = R sensor)"},
-      {"conditioning.rotation_tolerance", number_into(cond.rotation_tolerance), "a number"},
-      {"conditioning.startup_window_s", number_into(cond.startup_window_s), "a number"},
-      {"conditioning.startup_max_std_m_s2", number_into(cond.startup_max_std_m_s2), "a number"},
-      {"conditioning.startup_max_offset_m_s2", number_into(cond.startup_max_offset_m_s2),
-       "a number"},
-      {"conditioning.tracking_time_constant_s", number_into(cond.tracking_time_constant_s),
-       "a number"},
-      {"conditioning.tracking_gate_m_s2", number_into(cond.tracking_gate_m_s2), "a number"},
-      {"sensor_health.timeout_s", number_into(health.timeout_s), "a number"},
-      {"sensor_health.max_bridge_samples", integer_into(health.max_bridge_samples), "an integer"},
-      {"sensor_health.recovery_samples", integer_into(health.recovery_samples), "an integer"},
-      {"sensor_health.stuck_samples", integer_into(health.stuck_samples), "an integer"},
-      {"sensor_health.full_scale_g", number_into(health.full_scale_g), "a number"},
-      {"sensor_health.max_valid_g", number_into(health.max_valid_g), "a number"},
+      {"redundancy.window_s", number_into(c.redundancy.window_s), "a number"},
+      {"redundancy.tolerance_m_s2", number_into(c.redundancy.tolerance_m_s2), "a number"},
+      {"plate.window_s", number_into(c.plate.window_s), "a number"},
+      {"plate.threshold_m_s2", number_into(c.plate.threshold_m_s2), "a number"},
+      {"plate.raises_fault", flag_into(c.plate.raises_fault), "true or false"},
       {"alarm_policy.raise_hold_s", number_into(alarm.raise_hold_s), "a number"},
       {"alarm_policy.lower_hold_s", number_into(alarm.lower_hold_s), "a number"},
       {"alarm_policy.latch_warning", flag_into(alarm.latch_warning), "true or false"},
       {"alarm_policy.latch_alarm", flag_into(alarm.latch_alarm), "true or false"},
       {"alarm_policy.heartbeat_period_s", number_into(alarm.heartbeat_period_s), "a number"},
   };
+  sensor_bindings(b, "conditioning.", c.conditioning, c.sensor_health, unit);
   for (auto [name, thresholds] : {std::pair<const char*, monitor::RiskThresholds*>{"advisory", &alarm.advisory},
                                   {"warning", &alarm.warning},
                                   {"alarm", &alarm.alarm}}) {
@@ -142,6 +162,29 @@ void flatten(const toml::table& table, const std::string& prefix,
   }
 }
 
+
+// "g" or "m/s2"; false otherwise.
+bool parse_unit(const std::string& text, monitor::AccelerationUnit& unit) {
+  if (text == "g") {
+    unit = monitor::AccelerationUnit::kStandardGravity;
+  } else if (text == "m/s2") {
+    unit = monitor::AccelerationUnit::kMetresPerSecondSquared;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+// The file's key of a field validate() reports for sensor `index` of a [[sensor]] list.
+std::string sensor_key(int index, const std::string& field) {
+  const std::string head = cat("sensor[", std::to_string(index), "].");
+  for (const char* mounting : {"unit", "sensor_to_statue", "rotation_tolerance"}) {
+    if (field == cat("conditioning.", mounting)) return cat(head, mounting);
+  }
+  if (field.rfind("sensor.", 0) == 0) return cat(head, field.substr(7));
+  return cat(head, field);
+}
+
 }  // namespace
 
 MonitorFile load_monitor_text(const std::string& text, const std::string& origin,
@@ -159,6 +202,10 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   int node = defaults.ground_node;
   std::string unit;
   std::vector<Binding> known = bindings(file, node, unit);
+  // [[sensor]] tables: read after the top-level tables, whose [conditioning] and
+  // [sensor_health] are every sensor's defaults.
+  const toml::node* sensor_list = doc.get("sensor");
+  const toml::array* sensor_tables = sensor_list != nullptr ? sensor_list->as_array() : nullptr;
   std::vector<std::pair<std::string, const toml::node*>> leaves;
   flatten(doc, "", leaves);
   std::map<std::string, std::uint32_t> lines;
@@ -166,29 +213,95 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     const auto it = lines.find(key);
     return it != lines.end() && it->second > 0 ? cat(origin, ":", std::to_string(it->second)) : origin;
   };
+  const auto store = [&](std::vector<Binding>& table, const std::string& key, const std::string& name,
+                         const toml::node& value) {
+    const auto binding = std::find_if(table.begin(), table.end(),
+                                      [&](const Binding& b) { return b.key == key; });
+    if (binding == table.end()) {
+      throw InputError(cat(where(name), ": ", name, ": unknown key (docs/monitor.md lists them)"));
+    }
+    if (!binding->store(value)) {
+      throw InputError(cat(where(name), ": ", name, ": expected ", binding->expected));
+    }
+  };
   for (const auto& [key, node_ptr] : leaves) {
     lines[key] = node_ptr->source().begin.line;
-    const auto binding = std::find_if(known.begin(), known.end(),
-                                      [&](const Binding& b) { return b.key == key; });
-    if (binding == known.end()) {
-      throw InputError(cat(where(key), ": ", key, ": unknown key (docs/monitor.md lists them)"));
-    }
-    if (!binding->store(*node_ptr)) {
-      throw InputError(cat(where(key), ": ", key, ": expected ", binding->expected));
-    }
+    if (key == "sensor" && sensor_tables != nullptr) continue;
+    store(known, key, key, *node_ptr);
   }
   if (node < 1 || node > 15) {
     throw InputError(cat(where("monitor.ground_node"), ": monitor.ground_node: must lie in [1, 15]"));
   }
   file.config.ground_node = static_cast<std::uint8_t>(node);
-  if (!unit.empty()) {
-    if (unit == "g") {
-      file.config.conditioning.unit = monitor::AccelerationUnit::kStandardGravity;
-    } else if (unit == "m/s2") {
-      file.config.conditioning.unit = monitor::AccelerationUnit::kMetresPerSecondSquared;
-    } else {
-      throw InputError(cat(where("conditioning.unit"),
-                           ": conditioning.unit: expected \"g\" or \"m/s2\", got \"", unit, "\""));
+  if (!unit.empty() && !parse_unit(unit, file.config.conditioning.unit)) {
+    throw InputError(cat(where("conditioning.unit"),
+                         ": conditioning.unit: expected \"g\" or \"m/s2\", got \"", unit, "\""));
+  }
+  if (sensor_list != nullptr) {
+    if (sensor_tables == nullptr || !sensor_tables->is_array_of_tables()) {
+      throw InputError(cat(where("sensor"), ": sensor: expected [[sensor]] tables"));
+    }
+    if (lines.count("monitor.ground_node") > 0) {
+      throw InputError(cat(where("monitor.ground_node"),
+                           ": monitor.ground_node: not with [[sensor]] tables (each gives its node)"));
+    }
+    if (sensor_tables->size() > static_cast<std::size_t>(kMaxSensors)) {
+      const std::string name = cat("sensor[", std::to_string(kMaxSensors), "]");
+      lines[name] = (*sensor_tables)[static_cast<std::size_t>(kMaxSensors)].source().begin.line;
+      throw InputError(cat(where(name), ": ", name, ": at most ", std::to_string(kMaxSensors),
+                           " sensors"));
+    }
+    file.config.sensor_count = static_cast<int>(sensor_tables->size());
+    for (std::size_t i = 0; i < sensor_tables->size(); ++i) {
+      const int index = static_cast<int>(i);
+      const std::string head = cat("sensor[", std::to_string(index), "]");
+      const toml::table& table = *(*sensor_tables)[i].as_table();
+      lines[head] = table.source().begin.line;
+      SensorConfig& sc = file.config.sensors[i];
+      sc = SensorConfig{};
+      sc.conditioning = file.config.conditioning;
+      sc.sensor_health = file.config.sensor_health;
+      int sensor_node = 0;
+      std::string role = "ground";
+      std::string sensor_unit;
+      std::vector<Binding> keys = {
+          {"node", integer_into(sensor_node), "an integer"},
+          {"role", string_into(role), "a string, \"ground\" or \"plate\""},
+      };
+      sensor_bindings(keys, "", sc.conditioning, sc.sensor_health, sensor_unit);
+      std::vector<std::pair<std::string, const toml::node*>> sensor_leaves;
+      flatten(table, "", sensor_leaves);
+      for (const auto& [key, node_ptr] : sensor_leaves) {
+        const std::string name = cat(head, ".", key);
+        lines[name] = node_ptr->source().begin.line;
+        store(keys, key, name, *node_ptr);
+      }
+      if (lines.count(cat(head, ".node")) == 0) {
+        throw InputError(cat(where(head), ": ", head, ": no node (each [[sensor]] gives its CAN node)"));
+      }
+      if (sensor_node < 1 || sensor_node > 15) {
+        throw InputError(cat(where(cat(head, ".node")), ": ", head, ".node: must lie in [1, 15]"));
+      }
+      sc.node = static_cast<std::uint8_t>(sensor_node);
+      for (std::size_t j = 0; j < i; ++j) {
+        if (file.config.sensors[j].node == sc.node) {
+          throw InputError(cat(where(cat(head, ".node")), ": ", head, ".node: node ",
+                               std::to_string(sensor_node), " is already sensor[",
+                               std::to_string(j), "]'s"));
+        }
+      }
+      if (role == "ground") {
+        sc.role = SensorRole::kGround;
+      } else if (role == "plate") {
+        sc.role = SensorRole::kPlate;
+      } else {
+        throw InputError(cat(where(cat(head, ".role")), ": ", head,
+                             ".role: expected \"ground\" or \"plate\", got \"", role, "\""));
+      }
+      if (!sensor_unit.empty() && !parse_unit(sensor_unit, sc.conditioning.unit)) {
+        throw InputError(cat(where(cat(head, ".unit")), ": ", head,
+                             ".unit: expected \"g\" or \"m/s2\", got \"", sensor_unit, "\""));
+      }
     }
   }
   if (!file.second_scene_path.empty()) {
@@ -198,8 +311,15 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     }
     file.config.axis_count = 2;
   }
-  if (const Error e = validate(file.config); !e.ok()) {
-    throw InputError(cat(where(e.field), ": ", e.field, ": ", e.reason));
+  int sensor_index = -1;
+  if (const Error e = validate(file.config, &sensor_index); !e.ok()) {
+    if (sensor_index < 0) throw InputError(cat(where(e.field), ": ", e.field, ": ", e.reason));
+    // A sensor's field: its own key if the [[sensor]] table sets it, else the default's line.
+    const std::string key = sensor_key(sensor_index, e.field);
+    const std::string head = cat("sensor[", std::to_string(sensor_index), "]");
+    const std::string line = lines.count(key) > 0 ? where(key)
+                             : lines.count(e.field) > 0 ? where(e.field) : where(head);
+    throw InputError(cat(line, ": ", key, ": ", e.reason));
   }
   return file;
 }

@@ -116,6 +116,47 @@ class AxisEvents final : public plinth::EventSink {
 
 std::string phase_text(const plinth::Mode& mode) { return plinth::phase_name(mode.phase); }
 
+// A cross-check's RMS, m/s2, or null while its window is not full (or for the primary).
+std::string rms_text(const fw::SensorStatus& sensor) {
+  if (sensor.primary || !sensor.window_full) return "null";
+  char text[32];
+  std::snprintf(text, sizeof text, "%.4g", sensor.rms_m_s2);
+  return text;
+}
+
+// The sensors' part of a status line: their state, failovers, the plate's residual, and each
+// sensor (docs/monitor.md).
+std::string sensors_json(const fw::MonitorStatus& s) {
+  char head[160];
+  std::snprintf(head, sizeof head,
+                ", \"sensors_state\": \"%s\", \"disagreement\": %s, \"failovers\": %llu",
+                mon::health_state_name(s.sensors_state), s.disagreement ? "true" : "false",
+                static_cast<unsigned long long>(s.failovers));
+  std::string line = head;
+  if (s.plate >= 0) {
+    line += ", \"plate_residual_m_s2\": ";
+    line += rms_text(s.sensors[static_cast<std::size_t>(s.plate)]);
+    line += s.plate_mismatch ? ", \"plate_mismatch\": true" : ", \"plate_mismatch\": false";
+  }
+  line += ", \"sensors\": [";
+  for (int i = 0; i < s.sensor_count; ++i) {
+    const fw::SensorStatus& sensor = s.sensors[static_cast<std::size_t>(i)];
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "%s{\"node\": %u, \"role\": \"%s\", \"primary\": %s, \"health\": \"%s\", "
+                  "\"cause\": \"%s\", \"ready\": %s, \"rms_m_s2\": ",
+                  i > 0 ? ", " : "", static_cast<unsigned>(sensor.node),
+                  fw::sensor_role_name(sensor.role), sensor.primary ? "true" : "false",
+                  mon::health_state_name(sensor.health.state),
+                  mon::health_cause_name(sensor.health.cause), sensor.ready ? "true" : "false");
+    line += text;
+    line += rms_text(sensor);
+    line += sensor.disagreeing ? ", \"disagreeing\": true}" : ", \"disagreeing\": false}";
+  }
+  line += "]";
+  return line;
+}
+
 // {"type":"status","t":..,"phase":..,"risk":..,"alarm":..,...} (docs/monitor.md).
 std::string status_json(const fw::Monitor& monitor, double t_origin) {
   const fw::MonitorStatus& s = monitor.status();
@@ -149,6 +190,7 @@ std::string status_json(const fw::Monitor& monitor, double t_origin) {
                 s.estimating ? "true" : "false", mon::health_state_name(s.sensor.state),
                 mon::health_cause_name(s.sensor.cause));
   line += numbers;
+  line += sensors_json(s);
   per_axis("state", [&](const fw::AxisStatus& a) {
     char text[320];
     std::snprintf(text, sizeof text,
@@ -363,6 +405,33 @@ void print_summary(const fw::Monitor& monitor, const Outputs& outputs, const Sum
       static_cast<unsigned long long>(s.estimator_restarts),
       static_cast<unsigned long long>(outputs.bus_send_errors));
   std::string line = text;
+  const auto count = [](std::uint64_t value) { return static_cast<unsigned long long>(value); };
+  char totals[200];
+  std::snprintf(totals, sizeof totals,
+                ", \"sensors_state\": \"%s\", \"failovers\": %llu, \"failovers_continued\": %llu, "
+                "\"sensors\": [",
+                mon::health_state_name(s.sensors_state), count(s.failovers),
+                count(s.failovers_continued));
+  line += totals;
+  for (int i = 0; i < s.sensor_count; ++i) {
+    const fw::SensorStatus& sensor = s.sensors[static_cast<std::size_t>(i)];
+    const mon::SensorCounters& k = sensor.health.counters;
+    char one[512];
+    std::snprintf(
+        one, sizeof one,
+        "%s{\"node\": %u, \"role\": \"%s\", \"primary\": %s, \"state\": \"%s\", "
+        "\"received\": %llu, \"fed\": %llu, \"bridged\": %llu, \"missing\": %llu, "
+        "\"long_gaps\": %llu, \"rejected\": %llu, \"timeouts\": %llu, \"faults\": %llu, "
+        "\"pairs\": %llu, \"unpaired\": %llu, \"disagreements\": %llu, \"max_rms_m_s2\": %.4g}",
+        i > 0 ? ", " : "", static_cast<unsigned>(sensor.node), fw::sensor_role_name(sensor.role),
+        sensor.primary ? "true" : "false", mon::health_state_name(sensor.health.state),
+        count(k.received), count(k.fed), count(k.bridged), count(k.missing), count(k.long_gaps),
+        count(k.non_finite + k.out_of_range + k.undefined_status), count(k.timeouts),
+        count(k.faults), count(sensor.pairs), count(sensor.unpaired), count(sensor.disagreements),
+        sensor.max_rms_m_s2);
+    line += one;
+  }
+  line += "]";
   if (recorder != nullptr) {
     char rec[160];
     std::snprintf(rec, sizeof rec,
@@ -390,9 +459,31 @@ int run(const Options& opt) {
     if (scene_y_path.empty()) scene_y_path = file.second_scene_path;
   }
   if (opt.steps) config.estimator.steps_per_sample = *opt.steps;
-  if (opt.node) config.ground_node = static_cast<std::uint8_t>(*opt.node);
-  if (opt.startup_window) config.conditioning.startup_window_s = *opt.startup_window;
-  if (opt.stuck_samples) config.sensor_health.stuck_samples = *opt.stuck_samples;
+  if (opt.node) {
+    if (config.sensor_count > 0) {
+      throw InputError(std::string("--node names the single ground sensor; ") + opt.config_path +
+                       " lists [[sensor]] tables (give the nodes there)");
+    }
+    config.ground_node = static_cast<std::uint8_t>(*opt.node);
+  }
+  // The command line's sensor settings apply to every sensor.
+  const auto each_sensor = [&config](auto apply) {
+    apply(config.conditioning, config.sensor_health);
+    for (int i = 0; i < config.sensor_count && i < fw::kMaxSensors; ++i) {
+      fw::SensorConfig& sensor = config.sensors[static_cast<std::size_t>(i)];
+      apply(sensor.conditioning, sensor.sensor_health);
+    }
+  };
+  if (opt.startup_window) {
+    each_sensor([&](mon::ConditioningSettings& c, mon::SensorHealthSettings&) {
+      c.startup_window_s = *opt.startup_window;
+    });
+  }
+  if (opt.stuck_samples) {
+    each_sensor([&](mon::ConditioningSettings&, mon::SensorHealthSettings& h) {
+      h.stuck_samples = *opt.stuck_samples;
+    });
+  }
   if (!opt.replay_y_path.empty() && scene_y_path.empty()) {
     throw InputError("--replay-y needs a second axis: --scene-y or monitor.second_scene");
   }
@@ -414,6 +505,15 @@ int run(const Options& opt) {
   if (replay_record) {
     record = record_samples(opt, gravity);
     config.estimator.sample_rate_hz = record.rate_hz;
+    // One ideal ground sensor: a [[sensor]] list is reduced to its first ground sensor.
+    for (int i = config.sensor_count - 1; i >= 0; --i) {
+      const fw::SensorConfig& sensor = config.sensors[static_cast<std::size_t>(i)];
+      if (sensor.role != fw::SensorRole::kGround) continue;
+      config.ground_node = sensor.node;
+      config.conditioning = sensor.conditioning;
+      config.sensor_health = sensor.sensor_health;
+    }
+    config.sensor_count = 0;
     // The record is the ground's exact motion in m/s2, in the statue's frame: no bias to track,
     // no sensor noise (the stuck-value check needs noise), and the quiet lead-in estimates the
     // zero offset. The file's sensor settings describe the real sensor, not this one.
@@ -562,7 +662,11 @@ int run(const Options& opt) {
         bus_fault_until = 0;
         monitor.set_bus_fault(false);
       }
-      outputs.handle(monitor.on_tick(now_ns));
+      // After a frame, tick at its receive time: frames still queued in the socket are newer,
+      // and a monitor that fell behind must not count its own delay as a sensor timeout. Only
+      // with nothing to read is the wall clock the right time.
+      outputs.handle(
+          monitor.on_tick(status == plinth::hal::IoStatus::kOk ? frame.timestamp_ns : now_ns));
     }
   }
   if (recorder) recorder->flush();
@@ -592,7 +696,7 @@ int main(int argc, char** argv) {
   app.add_option("--rate", opt.rate, "sensor rate, Hz (100-1000; default: the record's, or 200)")
       ->check(plinth::cli::kFinitePositive);
   app.add_option("--steps", opt.steps, "solver steps per sample (default 4)")->check(CLI::Range(1, 64));
-  app.add_option("--node", opt.node, "CAN node of the ground sensor (default 1)")->check(CLI::Range(1, 15));
+  app.add_option("--node", opt.node, "CAN node of the single ground sensor (default 1; not with [[sensor]] tables)")->check(CLI::Range(1, 15));
   app.add_option("--status-interval", opt.status_interval, "s between status lines (default 0.1)")
       ->check(plinth::cli::kFinitePositive);
   app.add_option("--startup-window", opt.startup_window,

@@ -100,6 +100,47 @@ assert s["max_risk"] > 0.0, s
     if [[ -z "$problem" ]]; then pass "candump log replay: every frame a sample, none missing"
     else fail "candump log replay" "$problem"; fi
   fi
+  # Two ground sensors (node 2: node 1's frames 0.5 ms later); node 1 falls silent at 60 % of
+  # the log: the estimators fail over to node 2 and continue, the summary reports each sensor.
+  python3 - "$log" "$TMP/two.log" <<'PY'
+import sys
+rows = []
+lines = [l.split() for l in open(sys.argv[1]) if l.strip()]
+t0 = float(lines[0][0].strip("()"))
+t1 = float(lines[-1][0].strip("()"))
+cut = t0 + 0.6 * (t1 - t0)
+for stamp, iface, frame in lines:
+    t = float(stamp.strip("()"))
+    ident, data = frame.split("#")
+    if ident != "301":
+        continue
+    if t < cut:
+        rows.append((t, "%s %s 301#%s" % ("(%.6f)" % t, iface, data)))
+    rows.append((t + 0.0005, "(%.6f) %s 302#%s" % (t + 0.0005, iface, data)))
+with open(sys.argv[2], "w") as out:
+    for _, row in sorted(rows):
+        out.write(row + "\n")
+PY
+  printf '[[sensor]]\nnode = 1\n\n[[sensor]]\nnode = 2\nrole = "ground"\n' >"$TMP/two.toml"
+  if expect_success "two ground sensors, failover" --scene "$ISOLATED" --replay "$TMP/two.log" \
+      --config "$TMP/two.toml" --rate 344.8275862068966 --startup-window 1 --status-interval 1 \
+      --stuck-samples 0 --no-events; then
+    problem=$(check_output "$TMP/stdout" '
+s = summary[0]
+assert [x["node"] for x in s["sensors"]] == [1, 2], s
+assert s["failovers"] == 1 and s["failovers_continued"] == 1, s
+assert s["estimator_restarts"] == 1, s
+assert s["sensors_state"] == "degraded" and s["sensors"][0]["state"] == "fault", s
+assert s["sensors"][1]["primary"] and s["sensors"][1]["pairs"] > 0, s
+assert s["sensors"][1]["disagreements"] == 0, s
+assert all(len(x["sensors"]) == 2 for x in status), status[-1]
+assert status[-1]["sensors"][1]["primary"] and status[-1]["failovers"] == 1, status[-1]
+')
+    if [[ -z "$problem" ]]; then pass "two ground sensors: failover, the estimators continue"
+    else fail "two ground sensors" "$problem"; fi
+  fi
+  expect_failure "--node with [[sensor]] tables" '--node' -- --scene "$ISOLATED" \
+    --replay "$TMP/two.log" --config "$TMP/two.toml" --node 3
   head -n 5 "$log" >"$TMP/garbled.log"
   echo "(12.500000) can0 301#00112233445566778899" >>"$TMP/garbled.log"
   expect_failure "candump log: a garbled line" 'garbled\.log:6' -- \

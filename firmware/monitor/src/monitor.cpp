@@ -4,11 +4,66 @@
 
 namespace plinth::firmware {
 
-Error validate(const MonitorConfig& c) {
+namespace {
+
+// The settings of a cross-check window: window_s at the sample rate in [2, max] samples, and a
+// finite positive tolerance.
+Error validate_check(double window_s, double tolerance_m_s2, double rate_hz,
+                     const char* window_field, const char* tolerance_field) {
+  const double samples = window_s * rate_hz;
+  if (!std::isfinite(window_s) || samples < 2.0 ||
+      samples > static_cast<double>(kMaxCheckWindowSamples)) {
+    return {ErrorCode::kOutOfRange, window_field,
+            "must span 2 to 1000 sample periods at the sample rate"};
+  }
+  if (!std::isfinite(tolerance_m_s2) || tolerance_m_s2 <= 0.0) {
+    return {ErrorCode::kOutOfRange, tolerance_field, "must be a positive acceleration, m/s2"};
+  }
+  return ok_error();
+}
+
+int window_length(double window_s, double rate_hz) {
+  const long n = std::lround(window_s * rate_hz);
+  return n < 2 ? 2 : (n > kMaxCheckWindowSamples ? kMaxCheckWindowSamples : static_cast<int>(n));
+}
+
+}  // namespace
+
+const char* sensor_role_name(SensorRole role) {
+  switch (role) {
+    case SensorRole::kGround:
+      return "ground";
+    case SensorRole::kPlate:
+      return "plate";
+  }
+  return "invalid";
+}
+
+int resolved_sensors(const MonitorConfig& c, std::array<SensorConfig, kMaxSensors>& out) {
+  if (c.sensor_count <= 0) {
+    out[0].node = c.ground_node;
+    out[0].role = SensorRole::kGround;
+    out[0].conditioning = c.conditioning;
+    out[0].sensor_health = c.sensor_health;
+    return 1;
+  }
+  const int count = c.sensor_count > kMaxSensors ? kMaxSensors : c.sensor_count;
+  for (int i = 0; i < count; ++i) {
+    out[static_cast<std::size_t>(i)] = c.sensors[static_cast<std::size_t>(i)];
+  }
+  return count;
+}
+
+Error validate(const MonitorConfig& c, int* sensor_index) {
+  if (sensor_index != nullptr) *sensor_index = -1;
   if (c.axis_count < 1 || c.axis_count > kMaxAxes) {
     return {ErrorCode::kOutOfRange, "monitor.axis_count", "must be 1 or 2"};
   }
-  if (c.ground_node < can::kFirstSensorNode || c.ground_node > can::kLastSensorNode) {
+  if (c.sensor_count < 0 || c.sensor_count > kMaxSensors) {
+    return {ErrorCode::kOutOfRange, "monitor.sensor_count", "must lie in [0, 4]"};
+  }
+  if (c.sensor_count == 0 &&
+      (c.ground_node < can::kFirstSensorNode || c.ground_node > can::kLastSensorNode)) {
     return {ErrorCode::kOutOfRange, "monitor.ground_node", "must lie in [1, 15]"};
   }
   if (!std::isfinite(c.quiet_risk) || c.quiet_risk < 0.0 || c.quiet_risk > 1.0) {
@@ -21,12 +76,78 @@ Error validate(const MonitorConfig& c) {
       c.estimator.sample_rate_hz > 1000.0) {
     return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
   }
-  monitor::ConditioningSettings conditioning = c.conditioning;
-  conditioning.sample_period_s = c.estimator.sample_period();
-  if (Error e = monitor::validate(conditioning); !e.ok()) return e;
-  monitor::SensorHealthSettings health = c.sensor_health;
-  health.sample_period_s = c.estimator.sample_period();
-  return monitor::validate(health);
+  if (Error e = validate_check(c.redundancy.window_s, c.redundancy.tolerance_m_s2,
+                               c.estimator.sample_rate_hz, "redundancy.window_s",
+                               "redundancy.tolerance_m_s2");
+      !e.ok()) {
+    return e;
+  }
+  if (Error e = validate_check(c.plate.window_s, c.plate.threshold_m_s2,
+                               c.estimator.sample_rate_hz, "plate.window_s",
+                               "plate.threshold_m_s2");
+      !e.ok()) {
+    return e;
+  }
+  std::array<SensorConfig, kMaxSensors> sensors{};
+  const int count = resolved_sensors(c, sensors);
+  int grounds = 0;
+  int plates = 0;
+  for (int i = 0; i < count; ++i) {
+    const SensorConfig& s = sensors[static_cast<std::size_t>(i)];
+    if (sensor_index != nullptr) *sensor_index = c.sensor_count == 0 ? -1 : i;
+    if (s.node < can::kFirstSensorNode || s.node > can::kLastSensorNode) {
+      return {ErrorCode::kOutOfRange, "sensor.node", "must lie in [1, 15]"};
+    }
+    for (int j = 0; j < i; ++j) {
+      if (sensors[static_cast<std::size_t>(j)].node == s.node) {
+        return {ErrorCode::kInconsistent, "sensor.node", "is another sensor's node"};
+      }
+    }
+    if (s.role == SensorRole::kGround) {
+      ++grounds;
+    } else if (s.role == SensorRole::kPlate) {
+      if (++plates > 1) {
+        return {ErrorCode::kInconsistent, "sensor.role", "a second plate sensor: at most one"};
+      }
+    } else {
+      return {ErrorCode::kOutOfRange, "sensor.role", "must be ground or plate"};
+    }
+    monitor::ConditioningSettings conditioning = s.conditioning;
+    conditioning.sample_period_s = c.estimator.sample_period();
+    if (Error e = monitor::validate(conditioning); !e.ok()) return e;
+    monitor::SensorHealthSettings health = s.sensor_health;
+    health.sample_period_s = c.estimator.sample_period();
+    if (Error e = monitor::validate(health); !e.ok()) return e;
+  }
+  if (grounds == 0) {
+    if (sensor_index != nullptr) *sensor_index = 0;
+    return {ErrorCode::kInconsistent, "sensor.role",
+            "no ground sensor: at least one must drive the estimators"};
+  }
+  if (sensor_index != nullptr) *sensor_index = -1;
+  return ok_error();
+}
+
+void Monitor::RmsWindow::add(double square) {
+  const auto slot = static_cast<std::size_t>(next);
+  if (count >= length) {
+    sum -= squares[slot];
+  } else {
+    ++count;
+  }
+  squares[slot] = square;
+  sum += square;
+  next = next + 1 >= length ? 0 : next + 1;
+  if (next == 0) {  // once per window: the sum afresh, no drift of the running sum over hours
+    sum = 0.0;
+    for (int i = 0; i < count; ++i) sum += squares[static_cast<std::size_t>(i)];
+  }
+}
+
+double Monitor::RmsWindow::rms() const {
+  if (count == 0) return 0.0;
+  const double mean = sum / static_cast<double>(count);
+  return mean > 0.0 ? std::sqrt(mean) : 0.0;
 }
 
 Error Monitor::start(const MonitorConfig& config,
@@ -42,17 +163,46 @@ Error Monitor::start(const MonitorConfig& config,
   config_ = config;
   config_.conditioning.sample_period_s = config.estimator.sample_period();
   config_.sensor_health.sample_period_s = config.estimator.sample_period();
-  if (Error e = monitor::SensorHealthTracker::create(config_.sensor_health, health_); !e.ok()) {
-    return e;
-  }
-  if (Error e = monitor::Conditioner::create(config_.conditioning, conditioner_); !e.ok()) {
-    return e;
+  sensor_count_ = resolved_sensors(config_, sensor_configs_);
+  status_ = MonitorStatus{};
+  status_.axis_count = config.axis_count;
+  status_.sensor_count = sensor_count_;
+  for (int i = 0; i < sensor_count_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    SensorConfig& sc = sensor_configs_[k];
+    sc.conditioning.sample_period_s = config.estimator.sample_period();
+    sc.sensor_health.sample_period_s = config.estimator.sample_period();
+    Sensor& s = sensors_[k];
+    if (Error e = monitor::SensorHealthTracker::create(sc.sensor_health, s.health); !e.ok()) {
+      return e;
+    }
+    if (Error e = monitor::Conditioner::create(sc.conditioning, s.conditioner); !e.ok()) {
+      return e;
+    }
+    s.history = History{};
+    s.window.reset();
+    s.window.length = sc.role == SensorRole::kPlate
+                          ? window_length(config.plate.window_s, config.estimator.sample_rate_hz)
+                          : window_length(config.redundancy.window_s,
+                                          config.estimator.sample_rate_hz);
+    s.checked = 0;
+    SensorStatus& st = status_.sensors[k];
+    st = SensorStatus{};
+    st.node = sc.node;
+    st.role = sc.role;
+    st.health = s.health.health();
+    if (sc.role == SensorRole::kPlate) status_.plate = i;
   }
   if (Error e = monitor::AlarmPolicy::create(config_.alarm, alarm_); !e.ok()) return e;
   scenes_ = scenes;
-  status_ = MonitorStatus{};
-  status_.axis_count = config.axis_count;
-  status_.sensor = health_.health();
+  status_.sensor = sensors_[0].health.health();
+  estimate_ = History{};
+  period_ns_ = std::llround(config.estimator.sample_period() * 1e9);
+  consumed_ = 0;
+  restart_pending_ = false;
+  align_pending_ = false;
+  last_fed_ns_ = 0;
+  last_ground_.setZero();
   frames_ = FrameCounters{};
   have_epoch_ = false;
   bus_fault_ = false;
@@ -76,45 +226,278 @@ std::int64_t Monitor::monitor_time(std::int64_t receive_time_ns) {
   return t > status_.time_ns ? t : status_.time_ns;  // never backwards
 }
 
-MonitorUpdate Monitor::on_sample(const monitor::SensorSample& sample) {
-  MonitorUpdate update;
-  status_.time_ns = monitor_time(sample.receive_time_ns);
-  const monitor::SensorUpdate fed = health_.on_sample(sample);
-  for (std::size_t i = 0; i < fed.fed_count; ++i) feed(fed.fed[i]);
-  evaluate(update);
-  return update;
-}
-
-void Monitor::feed(const monitor::FedSample& sample) {
+bool Monitor::quiet() const {
   bool quiet = status_.estimating && status_.risk < config_.quiet_risk;
   for (int i = 0; i < status_.axis_count; ++i) {
     quiet = quiet && status_.axes[static_cast<std::size_t>(i)].mode.phase == Phase::kFullContact;
   }
-  const monitor::ConditionedSample c = conditioner_.condition(sample.acceleration_g, quiet);
+  return quiet;
+}
+
+bool Monitor::usable(int sensor) const {
+  const Sensor& s = sensors_[static_cast<std::size_t>(sensor)];
+  return sensor_configs_[static_cast<std::size_t>(sensor)].role == SensorRole::kGround &&
+         s.health.health().state != monitor::HealthState::kFault && s.conditioner.status().ready &&
+         !s.history.empty();
+}
+
+MonitorUpdate Monitor::on_sensor_sample(int sensor, const monitor::SensorSample& sample) {
+  MonitorUpdate update;
+  if (sensor < 0 || sensor >= sensor_count_) return update;
+  status_.time_ns = monitor_time(sample.receive_time_ns);
+  // The other sensors' silence shows on this one's clock (a silent primary fails over without
+  // waiting for a tick).
+  for (int j = 0; j < sensor_count_; ++j) {
+    if (j != sensor) (void)sensors_[static_cast<std::size_t>(j)].health.tick(sample.receive_time_ns);
+  }
+  const monitor::SensorUpdate fed = sensors_[static_cast<std::size_t>(sensor)].health.on_sample(sample);
+  for (std::size_t i = 0; i < fed.fed_count; ++i) process(sensor, fed.fed[i]);
+  update_primary();
+  drain_primary();
+  cross_check();
+  evaluate(update);
+  return update;
+}
+
+// One fed sample of `sensor`: conditioned, kept in its history; the primary's goes on to the
+// estimators at once.
+void Monitor::process(int sensor, const monitor::FedSample& sample) {
+  Sensor& s = sensors_[static_cast<std::size_t>(sensor)];
+  const monitor::ConditionedSample c = s.conditioner.condition(sample.acceleration_g, quiet());
   if (!c.ready) return;  // start-up window, or refused input (counted by the conditioner)
-  const bool restart = !status_.estimating || sample.restart;
+  if (sample.restart) {  // a seam: nothing before it connects, nor compares, to what follows
+    s.history.clear();
+    s.window.reset();
+    s.checked = s.history.pushed;
+  }
+  s.history.push({sample.time_ns, c.ground_m_s2, sample.restart});
+  update_primary();
+  drain_primary();
+}
+
+// Keeps the primary while it is usable; else the first usable ground sensor in configured
+// order takes over (a failover once the estimators have run).
+void Monitor::update_primary() {
+  if (status_.primary >= 0 && usable(status_.primary)) return;
+  int candidate = -1;
+  for (int i = 0; i < sensor_count_ && candidate < 0; ++i) {
+    if (usable(i)) candidate = i;
+  }
+  if (candidate < 0 || candidate == status_.primary) return;
+  const History& h = sensors_[static_cast<std::size_t>(candidate)].history;
+  if (status_.primary >= 0) ++status_.failovers;
+  status_.primary = candidate;
+  // The reference changed: every cross-check starts afresh.
+  for (int i = 0; i < sensor_count_; ++i) {
+    Sensor& s = sensors_[static_cast<std::size_t>(i)];
+    s.window.reset();
+    s.checked = s.history.pushed;
+    SensorStatus& st = status_.sensors[static_cast<std::size_t>(i)];
+    st.window_full = false;
+    st.disagreeing = false;
+    st.rms_m_s2 = 0.0;
+  }
+  // Continue from the estimators' state when the new primary's history holds the stream on
+  // from their newest sample within the bridge limit; else start again at rest on its newest.
+  const int bridge = sensor_configs_[static_cast<std::size_t>(candidate)].sensor_health.max_bridge_samples;
+  std::uint64_t next = h.valid_from();
+  while (next < h.pushed && h.at(next).time_ns <= last_fed_ns_ + period_ns_ / 2) ++next;
+  const bool continues = status_.estimating && next < h.pushed && !h.at(next).restart &&
+                         h.at(next).time_ns - last_fed_ns_ <=
+                             static_cast<std::int64_t>(bridge + 1) * period_ns_ + period_ns_ / 2;
+  if (continues) {
+    consumed_ = next;
+    align_pending_ = true;
+    restart_pending_ = false;
+    if (status_.failovers > 0) ++status_.failovers_continued;
+  } else {
+    consumed_ = h.pushed - 1;
+    restart_pending_ = true;
+    align_pending_ = false;
+  }
+}
+
+void Monitor::drain_primary() {
+  if (status_.primary < 0) return;
+  const History& h = sensors_[static_cast<std::size_t>(status_.primary)].history;
+  if (consumed_ < h.valid_from()) consumed_ = h.valid_from();
+  while (consumed_ < h.pushed) drive(h.at(consumed_++));
+}
+
+void Monitor::push_estimators(const Eigen::Vector3d& g) {
   for (int i = 0; i < status_.axis_count; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    const GroundAcceleration ground{c.ground_m_s2[i], c.ground_m_s2.z()};
-    if (restart) {
+    estimators_[static_cast<std::size_t>(i)].push(GroundAcceleration{g[i], g.z()});
+  }
+}
+
+// One sample of the primary into the estimators.
+void Monitor::drive(const HistoryEntry& entry) {
+  const bool restart = !status_.estimating || entry.restart || restart_pending_;
+  if (restart) {
+    for (int i = 0; i < status_.axis_count; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const GroundAcceleration ground{entry.value[i], entry.value.z()};
       // validate() in start() checked what start() can refuse but a non-finite sample, which
       // conditioning does not pass on.
       (void)estimators_[k].start(*scenes_[k], config_.estimator, ground);
       estimators_[k].set_event_sink(sinks_[k]);
-    } else {
-      estimators_[k].push(ground);
     }
-  }
-  if (restart) {
     ++status_.estimator_restarts;
-    status_.estimator_start_ns = sample.time_ns - epoch_ns_;
+    status_.estimator_start_ns = entry.time_ns - epoch_ns_;
+    restart_pending_ = false;
+    align_pending_ = false;
+    estimate_.clear();
+  } else if (align_pending_) {
+    // The first sample after a failover: as many sample periods as its time says (the new
+    // primary's clock), the ones between bridged linearly.
+    align_pending_ = false;
+    const double periods =
+        static_cast<double>(entry.time_ns - last_fed_ns_) / static_cast<double>(period_ns_);
+    const long n = std::lround(periods);
+    if (n < 1) return;  // at or before the estimators' newest sample: taken already
+    for (long j = 1; j < n; ++j) {
+      const double w = static_cast<double>(j) / static_cast<double>(n);
+      push_estimators(last_ground_ + w * (entry.value - last_ground_));
+    }
+    push_estimators(entry.value);
+  } else {
+    push_estimators(entry.value);
   }
   status_.estimating = true;
-  status_.newest_sample_time_ns = sample.time_ns - epoch_ns_;
+  status_.newest_sample_time_ns = entry.time_ns - epoch_ns_;
+  last_fed_ns_ = entry.time_ns;
+  last_ground_ = entry.value;
+  if (status_.plate >= 0) {
+    // The model's absolute base acceleration u'' + u_G'' per axis: the plate's reference.
+    HistoryEntry e;
+    e.time_ns = entry.time_ns;
+    for (int i = 0; i < status_.axis_count; ++i) {
+      const PlanarEstimator& est = estimators_[static_cast<std::size_t>(i)];
+      e.value[i] = est.simulator().accelerations().u + est.ground().horizontal;
+    }
+    estimate_.push(e);
+  }
+}
+
+// The reference's value at `time_ns`: interpolated between its samples around it (at most two
+// periods apart), else its nearest within one period. False: none.
+bool Monitor::reference_at(const History& reference, std::int64_t time_ns,
+                           Eigen::Vector3d& value) const {
+  const std::uint64_t from = reference.valid_from();
+  if (from >= reference.pushed) return false;
+  std::uint64_t after = reference.pushed;  // the first entry later than time_ns
+  while (after > from && reference.at(after - 1).time_ns > time_ns) --after;
+  const bool have_before = after > from;
+  const bool have_after = after < reference.pushed;
+  if (have_before && have_after) {
+    const HistoryEntry& a = reference.at(after - 1);
+    const HistoryEntry& b = reference.at(after);
+    if (b.time_ns - a.time_ns <= 2 * period_ns_ && !b.restart) {
+      const double w = static_cast<double>(time_ns - a.time_ns) /
+                       static_cast<double>(b.time_ns - a.time_ns);
+      value = a.value + w * (b.value - a.value);
+      return true;
+    }
+  }
+  std::int64_t best = period_ns_ + 1;
+  if (have_before && time_ns - reference.at(after - 1).time_ns < best) {
+    best = time_ns - reference.at(after - 1).time_ns;
+    value = reference.at(after - 1).value;
+  }
+  if (have_after && reference.at(after).time_ns - time_ns < best) {
+    best = reference.at(after).time_ns - time_ns;
+    value = reference.at(after).value;
+  }
+  return best <= period_ns_;
+}
+
+void Monitor::check_sensor(int sensor) {
+  const auto k = static_cast<std::size_t>(sensor);
+  Sensor& s = sensors_[k];
+  SensorStatus& st = status_.sensors[k];
+  const bool plate = sensor_configs_[k].role == SensorRole::kPlate;
+  const History& reference = plate ? estimate_ : sensors_[static_cast<std::size_t>(status_.primary)].history;
+  const int components = plate ? status_.axis_count : 3;
+  if (s.checked < s.history.valid_from()) {  // pushed out before a reference came: not compared
+    st.unpaired += s.history.valid_from() - s.checked;
+    s.checked = s.history.valid_from();
+  }
+  while (s.checked < s.history.pushed) {
+    const HistoryEntry& e = s.history.at(s.checked);
+    // Wait until the reference has a sample at or after this one (or nothing will come: the
+    // entry is then pushed out of the history and counted unpaired).
+    if (reference.empty() || reference.newest().time_ns < e.time_ns) break;
+    ++s.checked;
+    Eigen::Vector3d r = Eigen::Vector3d::Zero();
+    if (!reference_at(reference, e.time_ns, r)) {
+      ++st.unpaired;
+      continue;
+    }
+    ++st.pairs;
+    double square = 0.0;
+    for (int c = 0; c < components; ++c) {
+      const double d = e.value[c] - r[c];
+      square += d * d;
+    }
+    s.window.add(square);
+  }
+  st.window_full = s.window.full();
+  st.rms_m_s2 = s.window.rms();
+  const double limit = plate ? config_.plate.threshold_m_s2 : config_.redundancy.tolerance_m_s2;
+  const bool beyond = st.window_full && st.rms_m_s2 > limit;
+  if (st.window_full) st.max_rms_m_s2 = st.rms_m_s2 > st.max_rms_m_s2 ? st.rms_m_s2 : st.max_rms_m_s2;
+  if (beyond && !st.disagreeing) ++st.disagreements;
+  st.disagreeing = beyond;
+}
+
+void Monitor::cross_check() {
+  if (sensor_count_ < 2 || status_.primary < 0) return;
+  for (int i = 0; i < sensor_count_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    if (i == status_.primary) continue;
+    if (sensors_[k].health.health().state == monitor::HealthState::kFault) {
+      // Not compared while in fault: what it said before no longer counts.
+      sensors_[k].window.reset();
+      sensors_[k].checked = sensors_[k].history.pushed;
+      status_.sensors[k].window_full = false;
+      status_.sensors[k].disagreeing = false;
+      continue;
+    }
+    check_sensor(i);
+  }
 }
 
 void Monitor::evaluate(MonitorUpdate& update) {
-  status_.sensor = health_.health();
+  const int reported = status_.primary >= 0 ? status_.primary : 0;
+  status_.sensor = sensors_[static_cast<std::size_t>(reported)].health.health();
+  bool others_degraded = false;
+  bool disagreement = false;
+  for (int i = 0; i < sensor_count_; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    SensorStatus& st = status_.sensors[k];
+    st.health = sensors_[k].health.health();
+    st.ready = sensors_[k].conditioner.status().ready;
+    st.primary = i == status_.primary;
+    if (i == reported) continue;
+    others_degraded = others_degraded || st.health.state != monitor::HealthState::kOk;
+    disagreement = disagreement || (st.role == SensorRole::kGround && st.disagreeing);
+  }
+  status_.disagreement = disagreement;
+  if (status_.plate >= 0) {
+    const SensorStatus& plate = status_.sensors[static_cast<std::size_t>(status_.plate)];
+    status_.plate_residual_m_s2 = plate.rms_m_s2;
+    status_.plate_mismatch = plate.disagreeing;
+  }
+  const bool sensor_fault = status_.sensor.state == monitor::HealthState::kFault;
+  if (sensor_fault) {
+    status_.sensors_state = monitor::HealthState::kFault;
+  } else if (status_.sensor.state != monitor::HealthState::kOk || others_degraded ||
+             disagreement || status_.plate_mismatch) {
+    status_.sensors_state = monitor::HealthState::kDegraded;
+  } else {
+    status_.sensors_state = monitor::HealthState::kOk;
+  }
+
   double risk = 0.0;
   bool moving = false;
   bool collapse = false;
@@ -137,10 +520,11 @@ void Monitor::evaluate(MonitorUpdate& update) {
   input.risk = risk;
   input.out_of_full_contact = moving;
   input.collapse_detected = collapse;
-  const bool sensor_fault = status_.sensor.state == monitor::HealthState::kFault;
-  input.fault_active = sensor_fault || bus_fault_;
+  const bool mismatch_fault = status_.plate_mismatch && config_.plate.raises_fault;
+  input.fault_active = sensor_fault || disagreement || mismatch_fault || bus_fault_;
   input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status_.sensor.cause)
-                                   : can::AlarmCause::kBusError;
+                      : (disagreement || mismatch_fault) ? can::AlarmCause::kSensorDisagreement
+                                                         : can::AlarmCause::kBusError;
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
   pending_ack_ = false;
@@ -157,8 +541,13 @@ void Monitor::evaluate(MonitorUpdate& update) {
 MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
   MonitorUpdate update;
   if (have_epoch_) {
-    (void)health_.tick(receive_time_ns);
+    for (int i = 0; i < sensor_count_; ++i) {
+      (void)sensors_[static_cast<std::size_t>(i)].health.tick(receive_time_ns);
+    }
     status_.time_ns = monitor_time(receive_time_ns);
+    update_primary();
+    drain_primary();
+    cross_check();
   }
   evaluate(update);
   return update;
@@ -179,7 +568,11 @@ MonitorUpdate Monitor::on_frame(const hal::TimedFrame& timed) {
         reject(r);
         return {};
       }
-      if (message.node != config_.ground_node) {
+      int sensor = -1;
+      for (int i = 0; i < sensor_count_ && sensor < 0; ++i) {
+        if (sensor_configs_[static_cast<std::size_t>(i)].node == message.node) sensor = i;
+      }
+      if (sensor < 0) {
         ++frames_.other_nodes;
         return {};
       }
@@ -189,7 +582,7 @@ MonitorUpdate Monitor::on_frame(const hal::TimedFrame& timed) {
       sample.sequence = message.sequence;
       sample.status = message.status;
       sample.acceleration_g = Eigen::Vector3d(message.ax_g, message.ay_g, message.az_g);
-      return on_sample(sample);
+      return on_sensor_sample(sensor, sample);
     }
     case can::MessageKind::kSensorHeartbeat: {
       can::SensorHeartbeat message;

@@ -1,12 +1,46 @@
-// The box's main loop, without the operating system: CAN frames (or decoded sensor samples) in;
+// The box's loop, without the operating system: CAN frames (or decoded sensor samples) in;
 // sensor health, conditioning, one planar estimator per modelled axis, the overturning risk
 // and the alarm policy; a status and alarm events out. Freestanding like lib/core: no heap, no
 // exceptions; everything is sized at compile time and set up once by start().
 //
-//   frame --codec--> SensorSample --SensorHealthTracker--> fed samples (bridged, restarts)
-//     --Conditioner--> ground acceleration in the statue frame (m/s2)
-//     --PlanarEstimator per axis (x: statue axis 1, y: axis 2; z feeds g + v_G'')-->
-//     phase, state --overturning_risk--> risk --AlarmPolicy--> level, events
+//   frame --codec--> SensorSample --SensorHealthTracker (one per sensor)--> fed samples
+//     --Conditioner (one per sensor)--> acceleration in the statue frame (m/s2), kept in the
+//     sensor's history (its last kSensorHistory samples)
+//   the primary ground sensor's samples --PlanarEstimator per axis (x: statue axis 1, y: axis 2;
+//     z feeds g + v_G'')--> phase, state --overturning_risk--> risk --AlarmPolicy--> level, events
+//   the other ground sensors' samples --cross-check against the primary--> disagreement
+//   the plate sensor's samples --compared with the model's base acceleration--> residual
+//
+// Sensors. Up to kMaxSensors accelerometers, each with its own node, role, health tracker and
+// conditioner (unit, mounting rotation, offset). The single-sensor form (sensor_count = 0) is
+// one ground sensor: ground_node, conditioning, sensor_health.
+//  - Ground sensors (at least one): the primary drives the estimators. It is the first usable
+//    ground sensor in configured order (usable: health not fault, conditioning ready) when the
+//    estimators start; afterwards it stays primary until it faults (no switching back when an
+//    earlier sensor recovers: every switch is a seam in the estimators' input). Then the first
+//    usable ground sensor in configured order takes over (a failover): when the new primary's
+//    history continues the stream within the bridge limit ((max_bridge_samples + 1) sample
+//    periods after the last sample the estimators took), the estimators continue from their
+//    state on its samples (a short seam is bridged by linear interpolation); otherwise they
+//    start again at rest on its newest sample, as after a fault. With no usable ground sensor
+//    left, the primary's fault is the fault level, as with one sensor.
+//  - Cross-check: each other usable ground sensor's samples are paired with the primary's at
+//    the same receive time (linear interpolation between the primary's two samples around it,
+//    or its nearest sample within one period; samples of different nodes are not synchronous)
+//    and the RMS of the difference (all three axes, m/s2) over redundancy.window_s is compared
+//    with redundancy.tolerance_m_s2. Beyond it the sensors disagree: counted, reported, and the
+//    alarm policy's fault input is raised with cause kSensorDisagreement (the estimators' input
+//    is not trusted while two sensors of the same ground disagree; the alarm policy never hides
+//    an alarm behind a fault). Which of the two is wrong is not decided.
+//  - Plate sensor (at most one, on the isolation plate): its horizontal acceleration measures
+//    the base's absolute acceleration u'' + u_G''. It never drives the estimators; it is paired
+//    with the estimators' own u'' + u_G'' (Simulator::accelerations() of the current mode, plus
+//    the ground's) and the RMS of the difference over plate.window_s is the model-mismatch
+//    residual, beyond plate.threshold_m_s2 a mismatch: counted and reported (degraded), and
+//    raising the fault level with kSensorDisagreement only when plate.raises_fault (impacts at
+//    the stops and on the block make the residual jump while the model is right).
+//  - A sensor other than the one driving the estimators in fault (a lost redundant or plate
+//    sensor), a disagreement or a mismatch make the sensors' state degraded (status, summary).
 //
 // Time: monitor time is ns since the first sensor sample's receive time. The estimator starts
 // (at rest, full contact) with the first sample that conditioning marks ready, and starts again
@@ -14,6 +48,7 @@
 // what happened meanwhile; the fault level shows it).
 #pragma once
 
+#include <Eigen/Core>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -32,9 +67,43 @@
 namespace plinth::firmware {
 
 inline constexpr int kMaxAxes = 2;
+inline constexpr int kMaxSensors = 4;  // accelerometers, ground and plate together
+// Samples kept per sensor (conditioned, with receive times): the cross-checks' pairing and a
+// failover's catch-up. A timeout is below 128 sample periods, so a silent primary's failover
+// still finds the new primary's samples since the last one the estimators took.
+inline constexpr int kSensorHistory = 128;
+// Longest cross-check window, samples (window_s times the sample rate).
+inline constexpr int kMaxCheckWindowSamples = 1000;
+
+enum class SensorRole : std::uint8_t {
+  kGround = 0,  // on the ground (the foundation): may drive the estimators
+  kPlate = 1,   // on the isolation plate: checks the model, never drives it
+};
+[[nodiscard]] const char* sensor_role_name(SensorRole role);  // "ground", "plate"
+
+struct SensorConfig {
+  std::uint8_t node = 1;  // CAN node id, 1..15, one per sensor
+  SensorRole role = SensorRole::kGround;
+  monitor::ConditioningSettings conditioning;   // its sample period is the estimator's
+  monitor::SensorHealthSettings sensor_health;  // its sample period is the estimator's
+};
+
+// Ground sensors against the primary.
+struct RedundancySettings {
+  double window_s = 0.5;         // s: sliding window of the RMS difference, 2..1000 samples
+  double tolerance_m_s2 = 0.3;   // m/s2, > 0: an RMS difference beyond this is a disagreement
+};
+
+// The plate sensor against the model.
+struct PlateCheckSettings {
+  double window_s = 1.0;         // s: sliding window of the RMS residual, 2..1000 samples
+  double threshold_m_s2 = 0.5;   // m/s2, > 0: an RMS residual beyond this is a mismatch
+  bool raises_fault = false;     // a mismatch also raises the fault level (kSensorDisagreement)
+};
 
 struct MonitorConfig {
   int axis_count = 1;  // 1: the statue's first principal axis; 2: both
+  // The single-sensor form, used when sensor_count = 0: one ground accelerometer.
   std::uint8_t ground_node = 1;  // CAN node id of the ground accelerometer, 1..15
   EstimatorSettings estimator;   // sample rate (= the sensor's) and solver steps per sample
   RiskSettings risk;
@@ -43,10 +112,24 @@ struct MonitorConfig {
   monitor::AlarmPolicySettings alarm;
   // Quiet (offset tracking allowed): every axis at rest in full contact with risk below this.
   double quiet_risk = 1e-3;
+  // The sensor list, sensors[0 .. sensor_count): replaces ground_node, conditioning and
+  // sensor_health when sensor_count > 0. At least one ground sensor, at most one plate sensor,
+  // distinct nodes; the configured order is the order of preference for the primary.
+  int sensor_count = 0;
+  std::array<SensorConfig, kMaxSensors> sensors{};
+  RedundancySettings redundancy;
+  PlateCheckSettings plate;
 };
 
 // Checks every part; the Error names the field ("monitor.axis_count", "estimator....", ...).
-[[nodiscard]] Error validate(const MonitorConfig& config);
+// A sensor's fields are "sensor.node", "sensor.role", "conditioning....", "sensor_health....";
+// `sensor_index`, when given, receives the index of the sensor at fault (-1: none).
+[[nodiscard]] Error validate(const MonitorConfig& config, int* sensor_index = nullptr);
+
+// The sensors of `config`: its list, or the single-sensor form as one ground sensor. Returns
+// the count.
+[[nodiscard]] int resolved_sensors(const MonitorConfig& config,
+                                   std::array<SensorConfig, kMaxSensors>& out);
 
 struct AxisStatus {
   Mode mode;
@@ -54,10 +137,10 @@ struct AxisStatus {
   Risk risk;
 };
 
-// Frames that were not sensor samples of the ground node, or could not be decoded.
+// Frames that were not sensor samples of a configured node, or could not be decoded.
 struct FrameCounters {
   std::uint64_t received = 0;
-  std::uint64_t sensor_samples = 0;       // SensorAcceleration of the ground node, decoded
+  std::uint64_t sensor_samples = 0;       // SensorAcceleration of a configured node, decoded
   std::uint64_t other_nodes = 0;          // SensorAcceleration of other nodes (not used)
   std::uint64_t heartbeats = 0;           // SensorHeartbeat of any node
   std::uint64_t acknowledgements = 0;     // Acknowledge frames, decoded
@@ -66,6 +149,24 @@ struct FrameCounters {
   std::uint64_t unknown_identifiers = 0;  // not a plinth identifier
   can::CodecError last_error = can::CodecError::kOk;  // of the latest rejected frame
   const char* last_error_signal = "";
+};
+
+// One sensor's part of the status.
+struct SensorStatus {
+  std::uint8_t node = 1;
+  SensorRole role = SensorRole::kGround;
+  bool primary = false;  // drives the estimators
+  bool ready = false;    // conditioning ready (offset estimated)
+  monitor::SensorHealth health;
+  // Cross-check (ground sensors but the primary: the RMS difference to the primary; the plate:
+  // the model-mismatch residual), m/s2, over the sliding window; valid once the window is full.
+  double rms_m_s2 = 0.0;
+  bool window_full = false;
+  bool disagreeing = false;   // rms_m_s2 beyond the tolerance (plate: the threshold)
+  double max_rms_m_s2 = 0.0;  // the largest full-window RMS so far
+  std::uint64_t pairs = 0;         // samples compared
+  std::uint64_t unpaired = 0;      // samples with no reference sample within one period
+  std::uint64_t disagreements = 0;  // entries into the disagreeing state
 };
 
 struct MonitorStatus {
@@ -80,6 +181,20 @@ struct MonitorStatus {
   std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
   std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
   std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
+  // The sensors, in configured order; `sensor` above is the primary's health (before the
+  // first primary: the first ground sensor's).
+  int sensor_count = 1;
+  std::array<SensorStatus, kMaxSensors> sensors{};
+  int primary = -1;  // index of the sensor driving the estimators; -1 before the first
+  std::uint64_t failovers = 0;            // switches of the primary after the first choice
+  std::uint64_t failovers_continued = 0;  // of which the estimators continued from their state
+  // ok; degraded: a sensor but the primary not ok (a redundant or the plate sensor lost), a
+  // disagreement or a plate mismatch; fault: no usable ground sensor (the primary's fault).
+  monitor::HealthState sensors_state = monitor::HealthState::kFault;
+  bool disagreement = false;     // a ground sensor disagrees with the primary (fault input)
+  bool plate_mismatch = false;   // the plate's residual is beyond its threshold
+  int plate = -1;                // index of the plate sensor; -1: none
+  double plate_residual_m_s2 = 0.0;  // the plate's RMS residual (valid when its window is full)
 };
 
 // What one input did.
@@ -106,8 +221,13 @@ class Monitor {
 
   // One frame from the bus (or a candump log).
   [[nodiscard]] MonitorUpdate on_frame(const hal::TimedFrame& frame);
-  // One decoded sample of the ground node (file replay feeds these directly).
-  [[nodiscard]] MonitorUpdate on_sample(const monitor::SensorSample& sample);
+  // One decoded sample of the first sensor (the ground node of the single-sensor form; file
+  // replay feeds these directly).
+  [[nodiscard]] MonitorUpdate on_sample(const monitor::SensorSample& sample) {
+    return on_sensor_sample(0, sample);
+  }
+  // One decoded sample of sensor `sensor` (its index in the configured order).
+  [[nodiscard]] MonitorUpdate on_sensor_sample(int sensor, const monitor::SensorSample& sample);
   // Call periodically with the receive clock's time: sensor timeouts, heartbeats.
   [[nodiscard]] MonitorUpdate on_tick(std::int64_t receive_time_ns);
   // Bus trouble reported by the frame source (bus-off, dropped frames): raises the fault level
@@ -116,24 +236,96 @@ class Monitor {
 
   [[nodiscard]] const MonitorStatus& status() const { return status_; }
   [[nodiscard]] const FrameCounters& frames() const { return frames_; }
+  // The primary's conditioning (before the first primary: the first sensor's).
   [[nodiscard]] const monitor::ConditioningStatus& conditioning() const {
-    return conditioner_.status();
+    return conditioning(status_.primary < 0 ? 0 : status_.primary);
+  }
+  [[nodiscard]] const monitor::ConditioningStatus& conditioning(int sensor) const {
+    return sensors_[static_cast<std::size_t>(sensor)].conditioner.status();
+  }
+  [[nodiscard]] const PlanarEstimator& estimator(int axis) const {
+    return estimators_[static_cast<std::size_t>(axis)];
+  }
+  // The sensors as started (the single-sensor form resolved).
+  [[nodiscard]] const SensorConfig& sensor_config(int sensor) const {
+    return sensor_configs_[static_cast<std::size_t>(sensor)];
   }
   [[nodiscard]] const MonitorConfig& config() const { return config_; }
   // Records that a status went out (resets the heartbeat).
   void status_sent() { alarm_.heartbeat_sent(status_.time_ns); }
 
  private:
-  void feed(const monitor::FedSample& sample);
+  // A conditioned sample, statue frame, m/s2, at its receive time.
+  struct HistoryEntry {
+    std::int64_t time_ns = 0;  // receive clock
+    Eigen::Vector3d value = Eigen::Vector3d::Zero();
+    bool restart = false;  // the health tracker's restart mark
+  };
+  // The last kSensorHistory entries of a stream; entries [valid_from(), pushed) are kept.
+  struct History {
+    std::array<HistoryEntry, kSensorHistory> entries{};
+    std::uint64_t pushed = 0;      // entries ever pushed; the newest is pushed - 1
+    std::uint64_t first_kept = 0;  // entries before this were cleared (a seam in the stream)
+    [[nodiscard]] std::uint64_t valid_from() const {
+      const std::uint64_t held = pushed < kSensorHistory ? 0 : pushed - kSensorHistory;
+      return first_kept > held ? first_kept : held;
+    }
+    [[nodiscard]] bool empty() const { return valid_from() >= pushed; }
+    [[nodiscard]] const HistoryEntry& at(std::uint64_t n) const {
+      return entries[static_cast<std::size_t>(n % kSensorHistory)];
+    }
+    [[nodiscard]] const HistoryEntry& newest() const { return at(pushed - 1); }
+    void push(const HistoryEntry& e) { entries[static_cast<std::size_t>(pushed++ % kSensorHistory)] = e; }
+    void clear() { first_kept = pushed; }
+  };
+  // The RMS of a sliding window of squared differences.
+  struct RmsWindow {
+    std::array<double, kMaxCheckWindowSamples> squares{};
+    int length = 2;   // samples
+    int count = 0;    // samples held, up to length
+    int next = 0;     // slot of the next one
+    double sum = 0.0;
+    void reset() { count = 0; next = 0; sum = 0.0; }
+    void add(double square);
+    [[nodiscard]] bool full() const { return count >= length; }
+    [[nodiscard]] double rms() const;
+  };
+  struct Sensor {
+    monitor::SensorHealthTracker health;
+    monitor::Conditioner conditioner;
+    History history;
+    RmsWindow window;
+    std::uint64_t checked = 0;  // history entries cross-checked (or found unpairable)
+  };
+
+  void process(int sensor, const monitor::FedSample& sample);
+  void update_primary();
+  void drain_primary();
+  void drive(const HistoryEntry& entry);
+  void push_estimators(const Eigen::Vector3d& ground_m_s2);
+  void cross_check();
+  void check_sensor(int sensor);
+  [[nodiscard]] bool reference_at(const History& reference, std::int64_t time_ns,
+                                  Eigen::Vector3d& value) const;
+  [[nodiscard]] bool usable(int sensor) const;
+  [[nodiscard]] bool quiet() const;
   void evaluate(MonitorUpdate& update);
   [[nodiscard]] std::int64_t monitor_time(std::int64_t receive_time_ns);
 
   MonitorConfig config_;
+  std::array<SensorConfig, kMaxSensors> sensor_configs_{};
+  int sensor_count_ = 1;
+  std::array<Sensor, kMaxSensors> sensors_{};
+  History estimate_;  // the model's base acceleration u'' + u_G'' per axis (the plate's reference)
+  std::int64_t period_ns_ = 5'000'000;
+  std::uint64_t consumed_ = 0;  // the primary's history entries the estimators took
+  bool restart_pending_ = false;  // the next entry starts the estimators at rest
+  bool align_pending_ = false;    // the next entry continues after a failover: align by time
+  std::int64_t last_fed_ns_ = 0;  // receive time of the estimators' newest sample
+  Eigen::Vector3d last_ground_ = Eigen::Vector3d::Zero();  // its value, m/s2
   std::array<const Scene*, kMaxAxes> scenes_{};
   std::array<PlanarEstimator, kMaxAxes> estimators_{};
   std::array<EventSink*, kMaxAxes> sinks_{};
-  monitor::SensorHealthTracker health_;
-  monitor::Conditioner conditioner_;
   monitor::AlarmPolicy alarm_;
   MonitorStatus status_;
   FrameCounters frames_;
