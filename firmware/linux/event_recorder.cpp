@@ -47,19 +47,23 @@ EventRecorder::EventRecorder(EventRecorderSettings settings) : settings_(std::mo
   ring_.resize(frames_in(settings_.pre_trigger_s, settings_.frame_rate_hz));
   const std::size_t capture_frames =
       frames_in(settings_.pre_trigger_s + settings_.post_trigger_s, settings_.frame_rate_hz);
-  for (Capture& c : buffers_) c.frames.reserve(capture_frames);
-  spare_ = &buffers_[0];
+  for (Capture& c : buffers_) {
+    c.frames.reserve(capture_frames);
+    free_[free_count_++] = &c;
+  }
   writer_ = std::thread([this] { writer_loop(); });
 }
 
-EventRecorder::~EventRecorder() {
+EventRecorder::~EventRecorder() { close(); }
+
+void EventRecorder::close() {
   flush();
   {
     const std::lock_guard lock(mutex_);
     stopping_ = true;
   }
   wake_.notify_one();
-  writer_.join();
+  if (writer_.joinable()) writer_.join();
 }
 
 void EventRecorder::on_frame(const hal::TimedFrame& frame) {
@@ -81,8 +85,7 @@ void EventRecorder::trigger(const TriggerInfo& info, std::int64_t time_ns) {
   }
   {
     const std::lock_guard lock(mutex_);
-    active_ = spare_;
-    spare_ = nullptr;
+    if (free_count_ > 0) active_ = free_[--free_count_];
   }
   if (active_ == nullptr) {  // both buffers busy: the writer is behind
     dropped_.fetch_add(1);
@@ -109,7 +112,7 @@ void EventRecorder::flush() {
 void EventRecorder::hand_over() {
   {
     const std::lock_guard lock(mutex_);
-    to_write_ = active_;
+    waiting_[waiting_count_++] = active_;  // room: at most two buffers exist
   }
   active_ = nullptr;
   wake_.notify_one();
@@ -125,15 +128,15 @@ void EventRecorder::writer_loop() {
     Capture* capture = nullptr;
     {
       std::unique_lock lock(mutex_);
-      wake_.wait(lock, [this] { return to_write_ != nullptr || stopping_; });
-      if (to_write_ == nullptr) return;  // stopping, nothing left
-      capture = to_write_;
-      to_write_ = nullptr;
+      wake_.wait(lock, [this] { return waiting_count_ > 0 || stopping_; });
+      if (waiting_count_ == 0) return;  // stopping, nothing left
+      capture = waiting_[0];
+      waiting_[0] = waiting_[1];
+      --waiting_count_;
     }
     write(*capture);
     const std::lock_guard lock(mutex_);
-    // The other buffer may be active; this one is free again.
-    if (spare_ == nullptr) spare_ = capture;
+    free_[free_count_++] = capture;
   }
 }
 

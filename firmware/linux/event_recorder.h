@@ -48,6 +48,8 @@ class EventRecorder {
   void trigger(const TriggerInfo& info, std::int64_t time_ns);
   // The input ended: the capture in progress is written with what it has.
   void flush();
+  // flush(), then waits until the writer has written everything and stops it (idempotent).
+  void close();
 
   [[nodiscard]] std::uint64_t captures_written() const { return written_.load(); }
   [[nodiscard]] std::uint64_t captures_dropped() const { return dropped_.load(); }
@@ -75,13 +77,17 @@ class EventRecorder {
   std::size_t ring_next_ = 0;
   std::size_t ring_count_ = 0;
   Capture buffers_[2];
-  Capture* active_ = nullptr;  // the capture being filled, or none
-  Capture* spare_ = nullptr;   // free for the next capture, or none (the writer has it)
+  Capture* active_ = nullptr;  // the capture being filled (real-time side only), or none
   int next_index_ = 1;
 
+  // Under mutex_: buffers free for a new capture, and captures waiting for the writer (in
+  // order). Each buffer is in exactly one place: free, active, waiting or being written.
   std::mutex mutex_;
   std::condition_variable wake_;
-  Capture* to_write_ = nullptr;
+  Capture* free_[2] = {};
+  int free_count_ = 0;
+  Capture* waiting_[2] = {};
+  int waiting_count_ = 0;
   bool stopping_ = false;
   std::thread writer_;
   std::vector<std::string> paths_;

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <time.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
@@ -285,7 +286,9 @@ class Outputs {
       m.alarm_level = s.alarm;
       m.risk = a.risk.total;
       m.sequence = status_sequence_;
-      const std::int64_t age_ms = (s.time_ns - s.newest_sample_time_ns) / 1'000'000;
+      // Not estimating yet: no sample was used, the age is the largest the frame can say.
+      const std::int64_t age_ms =
+          s.estimating ? (s.time_ns - s.newest_sample_time_ns) / 1'000'000 : 65535;
       m.sample_age_ms = static_cast<std::uint16_t>(age_ms < 0 ? 0 : (age_ms > 65535 ? 65535 : age_ms));
       send(m);
     }
@@ -363,6 +366,9 @@ RecordSamples record_samples(const Options& opt, double gravity) {
 struct Summary {
   std::uint64_t samples = 0;
   std::string source;
+  std::uint64_t bus_errors = 0;      // error frames reported by the controller (live)
+  std::uint64_t overflows = 0;       // times the kernel reported dropped frames (live)
+  std::uint64_t dropped_frames = 0;  // frames the kernel dropped before we read them (live)
 };
 
 void print_summary(const fw::Monitor& monitor, const Outputs& outputs, const Summary& summary,
@@ -383,7 +389,8 @@ void print_summary(const fw::Monitor& monitor, const Outputs& outputs, const Sum
       "\"sensor\": {\"state\": \"%s\", \"fed\": %llu, \"bridged\": %llu, \"missing\": %llu, "
       "\"long_gaps\": %llu, \"duplicates\": %llu, \"out_of_order\": %llu, \"rejected\": %llu, "
       "\"saturated\": %llu, \"timeouts\": %llu, \"faults\": %llu}, "
-      "\"estimator_restarts\": %llu, \"bus_send_errors\": %llu",
+      "\"estimator_restarts\": %llu, \"bus_send_errors\": %llu, \"bus_errors\": %llu, "
+      "\"bus_dropped_frames\": %llu",
       summary.source.c_str(), static_cast<double>(s.time_ns) * 1e-9 - t_origin,
       static_cast<unsigned long long>(summary.samples), plinth::phase_name(s.axes[0].mode.phase),
       outputs.max_risk, can::alarm_level_name(outputs.max_level), can::alarm_level_name(s.alarm),
@@ -403,7 +410,9 @@ void print_summary(const fw::Monitor& monitor, const Outputs& outputs, const Sum
       static_cast<unsigned long long>(c.saturated), static_cast<unsigned long long>(c.timeouts),
       static_cast<unsigned long long>(c.faults),
       static_cast<unsigned long long>(s.estimator_restarts),
-      static_cast<unsigned long long>(outputs.bus_send_errors));
+      static_cast<unsigned long long>(outputs.bus_send_errors),
+      static_cast<unsigned long long>(summary.bus_errors),
+      static_cast<unsigned long long>(summary.dropped_frames));
   std::string line = text;
   const auto count = [](std::uint64_t value) { return static_cast<unsigned long long>(value); };
   char totals[200];
@@ -649,6 +658,7 @@ int run(const Options& opt) {
         }
         case plinth::hal::IoStatus::kBusError:
         case plinth::hal::IoStatus::kOverflow:
+          ++(status == plinth::hal::IoStatus::kBusError ? summary.bus_errors : summary.overflows);
           bus_fault_until = now_ns + 2'000'000'000;  // held 2 s after the latest report
           monitor.set_bus_fault(true);
           break;
@@ -662,17 +672,17 @@ int run(const Options& opt) {
         bus_fault_until = 0;
         monitor.set_bus_fault(false);
       }
-      // After a frame, tick at its receive time: frames still queued in the socket are newer,
+      // Tick at the newest frame's receive time: frames still queued in the socket are newer,
       // and a monitor that fell behind must not count its own delay as a sensor timeout. Only
       // with nothing to read is the wall clock the right time.
-      outputs.handle(
-          monitor.on_tick(status == plinth::hal::IoStatus::kOk ? frame.timestamp_ns : now_ns));
+      outputs.handle(monitor.on_tick(status == plinth::hal::IoStatus::kTimeout
+                                         ? now_ns
+                                         : std::max(outputs.last_frame_ns, frame.timestamp_ns)));
     }
+    summary.dropped_frames = port->total_dropped_frames();
   }
-  if (recorder) recorder->flush();
-  recorder.reset();  // joins the writer: every capture is on disk before the summary
-  fw::EventRecorder* none = nullptr;
-  print_summary(monitor, outputs, summary, none, t_origin, sinks);
+  if (recorder) recorder->close();  // every capture is on disk before the summary
+  print_summary(monitor, outputs, summary, recorder.get(), t_origin, sinks);
   std::fflush(stdout);
   return 0;
 }

@@ -83,7 +83,8 @@ if expect_success "recorder: captures written" --scene "$ISOLATED" --replay "$AT
   log=$TMP/captures/event-001.log
   if [[ -s "$log" && -s "$TMP/captures/event-001.json" ]] &&
       python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["level"]=="warning" and d["frames"]>0' \
-      "$TMP/captures/event-001.json" 2>/dev/null; then
+      "$TMP/captures/event-001.json" 2>/dev/null &&
+      tail -n 1 "$TMP/stdout" | grep -q '"recorder": {"captures_written": 1, "captures_dropped": 0'; then
     pass "recorder: log and summary"
   else
     fail "recorder: log and summary" "missing or wrong: $(ls "$TMP/captures" 2>&1)"
