@@ -5,33 +5,11 @@
 
 namespace plinth {
 
-double SampledSignal::at(double t) const {
-  if (count == 0 || t < 0.0) return 0.0;
-  const double position = t / dt;
-  const auto last = static_cast<double>(count - 1);
-  if (position >= last) return position == last ? values[count - 1] : 0.0;
-  const double floor_position = std::floor(position);
-  const auto i = static_cast<std::size_t>(floor_position);
-  const double w = position - floor_position;
-  return values[i] + w * (values[i + 1] - values[i]);
-}
-
-GroundAcceleration Excitation::at(double t) const {
-  switch (kind) {
-    case ExcitationKind::kNone:
-      return {};
-    case ExcitationKind::kRecord:
-      return {scale * horizontal.at(t), scale * vertical.at(t)};
-    case ExcitationKind::kSinePulse:
-      if (t < 0.0 || t > period) return {};
-      return {amplitude * std::sin(2.0 * std::numbers::pi * t / period), 0.0};
-    case ExcitationKind::kCosinePulse:
-      if (t < 0.0 || t > period) return {};
-      return {amplitude * std::cos(2.0 * std::numbers::pi * t / period), 0.0};
-    case ExcitationKind::kStream:
-      return stream->at(t);
-  }
-  return {};
+GroundAcceleration Excitation::pulse_at(double t) const {
+  if (t < 0.0 || t > period) return {};
+  const double phase = 2.0 * std::numbers::pi * t / period;
+  return {amplitude * (kind == ExcitationKind::kSinePulse ? std::sin(phase) : std::cos(phase)),
+          0.0};
 }
 
 double Excitation::duration() const {

@@ -1,10 +1,12 @@
 #include "plinth/core/simulator.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
+#include <string_view>
 
-#include "plinth/core/energy.h"
+#include "phase_kernels.h"
 #include "plinth/core/flows.h"
 #include "plinth/core/guards.h"
 #include "plinth/core/resets.h"
@@ -63,9 +65,39 @@ const char* event_name(EventKind kind) {
   return "unknown";
 }
 
+const char* stepper_name(Stepper stepper) {
+  switch (stepper) {
+    case Stepper::kRk4Located:
+      return "rk4_located";
+    case Stepper::kRk4StepEnd:
+      return "rk4_step_end";
+    case Stepper::kHeunLocated:
+      return "heun_located";
+    case Stepper::kSemiImplicitEuler:
+      return "semi_implicit_euler";
+  }
+  return "unknown";
+}
+
+bool parse_stepper(std::string_view name, Stepper& out) {
+  for (const Stepper stepper : kAllSteppers) {
+    if (name == stepper_name(stepper)) {
+      out = stepper;
+      return true;
+    }
+  }
+  return false;
+}
+
 Error validate(const SolverSettings& st) {
   if (!std::isfinite(st.step) || st.step <= 0.0) {
     return {ErrorCode::kOutOfRange, "solver.step", "must be a finite number greater than zero"};
+  }
+  bool known_stepper = false;
+  for (const Stepper stepper : kAllSteppers) known_stepper = known_stepper || st.stepper == stepper;
+  if (!known_stepper) {
+    return {ErrorCode::kOutOfRange, "solver.stepper",
+            "must be one of rk4_located, rk4_step_end, heun_located, semi_implicit_euler"};
   }
   if (!std::isfinite(st.rest_energy_ratio) || st.rest_energy_ratio <= 0.0 ||
       st.rest_energy_ratio >= 1.0) {
@@ -97,6 +129,69 @@ double largest_rate(double mass, double damping, double stiffness) {
   return a + std::sqrt(a * a - w2);       // overdamped: the fast real root
 }
 
+// A 2x2 matrix on (q, q').
+struct Matrix2 {
+  double a00, a01, a10, a11;
+};
+
+Matrix2 product(const Matrix2& x, const Matrix2& y) {
+  return {x.a00 * y.a00 + x.a01 * y.a10, x.a00 * y.a01 + x.a01 * y.a11,
+          x.a10 * y.a00 + x.a11 * y.a10, x.a10 * y.a01 + x.a11 * y.a11};
+}
+
+double spectral_radius(const Matrix2& g) {
+  const double half_trace = 0.5 * (g.a00 + g.a11);
+  const double det = g.a00 * g.a11 - g.a01 * g.a10;
+  const double discriminant = half_trace * half_trace - det;
+  if (discriminant < 0.0) return std::sqrt(det);  // complex pair, |mu|^2 = det
+  const double root = std::sqrt(discriminant);
+  return std::max(std::fabs(half_trace + root), std::fabs(half_trace - root));
+}
+
+// The one-step map of `stepper` with step h on m q'' + c q' + k q = 0.
+Matrix2 amplification(Stepper stepper, double mass, double damping, double stiffness, double h) {
+  const double a = -stiffness / mass;
+  const double b = -damping / mass;
+  if (stepper == Stepper::kSemiImplicitEuler) {
+    return {1.0 + h * h * a, h + h * h * b, h * a, 1.0 + h * b};
+  }
+  const Matrix2 ha{0.0, h, h * a, h * b};
+  const Matrix2 ha2 = product(ha, ha);
+  Matrix2 g{1.0 + ha.a00 + 0.5 * ha2.a00, ha.a01 + 0.5 * ha2.a01, ha.a10 + 0.5 * ha2.a10,
+            1.0 + ha.a11 + 0.5 * ha2.a11};
+  if (stepper == Stepper::kHeunLocated) return g;
+  const Matrix2 ha3 = product(ha2, ha);
+  const Matrix2 ha4 = product(ha3, ha);
+  g.a00 += ha3.a00 / 6.0 + ha4.a00 / 24.0;
+  g.a01 += ha3.a01 / 6.0 + ha4.a01 / 24.0;
+  g.a10 += ha3.a10 / 6.0 + ha4.a10 / 24.0;
+  g.a11 += ha3.a11 / 6.0 + ha4.a11 / 24.0;
+  return g;
+}
+
+// The largest h whose one-step map grows no mode by more than kStableGrowthPerStep: scanned up
+// from far below the system's time scale in steps of 2 %, the first failure then bisected.
+double largest_stable_step_of(Stepper stepper, double mass, double damping, double stiffness) {
+  const double rate = largest_rate(mass, damping, stiffness);
+  const auto stable = [&](double h) {
+    return spectral_radius(amplification(stepper, mass, damping, stiffness, h)) <=
+           1.0 + kStableGrowthPerStep;
+  };
+  double low = 1e-4 / rate;
+  if (!stable(low)) return 0.0;
+  double high = low;
+  while (stable(high)) {
+    low = high;
+    high *= 1.02;
+    if (high > 100.0 / rate) return high;
+  }
+  for (int i = 0; i < 60; ++i) {
+    const double middle = 0.5 * (low + high);
+    (stable(middle) ? low : high) = middle;
+  }
+  return low;
+}
+
 }  // namespace
 
 double largest_stable_step(const Scene& s) {
@@ -108,9 +203,19 @@ double largest_stable_step(const Scene& s) {
   return kRk4StabilityRadius / rate;
 }
 
-// The solver for one set of model features: what a scene does not have is compiled out.
+double largest_stable_step(const Scene& s, Stepper stepper) {
+  if (stepper == Stepper::kRk4Located || stepper == Stepper::kRk4StepEnd || !s.has_base()) {
+    return largest_stable_step(s);
+  }
+  return std::min(largest_stable_step_of(stepper, s.total_mass, s.damping, s.stiffness),
+                  largest_stable_step_of(stepper, s.total_mass - s.m, s.damping, s.stiffness));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The hybrid logic for one set of model features: which guards each mode has, what happens at
+// each event. What a scene does not have is compiled out.
 template <Features F>
-struct Stepper {
+struct Hybrid {
   static bool base_moves(const Mode& mode) {
     if constexpr (!F.base) {
       return false;
@@ -119,6 +224,7 @@ struct Stepper {
     }
   }
 
+  // The accelerations of `mode` at (y, ag), the same as the phase kernels' (phase_kernels.h).
   static Accelerations accelerations(const Scene& s, const Mode& mode, const State& y,
                                      GroundAcceleration ag) {
     const bool moves = base_moves(mode);
@@ -144,84 +250,7 @@ struct Stepper {
     return {};
   }
 
-  static State derivative(const Simulator& sim, const Mode& mode, double t, const State& y) {
-    const Accelerations a = accelerations(*sim.scene_, mode, y, sim.excitation_.at(t));
-    State d;
-    d << y[kUDot], y[kXDot], y[kThetaDot], a.u, a.x, a.theta;
-    return d;
-  }
-
-  // One classical Runge-Kutta step of size h from (t, y) in `mode`.
-  static State rk4(const Simulator& sim, const Mode& mode, double t, const State& y, double h) {
-    const State k1 = derivative(sim, mode, t, y);
-    const State k2 = derivative(sim, mode, t + 0.5 * h, y + 0.5 * h * k1);
-    const State k3 = derivative(sim, mode, t + 0.5 * h, y + 0.5 * h * k2);
-    const State k4 = derivative(sim, mode, t + h, y + h * k3);
-    return y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
-  }
-
-  static void evaluate_guards(const Simulator& sim, const Mode& mode, const ActiveGuards& guards,
-                              double t, const State& y, GuardValues& out) {
-    const GroundAcceleration ag = sim.excitation_.at(t);
-    const Accelerations acc = accelerations(*sim.scene_, mode, y, ag);
-    for (int i = 0; i < guards.count; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      out[k] = guard_value(guards.ids[k], *sim.scene_, mode, y, ag, acc);
-    }
-  }
-
-  static double guard_at(const Simulator& sim, const Mode& mode, GuardId id, double t,
-                         const State& y) {
-    const GroundAcceleration ag = sim.excitation_.at(t);
-    return guard_value(id, *sim.scene_, mode, y, ag, accelerations(*sim.scene_, mode, y, ag));
-  }
-
-  // Time tau in (a, b] at which guard `id` reaches 0 on the RK4 solution from (t0, y0):
-  // the witness tau -> g(t0 + tau, rk4(y0, tau)) is bracketed by g(a) < 0 <= g(b) and its root
-  // found by the Illinois variant of regula falsi, with a bisection whenever an update fails
-  // to halve the bracket. Returns the bracket's upper end, where the guard holds.
-  static double locate(const Simulator& sim, const Mode& mode, GuardId id, double t0,
-                       const State& y0, double a, double fa, double b, double fb) {
-    const double tolerance = sim.settings_.event_time_tolerance * sim.settings_.step;
-    int last_side = 0;
-    bool bisect = false;
-    for (int iteration = 0; iteration < 200 && b - a > tolerance; ++iteration) {
-      const double width = b - a;
-      double c = bisect ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
-      if (!(c > a && c < b)) c = 0.5 * (a + b);
-      const double fc = guard_at(sim, mode, id, t0 + c, rk4(sim, mode, t0, y0, c));
-      if (fc >= 0.0) {
-        b = c;
-        fb = fc;
-        if (last_side == 1) fa *= 0.5;
-        last_side = 1;
-      } else {
-        a = c;
-        fa = fc;
-        if (last_side == -1) fb *= 0.5;
-        last_side = -1;
-      }
-      bisect = (b - a) > 0.5 * width;
-    }
-    return b;
-  }
-
-  // Crossing time of a guard that is negative or exactly zero at the start and non-negative
-  // at the end. Exactly zero means a reset has just put the state on the guard's surface
-  // (theta = 0 after an impact, u = +-u_max after a stop hit): the motion leaves the surface
-  // and may come back within the same step, so the step is probed for the excursion below 0
-  // and the return is located from there. An excursion too small to see is taken as an event
-  // at the end of the interval.
-  static double first_crossing(const Simulator& sim, const Mode& mode, GuardId id, double t0,
-                               const State& y0, double h, double g_start, double g_end) {
-    if (g_start < 0.0) return locate(sim, mode, id, t0, y0, 0.0, g_start, h, g_end);
-    for (const double fraction : {0.0625, 0.25, 0.5, 0.75}) {
-      const double tau = fraction * h;
-      const double g = guard_at(sim, mode, id, t0 + tau, rk4(sim, mode, t0, y0, tau));
-      if (g < 0.0) return locate(sim, mode, id, t0, y0, tau, g, h, g_end);
-    }
-    return h;
-  }
+  static ActiveGuards guards(const Mode& mode) { return active_guards<F>(mode); }
 
   static void emit(Simulator& sim, double t, EventKind kind, int side = 0, double before = 0.0,
                    double after = 0.0) {
@@ -287,6 +316,24 @@ struct Stepper {
     emit(sim, t, EventKind::kRockingStop, 0, theta_dot_before);
   }
 
+  // The slowest rebound from a stop (or impact at theta = 0) the solver follows, m/s (rad/s):
+  // `rest_speed`, and with events taken at step ends also k |a| dt, a the acceleration back
+  // towards the stop. A hit seen up to a step late has gained up to |a| dt, so with restitution
+  // eta rebounds settle near eta |a| dt / (1 - eta) instead of dying out (the Zeno sequence the
+  // located methods resolve and settle): k = eta / (1 - eta), within [4, 32] steps.
+  static constexpr double kStepEndRestStepsMin = 4.0;
+  static constexpr double kStepEndRestStepsMax = 32.0;
+  // `acceleration()` gives a (computed only for step-end methods).
+  template <class Acceleration>
+  static double rest_speed(const Simulator& sim, double rest_speed, Acceleration acceleration,
+                           double restitution) {
+    if (!sim.events_at_step_ends_) return rest_speed;
+    const double steps =
+        restitution < 1.0 ? restitution / (1.0 - restitution) : kStepEndRestStepsMax;
+    return std::max(rest_speed, std::clamp(steps, kStepEndRestStepsMin, kStepEndRestStepsMax) *
+                                    std::fabs(acceleration()) * sim.settings_.step);
+  }
+
   // Impact at theta = 0 (Eqs 21-24; with friction, the Coulomb impact of resets.h), or the end
   // of rocking when it leaves less rocking energy than the rest criterion's fraction of the new
   // pivot's overturning barrier.
@@ -306,7 +353,12 @@ struct Stepper {
     const double barrier = s.m * s.g * (to.radius - s.h);
     sim.mode_ = mode;
     sim.y_ = y;
-    if (after * before <= 0.0 ||
+    // Taken at step ends, impacts closer than a few steps apart are chatter (see rest_speed).
+    const double slowest =
+        rest_speed(
+            sim, 0.0, [&] { return accelerations(s, mode, y, sim.excitation_.at(t)).theta; },
+            before != 0.0 ? std::fabs(after / before) : 0.0);
+    if (after * before <= 0.0 || std::fabs(after) < slowest ||
         0.5 * to.inertia * after * after < sim.settings_.rest_energy_ratio * barrier) {
       stop_rocking(sim, t, before);
     } else {
@@ -349,7 +401,11 @@ struct Stepper {
     const Scene& s = *sim.scene_;
     const double before = sim.y_[kXDot];
     const double rebound = s.params.sliding_stops.restitution * std::fabs(before);
-    if (rebound < sim.settings_.slide_rest_speed) {
+    const double slowest =
+        rest_speed(sim, sim.settings_.slide_rest_speed,
+                   [&] { return accelerations(s, sim.mode_, sim.y_, sim.excitation_.at(t)).x; },
+                   s.params.sliding_stops.restitution);
+    if (rebound < slowest) {
       coordinate_impulse_reset(s, sim.mode_, base_moves(sim.mode_), kXDot, 0.0, sim.y_);
       sim.y_[kX] = side * s.params.support.clearance;
       sliding_stop_reset(sim.mode_, sim.y_);
@@ -367,7 +423,11 @@ struct Stepper {
     base_stop_reset(s, side, sim.mode_, sim.y_);
     emit(sim, t, EventKind::kBaseStopHit, side, before, sim.y_[kUDot]);
     if (sim.mode_.sliding()) keep_sliding_consistent(sim, t);
-    if (std::fabs(sim.y_[kUDot]) < sim.settings_.base_rest_speed) hold_if_pushed(sim, t, side);
+    const double slowest =
+        rest_speed(sim, sim.settings_.base_rest_speed,
+                   [&] { return accelerations(s, sim.mode_, sim.y_, sim.excitation_.at(t)).u; },
+                   s.params.base_stops.restitution);
+    if (std::fabs(sim.y_[kUDot]) < slowest) hold_if_pushed(sim, t, side);
   }
 
   // An impulse on the base changes x' while sliding: the phase follows its new sign.
@@ -419,6 +479,7 @@ struct Stepper {
   }
 
   static void apply(Simulator& sim, GuardId id, double t) {
+    ++sim.event_count_;
     const double x_hat = sim.scene_->params.support.clearance;
     switch (id) {
       case GuardId::kRockingOnsetLeft:
@@ -512,86 +573,300 @@ struct Stepper {
     ++sim.chatter_steps_;
   }
 
-  static void step(Simulator& sim) {
-    if (sim.mode_.terminal()) return;
-    const double dt = sim.settings_.step;
-    const double t_end = static_cast<double>(sim.step_count_ + 1) * dt;
-    double t0 = sim.time();
-    int events = 0;
-    bool guards_live = true;
-    for (;;) {
+  // A whole step of full contact propagated exactly, with the guards full contact has in this
+  // model written out (their order is active_guards<F>'s). Returns false unless the step starts
+  // from the cache and has no event, having then written only the spare buffers; the step's
+  // interval runs instead (ExactFullContact in phase_kernels.h: the same values, to the last bit).
+  static bool exact_full_contact_step(Simulator& sim, double t0, double t_end) {
+    const Mode& mode = sim.mode_;
+    if constexpr (!F.base) {
+      return false;
+    } else {
       const double h = t_end - t0;
-      if (h <= 0.0) break;
-      const Mode mode = sim.mode_;
-      const State y0 = sim.y_;
-      const State y1 = rk4(sim, mode, t0, y0, h);
-      const ActiveGuards guards = guards_live ? active_guards<F>(mode) : ActiveGuards{};
-      // The guards at the interval's start: from the cache when the last step ended here in
-      // this mode with no event; one flow evaluation serves every guard.
-      GuardValues start;
-      if (sim.guard_cache_valid_ && events == 0) {
-        start = sim.guard_cache_;
-      } else {
-        evaluate_guards(sim, mode, guards, t0, y0, start);
+      if (!sim.cache_valid_ || mode.held_stop != 0 || mode.overhang != 0 || t0 + h != t_end) {
+        return false;
       }
-      GuardValues end;
-      evaluate_guards(sim, mode, guards, t_end, y1, end);
-      GuardId first = GuardId::kRockingImpact;
-      double first_tau = std::numeric_limits<double>::infinity();
-      for (int i = 0; i < guards.count; ++i) {
-        const auto k = static_cast<std::size_t>(i);
-        const double g_start = start[k];
-        const double g_end = end[k];
-        if (g_start > 0.0 || g_end < 0.0 || (g_start == 0.0 && g_end == 0.0)) continue;
-        const double tau = first_crossing(sim, mode, guards.ids[k], t0, y0, h, g_start, g_end);
-        if (tau < first_tau) {
-          first_tau = tau;
-          first = guards.ids[k];
-        }
+      const Scene& s = *sim.scene_;
+      const std::size_t next = 1 - sim.current_;
+      const FlowPoint& start = sim.points_[sim.current_];
+      const GuardValues& g_start = sim.guard_values_[sim.current_];
+      const GroundAcceleration ag = kernels::Base::ground(sim.excitation_, t_end);
+      State y1 = sim.y_;
+      y1.head<3>() += h * sim.y_.tail<3>();
+      y1[kU] = sim.y_[kU];
+      sim.propagator_.advance(y1[kU], y1[kUDot], start.ground.horizontal, ag.horizontal);
+      // The end point and guards go straight to the other buffer (free until the step ends).
+      FlowPoint& end = sim.points_[next];
+      end = {ag, sin_cos(y1[kTheta]), full_contact_flow(s, y1, ag)};
+      GuardValues& g_end = sim.guard_values_[next];
+      std::size_t n = 0;
+      bool crossed = false;
+      const auto add = [&](double b) {
+        const double a = g_start[n];
+        crossed = crossed || (a <= 0.0 && b >= 0.0 && (a < 0.0 || b > 0.0));
+        g_end[n++] = b;
+      };
+      add(rocking_onset_guard(s, s.corner1.sign, s.corner1.onset_ratio, end.acc, ag));
+      add(rocking_onset_guard(s, s.corner2.sign, s.corner2.onset_ratio, end.acc, ag));
+      if constexpr (F.sliding) {
+        const ContactForce f = sticking_contact_force(s, mode, y1, ag, end.acc, end.trig);
+        add(sliding_onset_guard(s, mode, y1, -1, f, end.trig));
+        add(sliding_onset_guard(s, mode, y1, 1, f, end.trig));
       }
-      if (!std::isfinite(first_tau)) {
-        sim.y_ = y1;
-        sim.guard_cache_ = end;
-        sim.guard_cache_valid_ = guards_live;
-        break;
+      if constexpr (F.base_stops) {
+        add(y1[kU] - s.params.base_stops.max_displacement);
+        add(-y1[kU] - s.params.base_stops.max_displacement);
       }
-      sim.guard_cache_valid_ = false;
-      t0 += first_tau;
-      sim.y_ = rk4(sim, mode, t0 - first_tau, y0, first_tau);
-      apply(sim, first, t0);
-      if (sim.mode_.terminal()) break;
-      if (++events >= sim.settings_.max_events_per_step) {
-        settle(sim, t0);
-        guards_live = false;
-      }
+      if (crossed) return false;
+      sim.y_ = y1;
+      sim.current_ = next;
+      return true;
     }
-    ++sim.step_count_;
-  }
-
-  static void bind(Simulator& sim) {
-    sim.step_fn_ = &step;
-    sim.enter_fn_ = &enter;
-    sim.acc_fn_ = &current;
   }
 
   static Accelerations current(const Simulator& sim, double t, const State& y) {
     return accelerations(*sim.scene_, sim.mode_, y, sim.excitation_.at(t));
   }
+
+  template <class Method>
+  static void bind_intervals(Simulator& sim, bool exact_full_contact);
+
+  static void bind(Simulator& sim, const SolverSettings& settings) {
+    sim.apply_fn_ = &apply;
+    sim.settle_fn_ = &settle;
+    sim.guards_fn_ = &guards;
+    sim.enter_fn_ = &enter;
+    sim.acc_fn_ = &current;
+    sim.full_contact_fn_ =
+        settings.exact_full_contact && F.base ? &exact_full_contact_step : nullptr;
+    switch (settings.stepper) {
+      case Stepper::kRk4Located:
+        bind_intervals<methods::Rk4>(sim, settings.exact_full_contact);
+        return;
+      case Stepper::kRk4StepEnd:
+        bind_intervals<methods::Rk4StepEnd>(sim, settings.exact_full_contact);
+        return;
+      case Stepper::kHeunLocated:
+        bind_intervals<methods::Heun>(sim, settings.exact_full_contact);
+        return;
+      case Stepper::kSemiImplicitEuler:
+        bind_intervals<methods::SemiImplicitEuler>(sim, settings.exact_full_contact);
+        return;
+    }
+  }
 };
+
+// ---------------------------------------------------------------------------------------------
+// One interval of a step in a fixed mode: the stepper `Method` on the phase's `Kernel`, guards
+// at both ends, the first crossing located (or, for a step-end method, taken at the end), its
+// reset applied.
+template <class Method, class Kernel>
+struct Interval {
+  static State advance(const Kernel& k, double t, const State& y, const FlowPoint& start,
+                       double h, const GroundAcceleration* end_ground = nullptr) {
+    if constexpr (Kernel::kExact) {
+      return k.advance(t, y, start, h, end_ground);
+    } else {
+      return Method::advance(k, t, y, state_derivative(y, start.acc), h, end_ground);
+    }
+  }
+
+  static void evaluate(const Scene& s, const Mode& mode, const ActiveGuards& guards,
+                       const State& y, const FlowPoint& p, GuardValues& out) {
+    for (int i = 0; i < guards.count; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      out[k] = step_guard_value(guards.ids[k], s, mode, y, p);
+    }
+  }
+
+  // evaluate at the interval's end, and whether any guard may have crossed since the start:
+  // negative or zero there and not negative now (both zero: resting on the surface). The
+  // step-end methods need a strict start; first_event sorts that out.
+  static bool evaluate_and_check(const Scene& s, const Mode& mode, const ActiveGuards& guards,
+                                 const State& y, const FlowPoint& p, const GuardValues& start,
+                                 GuardValues& out) {
+    bool any = false;
+    for (int i = 0; i < guards.count; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      const double b = step_guard_value(guards.ids[k], s, mode, y, p);
+      const double a = start[k];
+      out[k] = b;
+      any = any || (a <= 0.0 && b >= 0.0 && (a < 0.0 || b > 0.0));
+    }
+    return any;
+  }
+
+  static double guard_at(const Simulator& sim, const Kernel& k, const Mode& mode, GuardId id,
+                         double t, const State& y) {
+    const FlowPoint p = k.point(y, k.ground(t));
+    return guard_value(id, *sim.scene_, mode, y, p.ground, p.acc, p.trig);
+  }
+
+  // Time tau in (a, b] at which guard `id` reaches 0 on the method's solution from (t0, y0):
+  // the witness tau -> g(t0 + tau, advance(y0, tau)) is bracketed by g(a) < 0 <= g(b) and its
+  // root found by the Illinois variant of regula falsi, with a bisection whenever an update
+  // fails to halve the bracket. Returns the bracket's upper end, where the guard holds.
+  [[gnu::noinline]] static double locate(const Simulator& sim, const Kernel& k,
+                                         const Mode& mode, GuardId id, double t0,
+                                         const State& y0, const FlowPoint& start, double a,
+                                         double fa, double b, double fb) {
+    const double tolerance = sim.settings_.event_time_tolerance * sim.settings_.step;
+    int last_side = 0;
+    bool bisect = false;
+    for (int iteration = 0; iteration < 200 && b - a > tolerance; ++iteration) {
+      const double width = b - a;
+      double c = bisect ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
+      if (!(c > a && c < b)) c = 0.5 * (a + b);
+      const double fc = guard_at(sim, k, mode, id, t0 + c, advance(k, t0, y0, start, c));
+      if (fc >= 0.0) {
+        b = c;
+        fb = fc;
+        if (last_side == 1) fa *= 0.5;
+        last_side = 1;
+      } else {
+        a = c;
+        fa = fc;
+        if (last_side == -1) fb *= 0.5;
+        last_side = -1;
+      }
+      bisect = (b - a) > 0.5 * width;
+    }
+    return b;
+  }
+
+  // Crossing time of a guard that is negative or exactly zero at the start and non-negative
+  // at the end. Exactly zero means a reset has just put the state on the guard's surface
+  // (theta = 0 after an impact, u = +-u_max after a stop hit): the motion leaves the surface
+  // and may come back within the same step, so the step is probed for the excursion below 0
+  // and the return is located from there. An excursion too small to see is taken as an event
+  // at the end of the interval.
+  static double first_crossing(const Simulator& sim, const Kernel& k, const Mode& mode,
+                               GuardId id, double t0, const State& y0, const FlowPoint& start,
+                               double h, double g_start, double g_end) {
+    if (g_start < 0.0) return locate(sim, k, mode, id, t0, y0, start, 0.0, g_start, h, g_end);
+    for (const double fraction : {0.0625, 0.25, 0.5, 0.75}) {
+      const double tau = fraction * h;
+      const double g = guard_at(sim, k, mode, id, t0 + tau, advance(k, t0, y0, start, tau));
+      if (g < 0.0) return locate(sim, k, mode, id, t0, y0, start, tau, g, h, g_end);
+    }
+    return h;
+  }
+
+  // The guard that crossed first, and when (tau from t0); tau is infinite when none did.
+  struct Crossing {
+    GuardId id = GuardId::kRockingImpact;
+    double tau = std::numeric_limits<double>::infinity();
+  };
+
+  // Out of line: the step's hot path only checks that no guard changed sign (any_crossing).
+  [[gnu::noinline]] static Crossing first_event(const Simulator& sim, const Kernel& k,
+                                                const Mode& mode, const ActiveGuards& guards,
+                                                double t0, const State& y0,
+                                                const FlowPoint& start, double h,
+                                                const GuardValues& g_start,
+                                                const GuardValues& g_end) {
+    Crossing first;
+    for (int i = 0; i < guards.count; ++i) {
+      const auto j = static_cast<std::size_t>(i);
+      const double a = g_start[j];
+      const double b = g_end[j];
+      if constexpr (Method::kLocated) {
+        if (a > 0.0 || b < 0.0 || (a == 0.0 && b == 0.0)) continue;
+        const double tau = first_crossing(sim, k, mode, guards.ids[j], t0, y0, start, h, a, b);
+        if (tau < first.tau) first = {guards.ids[j], tau};
+      } else {
+        // No location: the crossing seen at the step's end; the guards are ranked by where
+        // their straight line between the ends crosses zero.
+        if (!(a < 0.0 && b >= 0.0)) continue;
+        const double tau = h * (a / (a - b));
+        if (tau < first.tau) first = {guards.ids[j], tau};
+      }
+    }
+    return first;
+  }
+
+  [[gnu::flatten]] static bool run(Simulator& sim, double& t0, double t_end, bool guards_live,
+                                   bool full_step) {
+    const Scene& s = *sim.scene_;
+    const Mode mode = sim.mode_;
+    const State& y0 = sim.y_;  // replaced only once y1 (or the event's state) is complete
+    const double h = t_end - t0;
+    Kernel k({s, sim.excitation_, sim.propagator_, full_step ? h : 0.0, mode, y0});
+    static constexpr ActiveGuards kNone{};
+    const ActiveGuards& guards = guards_live ? sim.active_guards_ : kNone;
+    // The start: kept from the end of the last step when it had no event.
+    const std::size_t next = 1 - sim.current_;
+    FlowPoint& start = sim.points_[sim.current_];
+    GuardValues& g_start = sim.guard_values_[sim.current_];
+    if (!sim.cache_valid_) {
+      start = k.point(y0, k.ground(t0));
+      evaluate(s, mode, guards, y0, start, g_start);
+    }
+    const GroundAcceleration end_ground = k.ground(t_end);
+    const State y1 = advance(k, t0, y0, start, h, t0 + h == t_end ? &end_ground : nullptr);
+    FlowPoint& end = sim.points_[next];
+    GuardValues& g_end = sim.guard_values_[next];
+    end = k.point(y1, end_ground);
+    const Crossing first =
+        evaluate_and_check(s, mode, guards, y1, end, g_start, g_end)
+            ? first_event(sim, k, mode, guards, t0, y0, start, h, g_start, g_end)
+            : Crossing{};
+    if (!std::isfinite(first.tau)) {
+      sim.y_ = y1;
+      sim.current_ = next;
+      sim.cache_valid_ = guards_live;
+      t0 = t_end;
+      return false;
+    }
+    sim.cache_valid_ = false;
+    if constexpr (Method::kLocated) {
+      sim.y_ = advance(k, t0, y0, start, first.tau);
+      t0 += first.tau;
+    } else {
+      sim.y_ = y1;
+      t0 = t_end;
+    }
+    sim.apply_fn_(sim, first.id, t0);
+    return true;
+  }
+};
+
+template <Features F>
+template <class Method>
+void Hybrid<F>::bind_intervals(Simulator& sim, bool exact_full_contact) {
+  auto& fns = sim.interval_fns_;
+  constexpr auto at = [](Phase p) { return static_cast<std::size_t>(p); };
+  if constexpr (F.base) {
+    fns[at(Phase::kFullContact)] = exact_full_contact
+                                       ? &Interval<Method, kernels::ExactFullContact>::run
+                                       : &Interval<Method, kernels::FullContact>::run;
+  } else {
+    (void)exact_full_contact;  // nothing moves in full contact on the ground
+    fns[at(Phase::kFullContact)] = &Interval<Method, kernels::FullContact>::run;
+  }
+  fns[at(Phase::kRocking)] = &Interval<Method, kernels::Rocking>::run;
+  if constexpr (F.sliding) {
+    fns[at(Phase::kSliding)] = &Interval<Method, kernels::Sliding>::run;
+    fns[at(Phase::kSlideRocking)] = &Interval<Method, kernels::SlideRocking>::run;
+  } else {
+    fns[at(Phase::kSliding)] = &Interval<Method, kernels::Frozen>::run;
+    fns[at(Phase::kSlideRocking)] = &Interval<Method, kernels::Frozen>::run;
+  }
+}
 
 namespace {
 
-// Binds the solver compiled for exactly the features the scene has.
+// Binds the hybrid logic compiled for exactly the features the scene has.
 template <bool kBase, bool kBaseStops>
-void bind_for_friction(Simulator& sim, const Features& f) {
+void bind_for_friction(Simulator& sim, const Features& f, const SolverSettings& settings) {
   if (!f.sliding) {
-    Stepper<Features{kBase, kBaseStops, false, false, false}>::bind(sim);
+    Hybrid<Features{kBase, kBaseStops, false, false, false}>::bind(sim, settings);
   } else if (f.support_edge) {
-    Stepper<Features{kBase, kBaseStops, true, true, false}>::bind(sim);
+    Hybrid<Features{kBase, kBaseStops, true, true, false}>::bind(sim, settings);
   } else if (f.sliding_stops) {
-    Stepper<Features{kBase, kBaseStops, true, false, true}>::bind(sim);
+    Hybrid<Features{kBase, kBaseStops, true, false, true}>::bind(sim, settings);
   } else {
-    Stepper<Features{kBase, kBaseStops, true, false, false}>::bind(sim);
+    Hybrid<Features{kBase, kBaseStops, true, false, false}>::bind(sim, settings);
   }
 }
 
@@ -600,7 +875,7 @@ void bind_for_friction(Simulator& sim, const Features& f) {
 Error Simulator::create(const Scene& scene, const Excitation& excitation,
                         const SolverSettings& settings, Simulator& out) {
   if (Error e = validate(settings); !e.ok()) return e;
-  if (const double limit = largest_stable_step(scene); settings.step > limit) {
+  if (const double limit = largest_stable_step(scene, settings.stepper); settings.step > limit) {
     return {ErrorCode::kOutOfRange, "solver.step",
             "is too large for a stable integration of this scene's base (stiff or light base)",
             limit};
@@ -609,13 +884,17 @@ Error Simulator::create(const Scene& scene, const Excitation& excitation,
   sim.scene_ = &scene;
   sim.excitation_ = excitation;
   sim.settings_ = settings;
+  sim.events_at_step_ends_ = settings.stepper == Stepper::kRk4StepEnd;
+  if (settings.exact_full_contact) {
+    sim.propagator_ = FullContactPropagator::make(scene, settings.step);
+  }
   const Features f = features_of(scene);
   if (!f.base) {
-    bind_for_friction<false, false>(sim, f);
+    bind_for_friction<false, false>(sim, f, settings);
   } else if (!f.base_stops) {
-    bind_for_friction<true, false>(sim, f);
+    bind_for_friction<true, false>(sim, f, settings);
   } else {
-    bind_for_friction<true, true>(sim, f);
+    bind_for_friction<true, true>(sim, f, settings);
   }
   out = sim;
   return ok_error();
@@ -623,11 +902,13 @@ Error Simulator::create(const Scene& scene, const Excitation& excitation,
 
 void Simulator::start_from(const Mode& mode, const State& state) {
   step_count_ = 0;
-  guard_cache_valid_ = false;
+  cache_valid_ = false;
   chatter_steps_ = 0;
+  event_count_ = 0;
   mode_ = mode;
   y_ = state;
   enter_fn_(*this, 0.0);
+  refresh_guards();
 }
 
 void Simulator::start_at_rest() { start_from(Mode{}, State::Zero()); }
@@ -648,6 +929,7 @@ void Simulator::start_with_impulse(double impulse) {
   mode_.phase = Phase::kRocking;
   mode_.corner = corner;
   y_[kThetaDot] = -scene_->m * scene_->h * impulse / scene_->corner(corner).inertia;
+  refresh_guards();
   Event e;
   e.t = 0.0;
   e.kind = EventKind::kRockingStart;
@@ -657,7 +939,38 @@ void Simulator::start_with_impulse(double impulse) {
   emit(e);
 }
 
-void Simulator::step() { step_fn_(*this); }
+void Simulator::step() {
+  if (mode_.terminal()) return;
+  const double t_end = static_cast<double>(step_count_ + 1) * settings_.step;
+  double t0 = time();
+  if (mode_.phase == Phase::kFullContact && full_contact_fn_ != nullptr &&
+      full_contact_fn_(*this, t0, t_end)) {
+    ++step_count_;
+    return;
+  }
+  if (interval_fns_[static_cast<std::size_t>(mode_.phase)](*this, t0, t_end, true, true)) {
+    finish_step(t0, t_end);
+  }
+  ++step_count_;
+}
+
+// The rest of a step after its first event, at t0: the new mode to t_end, event after event;
+// past max_events_per_step, chatter is settled and the step ends without guards.
+void Simulator::finish_step(double t0, double t_end) {
+  int events = 0;
+  bool guards_live = true;
+  do {
+    if (mode_.terminal()) return;
+    refresh_guards();
+    if (++events >= settings_.max_events_per_step) {
+      settle_fn_(*this, t0);
+      refresh_guards();
+      guards_live = false;
+    }
+  } while (t_end - t0 > 0.0 &&
+           interval_fns_[static_cast<std::size_t>(mode_.phase)](*this, t0, t_end, guards_live,
+                                                                false));
+}
 
 Accelerations Simulator::accelerations() const { return acc_fn_(*this, time(), y_); }
 

@@ -3,6 +3,7 @@
 // Simulator::start_with_impulse.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -21,7 +22,17 @@ struct SampledSignal {
 
   [[nodiscard]] bool empty() const { return count == 0; }
   // Linear interpolation between samples; zero before t = 0 and after the last sample.
-  [[nodiscard]] double at(double t) const;
+  // Inline: the solver calls it at every Runge-Kutta stage.
+  [[nodiscard]] double at(double t) const {
+    if (count == 0 || t < 0.0) return 0.0;
+    const double position = t / dt;
+    const auto last = static_cast<double>(count - 1);
+    if (position >= last) return position == last ? values[count - 1] : 0.0;
+    const double floor_position = std::floor(position);
+    const auto i = static_cast<std::size_t>(floor_position);
+    const double w = position - floor_position;
+    return values[i] + w * (values[i + 1] - values[i]);
+  }
   [[nodiscard]] double duration() const {
     return count == 0 ? 0.0 : static_cast<double>(count - 1) * dt;
   }
@@ -71,7 +82,18 @@ struct Excitation {
   double period = 0.0;       // pulses: duration of the single period, s
   const GroundStream* stream = nullptr;  // kStream only
 
-  [[nodiscard]] GroundAcceleration at(double t) const;
+  [[nodiscard]] GroundAcceleration pulse_at(double t) const;
+
+  // Inline for what the solver meets at every Runge-Kutta stage (none, a record, the stream);
+  // the pulses' sine out of line.
+  [[nodiscard]] GroundAcceleration at(double t) const {
+    if (kind == ExcitationKind::kNone) return {};
+    if (kind == ExcitationKind::kRecord) {
+      return {scale * horizontal.at(t), vertical.empty() ? 0.0 : scale * vertical.at(t)};
+    }
+    if (kind == ExcitationKind::kStream) return stream->at(t);
+    return pulse_at(t);
+  }
   // Time after which the ground is still, s.
   [[nodiscard]] double duration() const;
 

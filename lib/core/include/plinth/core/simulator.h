@@ -1,27 +1,39 @@
-// The fixed-step hybrid solver: RK4 on the current phase's equations, every event located
-// inside the step, the reset applied there, and the step finished in the new phase so the
-// time grid stays fixed.
+// The fixed-step hybrid solver: a one-step method (steppers.h; RK4 by default) on the current
+// phase's equations, every event located inside the step, the reset applied there, and the
+// step finished in the new phase so the time grid stays fixed.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include "plinth/core/error.h"
 #include "plinth/core/events.h"
 #include "plinth/core/excitation.h"
+#include "plinth/core/flows.h"
+#include "plinth/core/full_contact_propagator.h"
 #include "plinth/core/guards.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
+#include "plinth/core/steppers.h"
 
 namespace plinth {
 
 struct SolverSettings {
-  double step = 1e-4;  // s, the fixed time step of RK4
+  double step = 1e-4;  // s, the fixed time step
+  // The one-step method and how events are taken (steppers.h). docs/accuracy.md measures them.
+  Stepper stepper = Stepper::kRk4Located;
+  // Full contact (Eq 1, linear) propagated exactly over each step with the ground acceleration
+  // linear within it (full_contact_propagator.h), whatever the stepper; its guards (Eqs 15, 16,
+  // 28) are evaluated, and located, on that exact solution.
+  bool exact_full_contact = false;
   // Rest criterion: rocking ends at an impact that leaves less rocking energy than this
   // fraction of the energy needed to overturn, I theta'^2 / 2 < ratio m g (r_i - h).
   double rest_energy_ratio = 1e-6;
   // The base is held at a stop when it rebounds slower than this while the stop pushes, m/s.
+  // (rk4_step_end: or slower than a few steps of its acceleration; simulator.cpp, rest_speed.)
   double base_rest_speed = 1e-5;
-  // The block sticks against a sliding stop instead of rebounding slower than this, m/s.
+  // The block sticks against a sliding stop instead of rebounding slower than this, m/s (the
+  // same addition for rk4_step_end).
   double slide_rest_speed = 1e-5;
   // Events located within one step before the remaining ones are treated as chatter (Zeno):
   // rocking is brought to rest, sliding stopped and the base held, and the step finishes
@@ -40,13 +52,21 @@ struct SolverSettings {
 // reaches 2.78 on the real axis and 2.83 on the imaginary one. Infinity without a base.
 [[nodiscard]] double largest_stable_step(const Scene& scene);
 
+// The same for `stepper`: RK4 (either way of taking events) as above; Heun and semi-implicit
+// Euler, the largest step whose one-step map on those two linear systems grows no mode by more
+// than kStableGrowthPerStep per step (Heun's stability region misses the imaginary axis: an
+// undamped base grows by (h omega)^4 / 8 per step at any step).
+[[nodiscard]] double largest_stable_step(const Scene& scene, Stepper stepper);
+inline constexpr double kStableGrowthPerStep = 1e-8;
+
 class Simulator {
  public:
   Simulator() = default;
 
   // `scene` and the signals `excitation` refers to must outlive the simulator. Fails on
   // invalid settings (the Error names the field), and on a step too large for a stable
-  // integration of the scene (field "solver.step", `limit` = largest_stable_step).
+  // integration of the scene (field "solver.step", `limit` = largest_stable_step for the
+  // stepper). The stepper and the features of the scene select the code once, here.
   [[nodiscard]] static Error create(const Scene& scene, const Excitation& excitation,
                                     const SolverSettings& settings, Simulator& out);
 
@@ -75,30 +95,59 @@ class Simulator {
   [[nodiscard]] Accelerations accelerations() const;
   // Number of steps whose events were cut short as chatter (see max_events_per_step).
   [[nodiscard]] std::int64_t chatter_steps() const { return chatter_steps_; }
+  // Number of events located (or taken at step ends) since the start, resets applied.
+  [[nodiscard]] std::int64_t event_count() const { return event_count_; }
 
  private:
   template <Features F>
-  friend struct Stepper;
+  friend struct Hybrid;
+  template <class Method, class Kernel>
+  friend struct Interval;
 
   void emit(const Event& event) {
     if (sink_ != nullptr) sink_->on_event(event);
   }
+  // The guards of the current mode, after it changed.
+  void refresh_guards() { active_guards_ = guards_fn_(mode_); }
+  [[gnu::noinline]] void finish_step(double t0, double t_end);
+
+  // Advances in the current mode from t0 towards t_end (one interval of a step, Interval in
+  // simulator.cpp). On an event it applies the reset, sets t0 to the event's time and returns
+  // true.
+  // `full_step`: the interval is the whole step (no event before it in this step).
+  using IntervalFn = bool (*)(Simulator&, double& t0, double t_end, bool guards_live,
+                              bool full_step);
 
   const Scene* scene_ = nullptr;
   Excitation excitation_;
   SolverSettings settings_;
   EventSink* sink_ = nullptr;
-  void (*step_fn_)(Simulator&) = nullptr;
+  // Bound once by create: the stepper's interval for each non-terminal Phase, and the hybrid
+  // logic (guards, resets) compiled for the scene's features.
+  std::array<IntervalFn, 4> interval_fns_{};
+  void (*apply_fn_)(Simulator&, GuardId, double) = nullptr;
+  void (*settle_fn_)(Simulator&, double) = nullptr;
+  ActiveGuards (*guards_fn_)(const Mode&) = nullptr;
   void (*enter_fn_)(Simulator&, double) = nullptr;  // starts phases whose onset already holds
   Accelerations (*acc_fn_)(const Simulator&, double, const State&) = nullptr;
+  // exact_full_contact: a whole step of full contact without event (false: take the interval).
+  bool (*full_contact_fn_)(Simulator&, double t0, double t_end) = nullptr;
+  FullContactPropagator propagator_;  // for exact_full_contact, over one step
+  bool events_at_step_ends_ = false;  // the stepper takes events at step ends (rest speeds)
   Mode mode_;
   State y_ = State::Zero();
-  // Guard values at the end of the last step, valid when it had no event (the next step's
-  // start is the same time, state and mode).
-  GuardValues guard_cache_{};
-  bool guard_cache_valid_ = false;
+  ActiveGuards active_guards_;
+  // The flow point and guard values at the start of the interval (points_[current_]) and at its
+  // end (the other one, which becomes current when the step had no event: the next step starts
+  // at the same time, state and mode, and this is its first stage). cache_valid_: the current
+  // one holds the current time, state and mode.
+  std::array<FlowPoint, 2> points_{};
+  std::array<GuardValues, 2> guard_values_{};
+  std::size_t current_ = 0;
+  bool cache_valid_ = false;
   std::int64_t step_count_ = 0;
   std::int64_t chatter_steps_ = 0;
+  std::int64_t event_count_ = 0;
 };
 
 }  // namespace plinth

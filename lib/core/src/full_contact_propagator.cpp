@@ -1,0 +1,56 @@
+#include "plinth/core/full_contact_propagator.h"
+
+#include <Eigen/Core>
+#include <cmath>
+
+namespace plinth {
+namespace {
+
+using Matrix4 = Eigen::Matrix4d;
+
+// exp(a) by scaling and squaring with a Taylor series: |a| / 2^j <= 1/2, terms up to the
+// 24th (0.5^25 / 25! is below 1e-32).
+Matrix4 exponential(const Matrix4& a) {
+  const double norm = a.cwiseAbs().colwise().sum().maxCoeff();
+  int squarings = 0;
+  double scale = 1.0;
+  while (norm * scale > 0.5 && squarings < 60) {
+    scale *= 0.5;
+    ++squarings;
+  }
+  const Matrix4 scaled = a * scale;
+  Matrix4 sum = Matrix4::Identity();
+  Matrix4 term = Matrix4::Identity();
+  for (int n = 1; n <= 24; ++n) {
+    term = term * scaled / static_cast<double>(n);
+    sum += term;
+  }
+  for (int i = 0; i < squarings; ++i) sum = sum * sum;
+  return sum;
+}
+
+}  // namespace
+
+FullContactPropagator FullContactPropagator::make(const Scene& s, double h) {
+  FullContactPropagator p;
+  p.step = h;
+  if (!s.has_base()) return p;
+  // z = (u, u', a, a'), a = u_G'' linear in the step: z' = A z.
+  Matrix4 a = Matrix4::Zero();
+  a(0, 1) = 1.0;
+  a(1, 0) = -s.stiffness / s.total_mass;
+  a(1, 1) = -s.damping / s.total_mass;
+  a(1, 2) = -1.0;
+  a(2, 3) = 1.0;
+  const Matrix4 e = exponential(a * h);
+  // z(h) = e z(0) with a' = (a1 - a0) / h: Gamma0 = e(:, 2) - e(:, 3) / h, Gamma1 = e(:, 3) / h.
+  for (int i = 0; i < 2; ++i) {
+    p.phi[i][0] = e(i, 0);
+    p.phi[i][1] = e(i, 1);
+    p.gamma1[i] = e(i, 3) / h;
+    p.gamma0[i] = e(i, 2) - p.gamma1[i];
+  }
+  return p;
+}
+
+}  // namespace plinth

@@ -1,0 +1,230 @@
+// Steppers and features: ns per step of each phase for each stepper, and what each feature of a
+// scene costs per step on a run where it never engages ("only what the scene needs", issue 6).
+// Linked into plinth-bench with bench_solver.cpp (which has main).
+#include <benchmark/benchmark.h>
+
+#include <chrono>
+#include <cstdint>
+#include <exception>
+#include <string>
+
+#include "plinth/core/simulator.h"
+#include "plinth/host/record_io.h"
+#include "test_support.h"
+
+namespace {
+
+using namespace plinth;
+
+struct Variant {
+  Stepper stepper;
+  bool exact_full_contact;
+};
+
+SolverSettings settings_of(Variant v, double dt = 1e-4) {
+  SolverSettings s;
+  s.stepper = v.stepper;
+  s.exact_full_contact = v.exact_full_contact;
+  s.step = dt;
+  return s;
+}
+
+// A phase to stay in: the scene, the mode and state it starts from (no excitation).
+struct PhaseStart {
+  SceneParams params;
+  Mode mode;
+  State y;
+};
+
+SceneParams isolated_with_stops() {
+  SceneParams p = testing::paper_isolated();
+  p.has_base_stops = true;
+  p.base_stops = {0.2, 0.7};  // sim/scenes/paper-isolated-stops.toml
+  return p;
+}
+
+// The friction scene of bench_solver.cpp: mu_s, mu_k and a support of clearance 0.1 m.
+SceneParams on_support(double mu_s, double mu_k) {
+  SceneParams p = testing::paper_isolated();
+  p.has_friction = true;
+  p.friction = {mu_s, mu_k};
+  p.has_support = true;
+  p.support = {0.1};
+  return p;
+}
+
+// theta = 0.05 rad about the left corner; sliding right at 0.5 m/s; x = -0.15 m overhangs.
+PhaseStart start_in(Phase phase, const SceneParams& p, int overhang = 0) {
+  PhaseStart s{p, {phase, Corner::kLeft}, State::Zero()};
+  if (s.mode.rocking()) s.y[kTheta] = 0.05;
+  if (s.mode.sliding()) {
+    s.mode.slide_direction = 1;
+    s.y[kXDot] = 0.5;
+  }
+  s.mode.overhang = static_cast<std::int8_t>(overhang);
+  if (overhang < 0) s.y[kX] = -0.15;
+  return s;
+}
+
+// ns per step in one phase: each iteration runs from the start until the phase ends (impacts
+// included) or kMaxSteps, timed by hand (UseManualTime) so that the restart is not.
+void BM_PhaseStep(benchmark::State& state, PhaseStart start, Variant variant) {
+  constexpr std::int64_t kMaxSteps = 100'000;  // 10 s
+  const Scene scene = testing::make(start.params);
+  Simulator sim;
+  if (!Simulator::create(scene, Excitation::none(), settings_of(variant), sim).ok()) {
+    state.SkipWithError("Simulator::create failed");
+    return;
+  }
+  std::int64_t steps = 0;
+  for (auto _ : state) {
+    sim.start_from(start.mode, start.y);
+    const auto begin = std::chrono::steady_clock::now();
+    while (sim.step_count() < kMaxSteps && sim.mode().phase == start.mode.phase) sim.step();
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
+    steps += sim.step_count();
+  }
+  state.SetItemsProcessed(steps);
+  state.counters["ns_per_step"] = benchmark::Counter(
+      static_cast<double>(steps), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
+// Every phase of bench_solver.cpp's BM_Step, with every stepper (and full contact also
+// propagated exactly): BM_PhaseStep/<phase>/<stepper>.
+const bool kPhaseStepsRegistered = [] {
+  struct PhaseCase {
+    const char* name;
+    PhaseStart start;
+  };
+  const PhaseCase phases[] = {
+      {"full_contact_base", start_in(Phase::kFullContact, testing::paper_isolated())},
+      {"full_contact_base_stops", start_in(Phase::kFullContact, isolated_with_stops())},
+      {"rocking_base", start_in(Phase::kRocking, testing::paper_isolated())},
+      {"rocking_ground", start_in(Phase::kRocking, testing::paper_block())},
+      {"sliding_base", start_in(Phase::kSliding, on_support(0.25, 0.2))},
+      {"slide_rocking_base", start_in(Phase::kSlideRocking, on_support(0.5, 0.4))},
+      {"slide_rocking_overhanging_base", start_in(Phase::kSlideRocking, on_support(0.5, 0.4), -1)},
+  };
+  for (const PhaseCase& phase : phases) {
+    for (const Stepper stepper : kAllSteppers) {
+      for (const bool exact : {false, true}) {
+        if (exact &&
+            (phase.start.mode.phase != Phase::kFullContact || stepper != Stepper::kRk4Located)) {
+          continue;
+        }
+        const std::string name = std::string("BM_PhaseStep/") + phase.name + "/" +
+                                 stepper_name(stepper) + (exact ? "+exact" : "");
+        benchmark::RegisterBenchmark(name.c_str(), BM_PhaseStep, phase.start,
+                                     Variant{stepper, exact})
+            ->UseManualTime();
+      }
+    }
+  }
+  return true;
+}();
+
+// ---------------------------------------------------------------------------------------------
+// Only what the scene needs: the same run (Brienza 000, 12 s, the block rocking) with the
+// features a scene may add and this input never engages; ns per step over the whole run.
+
+enum class Extra { kNone, kFarStops, kStickingFriction, kFarSupportEdge, kFarSlidingStops, kAll };
+
+SceneParams with_extra(SceneParams p, Extra extra) {
+  const bool stops = extra == Extra::kFarStops || extra == Extra::kAll;
+  const bool friction = extra != Extra::kNone && extra != Extra::kFarStops;
+  if (stops && p.has_base) {
+    p.has_base_stops = true;
+    p.base_stops = {10.0, 0.7};  // never reached
+  }
+  if (friction) {
+    p.has_friction = true;
+    p.friction = {10.0, 8.0};  // never lets go on this input
+  }
+  if (extra == Extra::kFarSupportEdge || extra == Extra::kFarSlidingStops || extra == Extra::kAll) {
+    p.has_support = true;
+    p.support = {10.0};
+  }
+  if (extra == Extra::kFarSlidingStops || extra == Extra::kAll) {
+    p.has_sliding_stops = true;
+    p.sliding_stops = {0.7};
+  }
+  return p;
+}
+
+// Brienza 000 in m/s2, read once; nullptr when it cannot be read (*error says why).
+const host::Record* brienza_000(std::string* error) {
+  static std::string failure;
+  static const host::Record* const record = []() -> const host::Record* {
+    try {
+      static const host::Record r = host::read_at2(
+          std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
+          kStandardGravity);
+      return &r;
+    } catch (const std::exception& e) {
+      failure = e.what();
+      return nullptr;
+    }
+  }();
+  *error = failure;
+  return record;
+}
+
+void BM_FeatureRun(benchmark::State& state, bool on_base, Extra extra) {
+  std::string error;
+  const host::Record* record = brienza_000(&error);
+  if (record == nullptr) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  const SceneParams base = on_base ? testing::paper_isolated() : testing::paper_block();
+  const double pga_g = on_base ? 3.0 : 0.5;  // rocking with impacts, no collapse
+  const Scene scene = testing::make(with_extra(base, extra));
+  const Excitation ex = Excitation::record(record->horizontal_signal(), {},
+                                           pga_g * kStandardGravity / record->peak_horizontal());
+  Simulator sim;
+  if (!Simulator::create(scene, ex, settings_of({Stepper::kRk4Located, false}), sim).ok()) {
+    state.SkipWithError("Simulator::create failed");
+    return;
+  }
+  constexpr std::int64_t kSteps = 120'000;  // 12 s
+  std::int64_t steps = 0;
+  for (auto _ : state) {
+    sim.start_at_rest();
+    while (sim.step_count() < kSteps && !sim.mode().terminal()) sim.step();
+    steps += sim.step_count();
+  }
+  state.SetItemsProcessed(steps);
+  state.counters["ns_per_step"] = benchmark::Counter(
+      static_cast<double>(steps), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  state.counters["events"] = static_cast<double>(sim.event_count());
+}
+
+// BM_FeatureRun/<scene>+<feature>: the run on the ground and on the base, with each feature.
+const bool kFeatureRunsRegistered = [] {
+  struct FeatureCase {
+    const char* name;
+    bool on_base;
+    Extra extra;
+  };
+  const FeatureCase cases[] = {
+      {"ground", false, Extra::kNone},
+      {"ground+friction", false, Extra::kStickingFriction},
+      {"ground+support_edge", false, Extra::kFarSupportEdge},
+      {"ground+sliding_stops", false, Extra::kFarSlidingStops},
+      {"base", true, Extra::kNone},
+      {"base+stops", true, Extra::kFarStops},
+      {"base+friction", true, Extra::kStickingFriction},
+      {"base+support_edge", true, Extra::kFarSupportEdge},
+      {"base+sliding_stops", true, Extra::kFarSlidingStops},
+      {"base+everything", true, Extra::kAll},
+  };
+  for (const FeatureCase& c : cases) {
+    benchmark::RegisterBenchmark((std::string("BM_FeatureRun/") + c.name).c_str(), BM_FeatureRun,
+                                 c.on_base, c.extra)
+        ->Unit(benchmark::kMillisecond);
+  }
+  return true;
+}();
+
+}  // namespace
