@@ -200,6 +200,43 @@ void BM_FeatureRun(benchmark::State& state, bool on_base, Extra extra) {
   state.counters["events"] = static_cast<double>(sim.event_count());
 }
 
+// Full contact driven by a record: Brienza 000 at 0.1 g keeps the block on the isolated base in
+// full contact for the whole 12 s (checked), so every step reads the record; ns per step.
+void BM_FullContactOnRecord(benchmark::State& state, Variant variant) {
+  std::string error;
+  const host::Record* record = brienza_000(&error);
+  if (record == nullptr) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  const Scene scene = testing::make(testing::paper_isolated());
+  const Excitation ex = Excitation::record(record->horizontal_signal(), {},
+                                           0.1 * kStandardGravity / record->peak_horizontal());
+  Simulator sim;
+  if (!Simulator::create(scene, ex, settings_of(variant), sim).ok()) {
+    state.SkipWithError("Simulator::create failed");
+    return;
+  }
+  constexpr std::int64_t kSteps = 120'000;  // 12 s
+  std::int64_t steps = 0;
+  for (auto _ : state) {
+    sim.start_at_rest();
+    while (sim.step_count() < kSteps) sim.step();
+    steps += sim.step_count();
+    if (sim.mode().phase != Phase::kFullContact || sim.event_count() != 0) {
+      state.SkipWithError("the block left full contact");
+      return;
+    }
+  }
+  state.SetItemsProcessed(steps);
+  state.counters["ns_per_step"] = benchmark::Counter(
+      static_cast<double>(steps), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK_CAPTURE(BM_FullContactOnRecord, rk4_located, Variant{Stepper::kRk4Located, false})
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_FullContactOnRecord, rk4_located_exact, Variant{Stepper::kRk4Located, true})
+    ->Unit(benchmark::kMillisecond);
+
 // BM_FeatureRun/<scene>+<feature>: the run on the ground and on the base, with each feature.
 const bool kFeatureRunsRegistered = [] {
   struct FeatureCase {

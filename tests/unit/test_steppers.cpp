@@ -271,6 +271,74 @@ TEST(ExactFullContact, OnsetIsLocatedOnTheExactSolution) {
   }
 }
 
+}  // namespace
+
+// Reaches the simulator's quiet full-contact step (simulator.h befriends it).
+struct SimulatorTestPeer {
+  static void take_every_step_by_intervals(Simulator& sim) { sim.full_contact_fn_ = nullptr; }
+};
+
+namespace {
+
+// The quiet full-contact step (Simulator::step, exact_full_contact) skips the flow point and the
+// guard values the interval keeps; its states and events are the interval's to the last bit, in
+// every feature configuration, through onsets, impacts, stops and back to full contact.
+TEST(ExactFullContact, QuietStepsAreTheIntervalsToTheLastBit) {
+  SceneParams stops = testing::paper_isolated();
+  stops.has_base_stops = true;
+  stops.base_stops = {0.05, 0.7};
+  SceneParams everything = stops;
+  everything.has_friction = true;
+  everything.friction = {0.3, 0.24};
+  everything.has_support = true;
+  everything.support = {0.1};
+  everything.has_sliding_stops = true;
+  SceneParams edge = everything;
+  edge.has_sliding_stops = false;
+  const host::Record record = host::read_at2(
+      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
+      kStandardGravity);
+  int returns = 0;  // back to full contact after leaving it, over all runs
+  int events = 0;
+  for (const double pga_g : {1.0, 2.0, 2.5}) {
+    const Excitation ex = Excitation::record(record.horizontal_signal(), {},
+                                             pga_g * kStandardGravity / record.peak_horizontal());
+    for (const SceneParams& p : {testing::paper_isolated(), stops, everything, edge}) {
+      const Scene s = make(p);
+      Simulator quiet;
+      Simulator intervals;
+      const SolverSettings settings = with(Stepper::kRk4Located, 1e-3, true);
+      ASSERT_TRUE(Simulator::create(s, ex, settings, quiet).ok());
+      ASSERT_TRUE(Simulator::create(s, ex, settings, intervals).ok());
+      SimulatorTestPeer::take_every_step_by_intervals(intervals);
+      RecordingSink quiet_events;
+      RecordingSink interval_events;
+      quiet.set_event_sink(&quiet_events);
+      intervals.set_event_sink(&interval_events);
+      quiet.start_at_rest();
+      intervals.start_at_rest();
+      int differing = 0;
+      while (quiet.time() < 20.0 && !quiet.mode().terminal()) {
+        quiet.step();
+        intervals.step();
+        differing += quiet.state() != intervals.state() ? 1 : 0;
+      }
+      EXPECT_EQ(differing, 0) << pga_g;
+      EXPECT_EQ(quiet.step_count(), intervals.step_count());
+      ASSERT_EQ(quiet_events.events.size(), interval_events.events.size());
+      for (std::size_t i = 0; i < quiet_events.events.size(); ++i) {
+        EXPECT_EQ(quiet_events.events[i].t, interval_events.events[i].t);
+        EXPECT_EQ(quiet_events.events[i].kind, interval_events.events[i].kind);
+      }
+      events += static_cast<int>(quiet_events.events.size());
+      returns += quiet_events.count(EventKind::kRockingStop) +
+                 quiet_events.count(EventKind::kSlidingStop);
+    }
+  }
+  EXPECT_GE(returns, 2);
+  EXPECT_GE(events, 20);
+}
+
 // ---------------------------------------------------------------------------------------------
 // The fast forms of the flows against straightforward Eigen ones
 

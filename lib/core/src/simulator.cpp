@@ -573,53 +573,58 @@ struct Hybrid {
     ++sim.chatter_steps_;
   }
 
-  // A whole step of full contact propagated exactly, with the guards full contact has in this
-  // model written out (their order is active_guards<F>'s). Returns false unless the step starts
-  // from the cache and has no event, having then written only the spare buffers; the step's
-  // interval runs instead (ExactFullContact in phase_kernels.h: the same values, to the last bit).
-  static bool exact_full_contact_step(Simulator& sim, double t0, double t_end) {
-    const Mode& mode = sim.mode_;
+  // A quiet step of full contact, propagated exactly (full_contact_propagator.h). Full contact's
+  // guards (active_guards<F>: rocking onsets Eq 16, sliding onsets Eq 15, base stops Eq 28) are
+  // taken at the step's end only: when every one is strictly negative there the interval would
+  // see no crossing whatever their values at the start, so its state is this one to the last bit
+  // (the same expressions) and nothing else needs keeping: no flow point, no guard values. Only
+  // the end's horizontal ground acceleration is kept, as the next step's start. Otherwise returns false,
+  // nothing changed, and the step's interval runs (ExactFullContact in phase_kernels.h).
+  static bool quiet_full_contact_step(Simulator& sim, double t0, double t_end) {
     if constexpr (!F.base) {
       return false;
     } else {
+      const Mode& mode = sim.mode_;
       const double h = t_end - t0;
-      if (!sim.cache_valid_ || mode.held_stop != 0 || mode.overhang != 0 || t0 + h != t_end) {
+      State& y = sim.y_;
+      // x and theta at rest, as every reset into full contact leaves them (a state given to
+      // start_from may not: the interval advances it).
+      if (mode.held_stop != 0 || mode.overhang != 0 || y[kXDot] != 0.0 || y[kThetaDot] != 0.0 ||
+          t0 + h != t_end) {
         return false;
       }
       const Scene& s = *sim.scene_;
-      const std::size_t next = 1 - sim.current_;
-      const FlowPoint& start = sim.points_[sim.current_];
-      const GuardValues& g_start = sim.guard_values_[sim.current_];
-      const GroundAcceleration ag = kernels::Base::ground(sim.excitation_, t_end);
-      State y1 = sim.y_;
-      y1.head<3>() += h * sim.y_.tail<3>();
-      y1[kU] = sim.y_[kU];
-      sim.propagator_.advance(y1[kU], y1[kUDot], start.ground.horizontal, ag.horizontal);
-      // The end point and guards go straight to the other buffer (free until the step ends).
-      FlowPoint& end = sim.points_[next];
-      end = {ag, sin_cos(y1[kTheta]), full_contact_flow(s, y1, ag)};
-      GuardValues& g_end = sim.guard_values_[next];
-      std::size_t n = 0;
-      bool crossed = false;
-      const auto add = [&](double b) {
-        const double a = g_start[n];
-        crossed = crossed || (a <= 0.0 && b >= 0.0 && (a < 0.0 || b > 0.0));
-        g_end[n++] = b;
-      };
-      add(rocking_onset_guard(s, s.corner1.sign, s.corner1.onset_ratio, end.acc, ag));
-      add(rocking_onset_guard(s, s.corner2.sign, s.corner2.onset_ratio, end.acc, ag));
+      const double a0 = sim.quiet_ground_step_ == sim.step_count_
+                            ? sim.quiet_ground_horizontal_
+                            : kernels::Base::ground(sim.excitation_, t0).horizontal;
+      const GroundAcceleration a1 = kernels::Base::ground(sim.excitation_, t_end);
+      double u = y[kU];
+      double u_dot = y[kUDot];
+      sim.propagator_.advance(u, u_dot, a0, a1.horizontal);
+      // full_contact_flow's u'' at the end, written on the two scalars
+      const Accelerations acc{-a1.horizontal - (s.damping * u_dot + s.stiffness * u) / s.total_mass,
+                              0.0, 0.0};
+      if (rocking_onset_guard(s, s.corner1.sign, s.corner1.onset_ratio, acc, a1) >= 0.0 ||
+          rocking_onset_guard(s, s.corner2.sign, s.corner2.onset_ratio, acc, a1) >= 0.0) {
+        return false;
+      }
       if constexpr (F.sliding) {
-        const ContactForce f = sticking_contact_force(s, mode, y1, ag, end.acc, end.trig);
-        add(sliding_onset_guard(s, mode, y1, -1, f, end.trig));
-        add(sliding_onset_guard(s, mode, y1, 1, f, end.trig));
+        // Eq 15: full contact's contact force (sticking_contact_force), and no sliding stop
+        // holds the block (x stays, sliding_onset_guard's test of it is kept).
+        const ContactForce f{s.m * (acc.u + a1.horizontal), s.m * (s.g + a1.vertical)};
+        if (sliding_onset_guard(s, mode, y, -1, f, SinCos{}) >= 0.0 ||
+            sliding_onset_guard(s, mode, y, 1, f, SinCos{}) >= 0.0) {
+          return false;
+        }
       }
       if constexpr (F.base_stops) {
-        add(y1[kU] - s.params.base_stops.max_displacement);
-        add(-y1[kU] - s.params.base_stops.max_displacement);
+        if (std::fabs(u) - s.params.base_stops.max_displacement >= 0.0) return false;
       }
-      if (crossed) return false;
-      sim.y_ = y1;
-      sim.current_ = next;
+      y[kU] = u;
+      y[kUDot] = u_dot;
+      sim.cache_valid_ = false;
+      sim.quiet_ground_horizontal_ = a1.horizontal;
+      sim.quiet_ground_step_ = sim.step_count_ + 1;
       return true;
     }
   }
@@ -638,7 +643,7 @@ struct Hybrid {
     sim.enter_fn_ = &enter;
     sim.acc_fn_ = &current;
     sim.full_contact_fn_ =
-        settings.exact_full_contact && F.base ? &exact_full_contact_step : nullptr;
+        settings.exact_full_contact && F.base ? &quiet_full_contact_step : nullptr;
     switch (settings.stepper) {
       case Stepper::kRk4Located:
         bind_intervals<methods::Rk4>(sim, settings.exact_full_contact);
@@ -903,6 +908,7 @@ Error Simulator::create(const Scene& scene, const Excitation& excitation,
 void Simulator::start_from(const Mode& mode, const State& state) {
   step_count_ = 0;
   cache_valid_ = false;
+  quiet_ground_step_ = -1;
   chatter_steps_ = 0;
   event_count_ = 0;
   mode_ = mode;
@@ -939,15 +945,11 @@ void Simulator::start_with_impulse(double impulse) {
   emit(e);
 }
 
-void Simulator::step() {
+// One step by intervals: the stepper in the current mode, then event after event.
+void Simulator::step_intervals() {
   if (mode_.terminal()) return;
   const double t_end = static_cast<double>(step_count_ + 1) * settings_.step;
   double t0 = time();
-  if (mode_.phase == Phase::kFullContact && full_contact_fn_ != nullptr &&
-      full_contact_fn_(*this, t0, t_end)) {
-    ++step_count_;
-    return;
-  }
   if (interval_fns_[static_cast<std::size_t>(mode_.phase)](*this, t0, t_end, true, true)) {
     finish_step(t0, t_end);
   }

@@ -28,9 +28,9 @@ struct SampledSignal {
     const double position = t / dt;
     const auto last = static_cast<double>(count - 1);
     if (position >= last) return position == last ? values[count - 1] : 0.0;
-    const double floor_position = std::floor(position);
-    const auto i = static_cast<std::size_t>(floor_position);
-    const double w = position - floor_position;
+    // position >= 0: truncation is the floor (std::floor is a libm call without SSE4.1)
+    const auto i = static_cast<std::size_t>(position);
+    const double w = position - static_cast<double>(i);
     return values[i] + w * (values[i + 1] - values[i]);
   }
   [[nodiscard]] double duration() const {
@@ -86,7 +86,7 @@ struct Excitation {
 
   // Inline for what the solver meets at every Runge-Kutta stage (none, a record, the stream);
   // the pulses' sine out of line.
-  [[nodiscard]] GroundAcceleration at(double t) const {
+  [[nodiscard, gnu::always_inline]] GroundAcceleration at(double t) const {
     if (kind == ExcitationKind::kNone) return {};
     if (kind == ExcitationKind::kRecord) {
       return {scale * horizontal.at(t), vertical.empty() ? 0.0 : scale * vertical.at(t)};

@@ -26,8 +26,11 @@ struct FullContactPropagator {
   void advance(double& u, double& u_dot, double a0, double a1) const {
     const double u0 = u;
     const double v0 = u_dot;
-    u = phi[0][0] * u0 + phi[0][1] * v0 + gamma0[0] * a0 + gamma1[0] * a1;
-    u_dot = phi[1][0] * u0 + phi[1][1] * v0 + gamma0[1] * a0 + gamma1[1] * a1;
+    // The input's part first: off the chain from one step's state to the next.
+    const double forced_u = gamma0[0] * a0 + gamma1[0] * a1;
+    const double forced_u_dot = gamma0[1] * a0 + gamma1[1] * a1;
+    u = (phi[0][0] * u0 + phi[0][1] * v0) + forced_u;
+    u_dot = (phi[1][0] * u0 + phi[1][1] * v0) + forced_u_dot;
   }
 };
 

@@ -79,8 +79,16 @@ class Simulator {
   // Starts from an arbitrary mode and state at time 0 (tests and estimators).
   void start_from(const Mode& mode, const State& state);
 
-  // Advances one step (no-op once a terminal phase is reached).
-  void step();
+  // Advances one step (no-op once a terminal phase is reached). A quiet step of exactly
+  // propagated full contact is taken here, without a call to the step's intervals.
+  void step() {
+    if (mode_.phase == Phase::kFullContact && full_contact_fn_ != nullptr &&
+        full_contact_fn_(*this, time(), static_cast<double>(step_count_ + 1) * settings_.step)) {
+      ++step_count_;
+      return;
+    }
+    step_intervals();
+  }
 
   void set_event_sink(EventSink* sink) { sink_ = sink; }
 
@@ -103,12 +111,14 @@ class Simulator {
   friend struct Hybrid;
   template <class Method, class Kernel>
   friend struct Interval;
+  friend struct SimulatorTestPeer;  // tests: turns the quiet full-contact step off to compare
 
   void emit(const Event& event) {
     if (sink_ != nullptr) sink_->on_event(event);
   }
   // The guards of the current mode, after it changed.
   void refresh_guards() { active_guards_ = guards_fn_(mode_); }
+  void step_intervals();
   [[gnu::noinline]] void finish_step(double t0, double t_end);
 
   // Advances in the current mode from t0 towards t_end (one interval of a step, Interval in
@@ -130,8 +140,12 @@ class Simulator {
   ActiveGuards (*guards_fn_)(const Mode&) = nullptr;
   void (*enter_fn_)(Simulator&, double) = nullptr;  // starts phases whose onset already holds
   Accelerations (*acc_fn_)(const Simulator&, double, const State&) = nullptr;
-  // exact_full_contact: a whole step of full contact without event (false: take the interval).
+  // exact_full_contact: a quiet whole step of full contact (false: take the interval).
   bool (*full_contact_fn_)(Simulator&, double t0, double t_end) = nullptr;
+  // u_G'' at the end of the last quiet full-contact step, the start of step number
+  // quiet_ground_step_, m/s2.
+  double quiet_ground_horizontal_ = 0.0;
+  std::int64_t quiet_ground_step_ = -1;
   FullContactPropagator propagator_;  // for exact_full_contact, over one step
   bool events_at_step_ends_ = false;  // the stepper takes events at step ends (rest speeds)
   Mode mode_;
