@@ -98,6 +98,13 @@ TEST(Estimator, RefusesBadSettingsNamingTheField) {
   settings.steps_per_sample = static_cast<int>(std::ceil(0.01 / e.limit));
   ASSERT_LE(settings.steps_per_sample, 64);
   EXPECT_TRUE(estimator.start(stiff_scene, settings, {}).ok());
+  // Each stepper's own limit (semi-implicit Euler's is below RK4's for this damped base).
+  settings.solver.stepper = Stepper::kSemiImplicitEuler;
+  settings.steps_per_sample = 1;
+  const Error euler = estimator.start(stiff_scene, settings, {});
+  EXPECT_STREQ(euler.field, "estimator.steps_per_sample");
+  EXPECT_NEAR(euler.limit, largest_stable_step(stiff_scene, Stepper::kSemiImplicitEuler), 1e-15);
+  EXPECT_NE(euler.limit, largest_stable_step(stiff_scene));
 }
 
 TEST(Risk, ZeroAtRestOneAtCollapse) {

@@ -15,7 +15,7 @@ Error validate(const EstimatorSettings& st, const Scene& scene) {
   SolverSettings solver = st.solver;
   solver.step = st.step();
   if (Error e = validate(solver); !e.ok()) return e;
-  if (const double limit = largest_stable_step(scene); solver.step > limit) {
+  if (const double limit = largest_stable_step(scene, solver.stepper); solver.step > limit) {
     return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
             "gives a solver step too large for a stable integration of this scene's base; "
             "raise it so that 1 / (rate * steps) is below the limit",
