@@ -12,6 +12,7 @@
 
 #include "plinth/core/flows.h"
 #include "plinth/core/full_contact_propagator.h"
+#include "plinth/core/resets.h"
 #include "plinth/host/record_io.h"
 #include "test_support.h"
 
@@ -508,6 +509,49 @@ TEST(OnlyWhatTheSceneNeeds, UnusedFeaturesGiveTheSameRun) {
       }
     }
   }
+}
+
+
+// "A scene that cannot slide runs without the sliding machinery": in this model no finite
+// friction in the range the solver is tested over (mu_s up to 2, PGA up to 5 g) rules sliding
+// out, so only a scene without [friction] (the block held whatever the force) drops it.
+//  - Full contact: rocking starts first once mu_s > b_i / h (Eq 39), and the impact at theta = 0
+//    of a rocking block needs only |Pt| / Pn < b / h to stick (checked below), but
+//  - while rocking, Eq 18's ratio |X| / Y grows without bound as the ground accelerates the block
+//    towards lift-off (Y -> 0): a block of slenderness 3 with mu_s = 2 starts sliding out of pure
+//    rocking under one-sine pulses of 3 to 5 g.
+TEST(OnlyWhatTheSceneNeeds, NoFrictionUpToTwoRulesOutSliding) {
+  SceneParams p = testing::paper_block();
+  p.has_friction = true;
+  p.friction = {2.0, 1.6};
+  const Scene s = make(p);
+  ASSERT_TRUE(features_of(s).sliding);
+  for (const double pga_g : {3.0, 4.0, 5.0}) {
+    RecordingSink sink;
+    (void)testing::run(s, Excitation::sine_pulse(pga_g * kStandardGravity, 0.5), 1.0, 1e-4, &sink);
+    const Event* rocking = sink.first(EventKind::kRockingStart);
+    const Event* sliding = sink.first(EventKind::kSlidingStart);
+    ASSERT_NE(rocking, nullptr) << pga_g;
+    ASSERT_NE(sliding, nullptr) << pga_g << " g: no sliding with mu_s = 2";
+    EXPECT_LT(rocking->t, sliding->t);
+    EXPECT_EQ(sliding->phase, Phase::kSlideRocking) << "out of pure rocking (Eq 18)";
+    EXPECT_EQ(sink.count(EventKind::kImpact), 0) << "not through an impact";
+  }
+  // The impact's stick ratio, for the record: below b / h, so impacts alone never slide.
+  for (const bool on_base : {false, true}) {
+    SceneParams q = on_base ? testing::paper_isolated() : testing::paper_block();
+    q.has_friction = true;
+    q.friction = {100.0, 80.0};
+    const Scene t = make(q);
+    Mode mode{Phase::kRocking, Corner::kLeft, 0};
+    State y = State::Zero();
+    y[kThetaDot] = -1.0;
+    const CoulombImpact impact = coulomb_impact_reset(t, on_base, mode, y);
+    EXPECT_TRUE(impact.sticks);
+    EXPECT_LT(std::fabs(impact.tangential_impulse / impact.normal_impulse), t.b / t.h) << on_base;
+  }
+  // Without [friction] the scene has no sliding machinery at all.
+  EXPECT_FALSE(features_of(make(testing::paper_block())).sliding);
 }
 
 }  // namespace
