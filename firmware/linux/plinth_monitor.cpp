@@ -4,10 +4,8 @@
 // status lines at --status-interval and on every alarm change, alarm lines, phase events, and
 // a summary at the end. Live, status and alarm frames also go on the bus.
 #include <CLI/CLI.hpp>
-#include <time.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -16,13 +14,14 @@
 #include <string>
 #include <vector>
 
-#include "cli_validators.h"
 #include "event_recorder.h"
 #include "monitor_config.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/hal/can_codec.h"
+#include "plinth/hal/pacing.h"
 #include "plinth/hal/socketcan.h"
+#include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/run_output.h"
@@ -36,8 +35,8 @@ namespace fw = plinth::firmware;
 namespace can = plinth::can;
 namespace mon = plinth::monitor;
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop.store(true); }
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void on_signal(int) { g_stop = 1; }
 
 struct Options {
   std::string scene_path;
@@ -64,20 +63,6 @@ struct Options {
 };
 
 const char* axis_name(int axis) { return axis == 0 ? "x" : "y"; }
-
-std::int64_t monotonic_ns() {
-  timespec ts{};
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
-}
-
-void sleep_until(std::int64_t deadline_ns) {
-  timespec ts{};
-  ts.tv_sec = static_cast<time_t>(deadline_ns / 1'000'000'000);
-  ts.tv_nsec = static_cast<long>(deadline_ns % 1'000'000'000);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR && !g_stop) {
-  }
-}
 
 // --speed: a positive factor of real time, or "max".
 double parse_speed(const std::string& text) {
@@ -570,9 +555,13 @@ int run(const Options& opt) {
   Outputs outputs(monitor, t_origin, opt.status_interval, recorder.get(),
                   port ? &*port : nullptr);
   Summary summary;
-  const std::int64_t wall_start = monotonic_ns();
+  const std::int64_t wall_start = plinth::hal::monotonic_now_ns();
   const auto pace = [&](std::int64_t stream_ns) {
-    if (speed > 0.0) sleep_until(wall_start + std::llround(static_cast<double>(stream_ns) / speed));
+    if (speed > 0.0) {
+      // Cut short by Ctrl-C: the loops look at g_stop.
+      (void)plinth::hal::sleep_until_ns(
+          wall_start + std::llround(static_cast<double>(stream_ns) / speed), g_stop);
+    }
   };
 
   if (replay_record) {
@@ -642,11 +631,9 @@ int run(const Options& opt) {
     const std::int64_t end_ns =
         opt.duration > 0.0 ? wall_start + std::llround(opt.duration * 1e9) : INT64_MAX;
     std::int64_t bus_fault_until = 0;
-    while (!g_stop && monotonic_ns() < end_ns) {
+    while (!g_stop && plinth::hal::monotonic_now_ns() < end_ns) {
       const plinth::hal::IoStatus status = port->receive(frame, 10);
-      timespec now{};
-      clock_gettime(CLOCK_REALTIME, &now);
-      const std::int64_t now_ns = static_cast<std::int64_t>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+      const std::int64_t now_ns = plinth::hal::realtime_now_ns();
       switch (status) {
         case plinth::hal::IoStatus::kOk: {
           if (recorder) recorder->on_frame(frame);
@@ -701,34 +688,31 @@ int main(int argc, char** argv) {
   app.add_option("--can", opt.can_interface, "listen on a SocketCAN interface, e.g. can0");
   app.add_option("--pga", opt.pga, "scale the record to this PGA, e.g. 0.3g")->excludes("--can");
   app.add_option("--scale", opt.scale, "scale factor of the record")
-      ->check(plinth::cli::kFinite)->excludes("--pga");
+      ->check(plinth::host::kFinite)->excludes("--pga");
   app.add_option("--speed", opt.speed, "replay speed: a factor of real time, or max (default)");
   app.add_option("--rate", opt.rate, "sensor rate, Hz (100-1000; default: the record's, or 200)")
-      ->check(plinth::cli::kFinitePositive);
+      ->check(plinth::host::kFinitePositive);
   app.add_option("--steps", opt.steps, "solver steps per sample (default 4)")->check(CLI::Range(1, 64));
   app.add_option("--node", opt.node, "CAN node of the single ground sensor (default 1; not with [[sensor]] tables)")->check(CLI::Range(1, 15));
   app.add_option("--status-interval", opt.status_interval, "s between status lines (default 0.1)")
-      ->check(plinth::cli::kFinitePositive);
+      ->check(plinth::host::kFinitePositive);
   app.add_option("--startup-window", opt.startup_window,
                  "s of quiet input that estimate the sensor offset (default 2)")
-      ->check(plinth::cli::kFinitePositive);
+      ->check(plinth::host::kFinitePositive);
   app.add_option("--duration", opt.duration, "live: stop after this many seconds")
-      ->check(plinth::cli::kFinitePositive);
+      ->check(plinth::host::kFinitePositive);
   app.add_option("--record-dir", opt.record_dir, "event recorder: write captures here");
   app.add_option("--pre-trigger", opt.pre_trigger, "s kept before an alarm (default 30)")
-      ->check(plinth::cli::kFinite);
+      ->check(plinth::host::kFinite);
   app.add_option("--post-trigger", opt.post_trigger, "s kept after an alarm (default 60)")
-      ->check(plinth::cli::kFinite);
+      ->check(plinth::host::kFinite);
   app.add_flag("--no-events", opt.quiet_events, "leave out the phase event lines");
   app.add_option("--stuck-samples", opt.stuck_samples,
                  "identical samples that mean a stuck sensor (default 50; 0: off, for noise-free "
                  "synthetic logs)")
       ->check(CLI::Range(0, 100000));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help ends here with 0; every usage error exits with 2.
-    return app.exit(e) == 0 ? 0 : 2;
+  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+    return *exit_code;
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "plinth/core/simulator.h"
+#include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
@@ -649,10 +650,8 @@ int main(int argc, char** argv) {
   app.add_option("--out-dir", opt.out_dir, "where the CSV, Markdown and plot files go");
   app.add_flag("--plot", opt.plot, "draw accuracy.png and accuracy.svg with gnuplot");
   app.add_flag("--quick", opt.quick, "one case, two steps: a smoke test (seconds)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+    return *exit_code;
   }
   try {
     return run(opt);

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "cli_validators.h"
 #include "plinth/core/simulator.h"
+#include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/run_output.h"
@@ -290,28 +290,25 @@ int main(int argc, char** argv) {
   app.add_option("--scale", opt.scale, "scale factor gamma of the record")
       ->needs(record)
       ->excludes(pga)
-      ->check(plinth::cli::kFinite);
+      ->check(plinth::host::kFinite);
   auto* impulse = app.add_option("--impulse", opt.impulse, "impulse I, m/s (Eq 34)")
                       ->excludes(record)
-                      ->check(plinth::cli::kFinite);
+                      ->check(plinth::host::kFinite);
   auto* pulse = app.add_option("--pulse", opt.pulse, "one-period pulse: sine or cosine")
                     ->check(CLI::IsMember({"sine", "cosine"}))
                     ->excludes(record)
                     ->excludes(impulse);
   app.add_option("--amplitude", opt.amplitude, "pulse amplitude, e.g. 0.5g")->needs(pulse);
-  app.add_option("--period", opt.period, "pulse period, s")->needs(pulse)->check(plinth::cli::kFinitePositive);
-  app.add_option("--dt", opt.dt, "solver step, s")->check(plinth::cli::kFinitePositive);
+  app.add_option("--period", opt.period, "pulse period, s")->needs(pulse)->check(plinth::host::kFinitePositive);
+  app.add_option("--dt", opt.dt, "solver step, s")->check(plinth::host::kFinitePositive);
   app.add_option("--t-end", opt.t_end, "end time, s (default: the input's length + 5 s, at least 10 s)")
-      ->check(plinth::cli::kFinitePositive);
+      ->check(plinth::host::kFinitePositive);
   app.add_option("--out", opt.out_path, "CSV time history");
   app.add_option("--out-interval", opt.out_interval, "time between CSV rows, s (whole steps)")
-      ->check(plinth::cli::kFinitePositive);
+      ->check(plinth::host::kFinitePositive);
   app.add_option("--events", opt.events_path, "JSON Lines event log");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help and --version end here with 0; every usage error exits with 2.
-    return app.exit(e) == 0 ? 0 : 2;
+  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+    return *exit_code;
   }
   if (!opt.pulse.empty() && (opt.amplitude.empty() || !opt.period)) {
     std::fprintf(stderr, "plinth-sim: --pulse needs --amplitude and --period\n");

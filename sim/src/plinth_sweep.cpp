@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "cli_validators.h"
+#include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
@@ -225,8 +225,8 @@ int run_plot(const PlotOptions& opt) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  using plinth::cli::kFinite;
-  using plinth::cli::kFinitePositive;
+  using plinth::host::kFinite;
+  using plinth::host::kFinitePositive;
   CLI::App app{
       "plinth-sweep: the paper's parametric analyses (docs/sweep.md): first-occurrence "
       "PGA of each event against one parameter, two-parameter maps, impulse maps and "
@@ -294,11 +294,8 @@ int main(int argc, char** argv) {
   plot_command->add_option("csv", plot.csv_path, "a plinth-sweep CSV")->required();
   plot_command->add_option("--out", plot.plot_path, "image: map.png writes map.png and map.svg")
       ->required();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help and --version end here with 0; every usage error exits with 2.
-    return app.exit(e) == 0 ? 0 : 2;
+  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+    return *exit_code;
   }
   if (opt.compare_ground && opt.impulse_map) {
     std::fprintf(stderr,

@@ -15,11 +15,11 @@
 #include <string>
 #include <vector>
 
-#include "cli_validators.h"
 #include "frame_schedule.h"
-#include "pacing.h"
 #include "plinth/hal/candump_log.h"
+#include "plinth/hal/pacing.h"
 #include "plinth/hal/socketcan.h"
+#include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/units.h"
@@ -227,9 +227,9 @@ struct Destination {
   // real controller) is waited out for up to kQueueFullWaitNs rather than the frame dropped.
   [[nodiscard]] plinth::hal::IoStatus send(const plinth::can::CanFrame& frame) const {
     plinth::hal::IoStatus status = sink->send(frame);
-    const std::int64_t give_up_ns = plinth::replay::monotonic_now_ns() + kQueueFullWaitNs;
+    const std::int64_t give_up_ns = plinth::hal::monotonic_now_ns() + kQueueFullWaitNs;
     while (status == plinth::hal::IoStatus::kIoError && port != nullptr &&
-           port->transmit_queue_full() && plinth::replay::monotonic_now_ns() < give_up_ns) {
+           port->transmit_queue_full() && plinth::hal::monotonic_now_ns() < give_up_ns) {
       const timespec pause{0, kQueueFullPauseNs};
       nanosleep(&pause, nullptr);
       status = sink->send(frame);
@@ -275,7 +275,7 @@ struct Report {
   bool interrupted = false;
 };
 
-void print_report(const Options& opt, const Report& r, const plinth::replay::Pacer& pacer,
+void print_report(const Options& opt, const Report& r, const plinth::hal::Pacer& pacer,
                   const std::string& destination) {
   std::fprintf(
       stderr,
@@ -292,7 +292,7 @@ void print_report(const Options& opt, const Report& r, const plinth::replay::Pac
   if (!r.first_send_error.empty()) {
     std::fprintf(stderr, "plinth-replay: first send error: %s\n", r.first_send_error.c_str());
   }
-  const plinth::replay::LatenessHistogram& lateness = pacer.lateness();
+  const plinth::hal::LatenessHistogram& lateness = pacer.lateness();
   if (pacer.paced()) {
     std::fprintf(stderr,
                  "plinth-replay: pacing jitter (send time - deadline): median %.0f us, p99 %.0f "
@@ -391,7 +391,7 @@ int run(const Options& opt, const CLI::App& app) {
   // The log's timestamps are the frames' virtual send times (at speed 1) from now, so that
   // canplayer -I replays the log in real time whatever --speed wrote it.
   std::int64_t current_virtual_ns = 0;
-  const std::int64_t log_epoch_ns = plinth::replay::realtime_now_ns();
+  const std::int64_t log_epoch_ns = plinth::hal::realtime_now_ns();
   Destination destination;
   if (!opt.log_path.empty()) {
     auto writer = std::make_unique<plinth::hal::CandumpLogWriter>(
@@ -410,7 +410,7 @@ int run(const Options& opt, const CLI::App& app) {
   install_stop_handlers();
   Report report;
   report.skipped_log_lines = skipped_log_lines;
-  plinth::replay::Pacer pacer(speed);
+  plinth::hal::Pacer pacer(speed);
   pacer.start();
   plinth::replay::ScheduledFrame next;
   while (schedule->next(next)) {
@@ -464,14 +464,14 @@ int main(int argc, char** argv) {
                              "e.g. 0.3g");
   app.add_option("--scale", opt.scale, "scale factor of every record")
       ->excludes(pga)
-      ->check(plinth::cli::kFinite);
+      ->check(plinth::host::kFinite);
   app.add_option("--rate", opt.rate_hz, "sensor output rate, Hz (100-1000)")->check(kSensorRate);
   app.add_option("--speed", opt.speed, "speed factor: 1 real time, 2 twice as fast, max no pacing")
       ->check(kSpeed);
   app.add_option("--loop", opt.loops, "send the input this many times")
       ->check(CLI::Range(std::int64_t{1}, std::int64_t{1000000}));
   app.add_option("--t-end", opt.t_end_s, "send only the first T-END seconds of the input")
-      ->check(plinth::cli::kFinitePositive);
+      ->check(plinth::host::kFinitePositive);
   auto* can = app.add_option("--can", opt.can_interface, "SocketCAN interface, e.g. vcan0");
   auto* log = app.add_option("--log", opt.log_path, "write a candump log instead of using a bus")
                   ->excludes(can);
@@ -480,11 +480,8 @@ int main(int argc, char** argv) {
       ->needs(log);
   app.add_flag("--report-json", opt.report_json,
                "also print the report as one JSON line on stdout");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help ends here with 0; every usage error exits with 2.
-    return app.exit(e) == 0 ? 0 : 2;
+  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+    return *exit_code;
   }
   if (opt.can_interface.empty() && opt.log_path.empty()) {
     std::fprintf(stderr,

@@ -19,6 +19,8 @@
 #include <ctime>
 #include <utility>
 
+#include "plinth/hal/pacing.h"
+
 namespace plinth::hal {
 
 static_assert(kCanEffFlag == CAN_EFF_FLAG && kCanRtrFlag == CAN_RTR_FLAG &&
@@ -49,12 +51,6 @@ namespace {
 
 constexpr std::int64_t kNsPerSecond = 1'000'000'000;
 constexpr std::int64_t kNsPerMs = 1'000'000;
-
-std::int64_t now_ns(clockid_t clock) {
-  timespec ts{};
-  clock_gettime(clock, &ts);
-  return static_cast<std::int64_t>(ts.tv_sec) * kNsPerSecond + ts.tv_nsec;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Error frame text
@@ -500,7 +496,7 @@ SocketCanPort::ReadResult SocketCanPort::read_frame(RawFrame& raw, std::uint32_t
     }
   }
   // The kernel stamps every frame once SO_TIMESTAMPNS is on; this only guards the contract.
-  if (!stamped) raw.timestamp_ns = now_ns(CLOCK_REALTIME);
+  if (!stamped) raw.timestamp_ns = realtime_now_ns();
   return ReadResult::kFrame;
 }
 
@@ -533,7 +529,7 @@ IoStatus SocketCanPort::receive(TimedFrame& out, int timeout_ms) {
     pending_.reset();
     return classify(raw, out);
   }
-  const std::int64_t deadline_ns = now_ns(CLOCK_MONOTONIC) + std::int64_t{timeout_ms} * kNsPerMs;
+  const std::int64_t deadline_ns = monotonic_now_ns() + std::int64_t{timeout_ms} * kNsPerMs;
   for (;;) {
     RawFrame raw;
     std::uint32_t drop_count = last_drop_count_;  // no cmsg: the counter did not move
@@ -552,7 +548,7 @@ IoStatus SocketCanPort::receive(TimedFrame& out, int timeout_ms) {
 
     int wait_ms = -1;
     if (timeout_ms >= 0) {
-      const std::int64_t left_ns = deadline_ns - now_ns(CLOCK_MONOTONIC);
+      const std::int64_t left_ns = deadline_ns - monotonic_now_ns();
       // Round up: poll() waiting 0 ms short of the deadline would spin.
       wait_ms = left_ns <= 0 ? 0 : static_cast<int>((left_ns + kNsPerMs - 1) / kNsPerMs);
     }

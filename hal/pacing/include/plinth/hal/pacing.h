@@ -1,11 +1,28 @@
-// Sending frames on absolute deadlines, and how late each send was.
+// Clocks in ns, sleeping to absolute deadlines, and a pacer that sends on virtual time: the one
+// place the Linux tools (plinth-replay, plinth-monitor, the SocketCAN backend) read clocks.
+// Linux only (clock_gettime, clock_nanosleep with TIMER_ABSTIME, prctl).
 #pragma once
 
 #include <csignal>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
-namespace plinth::replay {
+namespace plinth::hal {
+
+// CLOCK_MONOTONIC and CLOCK_REALTIME in ns.
+[[nodiscard]] std::int64_t monotonic_now_ns();
+[[nodiscard]] std::int64_t realtime_now_ns();
+
+// Sleeps until `deadline_ns` on CLOCK_MONOTONIC. The deadline is absolute, so a late caller
+// does not push the next one back. Never returns before the deadline: a signal (EINTR) resumes
+// the sleep.
+void sleep_until_ns(std::int64_t deadline_ns);
+// The same, but returns false, early, once `stop` is set (a signal handler sets it; the signal
+// interrupts the sleep; set just before the sleep, it is seen within 100 ms). True at the
+// deadline.
+[[nodiscard]] bool sleep_until_ns(std::int64_t deadline_ns,
+                                  const volatile std::sig_atomic_t& stop);
 
 // Lateness of sends (actual send time minus deadline) in a log-linear histogram of
 // microseconds: exact below 1024 us, then 1024 bins per power of two (0.1 % resolution), so a
@@ -45,6 +62,10 @@ class Pacer {
 
   [[nodiscard]] bool paced() const { return speed_ > 0.0; }
   [[nodiscard]] const LatenessHistogram& lateness() const { return lateness_; }
+  // The deadline of `virtual_ns` on CLOCK_MONOTONIC, ns (paced only).
+  [[nodiscard]] std::int64_t deadline_ns(std::int64_t virtual_ns) const;
+  // CLOCK_MONOTONIC at start(), ns.
+  [[nodiscard]] std::int64_t start_ns() const { return start_ns_; }
   // Monotonic time since start(), s.
   [[nodiscard]] double elapsed_s() const;
 
@@ -55,8 +76,4 @@ class Pacer {
   LatenessHistogram lateness_;
 };
 
-// CLOCK_MONOTONIC and CLOCK_REALTIME in ns.
-[[nodiscard]] std::int64_t monotonic_now_ns();
-[[nodiscard]] std::int64_t realtime_now_ns();
-
-}  // namespace plinth::replay
+}  // namespace plinth::hal

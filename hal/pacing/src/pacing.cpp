@@ -1,4 +1,5 @@
-#include "pacing.h"
+// Clocks, absolute sleeps, the lateness histogram and the pacer.
+#include "plinth/hal/pacing.h"
 
 #include <sys/prctl.h>
 
@@ -7,12 +8,16 @@
 #include <cmath>
 #include <ctime>
 
-namespace plinth::replay {
+namespace plinth::hal {
 namespace {
 
 constexpr std::int64_t kNsPerSecond = 1'000'000'000;
 constexpr std::int64_t kNsPerMicrosecond = 1'000;
+// Longest single sleep while a stop flag is watched: a stop request that lands just before the
+// sleep (not interrupting it) must not wait for the end of a long gap.
 constexpr std::int64_t kLongestSleepNs = 100'000'000;
+// Never set: sleep_until_ns without a flag.
+const volatile std::sig_atomic_t kNeverStop = 0;
 
 std::int64_t now_ns(clockid_t clock) {
   timespec now{};
@@ -24,6 +29,21 @@ std::int64_t now_ns(clockid_t clock) {
 
 std::int64_t monotonic_now_ns() { return now_ns(CLOCK_MONOTONIC); }
 std::int64_t realtime_now_ns() { return now_ns(CLOCK_REALTIME); }
+
+void sleep_until_ns(std::int64_t deadline_ns) { (void)sleep_until_ns(deadline_ns, kNeverStop); }
+
+bool sleep_until_ns(std::int64_t deadline_ns, const volatile std::sig_atomic_t& stop) {
+  for (;;) {
+    if (stop != 0) return false;
+    const std::int64_t now = monotonic_now_ns();
+    if (now >= deadline_ns) return true;
+    const std::int64_t wake_ns = std::min(deadline_ns, now + kLongestSleepNs);
+    const timespec wake{static_cast<time_t>(wake_ns / kNsPerSecond),
+                        static_cast<long>(wake_ns % kNsPerSecond)};
+    // Returns EINTR on a signal: the loop looks at `stop` again.
+    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &wake, nullptr);
+  }
+}
 
 std::size_t LatenessHistogram::bin_of(std::int64_t us) {
   if (us < kExactUs) return static_cast<std::size_t>(us);
@@ -81,19 +101,12 @@ void Pacer::start() {
 bool Pacer::wait_until(std::int64_t virtual_ns, const volatile std::sig_atomic_t& stop) {
   if (stop != 0) return false;
   if (!paced()) return true;
-  deadline_ns_ = start_ns_ + std::llround(static_cast<double>(virtual_ns) / speed_);
-  for (;;) {
-    if (stop != 0) return false;
-    const std::int64_t now_ns = monotonic_now_ns();
-    if (now_ns >= deadline_ns_) return true;
-    // At most kLongestSleepNs at a time: a stop request that lands just before the sleep (not
-    // interrupting it) must not wait for the end of a long gap in a log.
-    const std::int64_t wake_ns = std::min(deadline_ns_, now_ns + kLongestSleepNs);
-    const timespec wake{static_cast<time_t>(wake_ns / kNsPerSecond),
-                        static_cast<long>(wake_ns % kNsPerSecond)};
-    // Returns EINTR on a signal: the loop looks at `stop` again.
-    clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &wake, nullptr);
-  }
+  deadline_ns_ = deadline_ns(virtual_ns);
+  return sleep_until_ns(deadline_ns_, stop);
+}
+
+std::int64_t Pacer::deadline_ns(std::int64_t virtual_ns) const {
+  return start_ns_ + std::llround(static_cast<double>(virtual_ns) / speed_);
 }
 
 void Pacer::record_send() {
@@ -104,4 +117,4 @@ double Pacer::elapsed_s() const {
   return static_cast<double>(monotonic_now_ns() - start_ns_) / static_cast<double>(kNsPerSecond);
 }
 
-}  // namespace plinth::replay
+}  // namespace plinth::hal

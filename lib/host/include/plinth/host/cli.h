@@ -1,0 +1,19 @@
+// The command-line tools' shared CLI11 pieces: number checks, and parsing with the tools' exit
+// codes.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <optional>
+
+namespace plinth::host {
+
+// A finite number; a finite number greater than zero. (CLI11's PositiveNumber lets NaN through
+// and prints DBL_MAX in its message.)
+extern const CLI::Validator kFinite;
+extern const CLI::Validator kFinitePositive;
+
+// Parses the command line. Empty: go on. Otherwise CLI11 has printed the help or the usage
+// error, and the tool exits with this code: 0 after --help (or --version), 2 on a usage error.
+[[nodiscard]] std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv);
+
+}  // namespace plinth::host

@@ -1,0 +1,37 @@
+#include "plinth/host/cli.h"
+
+#include <cmath>
+#include <string>
+
+namespace plinth::host {
+namespace {
+
+// The validator's message for `text`, or empty when it is a finite number (> 0 if asked).
+std::string check_finite(const std::string& text, bool positive) {
+  double value = 0.0;
+  if (CLI::detail::lexical_cast(text, value) && std::isfinite(value) &&
+      (!positive || value > 0.0)) {
+    return {};
+  }
+  std::string message("must be a finite number");
+  if (positive) message.append(" greater than zero");
+  return message.append(", got '").append(text).append("'");
+}
+
+}  // namespace
+
+const CLI::Validator kFinite([](const std::string& text) { return check_finite(text, false); },
+                             "FINITE");
+const CLI::Validator kFinitePositive(
+    [](const std::string& text) { return check_finite(text, true); }, "POSITIVE");
+
+std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+  return std::nullopt;
+}
+
+}  // namespace plinth::host
