@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <numbers>
 #include <random>
 #include <string>
@@ -362,6 +363,28 @@ TEST(FastFlows, SinCosIsWithinTwoRoundingsOfLibm) {
   EXPECT_EQ(zero.cos, 1.0);
   EXPECT_EQ(sin_cos(1e-300).sin, 1e-300);
   EXPECT_TRUE(std::isnan(sin_cos(std::nan("")).sin));
+}
+
+// lever_arms_turned (the rocking kernel's stages) against Eq 9 with libm's sin and cos, over
+// the angles a block turns through and every turn a stage makes (|d| <= kStageAngle).
+TEST(FastFlows, TurnedLeverArmsAreEq9ToRoundings) {
+  const Scene s = make(testing::paper_isolated(0.3));
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  double worst = 0.0;
+  for (int i = 0; i < 200000; ++i) {
+    const double offset = i % 2 == 0 ? s.corner1.offset : s.corner2.offset;
+    const double theta0 = 1.6 * unit(rng);
+    const double d = kStageAngle * unit(rng);
+    const LeverArms at0 = lever_arms(s, offset, SinCos{std::sin(theta0), std::cos(theta0)});
+    const LeverArms turned = lever_arms_turned(at0, d);
+    const LeverArms exact =
+        lever_arms(s, offset, SinCos{std::sin(theta0 + d), std::cos(theta0 + d)});
+    worst = std::max({worst, std::fabs(turned.horizontal - exact.horizontal),
+                      std::fabs(turned.vertical - exact.vertical)});
+  }
+  std::printf("worst |error| %.2e m (lever arms up to %.2f m)\n", worst, s.corner1.radius);
+  EXPECT_LE(worst, 4.0 * std::numeric_limits<double>::epsilon() * s.corner1.radius);
 }
 
 TEST(FastFlows, SlideRockingMatchesAnLuSolveOfTheMatrices) {

@@ -140,15 +140,24 @@ struct Rocking : Turning {
         d.overhanging
             ? c.scene.inertia_c + c.scene.m * (d.distance * d.distance + c.scene.h * c.scene.h)
             : c.scene.corner(c.mode.corner).inertia;
+    arms0 = lever_arms(c.scene, pivot.offset, trig0);
   }
 
+  // The lever arms at a stage turned from the start's (lever_arms_turned): the stages' chain of
+  // dependent operations skips sin and cos. Beyond kStageAngle, from sin_cos_near.
+  [[nodiscard]] LeverArms arms(const State& y) const {
+    const double d = y[kTheta] - theta0;
+    if (std::fabs(d) <= kStageAngle) return lever_arms_turned(arms0, d);
+    return lever_arms(*s, pivot.offset, trig(y));
+  }
   [[nodiscard]] State derivative(GroundAcceleration ag, const State& y) const {
-    return state_derivative(y, rocking_flow(*s, pivot, y, ag, moves, trig(y)));
+    return state_derivative(y, rocking_flow(*s, pivot, y, ag, moves, arms(y)));
   }
   [[nodiscard]] FlowPoint point(const State& y, GroundAcceleration ag) const {
-    const SinCos t = trig(y);
-    return {ag, t, rocking_flow(*s, pivot, y, ag, moves, t)};
+    return {ag, trig(y), rocking_flow(*s, pivot, y, ag, moves, arms(y))};
   }
+
+  LeverArms arms0;  // b'_i, h'_i at theta0 (Eq 9)
 };
 
 // Slide-rocking, Eqs 10-12 or 13-14: overhanging, the pivot's distance moves with x.

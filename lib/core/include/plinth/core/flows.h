@@ -142,6 +142,18 @@ inline constexpr double kNearAngle = 0.0625;
   return {offset * t.cos - s.h * t.sin, offset * t.sin + s.h * t.cos};
 }
 
+// The lever arms at theta from those at a nearby theta0, without sin and cos on the way: (b', h')
+// is (offset, h) turned by theta, so (Eq 9) h'(theta0 + d) = h'0 cos d + b'0 sin d and
+// b'(theta0 + d) = b'0 cos d - h'0 sin d, the same series as sin_cos_near (h' in the place of
+// sin, b' of cos). Within kStageAngle only (the caller falls back to lever_arms of sin_cos).
+[[nodiscard]] inline LeverArms lever_arms_turned(const LeverArms& at0, double d) {
+  const double d2 = d * d;
+  const double b = at0.horizontal;
+  const double v = at0.vertical;
+  return {(b - v * d) + d2 * ((-0.5 * b + (1.0 / 6.0) * v * d) + d2 * ((1.0 / 24.0) * b)),
+          (v + b * d) + d2 * ((-0.5 * v - (1.0 / 6.0) * b * d) + d2 * ((1.0 / 24.0) * v))};
+}
+
 [[nodiscard]] inline LeverArms lever_arms(const Scene& s, const CornerGeometry& c, double theta) {
   return lever_arms(s, c.offset, SinCos{std::sin(theta), std::cos(theta)});
 }
@@ -190,8 +202,7 @@ struct PivotDistance {
 // With the base fixed (no base, or held at a stop) u'' = 0 and only the second equation holds.
 [[nodiscard]] inline Accelerations rocking_flow(const Scene& s, const CornerGeometry& c,
                                                 const State& y, GroundAcceleration ag,
-                                                bool base_moves, const SinCos& trig) {
-  const LeverArms arm = lever_arms(s, c.offset, trig);
+                                                bool base_moves, const LeverArms& arm) {
   const double gravity_moment = s.m * (s.g + ag.vertical) * arm.horizontal;
   if (!base_moves) {
     return {0.0, 0.0, (s.m * ag.horizontal * arm.vertical - gravity_moment) / c.inertia};
@@ -201,9 +212,16 @@ struct PivotDistance {
   const double force_u = -s.total_mass * ag.horizontal - s.damping * y[kUDot] -
                          s.stiffness * y[kU] + s.m * y[kThetaDot] * y[kThetaDot] * arm.horizontal;
   const double force_theta = coupling * ag.horizontal - gravity_moment;
+  // One multiplication after the division: the numerators are ready by the time it ends.
   const double inverse_det = 1.0 / (s.total_mass * c.inertia - coupling * coupling);
-  return {c.inertia * inverse_det * force_u + coupling * inverse_det * force_theta, 0.0,
-          coupling * inverse_det * force_u + s.total_mass * inverse_det * force_theta};
+  return {(c.inertia * force_u + coupling * force_theta) * inverse_det, 0.0,
+          (coupling * force_u + s.total_mass * force_theta) * inverse_det};
+}
+
+[[nodiscard]] inline Accelerations rocking_flow(const Scene& s, const CornerGeometry& c,
+                                                const State& y, GroundAcceleration ag,
+                                                bool base_moves, const SinCos& trig) {
+  return rocking_flow(s, c, y, ag, base_moves, lever_arms(s, c.offset, trig));
 }
 
 [[nodiscard]] inline Accelerations rocking_flow(const Scene& s, const CornerGeometry& c,
