@@ -66,6 +66,13 @@ PhaseStart start_in(Phase phase, const SceneParams& p, int overhang = 0) {
   return s;
 }
 
+// Items (steps) and the ns_per_step counter of a run of `steps` steps.
+void set_ns_per_step(benchmark::State& state, std::int64_t steps) {
+  state.SetItemsProcessed(steps);
+  state.counters["ns_per_step"] = benchmark::Counter(
+      static_cast<double>(steps), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+
 // ns per step in one phase: each iteration runs from the start until the phase ends (impacts
 // included) or kMaxSteps, timed by hand (UseManualTime) so that the restart is not.
 void BM_PhaseStep(benchmark::State& state, PhaseStart start, Variant variant) {
@@ -85,9 +92,7 @@ void BM_PhaseStep(benchmark::State& state, PhaseStart start, Variant variant) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
     steps += sim.step_count();
   }
-  state.SetItemsProcessed(steps);
-  state.counters["ns_per_step"] = benchmark::Counter(
-      static_cast<double>(steps), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  set_ns_per_step(state, steps);
 }
 
 // Every phase of bench_solver.cpp's BM_Step, with every stepper (and full contact also
@@ -170,67 +175,60 @@ const host::Record* brienza_000(std::string* error) {
   return record;
 }
 
-void BM_FeatureRun(benchmark::State& state, bool on_base, Extra extra) {
+// `sim` made for `scene` under Brienza 000 scaled to `pga_g`; false, the benchmark skipped with
+// the reason, when the record cannot be read or the settings are refused.
+bool on_brienza(benchmark::State& state, const Scene& scene, double pga_g,
+                const SolverSettings& settings, Simulator& sim) {
   std::string error;
   const host::Record* record = brienza_000(&error);
   if (record == nullptr) {
     state.SkipWithError(error.c_str());
-    return;
+    return false;
   }
+  const Excitation ex = Excitation::record(record->horizontal_signal(), {},
+                                           pga_g * kStandardGravity / record->peak_horizontal());
+  if (!Simulator::create(scene, ex, settings, sim).ok()) {
+    state.SkipWithError("Simulator::create failed");
+    return false;
+  }
+  return true;
+}
+
+// The first 12 s from rest (or to a collapse); the number of steps taken.
+std::int64_t run_12_s(Simulator& sim) {
+  constexpr std::int64_t kSteps = 120'000;
+  sim.start_at_rest();
+  while (sim.step_count() < kSteps && !sim.mode().terminal()) sim.step();
+  return sim.step_count();
+}
+
+void BM_FeatureRun(benchmark::State& state, bool on_base, Extra extra) {
   const SceneParams base = on_base ? testing::paper_isolated() : testing::paper_block();
   const double pga_g = on_base ? 3.0 : 0.5;  // rocking with impacts, no collapse
   const Scene scene = testing::make(with_extra(base, extra));
-  const Excitation ex = Excitation::record(record->horizontal_signal(), {},
-                                           pga_g * kStandardGravity / record->peak_horizontal());
   Simulator sim;
-  if (!Simulator::create(scene, ex, settings_of({Stepper::kRk4Located, false}), sim).ok()) {
-    state.SkipWithError("Simulator::create failed");
-    return;
-  }
-  constexpr std::int64_t kSteps = 120'000;  // 12 s
+  if (!on_brienza(state, scene, pga_g, settings_of({Stepper::kRk4Located, false}), sim)) return;
   std::int64_t steps = 0;
-  for (auto _ : state) {
-    sim.start_at_rest();
-    while (sim.step_count() < kSteps && !sim.mode().terminal()) sim.step();
-    steps += sim.step_count();
-  }
-  state.SetItemsProcessed(steps);
-  state.counters["ns_per_step"] = benchmark::Counter(
-      static_cast<double>(steps), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  for (auto _ : state) steps += run_12_s(sim);
+  set_ns_per_step(state, steps);
   state.counters["events"] = static_cast<double>(sim.event_count());
 }
 
 // Full contact driven by a record: Brienza 000 at 0.1 g keeps the block on the isolated base in
 // full contact for the whole 12 s (checked), so every step reads the record; ns per step.
 void BM_FullContactOnRecord(benchmark::State& state, Variant variant) {
-  std::string error;
-  const host::Record* record = brienza_000(&error);
-  if (record == nullptr) {
-    state.SkipWithError(error.c_str());
-    return;
-  }
   const Scene scene = testing::make(testing::paper_isolated());
-  const Excitation ex = Excitation::record(record->horizontal_signal(), {},
-                                           0.1 * kStandardGravity / record->peak_horizontal());
   Simulator sim;
-  if (!Simulator::create(scene, ex, settings_of(variant), sim).ok()) {
-    state.SkipWithError("Simulator::create failed");
-    return;
-  }
-  constexpr std::int64_t kSteps = 120'000;  // 12 s
+  if (!on_brienza(state, scene, 0.1, settings_of(variant), sim)) return;
   std::int64_t steps = 0;
   for (auto _ : state) {
-    sim.start_at_rest();
-    while (sim.step_count() < kSteps) sim.step();
-    steps += sim.step_count();
+    steps += run_12_s(sim);
     if (sim.mode().phase != Phase::kFullContact || sim.event_count() != 0) {
       state.SkipWithError("the block left full contact");
       return;
     }
   }
-  state.SetItemsProcessed(steps);
-  state.counters["ns_per_step"] = benchmark::Counter(
-      static_cast<double>(steps), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+  set_ns_per_step(state, steps);
 }
 BENCHMARK_CAPTURE(BM_FullContactOnRecord, rk4_located, Variant{Stepper::kRk4Located, false})
     ->Unit(benchmark::kMillisecond);
