@@ -67,6 +67,13 @@ std::function<bool(const toml::node&)> string_into(std::string& target) {
   };
 }
 
+// A stepper's name (steppers.h: stepper_name).
+std::function<bool(const toml::node&)> stepper_into(Stepper& target) {
+  return [&target](const toml::node& n) {
+    return n.is_string() && parse_stepper(n.value<std::string>().value_or(""), target);
+  };
+}
+
 std::function<bool(const toml::node&)> rotation_into(Eigen::Matrix3d& target) {
   return [&target](const toml::node& n) {
     const toml::array* rows = n.as_array();
@@ -127,6 +134,10 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit) {
       {"monitor.second_scene", string_into(f.second_scene_path), "a string (a scene file)"},
       {"estimator.sample_rate_hz", number_into(c.estimator.sample_rate_hz), "a number"},
       {"estimator.steps_per_sample", integer_into(c.estimator.steps_per_sample), "an integer"},
+      {"estimator.stepper", stepper_into(c.estimator.solver.stepper),
+       "\"rk4_located\", \"rk4_step_end\", \"heun_located\" or \"semi_implicit_euler\""},
+      {"estimator.exact_full_contact", flag_into(c.estimator.solver.exact_full_contact),
+       "true or false"},
       {"risk.base_stop_weight", number_into(c.risk.base_stop_weight), "a number"},
       {"redundancy.window_s", number_into(c.redundancy.window_s), "a number"},
       {"redundancy.tolerance_m_s2", number_into(c.redundancy.tolerance_m_s2), "a number"},

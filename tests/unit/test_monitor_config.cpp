@@ -24,6 +24,8 @@ TEST(MonitorConfigFile, TheExampleSetsEveryField) {
   const MonitorFile f = load_monitor_file(kSource + "/firmware/monitor.example.toml", MonitorConfig{});
   EXPECT_EQ(f.config.ground_node, 1);
   EXPECT_EQ(f.config.estimator.sample_rate_hz, 200.0);
+  EXPECT_EQ(f.config.estimator.solver.stepper, Stepper::kRk4Located);
+  EXPECT_TRUE(f.config.estimator.solver.exact_full_contact);
   EXPECT_EQ(f.config.conditioning.sensor_to_statue(0, 1), -1.0);
   EXPECT_EQ(f.config.conditioning.sensor_to_statue(1, 0), 1.0);
   EXPECT_EQ(f.config.conditioning.startup_window_s, 10.0);
@@ -36,13 +38,16 @@ TEST(MonitorConfigFile, TheExampleSetsEveryField) {
 
 TEST(MonitorConfigFile, ValuesOverTheDefaults) {
   const MonitorFile f = load_monitor_text(
-      "[estimator]\nsample_rate_hz = 1000\nsteps_per_sample = 2\n"
+      "[estimator]\nsample_rate_hz = 1000\nsteps_per_sample = 2\nstepper = \"heun_located\"\n"
+      "exact_full_contact = false\n"
       "[conditioning]\nunit = \"m/s2\"\n"
       "[alarm_policy]\nwarning.on = 0.6\nlatch_warning = false\n"
       "[monitor]\nground_node = 7\nsecond_scene = \"y.toml\"\n",
       "/etc/plinth/box.toml", MonitorConfig{});
   EXPECT_EQ(f.config.estimator.sample_rate_hz, 1000.0);
   EXPECT_EQ(f.config.estimator.steps_per_sample, 2);
+  EXPECT_EQ(f.config.estimator.solver.stepper, Stepper::kHeunLocated);
+  EXPECT_FALSE(f.config.estimator.solver.exact_full_contact);
   EXPECT_EQ(f.config.conditioning.unit, monitor::AccelerationUnit::kMetresPerSecondSquared);
   EXPECT_EQ(f.config.alarm.warning.on, 0.6);
   EXPECT_EQ(f.config.alarm.warning.off, 0.4);  // the default kept
@@ -57,6 +62,9 @@ TEST(MonitorConfigFile, BadInputNamesFileLineAndKey) {
             "/etc/plinth/box.toml:2: estimator.steps: unknown key (docs/monitor.md lists them)");
   EXPECT_EQ(error_of("[estimator]\nsample_rate_hz = \"fast\"\n"),
             "/etc/plinth/box.toml:2: estimator.sample_rate_hz: expected a number");
+  EXPECT_EQ(error_of("[estimator]\nstepper = \"rk45\"\n"),
+            "/etc/plinth/box.toml:2: estimator.stepper: expected \"rk4_located\", "
+            "\"rk4_step_end\", \"heun_located\" or \"semi_implicit_euler\"");
   EXPECT_EQ(error_of("[sensor_health]\n\ntimeout_s = 0.001\n").rfind(
                 "/etc/plinth/box.toml:3: sensor_health.timeout_s: ", 0),
             0U);
