@@ -578,8 +578,9 @@ struct Hybrid {
   // taken at the step's end only: when every one is strictly negative there the interval would
   // see no crossing whatever their values at the start, so its state is this one to the last bit
   // (the same expressions) and nothing else needs keeping: no flow point, no guard values. Only
-  // the end's horizontal ground acceleration is kept, as the next step's start. Otherwise returns false,
-  // nothing changed, and the step's interval runs (ExactFullContact in phase_kernels.h).
+  // the end's horizontal ground acceleration is kept, as the next step's start. Otherwise (a
+  // guard at or past 0, or not a number) returns false, nothing changed, and the step's interval
+  // runs (ExactFullContact in phase_kernels.h).
   static bool quiet_full_contact_step(Simulator& sim, double t0, double t_end) {
     if constexpr (!F.base) {
       return false;
@@ -601,24 +602,23 @@ struct Hybrid {
       double u = y[kU];
       double u_dot = y[kUDot];
       sim.propagator_.advance(u, u_dot, a0, a1.horizontal);
-      // full_contact_flow's u'' at the end, written on the two scalars
-      const Accelerations acc{-a1.horizontal - (s.damping * u_dot + s.stiffness * u) / s.total_mass,
-                              0.0, 0.0};
-      if (rocking_onset_guard(s, s.corner1.sign, s.corner1.onset_ratio, acc, a1) >= 0.0 ||
-          rocking_onset_guard(s, s.corner2.sign, s.corner2.onset_ratio, acc, a1) >= 0.0) {
+      const Accelerations acc{full_contact_base_acceleration(s, u, u_dot, a1.horizontal), 0.0,
+                              0.0};
+      if (!(rocking_onset_guard(s, s.corner1.sign, s.corner1.onset_ratio, acc, a1) < 0.0 &&
+            rocking_onset_guard(s, s.corner2.sign, s.corner2.onset_ratio, acc, a1) < 0.0)) {
         return false;
       }
       if constexpr (F.sliding) {
         // Eq 15: full contact's contact force (sticking_contact_force), and no sliding stop
         // holds the block (x stays, sliding_onset_guard's test of it is kept).
         const ContactForce f{s.m * (acc.u + a1.horizontal), s.m * (s.g + a1.vertical)};
-        if (sliding_onset_guard(s, mode, y, -1, f, SinCos{}) >= 0.0 ||
-            sliding_onset_guard(s, mode, y, 1, f, SinCos{}) >= 0.0) {
+        if (!(sliding_onset_guard(s, mode, y, -1, f, SinCos{}) < 0.0 &&
+              sliding_onset_guard(s, mode, y, 1, f, SinCos{}) < 0.0)) {
           return false;
         }
       }
       if constexpr (F.base_stops) {
-        if (std::fabs(u) - s.params.base_stops.max_displacement >= 0.0) return false;
+        if (!(std::fabs(u) - s.params.base_stops.max_displacement < 0.0)) return false;
       }
       y[kU] = u;
       y[kUDot] = u_dot;

@@ -12,9 +12,14 @@
 namespace plinth {
 
 // Full contact, Eq 1: (m + m_b)(u'' + u_G'') + c u' + k u = 0.
+[[nodiscard]] inline double full_contact_base_acceleration(const Scene& s, double u, double u_dot,
+                                                           double ground_horizontal) {
+  return -ground_horizontal - (s.damping * u_dot + s.stiffness * u) / s.total_mass;
+}
+
 [[nodiscard]] inline Accelerations full_contact_flow(const Scene& s, const State& y,
                                                      GroundAcceleration ag) {
-  return {-ag.horizontal - (s.damping * y[kUDot] + s.stiffness * y[kU]) / s.total_mass, 0.0, 0.0};
+  return {full_contact_base_acceleration(s, y[kU], y[kUDot], ag.horizontal), 0.0, 0.0};
 }
 
 // Position of C relative to the rocking corner after a rotation theta, Eq 9:
