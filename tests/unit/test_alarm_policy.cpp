@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "settings_support.h"
+
 namespace plinth::monitor {
 namespace {
 
@@ -68,15 +70,19 @@ void expect_event(const AlarmOutput& out, std::size_t index, AlarmLevel level,
   EXPECT_EQ(e.latched, latched);
 }
 
+// The output's level is `level`, and its first event reports the change from `previous`.
+void expect_change(const AlarmOutput& out, AlarmLevel level, AlarmLevel previous,
+                   AlarmCause cause, bool latched) {
+  EXPECT_EQ(out.level, level);
+  expect_event(out, 0, level, previous, cause, latched);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Settings
 
 // create() validates: the Error names the field.
 void expect_refused(const AlarmPolicySettings& s, const char* field, ErrorCode code) {
-  AlarmPolicy unused;
-  const Error e = AlarmPolicy::create(s, unused);
-  EXPECT_EQ(e.code, code) << field;
-  EXPECT_STREQ(e.field, field);
+  plinth::testing::expect_create_refused<AlarmPolicy>(s, field, code);
 }
 
 TEST(AlarmPolicySettings, DefaultsAreValidAndThresholdsAreChecked) {
@@ -132,21 +138,17 @@ TEST(AlarmPolicy, HysteresisBoundary) {
   EXPECT_EQ(p.at(1, 0.1).level, AlarmLevel::kAdvisory);
   EXPECT_EQ(p.at(2, 0.4999).level, AlarmLevel::kAdvisory);
   const AlarmOutput on = p.at(3, 0.5);
-  EXPECT_EQ(on.level, AlarmLevel::kWarning);
-  expect_event(on, 0, AlarmLevel::kWarning, AlarmLevel::kAdvisory, AlarmCause::kRiskThreshold,
-               false);
+  expect_change(on, AlarmLevel::kWarning, AlarmLevel::kAdvisory, AlarmCause::kRiskThreshold, false);
   EXPECT_EQ(p.at(4, 0.4).level, AlarmLevel::kWarning);  // at off: still on
   const AlarmOutput off = p.at(5, 0.3999);
-  EXPECT_EQ(off.level, AlarmLevel::kAdvisory);
-  expect_event(off, 0, AlarmLevel::kAdvisory, AlarmLevel::kWarning, AlarmCause::kRiskThreshold,
-               false);
+  expect_change(off, AlarmLevel::kAdvisory, AlarmLevel::kWarning, AlarmCause::kRiskThreshold,
+                false);
   EXPECT_EQ(p.at(6, 0.4999).level, AlarmLevel::kAdvisory);  // below on again: stays off
   EXPECT_EQ(p.at(7, 0.8).level, AlarmLevel::kAlarm);
   EXPECT_EQ(p.at(8, 0.7).level, AlarmLevel::kAlarm);
   EXPECT_EQ(p.at(9, 0.6999).level, AlarmLevel::kWarning);
   const AlarmOutput normal = p.at(10, 0.0499);
-  EXPECT_EQ(normal.level, AlarmLevel::kNormal);
-  expect_event(normal, 0, AlarmLevel::kNormal, AlarmLevel::kWarning, AlarmCause::kNone, false);
+  expect_change(normal, AlarmLevel::kNormal, AlarmLevel::kWarning, AlarmCause::kNone, false);
 }
 
 TEST(AlarmPolicy, MinimumDurationBeforeRaisingAndLowering) {
@@ -159,9 +161,9 @@ TEST(AlarmPolicy, MinimumDurationBeforeRaisingAndLowering) {
     ASSERT_EQ(p.at(t, 0.6).level, AlarmLevel::kNormal) << t;
   }
   const AlarmOutput raised = p.at(1100, 0.6);
-  EXPECT_EQ(raised.level, AlarmLevel::kWarning);  // warning and advisory both held 100 ms
-  expect_event(raised, 0, AlarmLevel::kWarning, AlarmLevel::kNormal, AlarmCause::kRiskThreshold,
-               false);
+  // Warning and advisory both held 100 ms.
+  expect_change(raised, AlarmLevel::kWarning, AlarmLevel::kNormal, AlarmCause::kRiskThreshold,
+                false);
   EXPECT_EQ(raised.events[0].time_ns, 1100 * kMs);
   // Gone from t = 2000 ms: lowered at 2500 ms.
   EXPECT_EQ(p.at(2000, 0.0).level, AlarmLevel::kWarning);
@@ -188,8 +190,7 @@ TEST(AlarmPolicy, AdvisoryWhenTheBlockLeavesFullContact) {
   p.base.out_of_full_contact = true;
   EXPECT_EQ(p.at(0, 0.0).level, AlarmLevel::kNormal);
   const AlarmOutput out = p.at(50, 0.0);
-  EXPECT_EQ(out.level, AlarmLevel::kAdvisory);
-  expect_event(out, 0, AlarmLevel::kAdvisory, AlarmLevel::kNormal, AlarmCause::kPhaseChange, false);
+  expect_change(out, AlarmLevel::kAdvisory, AlarmLevel::kNormal, AlarmCause::kPhaseChange, false);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -257,9 +258,7 @@ TEST(AlarmPolicy, CollapseGoesStraightToAlarmAndLatches) {
   Policy p(s);
   p.base.collapse_detected = true;
   const AlarmOutput fell = p.at(0, 0.3);
-  EXPECT_EQ(fell.level, AlarmLevel::kAlarm);
-  expect_event(fell, 0, AlarmLevel::kAlarm, AlarmLevel::kNormal, AlarmCause::kOverturnDetected,
-               true);
+  expect_change(fell, AlarmLevel::kAlarm, AlarmLevel::kNormal, AlarmCause::kOverturnDetected, true);
   // Acknowledged while the block lies overturned: the alarm stays, unlatched.
   const AlarmOutput acked = p.ack(10, 0.3, AlarmLevel::kAlarm, 0);
   EXPECT_EQ(acked.acknowledgement, AckOutcome::kReleasedConditionHolds);
@@ -293,15 +292,12 @@ TEST(AlarmPolicy, FaultIsShownAtOnceAndClearsAfterTheLowerHold) {
   p.base.fault_active = true;
   p.base.fault_cause = AlarmCause::kSensorTimeout;
   const AlarmOutput fault = p.at(0, 0.0);
-  EXPECT_EQ(fault.level, AlarmLevel::kFault);
-  expect_event(fault, 0, AlarmLevel::kFault, AlarmLevel::kNormal, AlarmCause::kSensorTimeout,
-               false);
+  expect_change(fault, AlarmLevel::kFault, AlarmLevel::kNormal, AlarmCause::kSensorTimeout, false);
   p.base.fault_active = false;
   EXPECT_EQ(p.at(100, 0.0).level, AlarmLevel::kFault);
   EXPECT_EQ(p.at(599, 0.0).level, AlarmLevel::kFault);
   const AlarmOutput cleared = p.at(600, 0.0);
-  EXPECT_EQ(cleared.level, AlarmLevel::kNormal);
-  expect_event(cleared, 0, AlarmLevel::kNormal, AlarmLevel::kFault, AlarmCause::kNone, false);
+  expect_change(cleared, AlarmLevel::kNormal, AlarmLevel::kFault, AlarmCause::kNone, false);
 }
 
 TEST(AlarmPolicy, AFaultNeverHidesAnAlarm) {
@@ -315,8 +311,7 @@ TEST(AlarmPolicy, AFaultNeverHidesAnAlarm) {
   EXPECT_EQ(p.at(20, 0.0).level, AlarmLevel::kAlarm);
   // ...until acknowledged: then the fault shows.
   const AlarmOutput acked = p.ack(30, 0.0, AlarmLevel::kAlarm, 0);
-  EXPECT_EQ(acked.level, AlarmLevel::kFault);
-  expect_event(acked, 0, AlarmLevel::kFault, AlarmLevel::kAlarm, AlarmCause::kAcknowledged, false);
+  expect_change(acked, AlarmLevel::kFault, AlarmLevel::kAlarm, AlarmCause::kAcknowledged, false);
 }
 
 TEST(AlarmPolicy, AFaultHidesAWarningWhichShowsAgainAfterIt) {

@@ -34,6 +34,16 @@ void expect_frame(const CanFrame& f, std::uint32_t id, const Bytes& data) {
   for (std::size_t i = 0; i < 8; ++i) EXPECT_EQ(f.data[i], data[i]) << "byte " << i;
 }
 
+// A golden frame: `m` encodes to `golden` under identifier `id`, and `golden` decodes into
+// `decoded`, for the caller to check field by field.
+template <typename Message>
+void expect_golden(const Message& m, std::uint32_t id, const Bytes& golden, Message& decoded) {
+  CanFrame f;
+  ASSERT_TRUE(encode(m, f).ok());
+  expect_frame(f, id, golden);
+  ASSERT_TRUE(decode(make_frame(id, golden), decoded).ok());
+}
+
 std::uint64_t raw_at(const CanFrame& f, unsigned start, unsigned length) {
   return extract_bits(load_le64(f.data), start, length);
 }
@@ -81,12 +91,8 @@ TEST(CanGolden, SensorAcceleration) {
   m.az_g = -8.192;
   m.sequence = 0x5A;
   m.status = sensor_status::kSaturated | sensor_status::kOverTemperature;
-  CanFrame f;
-  ASSERT_TRUE(encode(m, f).ok());
-  expect_frame(f, 0x303, golden);
-
   SensorAcceleration d;
-  ASSERT_TRUE(decode(make_frame(0x303, golden), d).ok());
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x303, golden, d));
   EXPECT_EQ(d.node, 3);
   EXPECT_DOUBLE_EQ(d.ax_g, 1.0);
   EXPECT_DOUBLE_EQ(d.ay_g, -0.5);
@@ -110,12 +116,8 @@ TEST(CanGolden, SensorHeartbeat) {
   m.status = sensor_status::kSelfTestFailed;
   m.can_tx_errors = 128;
   m.can_rx_errors = 127;
-  CanFrame f;
-  ASSERT_TRUE(encode(m, f).ok());
-  expect_frame(f, 0x31F, golden);
-
   SensorHeartbeat d;
-  ASSERT_TRUE(decode(make_frame(0x31F, golden), d).ok());
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x31F, golden, d));
   EXPECT_EQ(d.node, 15);
   EXPECT_EQ(d.uptime_s, 0x12345678U);
   EXPECT_EQ(d.firmware_major, 2);
@@ -141,12 +143,8 @@ TEST(CanGolden, MonitorStatus) {
   m.risk = 0.75;
   m.sequence = 200;
   m.sample_age_ms = 1234;
-  CanFrame f;
-  ASSERT_TRUE(encode(m, f).ok());
-  expect_frame(f, 0x321, golden);
-
   MonitorStatus d;
-  ASSERT_TRUE(decode(make_frame(0x321, golden), d).ok());
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x321, golden, d));
   EXPECT_EQ(d.axis, 1);
   EXPECT_EQ(d.phase, Phase::kSlideRocking);
   EXPECT_EQ(d.corner, Corner::kRight);
@@ -171,12 +169,8 @@ TEST(CanGolden, AlarmEvent) {
   m.latched = true;
   m.time_since_start_ms = 0xDEADBEEF;
   m.sequence = 0x42;
-  CanFrame f;
-  ASSERT_TRUE(encode(m, f).ok());
-  expect_frame(f, 0x330, golden);
-
   AlarmEvent d;
-  ASSERT_TRUE(decode(make_frame(0x330, golden), d).ok());
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x330, golden, d));
   EXPECT_EQ(d.level, AlarmLevel::kAlarm);
   EXPECT_EQ(d.previous_level, AlarmLevel::kAdvisory);
   EXPECT_EQ(d.cause, AlarmCause::kOverturnDetected);
@@ -194,12 +188,8 @@ TEST(CanGolden, Acknowledge) {
   m.level = AlarmLevel::kAlarm;
   m.source_id = 0x21;
   m.event_sequence = 0x42;
-  CanFrame f;
-  ASSERT_TRUE(encode(m, f).ok());
-  expect_frame(f, 0x340, golden);
-
   Acknowledge d;
-  ASSERT_TRUE(decode(make_frame(0x340, golden), d).ok());
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x340, golden, d));
   EXPECT_EQ(d.level, AlarmLevel::kAlarm);
   EXPECT_EQ(d.source_id, 0x21);
   EXPECT_EQ(d.event_sequence, 0x42);

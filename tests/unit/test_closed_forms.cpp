@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "plinth/core/closed_forms.h"
+#include "bisection_support.h"
 #include "test_support.h"
 
 namespace plinth {
@@ -79,14 +80,9 @@ TEST(ClosedForms, Eq37RockingImpulseMatchesBisectionOnSimulation) {
     for (const double xi : {0.05, 0.2, 0.4, 0.7}) {
       const Scene s = make(paper_isolated(epsilon, 2.0, xi));
       const double predicted = rocking_impulse_threshold(s, Corner::kLeft);
-      double low = 0.5 * predicted;
-      double high = 2.0 * predicted;
-      ASSERT_FALSE(impulse_starts_rocking(s, -low));
-      ASSERT_TRUE(impulse_starts_rocking(s, -high));
-      const double found = testing::bisect_threshold(
-          [&](double i) { return impulse_starts_rocking(s, -i); }, low, high, 1e-8 * predicted);
-      EXPECT_NEAR(found, predicted, 1e-6 * predicted)
-          << "epsilon = " << epsilon << ", xi = " << xi;
+      SCOPED_TRACE(::testing::Message() << "epsilon = " << epsilon << ", xi = " << xi);
+      ASSERT_NO_FATAL_FAILURE(testing::expect_threshold_by_bisection(
+          [&](double i) { return impulse_starts_rocking(s, -i); }, predicted, 0.5, 2.0));
       // The paper's form of Eq 37: |I| = T g (1 + epsilon) / (2 pi a(xi) lambda).
       const double printed_form = s.params.base.period * s.g * (1.0 + epsilon) /
                                   (2.0 * std::numbers::pi * peak_acceleration_factor(xi) * 3.0);

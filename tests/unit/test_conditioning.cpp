@@ -7,12 +7,12 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <numbers>
 #include <random>
 
 #include "plinth/core/scene.h"
+#include "settings_support.h"
 
 namespace plinth::monitor {
 namespace {
@@ -45,11 +45,7 @@ Eigen::Vector3d reading_g(const Eigen::Matrix3d& r, const Eigen::Vector3d& groun
 // create() validates: the Error names the field and says what is wrong.
 void expect_refused(const ConditioningSettings& s, const char* field, ErrorCode code,
                     const char* reason_part = "") {
-  Conditioner unused;
-  const Error e = Conditioner::create(s, unused);
-  EXPECT_EQ(e.code, code) << field;
-  EXPECT_STREQ(e.field, field);
-  EXPECT_NE(std::strstr(e.reason, reason_part), nullptr) << e.reason;
+  plinth::testing::expect_create_refused<Conditioner>(s, field, code, reason_part);
 }
 
 TEST(ConditioningSettings, DefaultsAreValidAndEveryFieldIsChecked) {

@@ -11,6 +11,7 @@
 #include "plinth/core/closed_forms.h"
 #include "plinth/core/guards.h"
 #include "plinth/host/sweep_impulse.h"
+#include "bisection_support.h"
 #include "test_support.h"
 
 namespace plinth {
@@ -60,14 +61,10 @@ TEST(ImpulsiveCriteria, Eq38SlidingImpulseMatchesBisectionOnSimulation) {
         const double printed_form = mu_s * s.params.base.period * s.g /
                                     (2.0 * std::numbers::pi * peak_acceleration_factor(xi));
         EXPECT_NEAR(printed_form, predicted, 1e-12 * predicted);
-        double low = 0.8 * predicted;
-        double high = 1.25 * predicted;
-        ASSERT_FALSE(impulse_starts_sliding(s, -low));
-        ASSERT_TRUE(impulse_starts_sliding(s, -high));
-        const double found = testing::bisect_threshold(
-            [&](double i) { return impulse_starts_sliding(s, -i); }, low, high, 1e-8 * predicted);
-        EXPECT_NEAR(found, predicted, 1e-6 * predicted)
-            << "epsilon = " << epsilon << ", xi = " << xi << ", mu_s = " << mu_s;
+        SCOPED_TRACE(::testing::Message()
+                     << "epsilon = " << epsilon << ", xi = " << xi << ", mu_s = " << mu_s);
+        ASSERT_NO_FATAL_FAILURE(testing::expect_threshold_by_bisection(
+            [&](double i) { return impulse_starts_sliding(s, -i); }, predicted, 0.8, 1.25));
       }
     }
   }

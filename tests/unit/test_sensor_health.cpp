@@ -9,6 +9,8 @@
 #include <cstring>
 #include <limits>
 
+#include "settings_support.h"
+
 namespace plinth::monitor {
 namespace {
 
@@ -69,10 +71,7 @@ SensorHealthSettings with_recovery(int samples) {
 
 // create() validates: the Error names the field.
 void expect_refused(const SensorHealthSettings& s, const char* field, ErrorCode code) {
-  SensorHealthTracker unused;
-  const Error e = SensorHealthTracker::create(s, unused);
-  EXPECT_EQ(e.code, code) << field;
-  EXPECT_STREQ(e.field, field);
+  plinth::testing::expect_create_refused<SensorHealthTracker>(s, field, code);
 }
 
 TEST(SensorHealthSettings, DefaultsAreValidAndEveryFieldIsChecked) {

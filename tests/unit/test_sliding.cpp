@@ -254,6 +254,35 @@ double horizontal_momentum(const Scene& s, const Mode& mode, const State& y) {
   return (s.total_mass - s.m) * y[kUDot] + s.m * k.jx.dot(y.tail<3>());
 }
 
+// Random sliding (even draw i) and slide-rocking (odd i) states, sliding right: numbers drawn
+// uniformly from [-1, 1), the corner and the tilt drawn in the same order every time.
+class SlidingDraws {
+ public:
+  explicit SlidingDraws(std::mt19937::result_type seed) : rng_(seed) {}
+
+  double operator()() { return unit_(rng_); }
+
+  // Mode of draw i: the phase alternates, the corner is drawn.
+  Mode mode(int i) {
+    Mode m;
+    m.phase = i % 2 == 0 ? Phase::kSliding : Phase::kSlideRocking;
+    m.corner = unit_(rng_) > 0 ? Corner::kLeft : Corner::kRight;
+    m.slide_direction = 1;
+    return m;
+  }
+
+  // When `mode` rocks: a tilt toward its corner, up to 0.2 rad, and a tilt rate.
+  void tilt(const Scene& s, const Mode& mode, State& y) {
+    if (!mode.rocking()) return;
+    y[kTheta] = s.corner(mode.corner).sign * 0.2 * std::fabs(unit_(rng_));
+    y[kThetaDot] = unit_(rng_);
+  }
+
+ private:
+  std::mt19937 rng_;
+  std::uniform_real_distribution<double> unit_{-1.0, 1.0};
+};
+
 SceneParams with_sliding_stops(SceneParams p, double restitution) {
   p.has_support = true;
   p.support = {0.1};
@@ -262,28 +291,39 @@ SceneParams with_sliding_stops(SceneParams p, double restitution) {
   return p;
 }
 
+// Sliding right, toward the right sliding stop.
+Mode sliding_right() {
+  Mode m;
+  m.phase = Phase::kSliding;
+  m.slide_direction = 1;
+  return m;
+}
+
+// At the right sliding stop (x = 0.1, the support clearance of with_sliding_stops), the base
+// moving at u' = `u_dot` and the block sliding at x' = `x_dot`.
+State at_right_stop(double u_dot, double x_dot) {
+  State y = State::Zero();
+  y[kX] = 0.1;
+  y[kUDot] = u_dot;
+  y[kXDot] = x_dot;
+  return y;
+}
+
 // Sliding stop hit (Eqs 30-32 with restitution, resets.h): x'+ = -eta_s x'-, the horizontal
 // momentum kept for every eta_s, energy never grows and is kept at eta_s = 1; in sliding and
 // slide-rocking alike.
 TEST(SlidingStops, MomentumKeptEnergyNeverGrows) {
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  SlidingDraws draw(5);
   for (const double eta : {0.0, 0.3, 0.7, 1.0}) {
     const Scene s =
         make(with_sliding_stops(with_friction(testing::paper_isolated(0.2), 0.3, 0.24), eta));
     for (int i = 0; i < 200; ++i) {
-      Mode mode;
-      mode.phase = i % 2 == 0 ? Phase::kSliding : Phase::kSlideRocking;
-      mode.corner = unit(rng) > 0 ? Corner::kLeft : Corner::kRight;
-      mode.slide_direction = 1;
+      Mode mode = draw.mode(i);
       State y = State::Zero();
       y[kX] = 0.1;
-      y[kUDot] = unit(rng);
-      y[kXDot] = std::fabs(unit(rng));
-      if (mode.rocking()) {
-        y[kTheta] = s.corner(mode.corner).sign * 0.2 * std::fabs(unit(rng));
-        y[kThetaDot] = unit(rng);
-      }
+      y[kUDot] = draw();
+      y[kXDot] = std::fabs(draw());
+      draw.tilt(s, mode, y);
       const double momentum = horizontal_momentum(s, mode, y);
       const double energy = mechanical_energy(s, mode, y);
       const double x_dot = y[kXDot];
@@ -308,13 +348,8 @@ TEST(SlidingStops, MomentumKeptEnergyNeverGrows) {
 TEST(SlidingStops, PlasticStopIsPrintedEq32WithEtaOne) {
   const Scene s =
       make(with_sliding_stops(with_friction(testing::paper_isolated(0.0), 0.3, 0.24), 0.0));
-  Mode mode;
-  mode.phase = Phase::kSliding;
-  mode.slide_direction = 1;
-  State y = State::Zero();
-  y[kX] = 0.1;
-  y[kUDot] = -0.4;
-  y[kXDot] = 0.9;
+  Mode mode = sliding_right();
+  State y = at_right_stop(-0.4, 0.9);
   sliding_stop_hit_reset(s, 1, true, mode, y);
   EXPECT_NEAR(y[kUDot], -0.4 + s.m / s.total_mass * 0.9, 1e-14);
   EXPECT_EQ(y[kXDot], 0.0);
@@ -326,13 +361,9 @@ TEST(SlidingStops, PrintedEq32WithEtaBelowOneAddsEnergy) {
   const double eta = 0.5;
   const Scene s =
       make(with_sliding_stops(with_friction(testing::paper_isolated(0.0), 0.3, 0.24), eta));
-  Mode mode;
-  mode.phase = Phase::kSliding;
-  mode.slide_direction = 1;
-  State y = State::Zero();
-  y[kX] = 0.1;
-  y[kUDot] = -1.0;
-  y[kXDot] = 1.0;  // the block is still in the ground's frame, the base moves left
+  Mode mode = sliding_right();
+  // The block is still in the ground's frame, the base moves left.
+  State y = at_right_stop(-1.0, 1.0);
   const double before = mechanical_energy(s, mode, y);
   State printed = y;
   printed[kUDot] += eta * s.m / s.total_mass * printed[kXDot];
@@ -463,21 +494,14 @@ TEST(SlidingResets, BaseStopEnergyNeverGrows) {
   p.has_base_stops = true;
   p.base_stops = {0.2, 0.7};
   const Scene s = make(p);
-  std::mt19937 rng(9);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  SlidingDraws draw(9);
   for (int i = 0; i < 1000; ++i) {
-    Mode mode;
-    mode.phase = i % 2 == 0 ? Phase::kSliding : Phase::kSlideRocking;
-    mode.corner = unit(rng) > 0 ? Corner::kLeft : Corner::kRight;
-    mode.slide_direction = 1;
+    Mode mode = draw.mode(i);
     State y = State::Zero();
     y[kU] = 0.2;
-    y[kUDot] = 2.0 * std::fabs(unit(rng));
-    y[kXDot] = unit(rng);
-    if (mode.rocking()) {
-      y[kTheta] = s.corner(mode.corner).sign * 0.2 * std::fabs(unit(rng));
-      y[kThetaDot] = unit(rng);
-    }
+    y[kUDot] = 2.0 * std::fabs(draw());
+    y[kXDot] = draw();
+    draw.tilt(s, mode, y);
     const double before = mechanical_energy(s, mode, y);
     State hit = y;
     base_stop_reset(s, 1, mode, hit);

@@ -20,6 +20,12 @@ namespace {
 
 using ::testing::HasSubstr;
 
+// Impulse search settings: |I| scanned up to `impulse_max` at `scan_points` points, thresholds
+// bisected to `tolerance`; the solver step left at its default.
+ImpulseSearchSettings search_settings(double impulse_max, int scan_points, double tolerance) {
+  return {.impulse_max = impulse_max, .tolerance = tolerance, .scan_points = scan_points};
+}
+
 // The paper's isolated block (lambda = 3, xi = 0.2, T = 2 s) over mu_s from 0.05 to 0.8 and |I|
 // from 0.15 to 3 times Eq 37's threshold: away from the curves (5 %) the simulated start is the
 // one the closed forms predict. A slide late in the first rocking phase (theta >= alpha / 2) is
@@ -103,10 +109,7 @@ TEST(SweepImpulse, MapPlanRows) {
 // On the base the smallest rocking impulse is Eq 37's (within the search's tolerance); the
 // overturning impulse lies above it.
 TEST(SweepImpulse, CurveOnTheBaseMatchesEq37) {
-  ImpulseSearchSettings settings;
-  settings.impulse_max = 6.0;
-  settings.scan_points = 12;
-  settings.tolerance = 2e-3;
+  ImpulseSearchSettings settings = search_settings(6.0, 12, 2e-3);
   for (const double period : {1.0, 3.0}) {
     const Scene scene = plinth::testing::make(plinth::testing::paper_isolated(0.0, period));
     const double eq37 = rocking_impulse_threshold(scene, Corner::kLeft);
@@ -122,10 +125,7 @@ TEST(SweepImpulse, CurveOnTheBaseMatchesEq37) {
 // On the ground the block overturns when the impulse's rocking energy lifts C over corner 1,
 // or, for an eccentric block, over corner 2 after the first impact.
 TEST(SweepImpulse, CurveOnTheGroundMatchesTheEnergyBound) {
-  ImpulseSearchSettings settings;
-  settings.impulse_max = 4.0;
-  settings.scan_points = 8;
-  settings.tolerance = 2e-3;
+  ImpulseSearchSettings settings = search_settings(4.0, 8, 2e-3);
   for (const double epsilon : {0.0, 0.2, -0.2}) {
     const double lambda = epsilon == 0.0 ? 5.0 : 2.0;
     const Scene scene = plinth::testing::make(
@@ -153,10 +153,7 @@ TEST(SweepImpulse, CurveOnTheGroundMatchesTheEnergyBound) {
 // --compare-ground: the ground's columns are those of the impulse curve of the block on the
 // ground (overturned and its energy bound), to the bit; against T, one ground search for all.
 TEST(SweepImpulse, CurveComparesTheBlockOnTheGround) {
-  ImpulseSearchSettings settings;
-  settings.impulse_max = 4.0;
-  settings.scan_points = 8;
-  settings.tolerance = 5e-3;
+  ImpulseSearchSettings settings = search_settings(4.0, 8, 5e-3);
   settings.dt = 1e-3;
   const GridAxis lambda{"lambda", 2.0, 4.0, 2};
   const SweepPlan compared = plan_impulse_curve(plinth::testing::paper_isolated(),
