@@ -34,7 +34,9 @@ struct Base {
         moves(c.scene.has_base() && c.mode.held_stop == 0) {}
 
   // Without excitation (free motion, the benchmarks) no call at all.
-  [[nodiscard]] static GroundAcceleration ground(const Excitation& e, double t) {
+  // Inlined also where the solver is not flattened (the quiet full-contact step).
+  [[nodiscard, gnu::always_inline]] static GroundAcceleration ground(const Excitation& e,
+                                                                     double t) {
     return e.kind == ExcitationKind::kNone ? GroundAcceleration{} : e.at(t);
   }
   [[nodiscard]] GroundAcceleration ground(double t) const { return ground(*excitation, t); }
