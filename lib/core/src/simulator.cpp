@@ -609,9 +609,8 @@ struct Hybrid {
         return false;
       }
       if constexpr (F.sliding) {
-        // Eq 15: full contact's contact force (sticking_contact_force), and no sliding stop
-        // holds the block (x stays, sliding_onset_guard's test of it is kept).
-        const ContactForce f{s.m * (acc.u + a1.horizontal), s.m * (s.g + a1.vertical)};
+        // Eq 15 (x stays: sliding_onset_guard's test of the sliding stops holds as it did).
+        const ContactForce f = sticking_contact_force(s, mode, y, a1, acc, SinCos{});
         if (!(sliding_onset_guard(s, mode, y, -1, f, SinCos{}) < 0.0 &&
               sliding_onset_guard(s, mode, y, 1, f, SinCos{}) < 0.0)) {
           return false;
