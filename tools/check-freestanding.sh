@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Checks that the freestanding core archive references nothing of the hosted runtime: no heap
 # (malloc, operator new/delete), no exceptions (__cxa_throw, personality routines), no RTTI
-# (typeinfo) and no iostreams. Usage: check-freestanding.sh path/to/libplinth_core.a
+# (typeinfo) and no iostreams. Usage: [NM=arm-none-eabi-nm] check-freestanding.sh ARCHIVE.a
 set -euo pipefail
 archive=${1:?usage: check-freestanding.sh ARCHIVE}
 [ -f "$archive" ] || { echo "check-freestanding: no such archive: $archive" >&2; exit 2; }
-undefined=$(nm -C --undefined-only "$archive" | awk 'NF >= 2 && $1 == "U" { $1 = ""; print substr($0, 2) }' | sort -u)
+undefined=$("${NM:-nm}" -C --undefined-only "$archive" | awk 'NF >= 2 && $1 == "U" { $1 = ""; print substr($0, 2) }' | sort -u)
 forbidden='^(malloc|calloc|realloc|free|aligned_alloc|posix_memalign)$|operator new|operator delete|__cxa_throw|__cxa_allocate_exception|__cxa_begin_catch|__gxx_personality|typeinfo|std::ios_base|std::basic_ostream|std::cout|std::cerr|printf|puts|fwrite'
 bad=$(grep -E "$forbidden" <<<"$undefined" || true)
 if [ -n "$bad" ]; then

@@ -69,25 +69,18 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
   if (!std::isfinite(c.quiet_risk) || c.quiet_risk < 0.0 || c.quiet_risk > 1.0) {
     return {ErrorCode::kOutOfRange, "monitor.quiet_risk", "must lie in [0, 1]"};
   }
-  if (Error e = validate(c.risk); !e.ok()) return e;
-  if (Error e = monitor::validate(c.alarm); !e.ok()) return e;
+  PLINTH_TRY(validate(c.risk));
+  PLINTH_TRY(monitor::validate(c.alarm));
   // The sensor's period is the estimator's sample period: checked with the values start() uses.
   if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz < 100.0 ||
       c.estimator.sample_rate_hz > 1000.0) {
     return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
   }
-  if (Error e = validate_check(c.redundancy.window_s, c.redundancy.tolerance_m_s2,
-                               c.estimator.sample_rate_hz, "redundancy.window_s",
-                               "redundancy.tolerance_m_s2");
-      !e.ok()) {
-    return e;
-  }
-  if (Error e = validate_check(c.plate.window_s, c.plate.threshold_m_s2,
-                               c.estimator.sample_rate_hz, "plate.window_s",
-                               "plate.threshold_m_s2");
-      !e.ok()) {
-    return e;
-  }
+  PLINTH_TRY(validate_check(c.redundancy.window_s, c.redundancy.tolerance_m_s2,
+                            c.estimator.sample_rate_hz, "redundancy.window_s",
+                            "redundancy.tolerance_m_s2"));
+  PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
+                            "plate.window_s", "plate.threshold_m_s2"));
   std::array<SensorConfig, kMaxSensors> sensors{};
   const int count = resolved_sensors(c, sensors);
   int grounds = 0;
@@ -114,10 +107,10 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
     }
     monitor::ConditioningSettings conditioning = s.conditioning;
     conditioning.sample_period_s = c.estimator.sample_period();
-    if (Error e = monitor::validate(conditioning); !e.ok()) return e;
+    PLINTH_TRY(monitor::validate(conditioning));
     monitor::SensorHealthSettings health = s.sensor_health;
     health.sample_period_s = c.estimator.sample_period();
-    if (Error e = monitor::validate(health); !e.ok()) return e;
+    PLINTH_TRY(monitor::validate(health));
   }
   if (grounds == 0) {
     if (sensor_index != nullptr) *sensor_index = 0;
@@ -152,13 +145,13 @@ double Monitor::RmsWindow::rms() const {
 
 Error Monitor::start(const MonitorConfig& config,
                      const std::array<const Scene*, kMaxAxes>& scenes) {
-  if (Error e = validate(config); !e.ok()) return e;
+  PLINTH_TRY(validate(config));
   for (int i = 0; i < config.axis_count; ++i) {
     const Scene* scene = scenes[static_cast<std::size_t>(i)];
     if (scene == nullptr) {
       return {ErrorCode::kInconsistent, "monitor.axis_count", "names an axis without a scene"};
     }
-    if (Error e = validate(config.estimator, *scene); !e.ok()) return e;
+    PLINTH_TRY(validate(config.estimator, *scene));
   }
   config_ = config;
   config_.conditioning.sample_period_s = config.estimator.sample_period();
@@ -173,12 +166,8 @@ Error Monitor::start(const MonitorConfig& config,
     sc.conditioning.sample_period_s = config.estimator.sample_period();
     sc.sensor_health.sample_period_s = config.estimator.sample_period();
     Sensor& s = sensors_[k];
-    if (Error e = monitor::SensorHealthTracker::create(sc.sensor_health, s.health); !e.ok()) {
-      return e;
-    }
-    if (Error e = monitor::Conditioner::create(sc.conditioning, s.conditioner); !e.ok()) {
-      return e;
-    }
+    PLINTH_TRY(monitor::SensorHealthTracker::create(sc.sensor_health, s.health));
+    PLINTH_TRY(monitor::Conditioner::create(sc.conditioning, s.conditioner));
     s.history = History{};
     s.window.reset();
     s.window.length = sc.role == SensorRole::kPlate
@@ -193,7 +182,7 @@ Error Monitor::start(const MonitorConfig& config,
     st.health = s.health.health();
     if (sc.role == SensorRole::kPlate) status_.plate = i;
   }
-  if (Error e = monitor::AlarmPolicy::create(config_.alarm, alarm_); !e.ok()) return e;
+  PLINTH_TRY(monitor::AlarmPolicy::create(config_.alarm, alarm_));
   scenes_ = scenes;
   status_.sensor = sensors_[0].health.health();
   estimate_ = History{};

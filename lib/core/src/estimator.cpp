@@ -14,7 +14,7 @@ Error validate(const EstimatorSettings& st, const Scene& scene) {
   }
   SolverSettings solver = st.solver;
   solver.step = st.step();
-  if (Error e = validate(solver); !e.ok()) return e;
+  PLINTH_TRY(validate(solver));
   if (const double limit = largest_stable_step(scene, solver.stepper); solver.step > limit) {
     return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
             "gives a solver step too large for a stable integration of this scene's base; "
@@ -26,17 +26,14 @@ Error validate(const EstimatorSettings& st, const Scene& scene) {
 
 Error PlanarEstimator::start(const Scene& scene, const EstimatorSettings& settings,
                              GroundAcceleration first) {
-  if (Error e = validate(settings, scene); !e.ok()) return e;
+  PLINTH_TRY(validate(settings, scene));
   if (!std::isfinite(first.horizontal) || !std::isfinite(first.vertical)) {
     return {ErrorCode::kNotFinite, "sample", "the first ground acceleration is not finite"};
   }
   SolverSettings solver = settings.solver;
   solver.step = settings.step();
   stream_.reset(settings.sample_period(), first);
-  if (Error e = Simulator::create(scene, Excitation::streamed(stream_), solver, simulator_);
-      !e.ok()) {
-    return e;
-  }
+  PLINTH_TRY(Simulator::create(scene, Excitation::streamed(stream_), solver, simulator_));
   steps_per_sample_ = settings.steps_per_sample;
   simulator_.start_at_rest();
   started_ = true;

@@ -25,12 +25,12 @@ Error check_unit_interval(double value, const char* field) {
 }
 
 Error validate(const SceneParams& p) {
-  if (Error e = check_positive(p.gravity, "gravity"); !e.ok()) return e;
+  PLINTH_TRY(check_positive(p.gravity, "gravity"));
   const BlockParams& blk = p.block;
-  if (Error e = check_positive(blk.half_width, "block.half_width"); !e.ok()) return e;
-  if (Error e = check_positive(blk.com_height, "block.com_height"); !e.ok()) return e;
-  if (Error e = check_positive(blk.mass, "block.mass"); !e.ok()) return e;
-  if (Error e = check_positive(blk.inertia, "block.inertia"); !e.ok()) return e;
+  PLINTH_TRY(check_positive(blk.half_width, "block.half_width"));
+  PLINTH_TRY(check_positive(blk.com_height, "block.com_height"));
+  PLINTH_TRY(check_positive(blk.mass, "block.mass"));
+  PLINTH_TRY(check_positive(blk.inertia, "block.inertia"));
   if (!std::isfinite(blk.eccentricity)) {
     return fail(ErrorCode::kNotFinite, "block.eccentricity", "must be a finite number");
   }
@@ -39,8 +39,8 @@ Error validate(const SceneParams& p) {
                 "|e| must be smaller than the half-width b (|epsilon| < 1)");
   }
   if (p.has_base) {
-    if (Error e = check_positive(p.base.mass, "base.mass"); !e.ok()) return e;
-    if (Error e = check_positive(p.base.period, "base.period"); !e.ok()) return e;
+    PLINTH_TRY(check_positive(p.base.mass, "base.mass"));
+    PLINTH_TRY(check_positive(p.base.period, "base.period"));
     if (!std::isfinite(p.base.damping_ratio)) {
       return fail(ErrorCode::kNotFinite, "base.damping_ratio", "must be a finite number");
     }
@@ -52,14 +52,8 @@ Error validate(const SceneParams& p) {
     if (!p.has_base) {
       return fail(ErrorCode::kInconsistent, "base_stops", "base stops need a [base]");
     }
-    if (Error e = check_positive(p.base_stops.max_displacement, "base_stops.max_displacement");
-        !e.ok()) {
-      return e;
-    }
-    if (Error e = check_unit_interval(p.base_stops.restitution, "base_stops.restitution");
-        !e.ok()) {
-      return e;
-    }
+    PLINTH_TRY(check_positive(p.base_stops.max_displacement, "base_stops.max_displacement"));
+    PLINTH_TRY(check_unit_interval(p.base_stops.restitution, "base_stops.restitution"));
   }
   if (p.has_friction) {
     const FrictionParams& f = p.friction;
@@ -85,17 +79,14 @@ Error validate(const SceneParams& p) {
       return fail(ErrorCode::kInconsistent, "support",
                   "a block that never slides (no [friction]) cannot leave the support");
     }
-    if (Error e = check_positive(p.support.clearance, "support.clearance"); !e.ok()) return e;
+    PLINTH_TRY(check_positive(p.support.clearance, "support.clearance"));
   }
   if (p.has_sliding_stops) {
     if (!p.has_support) {
       return fail(ErrorCode::kInconsistent, "sliding_stops",
                   "sliding stops sit at the support's clearance: they need a [support]");
     }
-    if (Error e = check_unit_interval(p.sliding_stops.restitution, "sliding_stops.restitution");
-        !e.ok()) {
-      return e;
-    }
+    PLINTH_TRY(check_unit_interval(p.sliding_stops.restitution, "sliding_stops.restitution"));
   }
   return ok_error();
 }
@@ -118,7 +109,7 @@ CornerGeometry corner_geometry(const Scene& s, double distance, double sign) {
 }
 
 Error make_scene(const SceneParams& params, Scene& out) {
-  if (Error e = validate(params); !e.ok()) return e;
+  PLINTH_TRY(validate(params));
   Scene s;
   s.params = params;
   s.b = params.block.half_width;

@@ -878,7 +878,7 @@ void bind_for_friction(Simulator& sim, const Features& f, const SolverSettings& 
 
 Error Simulator::create(const Scene& scene, const Excitation& excitation,
                         const SolverSettings& settings, Simulator& out) {
-  if (Error e = validate(settings); !e.ok()) return e;
+  PLINTH_TRY(validate(settings));
   if (const double limit = largest_stable_step(scene, settings.stepper); settings.step > limit) {
     return {ErrorCode::kOutOfRange, "solver.step",
             "is too large for a stable integration of this scene's base (stiff or light base)",

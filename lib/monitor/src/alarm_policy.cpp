@@ -114,7 +114,7 @@ can::AlarmEvent to_can_event(const AlarmEventRecord& record) {
 }
 
 Error AlarmPolicy::create(const AlarmPolicySettings& settings, AlarmPolicy& out) {
-  if (Error e = validate(settings); !e.ok()) return e;
+  PLINTH_TRY(validate(settings));
   out = AlarmPolicy{};
   out.settings_ = settings;
   out.raise_hold_ns_ = detail::to_ns(settings.raise_hold_s);

@@ -51,20 +51,16 @@ Error validate(const ConditioningSettings& s) {
       s.unit != AccelerationUnit::kMetresPerSecondSquared) {
     return {ErrorCode::kOutOfRange, "conditioning.unit", "must be g or m/s2"};
   }
-  if (Error e = detail::first_error({
-          validate_rotation(s),
-          detail::check_duration(s.sample_period_s, "conditioning.sample_period_s", false),
-          detail::check_duration(s.startup_window_s, "conditioning.startup_window_s", false),
-          detail::check_positive(s.startup_max_std_m_s2, "conditioning.startup_max_std_m_s2"),
-          detail::check_positive(s.startup_max_offset_m_s2,
-                                 "conditioning.startup_max_offset_m_s2"),
-          detail::check_duration(s.tracking_time_constant_s,
-                                 "conditioning.tracking_time_constant_s", false),
-          detail::check_positive(s.tracking_gate_m_s2, "conditioning.tracking_gate_m_s2"),
-      });
-      !e.ok()) {
-    return e;
-  }
+  PLINTH_TRY(detail::first_error({
+      validate_rotation(s),
+      detail::check_duration(s.sample_period_s, "conditioning.sample_period_s", false),
+      detail::check_duration(s.startup_window_s, "conditioning.startup_window_s", false),
+      detail::check_positive(s.startup_max_std_m_s2, "conditioning.startup_max_std_m_s2"),
+      detail::check_positive(s.startup_max_offset_m_s2, "conditioning.startup_max_offset_m_s2"),
+      detail::check_duration(s.tracking_time_constant_s, "conditioning.tracking_time_constant_s",
+                             false),
+      detail::check_positive(s.tracking_gate_m_s2, "conditioning.tracking_gate_m_s2"),
+  }));
   // Needs a valid period and window.
   if (window_length(s) < 2) {
     return {ErrorCode::kInconsistent, "conditioning.startup_window_s",
@@ -94,7 +90,7 @@ const char* offset_tracking_name(OffsetTracking tracking) {
 }
 
 Error Conditioner::create(const ConditioningSettings& settings, Conditioner& out) {
-  if (Error e = validate(settings); !e.ok()) return e;
+  PLINTH_TRY(validate(settings));
   out = Conditioner{};
   out.settings_ = settings;
   out.unit_scale_ = settings.unit == AccelerationUnit::kStandardGravity ? kStandardGravity : 1.0;

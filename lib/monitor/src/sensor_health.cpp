@@ -27,15 +27,12 @@ bool bit_identical(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 }  // namespace
 
 Error validate(const SensorHealthSettings& s) {
-  if (Error e = detail::first_error({
-          detail::check_duration(s.sample_period_s, "sensor_health.sample_period_s", false),
-          detail::check_duration(s.timeout_s, "sensor_health.timeout_s", false),
-          detail::check_positive(s.full_scale_g, "sensor_health.full_scale_g"),
-          detail::check_positive(s.max_valid_g, "sensor_health.max_valid_g"),
-      });
-      !e.ok()) {
-    return e;
-  }
+  PLINTH_TRY(detail::first_error({
+      detail::check_duration(s.sample_period_s, "sensor_health.sample_period_s", false),
+      detail::check_duration(s.timeout_s, "sensor_health.timeout_s", false),
+      detail::check_positive(s.full_scale_g, "sensor_health.full_scale_g"),
+      detail::check_positive(s.max_valid_g, "sensor_health.max_valid_g"),
+  }));
   if (s.max_bridge_samples < 0 || s.max_bridge_samples > kMaxBridgeSamples) {
     return {ErrorCode::kOutOfRange, "sensor_health.max_bridge_samples", "must lie in 0..15",
             static_cast<double>(kMaxBridgeSamples)};
@@ -104,7 +101,7 @@ can::AlarmCause to_alarm_cause(HealthCause cause) {
 }
 
 Error SensorHealthTracker::create(const SensorHealthSettings& settings, SensorHealthTracker& out) {
-  if (Error e = validate(settings); !e.ok()) return e;
+  PLINTH_TRY(validate(settings));
   out = SensorHealthTracker{};
   out.settings_ = settings;
   out.timeout_ns_ = detail::to_ns(settings.timeout_s);

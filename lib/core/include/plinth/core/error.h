@@ -27,3 +27,11 @@ struct Error {
 [[nodiscard]] constexpr Error ok_error() { return Error{}; }
 
 }  // namespace plinth
+
+// Returns the Error of `expr` from the enclosing function when it is not ok (Pigweed's PW_TRY).
+#define PLINTH_TRY(expr)                                                             \
+  do {                                                                               \
+    if (const ::plinth::Error plinth_try_error_ = (expr); !plinth_try_error_.ok()) { \
+      return plinth_try_error_;                                                      \
+    }                                                                                \
+  } while (false)
