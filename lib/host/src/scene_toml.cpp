@@ -13,13 +13,16 @@
 #include <map>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <system_error>
 #include <utility>
+#include <vector>
 
 #include <toml++/toml.h>
 
+#include "plinth/core/ensemble_design.h"
 #include "plinth/host/input_error.h"
 
 namespace plinth::host {
@@ -49,7 +52,7 @@ std::string_view type_name(toml::node_type type) {
   return "an unknown type";
 }
 
-std::string join(std::initializer_list<std::string_view> words) {
+std::string join(std::span<const std::string_view> words) {
   std::string out;
   for (std::string_view word : words) {
     if (!out.empty()) out += ", ";
@@ -75,23 +78,45 @@ struct Provenance {
   std::optional<double> core_value;
 };
 
+// The keys of each table (check_keys below takes the same lists).
+const std::map<std::string_view, std::vector<std::string_view>, std::less<>> kKnownKeys{
+    {"block",
+     {"half_width", "slenderness", "com_height", "eccentricity_ratio", "eccentricity", "density",
+      "depth", "mass", "inertia"}},
+    {"base", {"mass_ratio", "mass", "period", "stiffness", "damping_ratio", "damping"}},
+    {"friction", {"static", "kinetic"}},
+    {"base_stops", {"max_displacement", "restitution"}},
+    {"support", {"clearance"}},
+    {"sliding_stops", {"restitution"}},
+};
+
+// Defaults that do not depend on other keys: an uncertainty may be declared around them.
+const std::map<std::string, double, std::less<>> kConstantDefaults{
+    {"block.eccentricity_ratio", 0.0}, {"block.eccentricity", 0.0}, {"block.depth", 1.0}};
+
 class Loader {
  public:
   explicit Loader(std::string origin) : origin_(std::move(origin)) {}
 
-  Scene load(const std::string& text) {
-    toml::table doc;
+  // Parses `text`; a TOML syntax error names the line and column.
+  toml::table parse(const std::string& text) const {
     try {
-      doc = toml::parse(text, origin_);
+      return toml::parse(text, origin_);
     } catch (const toml::parse_error& error) {
       const toml::source_position where = error.source().begin;
       throw InputError(origin_ + ":" + std::to_string(where.line) + ":" +
                        std::to_string(where.column) +
                        ": TOML syntax error: " + std::string(error.description()));
     }
+  }
+
+  // The scene a document describes; its [uncertainty] table, if any, is another reader's.
+  Scene load(const toml::table& doc) {
     SceneParams params;
-    check_keys(doc, "", {"gravity", "block", "base", "friction", "base_stops", "support",
-                         "sliding_stops"});
+    static constexpr std::array<std::string_view, 8> kTopLevel{
+        "gravity", "block", "base", "friction", "base_stops", "support", "sliding_stops",
+        "uncertainty"};
+    check_keys(doc, "", kTopLevel);
     if (std::optional<Number> g = number(doc, "", "gravity")) {
       params.gravity = g->value;
       record("gravity", *g);
@@ -108,6 +133,42 @@ class Loader {
     Scene scene;
     if (const Error error = make_scene(params, scene); !error.ok()) report(error);
     return scene;
+  }
+
+  // The [uncertainty] table: sub-tables named as the scene's, each key as in its table with a
+  // range [low, high] around the file's value (or the key's default).
+  std::vector<UncertainKey> read_uncertainty(const toml::table& doc) const {
+    std::vector<UncertainKey> out;
+    const toml::table* unc = table(doc, "uncertainty");
+    if (unc == nullptr) return out;
+    static constexpr std::array<std::string_view, 6> kTables{
+        "block", "base", "friction", "base_stops", "support", "sliding_stops"};
+    check_keys(*unc, "uncertainty", kTables);
+    for (auto&& [name, node] : *unc) {
+      const std::string prefix = "uncertainty." + std::string(name.str());
+      const toml::table* ranges = node.as_table();
+      if (ranges == nullptr) {
+        fail(node.source().begin.line, prefix,
+             "expected a table, got " + std::string(type_name(node.type())));
+      }
+      const toml::table* scene_table = table(doc, name.str());
+      if (scene_table == nullptr) {
+        fail(node.source().begin.line, prefix,
+             "the scene has no [" + std::string(name.str()) + "] table to be uncertain about");
+      }
+      for (auto&& [key, range] : *ranges) {
+        out.push_back(read_range(*scene_table, name.str(), key.str(), range));
+      }
+    }
+    // toml++ keeps a table's keys sorted: file order is line order.
+    std::stable_sort(out.begin(), out.end(),
+                     [](const UncertainKey& a, const UncertainKey& b) { return a.line < b.line; });
+    if (out.size() > static_cast<std::size_t>(kMaxUncertainParameters)) {
+      fail(unc->source().begin.line, "uncertainty",
+           "declares " + std::to_string(out.size()) + " uncertain keys; at most " +
+               std::to_string(kMaxUncertainParameters));
+    }
+    return out;
   }
 
  private:
@@ -130,7 +191,7 @@ class Loader {
 
   // Rejects every key of `tbl` not in `known`, naming it with its full dotted name.
   void check_keys(const toml::table& tbl, std::string_view prefix,
-                  std::initializer_list<std::string_view> known) const {
+                  std::span<const std::string_view> known) const {
     for (auto&& [key, node] : tbl) {
       bool found = false;
       for (std::string_view k : known) found = found || k == key.str();
@@ -217,9 +278,7 @@ class Loader {
   }
 
   void read_block(const toml::table& tbl, SceneParams& params) {
-    check_keys(tbl, "block",
-               {"half_width", "slenderness", "com_height", "eccentricity_ratio", "eccentricity",
-                "density", "depth", "mass", "inertia"});
+    check_keys(tbl, "block", kKnownKeys.at("block"));
     BlockParams& blk = params.block;
 
     const Number b = required(tbl, "block", "half_width");
@@ -266,8 +325,7 @@ class Loader {
   }
 
   void read_base(const toml::table& tbl, SceneParams& params) {
-    check_keys(tbl, "base",
-               {"mass_ratio", "mass", "period", "stiffness", "damping_ratio", "damping"});
+    check_keys(tbl, "base", kKnownKeys.at("base"));
     params.has_base = true;
     BaseParams& base = params.base;
     const double m = params.block.mass;
@@ -300,7 +358,7 @@ class Loader {
   }
 
   void read_friction(const toml::table& tbl, SceneParams& params) {
-    check_keys(tbl, "friction", {"static", "kinetic"});
+    check_keys(tbl, "friction", kKnownKeys.at("friction"));
     params.has_friction = true;
     const Number mu_s = required(tbl, "friction", "static");
     params.friction.static_coefficient = mu_s.value;
@@ -314,7 +372,7 @@ class Loader {
   }
 
   void read_base_stops(const toml::table& tbl, SceneParams& params) {
-    check_keys(tbl, "base_stops", {"max_displacement", "restitution"});
+    check_keys(tbl, "base_stops", kKnownKeys.at("base_stops"));
     params.has_base_stops = true;
     provenance_["base_stops"] = Provenance{"base_stops", tbl.source().begin.line, {}, {}};
     const Number u_max = required(tbl, "base_stops", "max_displacement");
@@ -326,7 +384,7 @@ class Loader {
   }
 
   void read_support(const toml::table& tbl, SceneParams& params) {
-    check_keys(tbl, "support", {"clearance"});
+    check_keys(tbl, "support", kKnownKeys.at("support"));
     params.has_support = true;
     provenance_["support"] = Provenance{"support", tbl.source().begin.line, {}, {}};
     const Number clearance = required(tbl, "support", "clearance");
@@ -335,7 +393,7 @@ class Loader {
   }
 
   void read_sliding_stops(const toml::table& tbl, SceneParams& params) {
-    check_keys(tbl, "sliding_stops", {"restitution"});
+    check_keys(tbl, "sliding_stops", kKnownKeys.at("sliding_stops"));
     params.has_sliding_stops = true;
     provenance_["sliding_stops"] = Provenance{"sliding_stops", tbl.source().begin.line, {}, {}};
     const Number eta = required(tbl, "sliding_stops", "restitution");
@@ -358,17 +416,78 @@ class Loader {
     fail(p.line, p.key, what);
   }
 
+  // One key's range: known in its table, given there (or with a constant default), and
+  // [low, high] two finite numbers with low <= nominal <= high.
+  UncertainKey read_range(const toml::table& scene_table, std::string_view table_name,
+                          std::string_view key, const toml::node& range) const {
+    const std::string name = "uncertainty." + std::string(table_name) + "." + std::string(key);
+    const std::uint32_t line = range.source().begin.line;
+    const auto known = kKnownKeys.find(table_name);
+    bool is_known = false;
+    for (std::string_view k : known->second) is_known = is_known || k == key;
+    if (!is_known) {
+      fail(line, name,
+           "unknown key (allowed in [" + std::string(table_name) + "]: " + join(known->second) + ")");
+    }
+    UncertainKey u;
+    u.table = std::string(table_name);
+    u.key = std::string(key);
+    u.line = line;
+    if (std::optional<Number> given = number(scene_table, table_name, key)) {
+      u.nominal = given->value;
+    } else if (const auto d = kConstantDefaults.find(dotted(table_name, key));
+               d != kConstantDefaults.end()) {
+      u.nominal = d->second;
+    } else {
+      fail(line, name,
+           "the scene does not give " + dotted(table_name, key) +
+               " (give it in [" + std::string(table_name) + "], or declare the uncertainty of "
+               "the key it gives)");
+    }
+    const toml::array* pair = range.as_array();
+    if (pair == nullptr || pair->size() != 2 || !(*pair)[0].is_number() ||
+        !(*pair)[1].is_number()) {
+      fail(line, name, "expected a range [low, high] of two numbers");
+    }
+    u.low = (*pair)[0].value<double>().value_or(0.0);
+    u.high = (*pair)[1].value<double>().value_or(0.0);
+    if (!std::isfinite(u.low) || !std::isfinite(u.high)) {
+      fail(line, name, "the range's ends must be finite numbers");
+    }
+    if (!(u.low <= u.nominal && u.nominal <= u.high)) {
+      fail(line, name,
+           "the range [" + format_number(u.low) + ", " + format_number(u.high) +
+               "] must hold the scene's value " + format_number(u.nominal) + " (low <= value <= high)");
+    }
+    return u;
+  }
+
   std::string origin_;
   std::map<std::string, Provenance, std::less<>> provenance_;
 };
 
-}  // namespace
-
-Scene load_scene_text(const std::string& text, const std::string& origin) {
-  return Loader(origin).load(text);
+// The document with the uncertain keys set: key i at `value(i)`.
+template <class ValueOf>
+toml::table with_values(const toml::table& doc, const std::vector<UncertainKey>& keys,
+                        ValueOf value) {
+  toml::table copy = doc;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    toml::table* tbl = copy.get_as<toml::table>(keys[i].table);
+    tbl->insert_or_assign(keys[i].key, value(i));
+  }
+  return copy;
 }
 
-Scene load_scene_file(const std::string& path) {
+std::string describe(const std::vector<UncertainKey>& keys, const std::vector<double>& values) {
+  std::string out;
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    if (!out.empty()) out += ", ";
+    out += keys[i].table + "." + keys[i].key + " = " + format_number(values[i]);
+  }
+  return out;
+}
+
+std::string read_text_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     throw InputError(path + ": cannot open scene file (it is a directory)");
@@ -381,7 +500,67 @@ Scene load_scene_file(const std::string& path) {
     text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
   }
   if (in.bad()) throw InputError(path + ": cannot open scene file (read error)");
-  return load_scene_text(text, path);
+  return text;
 }
+
+}  // namespace
+
+Scene UncertainScene::statue(std::span<const double> u) const {
+  std::vector<double> values(uncertain.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const double x = i < u.size() ? std::clamp(u[i], 0.0, 1.0) : 0.5;
+    values[i] = uncertain[i].low + x * (uncertain[i].high - uncertain[i].low);
+  }
+  return scene_at(values);
+}
+
+Scene UncertainScene::scene_at(const std::vector<double>& values) const {
+  Loader loader(origin_);
+  const toml::table doc =
+      with_values(loader.parse(text_), uncertain, [&](std::size_t i) { return values[i]; });
+  try {
+    return loader.load(doc);
+  } catch (const InputError& e) {
+    std::string_view why = e.what();
+    if (why.starts_with(origin_ + ":")) why.remove_prefix(origin_.size() + 1);
+    throw InputError(origin_ + ": uncertainty: the statue with " + describe(uncertain, values) +
+                     " is not a valid scene:" + std::string(why));
+  }
+}
+
+UncertainScene load_uncertain_scene_text(const std::string& text, const std::string& origin) {
+  UncertainScene out;
+  Loader loader(origin);
+  const toml::table doc = loader.parse(text);
+  out.text_ = text;
+  out.origin_ = origin;
+  out.nominal = loader.load(doc);
+  out.uncertain = loader.read_uncertainty(doc);
+  const int d = static_cast<int>(out.uncertain.size());
+  std::vector<DesignPoint> points(static_cast<std::size_t>(design_point_count(d)));
+  points.resize(static_cast<std::size_t>(two_level_design(d, points)));
+  if (d == 0) points.resize(1);  // no uncertainty: the nominal statue alone
+  out.members.push_back(out.nominal);
+  for (std::size_t p = 1; p < points.size(); ++p) {
+    std::vector<double> values(out.uncertain.size());
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      const UncertainKey& k = out.uncertain[i];
+      const double z = points[p][i];
+      values[i] = z < 0.0 ? k.nominal + z * (k.nominal - k.low) : k.nominal + z * (k.high - k.nominal);
+    }
+    out.members.push_back(out.scene_at(values));
+  }
+  return out;
+}
+
+UncertainScene load_uncertain_scene_file(const std::string& path) {
+  return load_uncertain_scene_text(read_text_file(path), path);
+}
+
+Scene load_scene_text(const std::string& text, const std::string& origin) {
+  return load_uncertain_scene_text(text, origin).nominal;
+}
+
+Scene load_scene_file(const std::string& path) { return load_uncertain_scene_file(path).nominal; }
 
 }  // namespace plinth::host

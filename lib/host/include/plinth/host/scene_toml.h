@@ -2,7 +2,10 @@
 // docs/scene-format.md; unknown keys and tables are rejected.
 #pragma once
 
+#include <cstdint>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "plinth/core/scene.h"
 
@@ -17,5 +20,45 @@ namespace plinth::host {
 
 // The same from TOML text; `origin` is used in messages in place of a file name.
 [[nodiscard]] Scene load_scene_text(const std::string& text, const std::string& origin);
+
+// One key whose true value is uncertain: `[uncertainty.<table>] <key> = [low, high]`, in the
+// key's own unit; nominal is the scene's value (given, or the key's constant default).
+struct UncertainKey {
+  std::string table;  // "block"
+  std::string key;    // "slenderness"
+  double nominal = 0.0;
+  double low = 0.0;
+  double high = 0.0;
+  std::uint32_t line = 0;
+};
+
+// A scene file with its declared uncertainty (docs/scene-format.md, [uncertainty]).
+struct UncertainScene {
+  Scene nominal;
+  std::vector<UncertainKey> uncertain;  // in file order
+  // The ensemble: the two-level design over `uncertain` (plinth/core/ensemble_design.h), each
+  // point's keys at low (z = -1), the scene's value (0) or high (+1); members[0] is nominal.
+  // Each member is validated as a scene of its own.
+  std::vector<Scene> members;
+
+  // A statue inside the ranges: key i at low + u[i] (high - low), u[i] in [0, 1] (missing
+  // entries: the middle). Throws InputError naming the values when they make no valid scene.
+  [[nodiscard]] Scene statue(std::span<const double> u) const;
+
+ private:
+  friend UncertainScene load_uncertain_scene_text(const std::string&, const std::string&);
+  [[nodiscard]] Scene scene_at(const std::vector<double>& values) const;
+  std::string text_;  // the file, read again for each statue
+  std::string origin_;
+};
+
+// Reads a scene file and its [uncertainty] table. Throws InputError naming the file, line and
+// key for everything load_scene_file refuses, and for: an uncertainty sub-table the scene does
+// not have, a key its table does not know or the scene does not give (unless it has a constant
+// default), a range that is not two finite numbers [low, high] holding the scene's value, more
+// than kMaxUncertainParameters keys, and a member of the ensemble that is not a valid scene.
+[[nodiscard]] UncertainScene load_uncertain_scene_file(const std::string& path);
+[[nodiscard]] UncertainScene load_uncertain_scene_text(const std::string& text,
+                                                       const std::string& origin);
 
 }  // namespace plinth::host
