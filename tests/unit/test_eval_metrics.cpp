@@ -1,0 +1,209 @@
+// plinth-eval's measures (eval_metrics.h): classification of runs, leads, ROC rules,
+// calibration choice, and the runs file.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "plinth/host/eval_metrics.h"
+#include "plinth/host/input_error.h"
+
+namespace plinth::host {
+namespace {
+
+EvalRun collapse_at(double t, double alarm_at) {
+  EvalRun r;
+  r.collapsed = true;
+  r.collapse_time_s = t;
+  r.peak_ratio = 1.0;
+  r.first_shown_s = {-1.0, -1.0, alarm_at};
+  return r;
+}
+
+EvalRun standing(double peak, double alarm_at) {
+  EvalRun r;
+  r.peak_ratio = peak;
+  r.first_shown_s = {-1.0, -1.0, alarm_at};
+  return r;
+}
+
+TEST(EvalMetrics, ClassifiesHitsMissesFalseAlarmsAndNearMisses) {
+  const std::vector<EvalRun> runs{
+      collapse_at(10.0, 8.0),   // hit, lead 2
+      collapse_at(10.0, 10.0),  // at the collapse: a miss
+      collapse_at(10.0, -1.0),  // never: a miss
+      collapse_at(5.0, 4.5),    // hit, lead 0.5
+      standing(0.1, 3.0),       // quiet, raised: false alarm
+      standing(0.49, -1.0),     // quiet, not raised
+      standing(0.5, 2.0),       // past half the angle: a near miss, raised
+      standing(0.9, -1.0),      // near miss, not raised
+  };
+  const Outcome o = level_outcome(runs, EvalLevel::kAlarm);
+  EXPECT_EQ(o.collapses, 4);
+  EXPECT_EQ(o.hits, 2);
+  EXPECT_EQ(o.misses, 2);
+  EXPECT_EQ(o.quiet_runs, 2);
+  EXPECT_EQ(o.false_alarms, 1);
+  EXPECT_DOUBLE_EQ(o.false_alarm_rate(), 0.5);
+  EXPECT_EQ(o.near_miss_runs, 2);
+  EXPECT_EQ(o.raised_on_near_misses, 1);
+  // Leads, misses as 0: {0, 0, 0.5, 2}.
+  EXPECT_DOUBLE_EQ(o.lead_quantile(0.5), 0.25);
+  EXPECT_DOUBLE_EQ(o.lead_quantile(0.0), 0.0);
+  EXPECT_DOUBLE_EQ(o.lead_quantile(1.0), 2.0);
+  EXPECT_DOUBLE_EQ(level_outcome(runs, EvalLevel::kWarning).lead_quantile(0.5), 0.0);
+  EXPECT_EQ(Outcome{}.lead_quantile(0.5), -1.0);
+  EXPECT_EQ(Outcome{}.false_alarm_rate(), 0.0);
+}
+
+TEST(EvalMetrics, ARuleIsFirstTrueAtTheEarlierCrossing) {
+  EvalRun r;
+  r.risk_crossing_s = {1.0, 3.0, -1.0};
+  r.probability_crossing_s = {2.0, -1.0};
+  EXPECT_EQ(first_time(r, {0, -1}), 1.0);
+  EXPECT_EQ(first_time(r, {1, 0}), 2.0);
+  EXPECT_EQ(first_time(r, {2, 1}), -1.0);
+  EXPECT_EQ(first_time(r, {2, 0}), 2.0);
+  EXPECT_EQ(first_time(r, {-1, -1}), -1.0);
+  EXPECT_EQ(first_time(r, {7, 9}), -1.0);  // outside the grids: unused
+}
+
+// Two collapses and two quiet runs; three risk thresholds, two probability ones.
+std::vector<EvalRun> roc_runs() {
+  std::vector<EvalRun> runs(4);
+  runs[0].collapsed = true;
+  runs[0].collapse_time_s = 10.0;
+  runs[0].risk_crossing_s = {5.0, 8.0, 9.5};
+  runs[0].probability_crossing_s = {4.0, 7.0};
+  runs[1].collapsed = true;
+  runs[1].collapse_time_s = 10.0;
+  runs[1].risk_crossing_s = {6.0, 9.0, -1.0};
+  runs[1].probability_crossing_s = {3.0, -1.0};
+  runs[2].risk_crossing_s = {2.0, -1.0, -1.0};  // quiet
+  runs[2].probability_crossing_s = {-1.0, -1.0};
+  runs[3].risk_crossing_s = {1.0, 1.5, -1.0};  // quiet
+  runs[3].probability_crossing_s = {2.0, -1.0};
+  return runs;
+}
+
+TEST(EvalMetrics, RocCoversEverySignalAloneAndEveryPair) {
+  const CrossingGrids grids{{0.2, 0.5, 0.8}, {0.5, 1.0}};
+  const std::vector<RocPoint> points = roc(roc_runs(), grids);
+  EXPECT_EQ(points.size(), 3U + 2U + 3U * 2U);
+  for (const RocPoint& p : points) {
+    if (p.rule.risk_index == 2 && p.rule.probability_index == -1) {
+      EXPECT_EQ(p.outcome.misses, 1);
+      EXPECT_EQ(p.outcome.false_alarms, 0);
+    }
+    if (p.rule.risk_index == -1 && p.rule.probability_index == 0) {
+      EXPECT_EQ(p.outcome.misses, 0);
+      EXPECT_EQ(p.outcome.false_alarms, 1);
+      EXPECT_DOUBLE_EQ(p.outcome.lead_quantile(0.5), 6.5);
+    }
+  }
+}
+
+TEST(EvalMetrics, ChoosesTheLongestLeadWithinTheTarget) {
+  const CrossingGrids grids{{0.2, 0.5, 0.8}, {0.5, 1.0}};
+  const std::vector<RocPoint> points = roc(roc_runs(), grids);
+  // Within 0 false alarms and 0 misses: risk 0.8 misses one; probability 1.0 misses one;
+  // "risk 0.8 or probability 1.0": misses one too. Nothing meets it: the fewest misses with
+  // no false alarm (1), longest lead among them.
+  Choice c = choose_rule(points, {0.0, 0});
+  ASSERT_TRUE(c.found);
+  EXPECT_FALSE(c.meets_target);
+  EXPECT_EQ(c.point.outcome.false_alarms, 0);
+  EXPECT_EQ(c.point.outcome.misses, 1);
+  // Allowing one false alarm in two: "probability 0.5" (leads 6 and 7) beats the others.
+  c = choose_rule(points, {0.5, 0});
+  ASSERT_TRUE(c.meets_target);
+  EXPECT_EQ(c.point.rule.probability_index, 0);
+  EXPECT_DOUBLE_EQ(c.point.outcome.lead_quantile(0.5), 6.5);
+  EXPECT_FALSE(choose_rule({}, {}).found);
+}
+
+std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("plinth_eval_" + name)).string();
+}
+
+TEST(EvalMetrics, RunsFileRoundTrips) {
+  const CrossingGrids grids{{0.2, 0.5}, {0.25}};
+  EvalRun a = collapse_at(12.5, 11.25);
+  a.record = "odd, \"name\".AT2";
+  a.scene = "s.toml";
+  a.statue = 3;
+  a.scale_g = 0.4;
+  a.risk_crossing_s = {10.0, -1.0};
+  a.probability_crossing_s = {9.5};
+  EvalRun b = standing(0.125, -1.0);
+  b.record = "r.AT2";
+  b.scene = "t.toml";
+  b.risk_crossing_s = {-1.0, -1.0};
+  b.probability_crossing_s = {-1.0};
+  const std::string path = temp_path("roundtrip.csv");
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  write_eval_csv_header(f, grids);
+  write_eval_csv_row(f, a);
+  write_eval_csv_row(f, b);
+  std::fclose(f);
+  const EvalTable t = read_eval_csv(path);
+  EXPECT_EQ(t.grids.risk, grids.risk);
+  EXPECT_EQ(t.grids.probability, grids.probability);
+  ASSERT_EQ(t.runs.size(), 2U);
+  EXPECT_EQ(t.runs[0].record, a.record);
+  EXPECT_EQ(t.runs[0].statue, 3);
+  EXPECT_DOUBLE_EQ(t.runs[0].collapse_time_s, 12.5);
+  EXPECT_EQ(t.runs[0].first_shown_s, a.first_shown_s);
+  EXPECT_EQ(t.runs[0].risk_crossing_s, a.risk_crossing_s);
+  EXPECT_EQ(t.runs[1].probability_crossing_s, b.probability_crossing_s);
+  EXPECT_FALSE(t.runs[1].collapsed);
+  std::filesystem::remove(path);
+}
+
+std::string error_reading(const std::string& text) {
+  const std::string path = temp_path("bad.csv");
+  std::ofstream(path) << text;
+  try {
+    (void)read_eval_csv(path);
+  } catch (const InputError& e) {
+    std::filesystem::remove(path);
+    return e.what();
+  }
+  std::filesystem::remove(path);
+  ADD_FAILURE() << "no InputError";
+  return "";
+}
+
+TEST(EvalMetrics, RunsFileErrorsNameTheLineAndColumn) {
+  const std::string header =
+      "record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,first_advisory_s,"
+      "first_warning_s,first_alarm_s,risk_ge_0.5\n";
+  EXPECT_NE(error_reading("").find(":1: not a plinth-eval runs file"), std::string::npos);
+  EXPECT_NE(error_reading("a,b\n").find(":1: not a plinth-eval runs file"), std::string::npos);
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,1,nan,1,-1,-1,-1,-1\n")
+                .find(":2: collapse_time_s: expected a finite number, got \"nan\""),
+            std::string::npos);
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,1,-1,1,-1,-1,-1,-1\n")
+                .find(":2: collapse_time_s: must be >= 0 exactly when collapsed is 1"),
+            std::string::npos);
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,2,-1,1,-1,-1,-1,-1\n")
+                .find(":2: collapsed: expected 0 or 1"),
+            std::string::npos);
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,0,-1,1,-1,-1\n").find(":2: expected 11 fields"),
+            std::string::npos);
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,0,-1,1,-1,-1,-1,-3\n")
+                .find(":2: risk crossing: expected a time >= 0 or -1"),
+            std::string::npos);
+  EXPECT_NE(error_reading(header + "\"r,s,0\n").find(":2: unterminated quoted field"),
+            std::string::npos);
+  EXPECT_NE(error_reading("record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,"
+                          "first_advisory_s,first_warning_s,first_alarm_s,colour\n")
+                .find(":1: column 11: unknown column \"colour\""),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace plinth::host
