@@ -15,6 +15,7 @@
 # Usage: tools/vcan-bus.sh [options] [--] PROGRAM [ARG...]
 #        tools/vcan-bus.sh [options] -c 'SHELL COMMAND LINE'
 #        tools/vcan-bus.sh [--route R] --which        the route that would run, without booting
+#        tools/vcan-bus.sh --qemu-kernel              the kernel version the qemu route boots
 #        tools/vcan-bus.sh [options] --choose FILE    send a frame on the route that runs here,
 #                                                     write its name (uml, qemu) to FILE
 # Options:
@@ -87,6 +88,7 @@ while [ $# -gt 0 ]; do
     --out) out_dir=${2:?}; shift 2 ;;
     --if-chosen) chosen_file=${2:?}; shift 2 ;;
     --which) mode=which; shift ;;
+    --qemu-kernel) mode=qemu-kernel; shift ;;
     --choose) mode=choose; choose_file=${2:?}; shift 2 ;;
     -c) shell_line=${2:?}; shift 2 ;;
     -h | --help) usage ;;
@@ -431,6 +433,12 @@ candidates() {
   esac
 }
 
+if [ "$mode" = qemu-kernel ]; then
+  kernel_version=$(qemu_kernel_version)
+  [ -n "$kernel_version" ] || { echo "$me: no /boot/vmlinuz-* with vcan.ko" >&2; exit 1; }
+  echo "$kernel_version"
+  exit 0
+fi
 if [ "$mode" = which ]; then
   reasons=""
   for candidate in $(candidates); do
