@@ -9,10 +9,11 @@
 # irq_to_desc(), which modules cannot (not exported), to run handle_simple_irq(); it calls
 # generic_handle_irq() instead, which runs the same handler (irq_sim sets it on each interrupt).
 #
-# Usage: tools/build-gpio-sim.sh [--kernel VERSION] [--out DIR] [--force]
+# Usage: tools/build-gpio-sim.sh [--kernel VERSION] [--out DIR] [--force | --check]
 #   --kernel VERSION  default: the kernel the qemu route boots (tools/vcan-bus.sh --qemu-kernel)
 #   --out DIR         default /usr/local/lib/plinth/modules/VERSION, where vcan-bus.sh looks
 #   --force           build even if DIR/gpio-sim.ko is there for VERSION
+#   --check           build nothing: exit 0 if it is there, 1 if not
 # Exit status: 0 built or already there; 1 failed (why on stderr); 2 usage.
 set -euo pipefail
 
@@ -21,12 +22,14 @@ root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 kernel=""
 out=""
 force=0
+check=0
 usage() { sed -n '/^# Usage:/,/^# Exit status/p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --kernel) kernel=${2:?}; shift 2 ;;
     --out) out=${2:?}; shift 2 ;;
     --force) force=1; shift ;;
+    --check) check=1; shift ;;
     -h | --help) usage ;;
     *) echo "$me: unknown argument $1" >&2; usage ;;
   esac
@@ -42,6 +45,7 @@ if [ "$force" -eq 0 ] && [ -e "$module" ] &&
   echo "$me: $module is there for $kernel"
   exit 0
 fi
+[ "$check" -eq 0 ] || { echo "$me: no $module for $kernel" >&2; exit 1; }
 headers=/lib/modules/$kernel/build
 [ -e "$headers/Makefile" ] || fail "no $headers (install linux-headers-$kernel)"
 sources=(/usr/src/linux-source-*.tar.xz)

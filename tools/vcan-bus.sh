@@ -32,8 +32,9 @@
 #                     exit 77 (ctest: the tests of the other route)
 # Example: tools/vcan-bus.sh --vcan 2 build/release/tests/test_socketcan
 # Exit status: the command's; 77 when no route can start here (ctest's SKIP_RETURN_CODE: the
-# reasons are printed; with CI=true, --choose and --if-chosen fail with 1 instead); 124 when the
-# time ran out; 125 when the guest could not set up the bus or the harness was misused.
+# reasons are printed; with CI=true 1 instead: CI must run the real-bus tests) or, with
+# --if-chosen, when FILE names another route; 124 when the time ran out; 125 when the guest could
+# not set up the bus or the harness was misused.
 # shellcheck disable=SC2317  # functions run by traps and through "route_$name"
 set -euo pipefail
 
@@ -74,7 +75,7 @@ choose_file=""
 chosen_file=""
 
 usage() {
-  sed -n '/^# Usage:/,/^# time ran out/p' "$0" | sed 's/^# \{0,1\}//' >&2
+  sed -n '/^# Usage:/,/^# not set up the bus/p' "$0" | sed 's/^# \{0,1\}//' >&2
   exit 125
 }
 while [ $# -gt 0 ]; do
@@ -214,7 +215,13 @@ collect() {  # ROUTE
   fi
   if [ ! -e "$run/status" ]; then
     if timed_out; then
-      echo "$me: route $1: timed out after ${timeout_s} s (the command was still running)" >&2
+      if [ -e "$run/started" ]; then
+        echo "$me: route $1: timed out after ${timeout_s} s (the command, started after" \
+          "$(seconds "$boot_ms") s of boot, was still running)" >&2
+      else
+        echo "$me: route $1: timed out after ${timeout_s} s, before the command started:" \
+          "$(console_tail)" >&2
+      fi
       return 124
     fi
     echo "$me: route $1: the guest stopped before the command finished (status" \
@@ -439,19 +446,14 @@ if [ "$mode" = qemu-kernel ]; then
   echo "$kernel_version"
   exit 0
 fi
-if [ "$mode" = which ]; then
-  reasons=""
-  for candidate in $(candidates); do
-    why=""
-    if "${candidate}_can_start"; then
-      echo "$candidate${accel:+ ($accel)}"
-      exit 0
-    fi
-    reasons+="  $candidate: $why"$'\n'
-  done
-  printf 'none\n%s' "$reasons"
+no_route() {  # a skip (77); with CI=true a failure: the real-bus tests must run in CI
+  echo "$me: no route can start here${1:+: $1}" >&2
+  if on_ci; then
+    echo "$me: CI=true: the real-bus tests must run in CI, failing" >&2
+    exit 1
+  fi
   exit 77
-fi
+}
 
 if [ -n "$chosen_file" ]; then
   chosen=$(cat "$chosen_file" 2>/dev/null) || chosen=""
@@ -460,6 +462,19 @@ if [ -n "$chosen_file" ]; then
       "$chosen_file, written by the vcan_route test)" >&2
     exit 77
   fi
+fi
+
+if [ "$mode" = which ]; then
+  reasons=""
+  for candidate in $(candidates); do
+    why=""
+    if "${candidate}_can_start"; then
+      echo "$candidate${accel:+ ($accel)}"
+      exit 0
+    fi
+    reasons+="; $candidate: $why"
+  done
+  no_route "${reasons#; }"
 fi
 
 if [ "$mode" = choose ]; then
@@ -484,9 +499,4 @@ for candidate in $(candidates); do
   echo "$me: route $candidate cannot start here: $why" >&2
   reasons+="  $candidate: $why"$'\n'
 done
-echo "$me: no route can start here (above: why)" >&2
-if { [ "$mode" = choose ] || [ -n "$chosen_file" ]; } && on_ci; then
-  echo "$me: CI=true: the real-bus tests must run in CI, failing" >&2
-  exit 1
-fi
-exit 77
+no_route "above: why"
