@@ -447,7 +447,7 @@ if [ "$mode" = qemu-kernel ]; then
   exit 0
 fi
 no_route() {  # a skip (77); with CI=true a failure: the real-bus tests must run in CI
-  echo "$me: no route can start here${1:+: $1}" >&2
+  echo "$me: no route can start here${1:-" (the reasons above)"}" >&2
   if on_ci; then
     echo "$me: CI=true: the real-bus tests must run in CI, failing" >&2
     exit 1
@@ -474,7 +474,7 @@ if [ "$mode" = which ]; then
     fi
     reasons+="; $candidate: $why"
   done
-  no_route "${reasons#; }"
+  no_route ": ${reasons#; }"
 fi
 
 if [ "$mode" = choose ]; then
@@ -499,4 +499,4 @@ for candidate in $(candidates); do
   echo "$me: route $candidate cannot start here: $why" >&2
   reasons+="  $candidate: $why"$'\n'
 done
-no_route "above: why"
+no_route ""
