@@ -114,8 +114,9 @@ if [ -n "$chosen_file" ] && [ "$route" = auto ]; then misuse "--if-chosen needs 
 on_ci() { [ "${CI:-}" = true ]; }
 
 # --- What every guest does: its init on the host's root --------------------------------------
-# shellcheck disable=SC2016  # the snippets are code for the guest
-write_guest_init() {  # RUN_DIR MODULE_LOADING [GPIO_SETUP]
+# The route's BUS_SETUP (code for the guest's bash) runs first, unless the route set the bus up
+# before (qemu: in its initramfs, with busybox: no dynamic program to load over 9p).
+write_guest_init() {  # RUN_DIR BUS_SETUP
   local run=$1
   cat >"$run/init" <<EOF
 #!/bin/bash
@@ -125,21 +126,14 @@ run=$(printf %q "$run")
 # Never returns. PATH: the command's environment may have replaced the one above.
 finish() { sync; PATH=/usr/sbin:/sbin:\$PATH poweroff -f; echo o >/proc/sysrq-trigger; sleep 3600; }
 setup_failed() { echo "\$*" >"\$run/setup-error"; finish; }
-echo booted >"\$run/booted"
-{ mountpoint -q /proc || mount -t proc proc /proc; } &&
-  { mountpoint -q /sys || mount -t sysfs sysfs /sys; } || setup_failed "mount proc/sysfs failed"
-mkdir -p /dev/shm && mount -t tmpfs tmpfs /dev/shm
+[ -e "\$run/booted" ] || echo booted >"\$run/booted"
 $2
-ip link set lo up
-for i in \$(seq 0 \$(($vcan_count - 1))); do
-  { ip link add dev vcan\$i type vcan && ip link set vcan\$i up; } 2>>"\$run/setup-log" ||
-    setup_failed "vcan\$i: \$(cat "\$run/setup-log")"
-done
-${3:-}
-set -a; . "\$run/environment"; set +a
-${3:+export GPIO_SIM_CHIP GPIO_SIM_LINES GPIO_SIM_SYSFS}
+set -a
+. "\$run/environment"
+[ ! -e "\$run/gpio-sim.env" ] || . "\$run/gpio-sim.env"
+set +a
 cd $(printf '%q' "$PWD") || setup_failed "cannot cd to the working directory"
-echo started >"\$run/started"
+read -r uptime _ </proc/uptime && echo "\$uptime" >"\$run/started"  # the guest's clock
 $(cat "$run/command") >"\$run/stdout" 2>"\$run/stderr" </dev/null
 echo \$? >"\$run/status"
 finish
@@ -287,17 +281,23 @@ route_uml() {
   accel=""
   new_run_dir uml
   # No module autoloading: the guest's modprobe would look in the host's /lib/modules and fail,
-  # slowly. In this order: vcan needs can-dev.
+  # slowly. In this order: vcan needs can-dev. Few programs: each exec costs 40-300 ms here.
   write_guest_init "$run" '
+mount -t proc proc /proc && mount -t sysfs sysfs /sys || setup_failed "mount proc/sysfs failed"
+mkdir -p /dev/shm && mount -t tmpfs tmpfs /dev/shm
 echo >/proc/sys/kernel/modprobe
-modules=/usr/lib/uml/modules/$(uname -r)/kernel
+read -r release </proc/sys/kernel/osrelease
 for m in net/can/can net/can/can-raw drivers/net/can/dev/can-dev drivers/net/can/vcan; do
-  insmod "$modules/$m.ko" 2>>"$run/setup-log" ||
+  insmod "/usr/lib/uml/modules/$release/kernel/$m.ko" 2>>"$run/setup-log" ||
     setup_failed "insmod $m.ko failed: $(cat "$run/setup-log")"
-done'
+done
+{ echo link set lo up
+  for ((i = 0; i < '"$vcan_count"'; i++)); do
+    echo "link add dev vcan$i type vcan"; echo "link set vcan$i up"
+  done; } | ip -batch - 2>>"$run/setup-log" || setup_failed "vcan: $(cat "$run/setup-log")"'
   # uml_dir/umid keep UML's pid file and management socket in the run's folder.
-  boot_guest "$run/console.log" "$uml_kernel" mem="$mem" root=/dev/root rootfstype=hostfs rootflags=/ rw \
-    init="$run/init" uml_dir="$run" umid=uml con=null con0=null,fd:1
+  boot_guest "$run/console.log" "$uml_kernel" mem="$mem" root=/dev/root rootfstype=hostfs \
+    rootflags=/ rw init="$run/init" uml_dir="$run" umid=uml con=null con0=null,fd:1
   collect uml
 }
 
@@ -359,72 +359,103 @@ qemu_kernel_image() {
   echo "$elf"
 }
 
-# The initramfs: busybox and the modules that reach the host's root; its /init mounts that root
-# through virtio-9p and hands over to the run's init there (plinth_init= on the command line).
+# The initramfs: busybox and the modules of each GROUP (virtio and 9p; CAN; configfs with
+# --gpio-sim), in the order insmod needs, in modules/GROUP.order.
+qemu_initramfs_modules() {  # DIR GROUP MODULE...
+  local dir=$1 group=$2 module
+  shift 2
+  for module in "$@"; do
+    PATH="$PATH:/usr/sbin:/sbin" modprobe -S "$kernel_version" --show-depends "$module" ||
+      return 1
+  done | awk '$1 == "insmod" { print $2 }' >"$dir/$group.paths"
+  while read -r module; do
+    [ -e "$dir/modules/$(basename "$module")" ] && continue  # in an earlier group
+    cp "$module" "$dir/modules/" && basename "$module"
+  done <"$dir/$group.paths" >"$dir/modules/$group.order"
+  rm "$dir/$group.paths"
+  [ -s "$dir/modules/$group.order" ]
+}
+
+# Its /init mounts the host's root through virtio-9p, sets up the bus (and gpio-sim) with
+# busybox, and hands over to the run's init there. Setup errors go to the run's folder.
 qemu_initramfs() {
-  local dir=$run/initramfs module
+  local dir=$run/initramfs gpio_ko=""
   mkdir -p "$dir"/{bin,modules,proc,sys,dev,root}
   cp /bin/busybox "$dir/bin/"
-  for module in virtio_pci 9pnet_virtio 9p; do
-    PATH="$PATH:/usr/sbin:/sbin" modprobe -S "$kernel_version" --show-depends "$module"
-  done | awk '$1 == "insmod" && !seen[$2]++ { print $2 }' >"$run/initramfs-modules"
-  [ -s "$run/initramfs-modules" ] || return 1
-  while read -r module; do
-    cp "$module" "$dir/modules/" && basename "$module"
-  done <"$run/initramfs-modules" >"$dir/modules/order"
-  cat >"$dir/init" <<'EOF'
+  qemu_initramfs_modules "$dir" base virtio_pci 9pnet_virtio 9p &&
+    qemu_initramfs_modules "$dir" can can-raw vcan || return 1
+  if [ "$gpio_lines" -gt 0 ]; then
+    qemu_initramfs_modules "$dir" gpio configfs || return 1
+    gpio_ko=$(gpio_sim_module "$kernel_version")
+  fi
+  cat >"$dir/init" <<EOF
 #!/bin/busybox sh
-# First stage of the qemu route's guest: virtio and 9p, the host's root, then its init there.
+# First stage of the qemu route's guest: virtio and 9p, the host's root, the bus, the run's init.
 b=/bin/busybox
-fail() { echo "vcan-bus (qemu guest): $*"; $b poweroff -f; $b sleep 3600; }
-$b mount -t proc proc /proc && $b mount -t sysfs sysfs /sys &&
-  $b mount -t devtmpfs devtmpfs /dev || fail "cannot mount proc, sysfs, devtmpfs"
-while read -r module; do
-  $b insmod "/modules/$module" || fail "insmod $module failed"
-done </modules/order
-$b mount -t 9p -o trans=virtio,version=9p2000.L,msize=262144,cache=loose hostroot /root ||
+run=/root$run  # the run's folder, before switch_root
+fail() { echo "vcan-bus (qemu guest): \$*"; \$b poweroff -f; \$b sleep 3600; }
+setup_failed() { echo "\$*" >"\$run/setup-error"; \$b sync; \$b poweroff -f; \$b sleep 3600; }
+load() {  # GROUP
+  for module in \$(\$b cat "/modules/\$1.order"); do
+    \$b insmod "/modules/\$module" 2>>/setup-log || return 1
+  done
+}
+\$b mount -t proc proc /proc && \$b mount -t sysfs sysfs /sys &&
+  \$b mount -t devtmpfs devtmpfs /dev || fail "cannot mount proc, sysfs, devtmpfs"
+load base || fail "insmod: \$(\$b cat /setup-log)"
+\$b mount -t 9p -o trans=virtio,version=9p2000.L,msize=262144,cache=loose hostroot /root ||
   fail "cannot mount the host's root filesystem through virtio-9p"
-for d in proc sys dev; do $b mount --move "/$d" "/root/$d" || fail "cannot move /$d"; done
-exec $b switch_root /root "$plinth_init"
+echo booted >"\$run/booted"
+\$b cat /proc/uptime >>"\$run/booted"  # the guest's clock, for diagnosis
+# kvm-clock: the accelerator that ran (QEMU falls back from KVM to TCG when KVM fails).
+\$b grep -qw kvm-clock /sys/devices/system/clocksource/clocksource0/available_clocksource &&
+  echo kvm >"\$run/accel" || echo tcg >"\$run/accel"
+load can || setup_failed "insmod: \$(\$b cat /setup-log)"
+{ \$b ip link set lo up && for i in \$(\$b seq 0 $((vcan_count - 1))); do
+    \$b ip link add dev "vcan\$i" type vcan && \$b ip link set "vcan\$i" up || exit 1
+  done; } 2>>/setup-log || setup_failed "vcan: \$(\$b cat /setup-log)"
+EOF
+  if [ "$gpio_lines" -gt 0 ]; then
+    # One bank of N lines (configfs: the kernel's Documentation/admin-guide/gpio/gpio-sim.rst).
+    cat >>"$dir/init" <<EOF
+sim=/sys/kernel/config/gpio-sim/plinth
+{ load gpio && \$b mount -t configfs configfs /sys/kernel/config &&
+  \$b insmod "/root$gpio_ko" && \$b mkdir "\$sim" "\$sim/bank0" &&
+  echo $gpio_lines >"\$sim/bank0/num_lines" && echo plinth >"\$sim/bank0/label" &&
+  echo 1 >"\$sim/live"; } 2>>/setup-log || setup_failed "gpio-sim: \$(\$b cat /setup-log)"
+chip=\$(\$b cat "\$sim/bank0/chip_name")
+{ echo "GPIO_SIM_CHIP=\$chip"
+  echo "GPIO_SIM_LINES=$gpio_lines"
+  echo "GPIO_SIM_SYSFS=/sys/devices/platform/\$(\$b cat "\$sim/dev_name")/\$chip"
+} >"\$run/gpio-sim.env"
+EOF
+  fi
+  cat >>"$dir/init" <<EOF
+for d in proc sys dev; do \$b mount --move "/\$d" "/root/\$d" || fail "cannot move /\$d"; done
+\$b mkdir -p /root/dev/shm && \$b mount -t tmpfs tmpfs /root/dev/shm
+exec \$b switch_root /root "$run/init"
 EOF
   chmod +x "$dir/init"
   (cd "$dir" && find . | busybox cpio -o -H newc 2>/dev/null) >"$run/initramfs.cpio"
 }
 
-# shellcheck disable=SC2016  # the snippets are code for the guest
+# A throwaway guest: no crypto self-tests (1.2 s of an emulated boot in crypto_algapi_init), no
+# speculation mitigations (their cost under emulation).
+qemu_kernel_options="cryptomgr.notests mitigations=off"
+
 route_qemu() {
   qemu_can_start || return 77
   new_run_dir qemu
-  local kernel_image gpio_setup=""
+  local kernel_image
   kernel_image=$(qemu_kernel_image)
   qemu_initramfs || { why="cannot build the initramfs for $kernel_version"; return 77; }
-  if [ "$gpio_lines" -gt 0 ]; then
-    # One bank of N lines (configfs: Documentation/admin-guide/gpio/gpio-sim.rst).
-    gpio_setup='
-modprobe configfs && { mountpoint -q /sys/kernel/config ||
-  mount -t configfs configfs /sys/kernel/config; } || setup_failed "configfs failed"
-insmod '"$(printf %q "$(gpio_sim_module "$kernel_version")")"' 2>>"$run/setup-log" ||
-  setup_failed "insmod gpio-sim.ko failed: $(cat "$run/setup-log")"
-sim=/sys/kernel/config/gpio-sim/plinth
-{ mkdir "$sim" "$sim/bank0" && echo '"$gpio_lines"' >"$sim/bank0/num_lines" &&
-  echo plinth >"$sim/bank0/label" && echo 1 >"$sim/live"; } 2>>"$run/setup-log" ||
-  setup_failed "gpio-sim chip: $(cat "$run/setup-log")"
-GPIO_SIM_CHIP=$(cat "$sim/bank0/chip_name")
-GPIO_SIM_LINES='"$gpio_lines"'
-GPIO_SIM_SYSFS=/sys/devices/platform/$(cat "$sim/dev_name")/$GPIO_SIM_CHIP'
-  fi
-  # kvm-clock: the accelerator that ran (QEMU falls back from KVM to TCG when KVM fails).
-  write_guest_init "$run" '
-grep -qw kvm-clock /sys/devices/system/clocksource/clocksource0/available_clocksource &&
-  echo kvm >"$run/accel" || echo tcg >"$run/accel"
-modprobe -a can can-raw can-dev vcan 2>>"$run/setup-log" ||
-  setup_failed "modprobe can can-raw can-dev vcan failed: $(cat "$run/setup-log")"' "$gpio_setup"
+  write_guest_init "$run" ""
   local accelerators=(-accel tcg)
   [ "$accel" = tcg ] || accelerators=(-accel kvm)
   [ "${PLINTH_QEMU_ACCEL:-auto}" != auto ] || [ "$accel" = tcg ] || accelerators+=(-accel tcg)
   boot_guest "$run/qemu.log" qemu-system-x86_64 -nodefaults -no-user-config -machine pc \
-    "${accelerators[@]}" -cpu max -m "$mem" -smp "$cpus" -kernel "$kernel_image" -initrd "$run/initramfs.cpio" \
-    -append "console=ttyS0 panic=-1 quiet plinth_init=$run/init" \
+    "${accelerators[@]}" -cpu max -m "$mem" -smp "$cpus" -kernel "$kernel_image" \
+    -initrd "$run/initramfs.cpio" -append "console=ttyS0 panic=-1 quiet $qemu_kernel_options" \
     -virtfs local,path=/,mount_tag=hostroot,security_model=none,multidevs=remap \
     -chardev "file,id=console,path=$run/console.log" -serial chardev:console \
     -display none -monitor none -no-reboot
