@@ -8,8 +8,8 @@
 #         (AMX): checked before it boots (tools/host-xstate-size.py, docs/can-e2e.md).
 #   qemu  Debian's kernel (linux-image-amd64) in qemu-system-x86_64, KVM where /dev/kvm is
 #         usable, TCG emulation otherwise; an initramfs built per run from busybox-static and the
-#         kernel's virtio and 9p modules mounts the host's root through virtio-9p. It can also
-#         give the guest a gpio-sim chip (--gpio-sim; module built by tools/build-gpio-sim.sh).
+#         kernel's modules mounts the host's root through virtio-9p and sets up the bus. It can
+#         also give the guest a gpio-sim chip (--gpio-sim; module: tools/build-gpio-sim.sh).
 # auto (the default) takes uml when it starts here, else qemu. See hal/README.md.
 #
 # Usage: tools/vcan-bus.sh [options] [--] PROGRAM [ARG...]
@@ -35,6 +35,11 @@
 # reasons are printed; with CI=true 1 instead: CI must run the real-bus tests) or, with
 # --if-chosen, when FILE names another route; 124 when the time ran out; 125 when the guest could
 # not set up the bus or the harness was misused.
+# Environment: PLINTH_VCAN_ROUTE (above); PLINTH_QEMU_ACCEL=kvm|tcg|auto; PLINTH_QEMU_KERNEL (a
+# version in /boot, default the newest with vcan); PLINTH_GPIO_SIM_MODULE (default
+# /usr/local/lib/plinth/modules/VERSION/gpio-sim.ko); PLINTH_CACHE_DIR (default
+# ~/.cache/plinth: the kernel's uncompressed image); for testing this script, UML_VCAN_KERNEL
+# (default /usr/bin/linux.uml) and UML_VCAN_XSTATE_SIZE (the host's XSAVE size, bytes).
 # shellcheck disable=SC2317  # functions run by traps and through "route_$name"
 set -euo pipefail
 
