@@ -368,18 +368,14 @@ qemu_kernel_image() {
 # The initramfs: busybox and the modules of each GROUP (virtio and 9p; CAN; configfs with
 # --gpio-sim), in the order insmod needs, in modules/GROUP.order.
 qemu_initramfs_modules() {  # DIR GROUP MODULE...
-  local dir=$1 group=$2 module
+  local dir=$1 group=$2 listing module
   shift 2
-  for module in "$@"; do
-    PATH="$PATH:/usr/sbin:/sbin" modprobe -S "$kernel_version" --show-depends "$module" ||
-      return 1
-  done | awk '$1 == "insmod" { print $2 }' >"$dir/$group.paths"
-  while read -r module; do
+  listing=$(PATH="$PATH:/usr/sbin:/sbin" modprobe -S "$kernel_version" --show-depends -a "$@") ||
+    return 1
+  awk '$1 == "insmod" { print $2 }' <<<"$listing" | while read -r module; do
     [ -e "$dir/modules/$(basename "$module")" ] && continue  # in an earlier group
     cp "$module" "$dir/modules/" && basename "$module"
-  done <"$dir/$group.paths" >"$dir/modules/$group.order"
-  rm "$dir/$group.paths"
-  [ -s "$dir/modules/$group.order" ]
+  done >"$dir/modules/$group.order"
 }
 
 # Its /init mounts the host's root through virtio-9p, sets up the bus (and gpio-sim) with
