@@ -115,7 +115,9 @@ whole_number "$gpio_lines" --gpio-sim
 [ "$gpio_lines" -le 64 ] || misuse "--gpio-sim wants at most 64 lines"
 [ "$cpus" -ge 1 ] || misuse "--cpus wants at least 1"
 if [ "$mode" = run ] && [ -z "$shell_line" ] && [ $# -eq 0 ]; then usage; fi
-if [ -n "$chosen_file" ] && [ "$route" = auto ]; then misuse "--if-chosen needs --route uml|qemu"; fi
+if [ -n "$chosen_file" ] && [ "$route" = auto ]; then
+  misuse "--if-chosen needs --route uml|qemu"
+fi
 on_ci() { [ "${CI:-}" = true ]; }
 
 # --- What every guest does: its init on the host's root --------------------------------------
