@@ -20,8 +20,8 @@
 #   --route R     tools/vcan-bus.sh's route: auto (default: $PLINTH_VCAN_ROUTE, else auto), uml,
 #                 qemu
 #   --if-chosen FILE  run only if FILE (vcan-bus.sh --choose) names the route given with --route
-# Exit status: 0 all checks passed, 1 a check failed, 77 no route can start here, or the
-# route is not the one FILE names (ctest's SKIP_RETURN_CODE), 2 usage.
+# Exit status: 0 all checks passed, 1 a check failed, 2 usage, 77 no route can start here or
+# FILE names another route (ctest's SKIP_RETURN_CODE).
 # shellcheck disable=SC2153,SC2317  # the guest's settings come from config.env; the scenario_*
 #                                   # functions are called through attempt()
 set -euo pipefail
@@ -254,7 +254,7 @@ work=""
 speed=2
 keep=0
 bus=()  # tools/vcan-bus.sh's --route, --if-chosen
-usage() { sed -n '/^# Usage:/,/^# (ctest/p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '/^# Usage:/,/^# FILE names another/p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --build) build=${2:?}; shift 2 ;;
