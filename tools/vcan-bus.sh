@@ -149,8 +149,9 @@ EOF
 }
 
 new_run_dir() {  # ROUTE: one private folder per boot (several runs at once do not meet)
-  run=$(mktemp -d "/tmp/vcan-bus-$1.XXXXXX")  # /tmp: no spaces for a kernel command line,
-  runs+=("$run")                              # and not /dev/shm, which the guest's hides
+  # /tmp: no spaces for a kernel command line, and not /dev/shm, which the guest's hides.
+  run=$(mktemp -d "/tmp/vcan-bus-$1.XXXXXX") || misuse "cannot create a folder in /tmp"
+  runs+=("$run")
   if [ -n "$shell_line" ]; then
     printf '%q ' bash -c "$shell_line" >"$run/command"
   else
