@@ -6,8 +6,6 @@
 #include <limits>
 #include <utility>
 
-#include "plinth/host/input_error.h"
-
 namespace plinth::hal {
 namespace {
 
@@ -202,18 +200,6 @@ std::string parse_frame(std::string_view token, CandumpLine& out) {
 
 }  // namespace
 
-const char* candump_frame_kind_name(CandumpFrameKind kind) {
-  switch (kind) {
-    case CandumpFrameKind::kComment: return "comment";
-    case CandumpFrameKind::kClassic: return "classic";
-    case CandumpFrameKind::kExtended: return "extended";
-    case CandumpFrameKind::kRemote: return "remote request";
-    case CandumpFrameKind::kFd: return "CAN FD";
-    case CandumpFrameKind::kErrorFrame: return "error frame";
-  }
-  return "invalid";
-}
-
 std::string parse_candump_line(std::string_view line, CandumpLine& out) {
   out = CandumpLine{};
   if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
@@ -269,9 +255,19 @@ std::string format_candump_line(std::int64_t timestamp_ns, std::string_view inte
   return line;
 }
 
-CandumpLogReader::CandumpLogReader(std::string path) : path_(std::move(path)), in_(path_) {
-  if (!in_) throw host::InputError(path_ + ": cannot open file");
+CandumpLogReaderOpenResult CandumpLogReader::open(std::string path) {
+  CandumpLogReaderOpenResult result;
+  std::ifstream in(path);
+  if (!in) {
+    result.message = path + ": cannot open file";
+    return result;
+  }
+  result.reader.emplace(CandumpLogReader(std::move(path), std::move(in)));
+  return result;
 }
+
+CandumpLogReader::CandumpLogReader(std::string path, std::ifstream in)
+    : path_(std::move(path)), in_(std::move(in)) {}
 
 IoStatus CandumpLogReader::receive(TimedFrame& out, int /*timeout_ms*/) {
   error_.clear();
@@ -303,17 +299,32 @@ IoStatus CandumpLogReader::receive(TimedFrame& out, int /*timeout_ms*/) {
   return IoStatus::kEndOfInput;
 }
 
-CandumpLogWriter::CandumpLogWriter(std::string path, std::string interface_name, Clock clock)
-    : path_(std::move(path)), interface_name_(std::move(interface_name)), clock_(std::move(clock)) {
+CandumpLogWriterOpenResult CandumpLogWriter::open(std::string path, std::string interface_name,
+                                                  Clock clock) {
+  CandumpLogWriterOpenResult result;
   bool has_blank = false;
-  for (const char c : interface_name_) has_blank = has_blank || is_blank(c) || c == '\n';
-  if (interface_name_.empty() || interface_name_.size() > kCandumpMaxInterfaceLength || has_blank) {
-    throw host::InputError(join({"log interface name ", quoted(interface_name_),
-                                 ": must be 1 to 15 characters without spaces"}));
+  for (const char c : interface_name) has_blank = has_blank || is_blank(c) || c == '\n';
+  if (interface_name.empty() || interface_name.size() > kCandumpMaxInterfaceLength || has_blank) {
+    result.message = join({"log interface name ", quoted(interface_name),
+                           ": must be 1 to 15 characters without spaces"});
+    return result;
   }
-  out_.open(path_, std::ios::out | std::ios::trunc);
-  if (!out_) throw host::InputError(path_ + ": cannot open the log for writing");
+  std::ofstream out(path, std::ios::out | std::ios::trunc);
+  if (!out) {
+    result.message = path + ": cannot open the log for writing";
+    return result;
+  }
+  result.writer.emplace(CandumpLogWriter(std::move(path), std::move(interface_name),
+                                         std::move(clock), std::move(out)));
+  return result;
 }
+
+CandumpLogWriter::CandumpLogWriter(std::string path, std::string interface_name, Clock clock,
+                                   std::ofstream out)
+    : path_(std::move(path)),
+      interface_name_(std::move(interface_name)),
+      clock_(std::move(clock)),
+      out_(std::move(out)) {}
 
 IoStatus CandumpLogWriter::send(const can::CanFrame& frame) {
   if (frame.id > kStandardIdMask || frame.length > kMaxClassicLength) {

@@ -16,18 +16,19 @@
 #include <vector>
 
 #include "frame_schedule.h"
+#include "plinth/core/scene.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/hal/pacing.h"
 #include "plinth/hal/socketcan.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
-#include "plinth/host/units.h"
+#include "plinth/host/record_sampling.h"
 
 namespace {
 
+using plinth::kStandardGravity;
 using plinth::host::InputError;
-using plinth::replay::kStandardGravity;
 
 constexpr double kMinRateHz = 100.0;
 constexpr double kMaxRateHz = 1000.0;
@@ -173,22 +174,9 @@ RecordPlan plan_records(const Options& opt) {
       input.z = record.vertical_signal();
   }
 
-  double scale = 1.0;
   const plinth::host::Record& main_record = records.at(opt.record_path);
-  if (!opt.pga.empty()) {
-    const double pga = plinth::host::parse_acceleration(opt.pga, kStandardGravity, "--pga");
-    if (pga <= 0.0) {
-      throw InputError(
-          "--pga: must be greater than zero (use --scale with a negative factor to "
-          "mirror the record)");
-    }
-    const double peak = main_record.peak_horizontal();
-    if (peak <= 0.0)
-      throw InputError(opt.record_path + ": record is all zeros, cannot scale to --pga");
-    scale = pga / peak;
-  } else if (opt.scale) {
-    scale = *opt.scale;
-  }
+  const double scale = plinth::host::record_scale(main_record, opt.record_path, opt.pga, opt.scale,
+                                                  kStandardGravity);
 
   double duration_s = 0.0;
   double peak_g = 0.0;
@@ -394,9 +382,11 @@ int run(const Options& opt, const CLI::App& app) {
   const std::int64_t log_epoch_ns = plinth::hal::realtime_now_ns();
   Destination destination;
   if (!opt.log_path.empty()) {
-    auto writer = std::make_unique<plinth::hal::CandumpLogWriter>(
+    plinth::hal::CandumpLogWriterOpenResult opened = plinth::hal::CandumpLogWriter::open(
         opt.log_path, opt.log_interface,
         [&current_virtual_ns, log_epoch_ns] { return log_epoch_ns + current_virtual_ns; });
+    if (!opened.ok()) throw InputError(opened.message);
+    auto writer = std::make_unique<plinth::hal::CandumpLogWriter>(std::move(*opened.writer));
     destination.log = writer.get();
     destination.sink = std::move(writer);
     destination.name = opt.log_path;
@@ -488,13 +478,5 @@ int main(int argc, char** argv) {
                  "plinth-replay: give --can INTERFACE (a bus) or --log FILE (a candump log)\n");
     return 2;
   }
-  try {
-    return run(opt, app);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "plinth-replay: %s\n", e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "plinth-replay: error: %s\n", e.what());
-    return 1;
-  }
+  return plinth::host::run_tool("plinth-replay", [&] { return run(opt, app); });
 }
