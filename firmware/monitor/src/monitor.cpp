@@ -46,8 +46,10 @@ int resolved_sensors(const MonitorConfig& c, std::array<SensorConfig, kMaxSensor
   return count;
 }
 
-Error validate(const MonitorConfig& c, int* sensor_index) {
-  if (sensor_index != nullptr) *sensor_index = -1;
+namespace {
+
+// The [monitor] fields.
+Error validate_monitor_fields(const MonitorConfig& c) {
   if (c.axis_count < 1 || c.axis_count > kMaxAxes) {
     return {ErrorCode::kOutOfRange, "monitor.axis_count", "must be 1 or 2"};
   }
@@ -66,18 +68,12 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
       c.status_interval_s > 1e6) {
     return {ErrorCode::kOutOfRange, "monitor.status_interval_s", "must lie in [1e-9, 1e6] s"};
   }
-  PLINTH_TRY(validate(c.risk));
-  PLINTH_TRY(monitor::validate(c.alarm));
-  // The sensor's period is the estimator's sample period: checked with the values start() uses.
-  if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz < 100.0 ||
-      c.estimator.sample_rate_hz > 1000.0) {
-    return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
-  }
-  PLINTH_TRY(validate_check(c.redundancy.window_s, c.redundancy.tolerance_m_s2,
-                            c.estimator.sample_rate_hz, "redundancy.window_s",
-                            "redundancy.tolerance_m_s2"));
-  PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
-                            "plate.window_s", "plate.threshold_m_s2"));
+  return ok_error();
+}
+
+// Every sensor: node, role, its conditioning and health at the estimator's sample period; at
+// least one ground sensor. `sensor_index` receives the index of the sensor at fault.
+Error validate_sensors(const MonitorConfig& c, int* sensor_index) {
   std::array<SensorConfig, kMaxSensors> sensors{};
   const int count = resolved_sensors(c, sensors);
   int grounds = 0;
@@ -116,6 +112,26 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
   }
   if (sensor_index != nullptr) *sensor_index = -1;
   return ok_error();
+}
+
+}  // namespace
+
+Error validate(const MonitorConfig& c, int* sensor_index) {
+  if (sensor_index != nullptr) *sensor_index = -1;
+  PLINTH_TRY(validate_monitor_fields(c));
+  PLINTH_TRY(validate(c.risk));
+  PLINTH_TRY(monitor::validate(c.alarm));
+  // The sensor's period is the estimator's sample period: checked with the values start() uses.
+  if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz < 100.0 ||
+      c.estimator.sample_rate_hz > 1000.0) {
+    return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
+  }
+  PLINTH_TRY(validate_check(c.redundancy.window_s, c.redundancy.tolerance_m_s2,
+                            c.estimator.sample_rate_hz, "redundancy.window_s",
+                            "redundancy.tolerance_m_s2"));
+  PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
+                            "plate.window_s", "plate.threshold_m_s2"));
+  return validate_sensors(c, sensor_index);
 }
 
 void Monitor::RmsWindow::add(double square) {
@@ -463,7 +479,8 @@ void Monitor::cross_check() {
   }
 }
 
-void Monitor::evaluate(MonitorUpdate& update) {
+// The sensors' part of the status: each sensor's health, the primary's, the sensors' state.
+void Monitor::update_sensors_status() {
   const int reported = status_.primary >= 0 ? status_.primary : 0;
   status_.sensor = sensors_[static_cast<std::size_t>(reported)].health.health();
   bool others_degraded = false;
@@ -484,16 +501,18 @@ void Monitor::evaluate(MonitorUpdate& update) {
     status_.plate_residual_m_s2 = plate.rms_m_s2;
     status_.plate_mismatch = plate.disagreeing;
   }
-  const bool sensor_fault = status_.sensor.state == monitor::HealthState::kFault;
-  if (sensor_fault) {
+  if (status_.sensor.state == monitor::HealthState::kFault) {
     status_.sensors_state = monitor::HealthState::kFault;
-  } else if (status_.sensor.state != monitor::HealthState::kOk || others_degraded ||
-             disagreement || status_.plate_mismatch) {
+  } else if (status_.sensor.state != monitor::HealthState::kOk || others_degraded || disagreement ||
+             status_.plate_mismatch) {
     status_.sensors_state = monitor::HealthState::kDegraded;
   } else {
     status_.sensors_state = monitor::HealthState::kOk;
   }
+}
 
+// The axes' part of the status (mode, state, risk), and the alarm policy's input from them.
+void Monitor::update_axes_status(monitor::AlarmInput& input) {
   double risk = 0.0;
   bool moving = false;
   bool collapse = false;
@@ -510,12 +529,18 @@ void Monitor::evaluate(MonitorUpdate& update) {
     collapse = collapse || axis.mode.terminal();
   }
   status_.risk = risk;
-
-  monitor::AlarmInput input;
-  input.time_ns = status_.time_ns;
   input.risk = risk;
   input.out_of_full_contact = moving;
   input.collapse_detected = collapse;
+}
+
+void Monitor::evaluate(MonitorUpdate& update) {
+  update_sensors_status();
+  monitor::AlarmInput input;
+  input.time_ns = status_.time_ns;
+  update_axes_status(input);
+  const bool sensor_fault = status_.sensor.state == monitor::HealthState::kFault;
+  const bool disagreement = status_.disagreement;
   const bool mismatch_fault = status_.plate_mismatch && config_.plate.raises_fault;
   input.fault_active = sensor_fault || disagreement || mismatch_fault || bus_fault_;
   input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status_.sensor.cause)
@@ -528,7 +553,9 @@ void Monitor::evaluate(MonitorUpdate& update) {
   for (std::size_t i = 0; i < out.event_count && update.event_count < update.events.size(); ++i) {
     update.events[update.event_count++] = out.events[i];
   }
-  if (out.acknowledgement != monitor::AckOutcome::kNone) update.acknowledgement = out.acknowledgement;
+  if (out.acknowledgement != monitor::AckOutcome::kNone) {
+    update.acknowledgement = out.acknowledgement;
+  }
   status_.alarm = out.level;
   status_.latched = out.latched_level;
   report(update);

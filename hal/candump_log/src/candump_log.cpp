@@ -116,13 +116,9 @@ std::string parse_data(std::string_view text, std::size_t max_length, std::uint8
   return {};
 }
 
-// The frame after the interface name: "<id>#<data>", "<id>#R[dlc]", "<id>##<flags><data>".
-std::string parse_frame(std::string_view token, CandumpLine& out) {
-  const std::size_t hash = token.find('#');
-  if (hash == std::string_view::npos) {
-    return join({"frame ", quoted(token), " has no '#' between identifier and data"});
-  }
-  const std::string_view id_text = token.substr(0, hash);
+// The identifier before '#': 3 hex digits (standard) or 8 (extended, or an error frame with
+// CAN_ERR_FLAG). Sets out.id, out.extended and `error_frame`; "" or the reason.
+std::string parse_identifier(std::string_view id_text, CandumpLine& out, bool& error_frame) {
   if (id_text.size() != 3 && id_text.size() != 8) {
     return join(
         {"identifier ", quoted(id_text), " must have 3 (standard) or 8 (extended) hex digits"});
@@ -137,7 +133,7 @@ std::string parse_frame(std::string_view token, CandumpLine& out) {
   if (!out.extended && id > kStandardIdMask) {
     return join({"standard identifier ", quoted(id_text), " is above 7FF"});
   }
-  bool error_frame = false;
+  error_frame = false;
   if (out.extended && id > kExtendedIdMask) {
     if ((id & ~(kCanErrorFlag | kExtendedIdMask)) != 0) {
       return join({"extended identifier ", quoted(id_text), " is above 1FFFFFFF"});
@@ -146,24 +142,39 @@ std::string parse_frame(std::string_view token, CandumpLine& out) {
     id &= kExtendedIdMask;
   }
   out.id = id;
+  return {};
+}
 
+// A remote request after "R": an optional DLC; "" or the reason.
+std::string parse_remote(std::string_view rest, const std::string& in_frame, CandumpLine& out) {
+  out.kind = CandumpFrameKind::kRemote;
+  if (!rest.empty()) {
+    const int dlc = hex_value(rest.front());
+    if (dlc < 0 || static_cast<std::size_t>(dlc) > kMaxClassicLength) {
+      return join({"remote request length ", quoted(rest), " is not 0-8", in_frame});
+    }
+    out.length = static_cast<std::uint8_t>(dlc);
+    rest.remove_prefix(1);
+  }
+  if (!rest.empty()) {
+    return join({"unexpected ", quoted(rest), " after the remote request", in_frame});
+  }
+  return {};
+}
+
+// The frame after the interface name: "<id>#<data>", "<id>#R[dlc]", "<id>##<flags><data>".
+std::string parse_frame(std::string_view token, CandumpLine& out) {
+  const std::size_t hash = token.find('#');
+  if (hash == std::string_view::npos) {
+    return join({"frame ", quoted(token), " has no '#' between identifier and data"});
+  }
+  bool error_frame = false;
+  std::string problem = parse_identifier(token.substr(0, hash), out, error_frame);
+  if (!problem.empty()) return problem;
   std::string_view rest = token.substr(hash + 1);
   const std::string in_frame = join({" in frame ", quoted(token)});
   if (!rest.empty() && (rest.front() == 'R' || rest.front() == 'r')) {
-    out.kind = CandumpFrameKind::kRemote;
-    rest.remove_prefix(1);
-    if (!rest.empty()) {
-      const int dlc = hex_value(rest.front());
-      if (dlc < 0 || static_cast<std::size_t>(dlc) > kMaxClassicLength) {
-        return join({"remote request length ", quoted(rest), " is not 0-8", in_frame});
-      }
-      out.length = static_cast<std::uint8_t>(dlc);
-      rest.remove_prefix(1);
-    }
-    if (!rest.empty()) {
-      return join({"unexpected ", quoted(rest), " after the remote request", in_frame});
-    }
-    return {};
+    return parse_remote(rest.substr(1), in_frame, out);
   }
 
   std::size_t max_length = kMaxClassicLength;
@@ -182,7 +193,7 @@ std::string parse_frame(std::string_view token, CandumpLine& out) {
   }
   std::size_t length = 0;
   std::size_t consumed = 0;
-  std::string problem = parse_data(rest, max_length, out.data.data(), length, consumed);
+  problem = parse_data(rest, max_length, out.data.data(), length, consumed);
   if (!problem.empty()) return join({problem, in_frame});
   out.length = static_cast<std::uint8_t>(length);
   rest.remove_prefix(consumed);

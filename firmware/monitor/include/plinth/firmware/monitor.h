@@ -338,6 +338,8 @@ class Monitor {
   template <typename Message>
   [[nodiscard]] bool decoded(const can::CanFrame& frame, Message& message);
   [[nodiscard]] int sensor_of_node(std::uint8_t node) const;  // -1: not configured
+  void update_sensors_status();
+  void update_axes_status(monitor::AlarmInput& input);
   void evaluate(MonitorUpdate& update);
   void report(MonitorUpdate& update);
   template <typename Message>
