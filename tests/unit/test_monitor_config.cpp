@@ -32,6 +32,7 @@ TEST(MonitorConfigFile, TheExampleSetsEveryField) {
   EXPECT_EQ(f.config.alarm.warning.on, 0.5);
   EXPECT_EQ(f.config.alarm.alarm.off, 0.7);
   EXPECT_EQ(f.config.sensor_health.max_valid_g, 8.192);
+  EXPECT_EQ(f.config.status_interval_s, 0.1);
   EXPECT_EQ(f.config.axis_count, 1);
   EXPECT_TRUE(f.second_scene_path.empty());
 }

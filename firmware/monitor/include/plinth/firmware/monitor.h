@@ -211,8 +211,8 @@ struct MonitorStatus {
   double plate_residual_m_s2 = 0.0;  // the plate's RMS residual (valid when its window is full)
 };
 
-// An update's alarm events (room for two alarm policy updates' worth).
-inline constexpr std::size_t kMaxUpdateEvents = 2 * monitor::kMaxEventsPerUpdate;
+// An update's alarm events: each update evaluates the alarm policy once.
+inline constexpr std::size_t kMaxUpdateEvents = monitor::kMaxEventsPerUpdate;
 // An AlarmEvent per event, then a MonitorStatus per axis.
 inline constexpr std::size_t kMaxFramesPerUpdate =
     kMaxUpdateEvents + static_cast<std::size_t>(kMaxAxes);
