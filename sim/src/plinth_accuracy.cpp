@@ -653,10 +653,5 @@ int main(int argc, char** argv) {
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
     return *exit_code;
   }
-  try {
-    return run(opt);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "plinth-accuracy: %s\n", e.what());
-    return 1;
-  }
+  return plinth::host::run_tool("plinth-accuracy", [&] { return run(opt); });
 }

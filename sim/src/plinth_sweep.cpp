@@ -308,15 +308,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "plinth-sweep: --jobs: must be at least 1, got %d\n", *opt.jobs);
     return 2;
   }
-  try {
+  return plinth::host::run_tool("plinth-sweep", [&] {
     if (merge_command->parsed()) return run_merge(merge);
     if (plot_command->parsed()) return run_plot(plot);
     return run_sweep_mode(opt);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "plinth-sweep: %s\n", e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "plinth-sweep: error: %s\n", e.what());
-    return 1;
-  }
+  });
 }
