@@ -12,7 +12,6 @@
 #include <thread>
 
 #include "plinth/core/events.h"
-#include "plinth/core/guards.h"
 #include "plinth/core/simulator.h"
 #include "plinth/host/input_error.h"
 
