@@ -9,6 +9,11 @@
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 #include "plinth/core/stepper.h"
+#include "plinth/host/parse_name.h"
+#include "plinth/host/run_output.h"
+#include "plinth/host/sweep_impulse.h"
+#include "plinth/host/sweep_parameter.h"
+#include "plinth/host/sweep_search.h"
 
 namespace plinth {
 namespace {
@@ -85,6 +90,29 @@ TEST(NameTable, CoreTablesNameEveryValueOnce) {
   EXPECT_STREQ(phase_name(Phase::kSlideRocking), "slide_rocking");
   EXPECT_STREQ(corner_name(Corner::kRight), "right");
   EXPECT_STREQ(event_name(EventKind::kBaseStopReleased), "base_stop_released");
+}
+
+TEST(NameTable, HostTablesNameEveryValueOnce) {
+  using host::ImpulseStart;
+  using host::Outcome;
+  using host::SweepEvent;
+  using host::SweepParameter;
+  expect_complete(host::kOutcomeNames, Outcome::kSurvived, Outcome::kFell);
+  expect_complete(host::kSweepEventNames, SweepEvent::kSliding, SweepEvent::kOverturned);
+  expect_complete(host::kSweepParameterNames, SweepParameter::kMuS, SweepParameter::kMassRatio);
+  expect_complete(host::kImpulseStartNames, ImpulseStart::kFullContact,
+                  ImpulseStart::kSlideRocking);
+}
+
+// A name read from the command line: the error names the option and every name there is.
+TEST(NameTable, ParseNameListsTheNamesOnError) {
+  EXPECT_EQ(host::parse_name<kColourNames>("green", "--colour", "colour"), Colour::kGreen);
+  try {
+    (void)host::parse_name<kColourNames>("pink", "--colour", "colour");
+    ADD_FAILURE() << "no InputError";
+  } catch (const host::InputError& e) {
+    EXPECT_STREQ(e.what(), "--colour: unknown colour 'pink' (one of red, green, blue)");
+  }
 }
 
 }  // namespace

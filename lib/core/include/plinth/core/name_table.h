@@ -21,6 +21,8 @@ struct NamedValue {
 
 template <class Enum, std::size_t N>
 struct NameTable {
+  using value_type = Enum;
+
   std::array<NamedValue<Enum>, N> entries;
 
   // The value's name; `fallback` for a value not in the table (a corrupted or foreign value).
