@@ -1,5 +1,6 @@
 // Private to plinth_core: one interval of a step (Simulator::step_intervals, finish_step), the
-// solver's hot path, instantiated (flattened) for each stepper and phase kernel in simulator.cpp.
+// solver's hot path, one flattened instance per stepper and phase kernel (bound by
+// EventLogic::bind_intervals, event_logic.h).
 #pragma once
 
 #include <cmath>
