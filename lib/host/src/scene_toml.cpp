@@ -23,6 +23,7 @@
 #include <toml++/toml.h>
 
 #include "plinth/core/ensemble_design.h"
+#include "plinth/core/name_table.h"
 #include "plinth/host/input_error.h"
 
 namespace plinth::host {
@@ -36,20 +37,22 @@ std::string format_number(double value) {
   return std::string(buffer.data(), result.ptr);
 }
 
+// What a TOML value is, for messages ("expected a number, got a string").
+constexpr NameTable<toml::node_type, 10> kNodeTypeNames{{{
+    {toml::node_type::none, "nothing"},
+    {toml::node_type::table, "a table"},
+    {toml::node_type::array, "an array"},
+    {toml::node_type::string, "a string"},
+    {toml::node_type::integer, "an integer"},
+    {toml::node_type::floating_point, "a float"},
+    {toml::node_type::boolean, "a boolean"},
+    {toml::node_type::date, "a date"},
+    {toml::node_type::time, "a time"},
+    {toml::node_type::date_time, "a date-time"},
+}}};
+
 std::string_view type_name(toml::node_type type) {
-  switch (type) {
-    case toml::node_type::none: return "nothing";
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-  }
-  return "an unknown type";
+  return kNodeTypeNames.name(type, "an unknown type");
 }
 
 std::string join(std::span<const std::string_view> words) {

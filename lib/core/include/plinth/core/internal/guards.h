@@ -1,17 +1,18 @@
-// Guards (witness functions) of the hybrid system. Each guard is a scalar function of time and
-// state whose crossing from negative to non-negative is its event; only the guards of the
-// current mode are live (active_guards).
+// Internal to plinth_core (tests may include it). Guards (witness functions) of the hybrid
+// system: each is a scalar function of time and state whose crossing from negative to
+// non-negative is its event; only the guards of the current mode are live (active_guards, for
+// the scene's Features, scene.h).
 #pragma once
 
 #include <array>
 #include <cstdint>
 
 #include "plinth/core/excitation.h"
-#include "plinth/core/flows.h"
+#include "plinth/core/internal/flows.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 
-namespace plinth {
+namespace plinth::internal {
 
 enum class GuardId : std::uint8_t {
   kRockingOnsetLeft,     // Eq 16 (from rest or full contact) or Eq 17 (while sliding), corner 1
@@ -43,22 +44,6 @@ struct ActiveGuards {
 
   constexpr void add(GuardId id) { ids[static_cast<std::size_t>(count++)] = id; }
 };
-
-// What the model of a scene carries, fixed once when the scene is loaded.
-struct Features {
-  bool base = false;           // an isolated base (u is a degree of freedom)
-  bool base_stops = false;     // security stops on the base (Eqs 28-29)
-  bool sliding = false;        // friction is finite: sliding phases exist (Eqs 2-5, 10-15, 17-20)
-  bool support_edge = false;   // the block can overhang the support and fall (Eqs 13-14)
-  bool sliding_stops = false;  // sliding stops at |x| = x_hat (Eqs 30-32)
-};
-
-[[nodiscard]] constexpr Features features_of(const Scene& s) {
-  const SceneParams& p = s.params;
-  return {p.has_base, p.has_base_stops, p.has_friction,
-          p.has_friction && p.has_support && !p.has_sliding_stops,
-          p.has_friction && p.has_sliding_stops};
-}
 
 template <Features F>
 [[nodiscard]] constexpr ActiveGuards active_guards(const Mode& mode) {
@@ -283,4 +268,4 @@ template <Features F>
   return guard_value(id, s, mode, y, ag, acc, p.trig);
 }
 
-}  // namespace plinth
+}  // namespace plinth::internal

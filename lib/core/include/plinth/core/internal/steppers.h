@@ -1,31 +1,13 @@
-// The one-step methods the solver offers, chosen once in SolverSettings. Each advances the state
-// of one phase's flow over h from (t, y), given the derivative k1 at (t, y) (the last point of
-// the previous step or interval, FlowPoint); the same map with h < step is the solution on which
-// events are located.
+// Internal to plinth_core (tests may include it). The one-step methods behind Stepper
+// (stepper.h). Each advances the state of one phase's flow over h from (t, y), given the
+// derivative k1 at (t, y) (the last point of the previous step or interval, FlowPoint); the same
+// map with h < step is the solution on which events are located.
 #pragma once
-
-#include <cstdint>
-#include <string_view>
 
 #include "plinth/core/excitation.h"
 #include "plinth/core/state.h"
 
-namespace plinth {
-
-enum class Stepper : std::uint8_t {
-  kRk4Located,         // classical Runge-Kutta (4th order), events located inside the step
-  kRk4StepEnd,         // the same, guards checked at step ends only, resets applied there
-  kHeunLocated,        // Heun's method (explicit trapezoid, 2nd order), events located
-  kSemiImplicitEuler,  // semi-implicit (symplectic) Euler (1st order), events located
-};
-
-inline constexpr Stepper kAllSteppers[] = {Stepper::kRk4Located, Stepper::kRk4StepEnd,
-                                           Stepper::kHeunLocated, Stepper::kSemiImplicitEuler};
-
-// "rk4_located", "rk4_step_end", "heun_located", "semi_implicit_euler".
-[[nodiscard]] const char* stepper_name(Stepper stepper);
-// The stepper named `name`; false when there is none.
-[[nodiscard]] bool parse_stepper(std::string_view name, Stepper& out);
+namespace plinth::internal {
 
 // A flow as the methods see it: `ground(t)` and `derivative(ground, y)` = dy/dt.
 namespace methods {
@@ -82,4 +64,4 @@ struct SemiImplicitEuler {
 };
 
 }  // namespace methods
-}  // namespace plinth
+}  // namespace plinth::internal

@@ -1,13 +1,14 @@
-// Reset maps of the hybrid system: the state just after each event.
+// Internal to plinth_core (tests may include it). Reset maps of the hybrid system: the state
+// just after each event.
 #pragma once
 
 #include <cmath>
 
-#include "plinth/core/flows.h"
+#include "plinth/core/internal/flows.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 
-namespace plinth {
+namespace plinth::internal {
 
 [[nodiscard]] constexpr Corner opposite(Corner c) {
   return c == Corner::kLeft ? Corner::kRight : Corner::kLeft;
@@ -272,4 +273,4 @@ inline CoulombImpact coulomb_impact_reset(const Scene& s, bool base_moves, Mode&
   return result;
 }
 
-}  // namespace plinth
+}  // namespace plinth::internal

@@ -1,4 +1,5 @@
-// Exact propagation of full contact over one step. Full contact is linear (Eq 1):
+// Internal to plinth_core (tests may include it). Exact propagation of full contact over one
+// step. Full contact is linear (Eq 1):
 //   u'' = -u_G'' - (c u' + k u) / (m + m_b),
 // so with the ground acceleration linear within the step (as a record is between samples) the
 // state after a step h is exact (the state-transition method of response-spectrum codes,
@@ -10,7 +11,7 @@
 
 #include "plinth/core/scene.h"
 
-namespace plinth {
+namespace plinth::internal {
 
 struct FullContactPropagator {
   double step = 0.0;                            // h, s
@@ -34,4 +35,4 @@ struct FullContactPropagator {
   }
 };
 
-}  // namespace plinth
+}  // namespace plinth::internal

@@ -1,4 +1,5 @@
-// Continuous dynamics: the equations of motion of each phase, solved for the accelerations.
+// Internal to plinth_core (tests may include it). Continuous dynamics: the equations of motion
+// of each phase, solved for the accelerations.
 #pragma once
 
 #include <Eigen/Dense>
@@ -9,7 +10,7 @@
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 
-namespace plinth {
+namespace plinth::internal {
 
 // Full contact, Eq 1: (m + m_b)(u'' + u_G'') + c u' + k u = 0.
 [[nodiscard]] inline double full_contact_base_acceleration(const Scene& s, double u, double u_dot,
@@ -498,4 +499,4 @@ struct FlowPoint {
   return d;
 }
 
-}  // namespace plinth
+}  // namespace plinth::internal
