@@ -76,6 +76,12 @@ std::function<bool(const toml::node&)> stepper_into(Stepper& target) {
   };
 }
 
+std::function<bool(const toml::node&)> continuation_into(Continuation& target) {
+  return [&target](const toml::node& n) {
+    return n.is_string() && kContinuationNames.parse(n.value<std::string>().value_or(""), target);
+  };
+}
+
 std::function<bool(const toml::node&)> rotation_into(Eigen::Matrix3d& target) {
   return [&target](const toml::node& n) {
     const toml::array* rows = n.as_array();
@@ -142,6 +148,17 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit) {
       {"estimator.exact_full_contact", flag_into(c.estimator.solver.exact_full_contact),
        "true or false"},
       {"risk.base_stop_weight", number_into(c.risk.base_stop_weight), "a number"},
+      {"forecast.enabled", flag_into(c.forecast.enabled), "true or false"},
+      {"forecast.continuation", continuation_into(c.forecast.continuation),
+       "\"recent_window\" or \"strongest_window\""},
+      {"forecast.horizon_s", number_into(c.forecast.horizon_s), "a number"},
+      {"forecast.window_s", number_into(c.forecast.window_s), "a number"},
+      {"forecast.growth", number_into(c.forecast.growth), "a number"},
+      {"forecast.memory_s", number_into(c.forecast.memory_s), "a number"},
+      {"forecast.interval_s", number_into(c.forecast.interval_s), "a number"},
+      {"forecast.rate_hz", number_into(c.forecast.rate_hz), "a number"},
+      {"forecast.steps_per_period", integer_into(c.forecast.steps_per_period), "an integer"},
+      {"forecast.work_steps_per_s", number_into(c.forecast.work_steps_per_s), "a number"},
       {"redundancy.window_s", number_into(c.redundancy.window_s), "a number"},
       {"redundancy.tolerance_m_s2", number_into(c.redundancy.tolerance_m_s2), "a number"},
       {"plate.window_s", number_into(c.plate.window_s), "a number"},
@@ -156,7 +173,10 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit) {
   sensor_bindings(b, "conditioning.", c.conditioning, c.sensor_health, unit);
   for (auto [name, thresholds] : {std::pair<const char*, monitor::RiskThresholds*>{"advisory", &alarm.advisory},
                                   {"warning", &alarm.warning},
-                                  {"alarm", &alarm.alarm}}) {
+                                  {"alarm", &alarm.alarm},
+                                  {"advisory_forecast", &alarm.advisory_forecast},
+                                  {"warning_forecast", &alarm.warning_forecast},
+                                  {"alarm_forecast", &alarm.alarm_forecast}}) {
     b.push_back({cat("alarm_policy.", name, ".on"), number_into(thresholds->on), "a number"});
     b.push_back({cat("alarm_policy.", name, ".off"), number_into(thresholds->off), "a number"});
   }

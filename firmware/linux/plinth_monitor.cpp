@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -165,9 +166,15 @@ void take(const fw::InputItem& item, fw::Monitor& monitor, Outputs& outputs,
   }
 }
 
+// Each axis's ensemble: the scene file's statue first, then the corners of its [uncertainty]
+// (one member when it declares none).
 void start_monitor(fw::Monitor& monitor, const fw::MonitorConfig& config,
-                   const plinth::Scene& scene_x, const std::optional<plinth::Scene>& scene_y) {
-  const plinth::Error e = monitor.start(config, {&scene_x, scene_y ? &*scene_y : nullptr});
+                   const plinth::host::UncertainScene& scene_x,
+                   const std::optional<plinth::host::UncertainScene>& scene_y) {
+  const plinth::Error e = monitor.start(
+      config, {std::span<const plinth::Scene>(scene_x.members),
+               scene_y ? std::span<const plinth::Scene>(scene_y->members)
+                       : std::span<const plinth::Scene>()});
   if (e.ok()) return;
   std::string message = std::string("monitor settings: ") + e.field + " " + e.reason;
   if (std::isfinite(e.limit)) message += " (limit " + std::to_string(e.limit) + ")";
@@ -230,10 +237,12 @@ int run(const Options& opt) {
   if (!opt.replay_y_path.empty() && file.second_scene_path.empty()) {
     throw InputError("--replay-y needs a second axis: --scene-y or monitor.second_scene");
   }
-  const plinth::Scene scene_x = plinth::host::load_scene_file(opt.scene_path);
-  std::optional<plinth::Scene> scene_y;
-  if (!file.second_scene_path.empty())
-    scene_y = plinth::host::load_scene_file(file.second_scene_path);
+  const plinth::host::UncertainScene scene_x =
+      plinth::host::load_uncertain_scene_file(opt.scene_path);
+  std::optional<plinth::host::UncertainScene> scene_y;
+  if (!file.second_scene_path.empty()) {
+    scene_y = plinth::host::load_uncertain_scene_file(file.second_scene_path);
+  }
   fw::MonitorConfig& config = file.config;
   config.axis_count = scene_y ? 2 : 1;
   const std::unique_ptr<fw::MonitorInput> input = fw::open_input(input_settings, config, g_stop);

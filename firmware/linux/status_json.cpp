@@ -66,6 +66,8 @@ std::string axis_state(const AxisStatus& a) {
       .fixed("risk_overturning", a.risk.overturning, 4)
       .fixed("risk_falling", a.risk.falling, 4)
       .fixed("risk_base_stops", a.risk.base_stops, 4)
+      .count("members", static_cast<std::uint64_t>(a.members))
+      .count("worst_member", static_cast<std::uint64_t>(a.worst_member))
       .close();
 }
 
@@ -217,6 +219,10 @@ std::string status_json(const MonitorStatus& s, double t_origin) {
              return quoted(a.mode.rocking() ? corner_name(a.mode.corner) : "none");
            }));
   line.fixed("risk", s.risk, 4)
+      .fixed("probability", s.probability, 4)
+      .raw("collapse_forecast_t", s.collapse_forecast_s < 0.0
+                                      ? std::string("null")
+                                      : formatted(s.collapse_forecast_s - t_origin, 3, true))
       .text("alarm", monitor::alarm_level_name(s.alarm))
       .text("latched", monitor::alarm_level_name(s.latched))
       .flag("estimating", s.estimating)

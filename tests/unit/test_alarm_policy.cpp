@@ -108,6 +108,12 @@ TEST(AlarmPolicySettings, DefaultsAreValidAndThresholdsAreChecked) {
   s.warning = {0.5, 0.04};  // off below advisory.off 0.09
   expect_refused(s, "alarm_policy.warning.off", ErrorCode::kInconsistent);
   s = {};
+  s.warning_forecast = {0.95, 0.4};  // above alarm_forecast.on 0.9
+  expect_refused(s, "alarm_policy.alarm_forecast.on", ErrorCode::kInconsistent);
+  s = {};
+  s.advisory_forecast.off = 0.2;  // equal to its on
+  expect_refused(s, "alarm_policy.advisory_forecast.off", ErrorCode::kInconsistent);
+  s = {};
   s.alarm.on = 1.0;  // the edges of [0, 1] are allowed
   s.advisory.off = 0.0;
   EXPECT_TRUE(validate(s).ok());
@@ -346,6 +352,42 @@ TEST(AlarmPolicy, AnInvalidRiskIsAnInternalFault) {
   EXPECT_EQ(p.at(30, 1.0001).input_problem, InputProblem::kRiskInvalid);
   EXPECT_EQ(p.at(40, -0.0001).level, AlarmLevel::kFault);
   EXPECT_EQ(p.at(50, 1.0).input_problem, InputProblem::kNone);
+}
+
+// The forecast's probability raises the levels as the risk does, with its own thresholds; the
+// cause says which of the two holds the level.
+TEST(AlarmPolicy, TheForecastRaisesLevelsWithItsOwnCause) {
+  Policy p(immediate());
+  const auto at = [&p](std::int64_t ms, double risk, double probability) {
+    p.base.probability = probability;
+    return p.at(ms, risk);
+  };
+  EXPECT_EQ(at(0, 0.0, 0.1999).level, AlarmLevel::kNormal);
+  EXPECT_EQ(at(1, 0.0, 0.2).level, AlarmLevel::kAdvisory);
+  expect_change(at(2, 0.0, 0.5), AlarmLevel::kWarning, AlarmLevel::kAdvisory,
+                AlarmCause::kCollapseForecast, false);
+  expect_change(at(3, 0.0, 0.9), AlarmLevel::kAlarm, AlarmLevel::kWarning,
+                AlarmCause::kCollapseForecast, false);
+  EXPECT_EQ(at(4, 0.0, 0.8).level, AlarmLevel::kAlarm);  // at off: still on
+  // Both below their off: lowered; the risk alone at alarm: cause risk_threshold.
+  EXPECT_EQ(at(5, 0.0, 0.7999).level, AlarmLevel::kWarning);
+  expect_change(at(6, 0.8, 0.0), AlarmLevel::kAlarm, AlarmLevel::kWarning,
+                AlarmCause::kRiskThreshold, false);
+  // An invalid probability is an internal fault, as an invalid risk is.
+  const AlarmOutput nan = at(7, 0.0, std::numeric_limits<double>::quiet_NaN());
+  EXPECT_EQ(nan.input_problem, InputProblem::kRiskInvalid);
+  EXPECT_EQ(at(8, 0.0, 1.5).input_problem, InputProblem::kRiskInvalid);
+}
+
+TEST(AlarmPolicy, ALevelLatchedByTheForecastKeepsItsCause) {
+  Policy p(latching(true, true));
+  p.base.probability = 0.95;
+  expect_change(p.at(0, 0.0), AlarmLevel::kAlarm, AlarmLevel::kNormal,
+                AlarmCause::kCollapseForecast, true);
+  p.base.probability = 0.0;
+  const AlarmOutput held = p.at(10, 0.0);
+  EXPECT_EQ(held.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(held.latched_level, AlarmLevel::kAlarm);
 }
 
 TEST(AlarmPolicy, AnUpdateFromThePastIsRefused) {

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -223,6 +224,50 @@ TEST(Monitor, RefusesBadConfigurationNamingTheField) {
   c = quick_config();
   c.alarm.warning.off = 0.9;
   EXPECT_FALSE(monitor.start(c, {&scene, nullptr}).ok());
+}
+
+// An ensemble: a member's estimate does not depend on where it stands in the ensemble (the
+// offset tracking waits for every member); the axis's risk is the worst member's, its mode and
+// state the nominal statue's (member 0).
+TEST(Monitor, EnsembleMembersFollowTheirOwnStatues) {
+  std::vector<Scene> statues;
+  for (const double height_factor : {1.0, 0.87, 1.13}) {  // slenderness 3, 2.6, 3.4
+    SceneParams p = testing::paper_isolated(0.0);
+    p.block.com_height *= height_factor;
+    statues.push_back(testing::make(p));
+  }
+  const std::vector<Scene> rotated{statues[1], statues[2], statues[0]};
+  fw::MonitorConfig config;
+  config.estimator.sample_rate_hz = 200.0;
+  fw::Monitor first;
+  fw::Monitor second;
+  ASSERT_TRUE(first.start(config, {std::span<const Scene>(statues), {}}).ok());
+  ASSERT_TRUE(second.start(config, {std::span<const Scene>(rotated), {}}).ok());
+  ASSERT_EQ(first.members(0), 3);
+  testing::QuietThenQuake input(200.0, 10.0, brienza(), 12.0);
+  testing::QuietThenQuake same(200.0, 10.0, brienza(), 12.0);  // the same samples again
+  bool worst_not_nominal = false;
+  for (long n = 0; n < input.size(); ++n) {
+    (void)first.on_sample(input.sample(n));
+    (void)second.on_sample(same.sample(n));
+    double worst = 0.0;
+    for (int m = 0; m < 3; ++m) {
+      const PlanarEstimator& e = first.member(0, m);
+      ASSERT_EQ(e.state(), second.member(0, (m + 2) % 3).state()) << n << " " << m;
+      worst = std::fmax(worst, overturning_risk(statues[static_cast<std::size_t>(m)], e.mode(),
+                                                e.state(), config.risk).total);
+    }
+    const fw::AxisStatus& axis = first.status().axes[0];
+    if (!first.status().estimating) continue;
+    ASSERT_EQ(axis.state, first.member(0, 0).state());
+    ASSERT_EQ(axis.risk.total, worst);
+    ASSERT_EQ(axis.risk.total, second.status().axes[0].risk.total);
+    worst_not_nominal = worst_not_nominal || (axis.worst_member != 0 && worst > 0.0);
+    if (axis.forecast.valid) {
+      ASSERT_EQ(axis.forecast.members, 3);
+    }
+  }
+  EXPECT_TRUE(worst_not_nominal);  // the slenderer statue is the more fragile at times
 }
 
 // Quiet noise with a drifting sensor bias, then an earthquake that overturns the block: no

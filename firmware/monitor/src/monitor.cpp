@@ -126,6 +126,7 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
       c.estimator.sample_rate_hz > 1000.0) {
     return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
   }
+  PLINTH_TRY(validate(c.forecast, c.estimator.sample_rate_hz));
   PLINTH_TRY(validate_check(c.redundancy.window_s, c.redundancy.tolerance_m_s2,
                             c.estimator.sample_rate_hz, "redundancy.window_s",
                             "redundancy.tolerance_m_s2"));
@@ -158,13 +159,29 @@ double Monitor::RmsWindow::rms() const {
 
 Error Monitor::start(const MonitorConfig& config,
                      const std::array<const Scene*, kMaxAxes>& scenes) {
+  std::array<std::span<const Scene>, kMaxAxes> ensembles{};
+  for (std::size_t i = 0; i < kMaxAxes; ++i) {
+    if (scenes[i] != nullptr) ensembles[i] = std::span<const Scene>(scenes[i], 1);
+  }
+  return start(config, ensembles);
+}
+
+Error Monitor::start(const MonitorConfig& config,
+                     const std::array<std::span<const Scene>, kMaxAxes>& ensembles) {
   PLINTH_TRY(validate(config));
   for (int i = 0; i < config.axis_count; ++i) {
-    const Scene* scene = scenes[static_cast<std::size_t>(i)];
-    if (scene == nullptr) {
+    const std::span<const Scene> members = ensembles[static_cast<std::size_t>(i)];
+    if (members.empty()) {
       return {ErrorCode::kInconsistent, "monitor.axis_count", "names an axis without a scene"};
     }
-    PLINTH_TRY(validate(config.estimator, *scene));
+    if (members.size() > static_cast<std::size_t>(kMaxEnsembleMembers)) {
+      return {ErrorCode::kOutOfRange, "uncertainty",
+              "gives more ensemble members than this build holds (kMaxEnsembleMembers)",
+              static_cast<double>(kMaxEnsembleMembers)};
+    }
+    for (const Scene& scene : members) PLINTH_TRY(validate(config.estimator, scene));
+    PLINTH_TRY(forecasters_[static_cast<std::size_t>(i)].start(config.forecast,
+                                                               config.estimator.sample_rate_hz));
   }
   config_ = config;
   config_.conditioning.sample_period_s = config.estimator.sample_period();
@@ -196,7 +213,10 @@ Error Monitor::start(const MonitorConfig& config,
     if (sc.role == SensorRole::kPlate) status_.plate = i;
   }
   PLINTH_TRY(monitor::AlarmPolicy::create(config_.alarm, alarm_));
-  scenes_ = scenes;
+  scenes_ = ensembles;
+  for (int i = 0; i < config.axis_count; ++i) {
+    status_.axes[static_cast<std::size_t>(i)].members = members(i);
+  }
   status_.sensor = sensors_[0].health.health();
   estimate_ = History{};
   period_ns_ = std::llround(config.estimator.sample_period() * 1e9);
@@ -219,7 +239,7 @@ void Monitor::set_event_sink(int axis, EventSink* sink) {
   if (axis < 0 || axis >= kMaxAxes) return;
   const auto i = static_cast<std::size_t>(axis);
   sinks_[i] = sink;
-  estimators_[i].set_event_sink(sink);
+  ensembles_[i][0].set_event_sink(sink);  // the nominal statue's phases and impacts
 }
 
 std::int64_t Monitor::monitor_time(std::int64_t receive_time_ns) {
@@ -231,10 +251,15 @@ std::int64_t Monitor::monitor_time(std::int64_t receive_time_ns) {
   return t > status_.time_ns ? t : status_.time_ns;  // never backwards
 }
 
+// Quiet: every member of every axis in full contact, and the worst risk low (the offset is
+// tracked only then; the same for every member, whatever their order).
 bool Monitor::quiet() const {
   bool quiet = status_.estimating && status_.risk < config_.quiet_risk;
-  for (int i = 0; i < status_.axis_count; ++i) {
-    quiet = quiet && status_.axes[static_cast<std::size_t>(i)].mode.phase == Phase::kFullContact;
+  for (int i = 0; i < status_.axis_count && quiet; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
+      quiet = quiet && ensembles_[k][m].mode().phase == Phase::kFullContact;
+    }
   }
   return quiet;
 }
@@ -338,7 +363,11 @@ void Monitor::drain_primary() {
 
 void Monitor::push_estimators(const Eigen::Vector3d& g) {
   for (int i = 0; i < status_.axis_count; ++i) {
-    estimators_[static_cast<std::size_t>(i)].push(GroundAcceleration{g[i], g.z()});
+    const auto k = static_cast<std::size_t>(i);
+    const GroundAcceleration ground{g[i], g.z()};
+    const std::span<PlanarEstimator> members(ensembles_[k].data(), scenes_[k].size());
+    for (PlanarEstimator& e : members) e.push(ground);
+    forecasters_[k].on_sample(ground, members[0].time(), members);
   }
 }
 
@@ -351,8 +380,11 @@ void Monitor::drive(const HistoryEntry& entry) {
       const GroundAcceleration ground{entry.value[i], entry.value.z()};
       // validate() in start() checked what start() can refuse but a non-finite sample, which
       // conditioning does not pass on.
-      (void)estimators_[k].start(*scenes_[k], config_.estimator, ground);
-      estimators_[k].set_event_sink(sinks_[k]);
+      for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
+        (void)ensembles_[k][m].start(scenes_[k][m], config_.estimator, ground);
+      }
+      ensembles_[k][0].set_event_sink(sinks_[k]);
+      forecasters_[k].reset();
     }
     ++status_.estimator_restarts;
     status_.estimator_start_ns = entry.time_ns - epoch_ns_;
@@ -384,7 +416,7 @@ void Monitor::drive(const HistoryEntry& entry) {
     HistoryEntry e;
     e.time_ns = entry.time_ns;
     for (int i = 0; i < status_.axis_count; ++i) {
-      const PlanarEstimator& est = estimators_[static_cast<std::size_t>(i)];
+      const PlanarEstimator& est = estimator(i);
       e.value[i] = est.simulator().accelerations().u + est.ground().horizontal;
     }
     estimate_.push(e);
@@ -511,25 +543,57 @@ void Monitor::update_sensors_status() {
   }
 }
 
+// One axis: the nominal statue's mode and state, the worst member's risk, the forecast.
+void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
+  const auto k = static_cast<std::size_t>(axis_index);
+  const PlanarEstimator& nominal = ensembles_[k][0];
+  axis.mode = nominal.mode();
+  axis.state = nominal.state();
+  axis.risk = Risk{};
+  axis.worst_member = 0;
+  for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
+    const PlanarEstimator& e = ensembles_[k][m];
+    const Risk r = overturning_risk(scenes_[k][m], e.mode(), e.state(), config_.risk);
+    if (m == 0 || r.total > axis.risk.total) {
+      axis.risk = r;
+      axis.worst_member = static_cast<int>(m);
+    }
+  }
+  axis.forecast = forecasters_[k].latest();
+}
+
 // The axes' part of the status (mode, state, risk), and the alarm policy's input from them.
 void Monitor::update_axes_status(monitor::AlarmInput& input) {
   double risk = 0.0;
   bool moving = false;
   bool collapse = false;
+  status_.probability = 0.0;
+  status_.forecast_axis = -1;
+  status_.collapse_forecast_s = -1.0;
   for (int i = 0; i < status_.axis_count; ++i) {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
-    if (status_.estimating) {
-      axis.mode = estimators_[k].mode();
-      axis.state = estimators_[k].state();
-      axis.risk = overturning_risk(*scenes_[k], axis.mode, axis.state, config_.risk);
-    }
+    if (status_.estimating) update_axis(i, axis);
     risk = axis.risk.total > risk ? axis.risk.total : risk;
     moving = moving || axis.mode.phase != Phase::kFullContact;
     collapse = collapse || axis.mode.terminal();
+    const ForecastOutcome& f = axis.forecast;
+    if (!f.valid) continue;
+    if (status_.forecast_axis < 0 || f.probability > status_.probability) {
+      status_.probability = f.probability;
+      status_.forecast_axis = i;
+    }
+    if (f.worst_member >= 0) {
+      const double at_s = static_cast<double>(status_.estimator_start_ns) * 1e-9 +
+                          f.start_time_s + f.collapse_in_s;
+      if (status_.collapse_forecast_s < 0.0 || at_s < status_.collapse_forecast_s) {
+        status_.collapse_forecast_s = at_s;
+      }
+    }
   }
   status_.risk = risk;
   input.risk = risk;
+  input.probability = status_.probability;
   input.out_of_full_contact = moving;
   input.collapse_detected = collapse;
 }

@@ -60,7 +60,7 @@ enum EventSignal : std::size_t { kLevel, kPreviousLevel, kCause, kLatched, kTime
 constexpr std::array<SignalLayout, 6> kEventSignals{{
     {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true},
     {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true},
-    {"Cause", 8, 8, false, 1.0, 0.0, 0, 9, "", true},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 11, "", true},
     {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true},
     {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false},
     {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false},

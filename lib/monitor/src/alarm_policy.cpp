@@ -41,10 +41,12 @@ Error check_order(const RiskThresholds& lower, const RiskThresholds& upper, cons
   return ok_error();
 }
 
-// The risk condition with hysteresis: start at `on`, hold down to `off`.
-bool risk_condition(const detail::HeldCondition& held, const RiskThresholds& t, double risk) {
-  return risk >= (held.active ? t.off : t.on);
+// A threshold with hysteresis: start at `on`, hold down to `off`.
+bool above(const detail::HeldCondition& held, const RiskThresholds& t, double value) {
+  return value >= (held.active ? t.off : t.on);
 }
+
+bool valid_fraction(double v) { return std::isfinite(v) && v >= 0.0 && v <= 1.0; }
 
 }  // namespace
 
@@ -71,6 +73,16 @@ Error validate(const AlarmPolicySettings& s) {
       check_thresholds(s.alarm, "alarm_policy.alarm.on", "alarm_policy.alarm.off"),
       check_order(s.advisory, s.warning, "alarm_policy.warning.on", "alarm_policy.warning.off"),
       check_order(s.warning, s.alarm, "alarm_policy.alarm.on", "alarm_policy.alarm.off"),
+      check_thresholds(s.advisory_forecast, "alarm_policy.advisory_forecast.on",
+                       "alarm_policy.advisory_forecast.off"),
+      check_thresholds(s.warning_forecast, "alarm_policy.warning_forecast.on",
+                       "alarm_policy.warning_forecast.off"),
+      check_thresholds(s.alarm_forecast, "alarm_policy.alarm_forecast.on",
+                       "alarm_policy.alarm_forecast.off"),
+      check_order(s.advisory_forecast, s.warning_forecast, "alarm_policy.warning_forecast.on",
+                  "alarm_policy.warning_forecast.off"),
+      check_order(s.warning_forecast, s.alarm_forecast, "alarm_policy.alarm_forecast.on",
+                  "alarm_policy.alarm_forecast.off"),
       detail::check_duration(s.raise_hold_s, "alarm_policy.raise_hold_s", true),
       detail::check_duration(s.lower_hold_s, "alarm_policy.lower_hold_s", true),
       detail::check_duration(s.heartbeat_period_s, "alarm_policy.heartbeat_period_s", false),
@@ -105,10 +117,17 @@ AckOutcome AlarmPolicy::acknowledge(const Acknowledgement& ack) {
 void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   // An invalid risk leaves the risk conditions as they were (their holds keep running).
   if (risk_valid) {
-    const bool advisory = risk_condition(advisory_, settings_.advisory, in.risk) ||
+    const bool advisory = above(advisory_, settings_.advisory, in.risk) ||
+                          above(advisory_, settings_.advisory_forecast, in.probability) ||
                           in.out_of_full_contact;
-    const bool warning = risk_condition(warning_, settings_.warning, in.risk);
-    const bool alarm = risk_condition(alarm_, settings_.alarm, in.risk);
+    const bool warning_risk = above(warning_, settings_.warning, in.risk);
+    const bool warning_forecast = above(warning_, settings_.warning_forecast, in.probability);
+    const bool alarm_risk = above(alarm_, settings_.alarm, in.risk);
+    const bool alarm_forecast = above(alarm_, settings_.alarm_forecast, in.probability);
+    const bool warning = warning_risk || warning_forecast;
+    const bool alarm = alarm_risk || alarm_forecast;
+    warning_by_forecast_ = warning_forecast && !warning_risk;
+    alarm_by_forecast_ = alarm_forecast && !alarm_risk;
     advisory_.update(advisory, in.time_ns, raise_hold_ns_, lower_hold_ns_);
     warning_.update(warning, in.time_ns, raise_hold_ns_, lower_hold_ns_);
     alarm_.update(alarm, in.time_ns, raise_hold_ns_, lower_hold_ns_);
@@ -143,7 +162,10 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   }
   if (latch != AlarmLevel::kNormal && rank(latch) >= rank(latched_level_)) {
     latched_level_ = latch;
-    latched_cause_ = collapse_began ? AlarmCause::kOverturnDetected : AlarmCause::kRiskThreshold;
+    const bool by_forecast = latch == AlarmLevel::kAlarm ? alarm_by_forecast_ : warning_by_forecast_;
+    latched_cause_ = collapse_began ? AlarmCause::kOverturnDetected
+                     : by_forecast  ? AlarmCause::kCollapseForecast
+                                    : AlarmCause::kRiskThreshold;
   }
 }
 
@@ -167,7 +189,9 @@ AlarmCause AlarmPolicy::cause_of(AlarmLevel level) const {
       if (collapse_) return AlarmCause::kOverturnDetected;
       // Held by its latch alone: the cause it latched with.
       if (rank(condition_level_) < rank(level) && latched_level_ == level) return latched_cause_;
-      return AlarmCause::kRiskThreshold;
+      return (level == AlarmLevel::kAlarm ? alarm_by_forecast_ : warning_by_forecast_)
+                 ? AlarmCause::kCollapseForecast
+                 : AlarmCause::kRiskThreshold;
   }
   return AlarmCause::kNone;
 }
@@ -211,7 +235,7 @@ AlarmOutput AlarmPolicy::update(const AlarmInput& in) {
       out.acknowledgement = acknowledge(in.acknowledgement);
       emit_if_changed(out, in.time_ns, true);
     }
-    const bool risk_valid = std::isfinite(in.risk) && in.risk >= 0.0 && in.risk <= 1.0;
+    const bool risk_valid = valid_fraction(in.risk) && valid_fraction(in.probability);
     if (!risk_valid) out.input_problem = InputProblem::kRiskInvalid;
     evaluate_conditions(in, risk_valid);
     emit_if_changed(out, in.time_ns, false);

@@ -6,8 +6,11 @@
 //   frame --codec--> SensorSample --SensorHealthTracker (one per sensor)--> fed samples
 //     --Conditioner (one per sensor)--> acceleration in the statue frame (m/s2), kept in the
 //     sensor's history (its last kSensorHistory samples)
-//   the primary ground sensor's samples --PlanarEstimator per axis (x: statue axis 1, y: axis 2;
-//     z feeds g + v_G'')--> phase, state --overturning_risk--> risk --AlarmPolicy--> level, events
+//   the primary ground sensor's samples --an ensemble of PlanarEstimators per axis (x: statue
+//     axis 1, y: axis 2; z feeds g + v_G''; member 0 the nominal statue, the others the corners
+//     of the scene's declared uncertainty)--> phase, state per member --overturning_risk--> the
+//     worst member's risk; --Forecaster per axis (forecast.h)--> the probability of a collapse
+//     within the horizon, its worst member and time --AlarmPolicy--> level, events
 //   events, and the status at status_interval_s --can_frames.h--> frames ready to send
 //   the other ground sensors' samples --cross-check against the primary--> disagreement
 //   the plate sensor's samples --compared with the model's base acceleration--> residual
@@ -53,10 +56,12 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 
 #include "plinth/core/error.h"
 #include "plinth/core/estimator.h"
 #include "plinth/core/events.h"
+#include "plinth/core/forecast.h"
 #include "plinth/core/name_table.h"
 #include "plinth/core/risk.h"
 #include "plinth/core/scene.h"
@@ -117,6 +122,7 @@ struct MonitorConfig {
   std::uint8_t ground_node = 1;  // CAN node id of the ground accelerometer, 1..15
   EstimatorSettings estimator;   // sample rate (= the sensor's) and solver steps per sample
   RiskSettings risk;
+  ForecastSettings forecast;     // the ensemble's look ahead (forecast.h)
   monitor::ConditioningSettings conditioning;  // its sample period is the estimator's
   monitor::SensorHealthSettings sensor_health;  // its sample period is the estimator's
   monitor::AlarmPolicySettings alarm;
@@ -145,9 +151,12 @@ struct MonitorConfig {
                                    std::array<SensorConfig, kMaxSensors>& out);
 
 struct AxisStatus {
-  Mode mode;
+  Mode mode;  // the nominal statue's (member 0)
   State state = State::Zero();
-  Risk risk;
+  Risk risk;             // the worst member's (the highest total)
+  int members = 1;       // the ensemble's size
+  int worst_member = 0;  // whose risk that is
+  ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
 };
 
 // Frames that were not sensor samples of a configured node, or could not be decoded.
@@ -189,6 +198,12 @@ struct MonitorStatus {
   int axis_count = 1;
   std::array<AxisStatus, kMaxAxes> axes{};
   double risk = 0.0;  // the worst axis's total
+  // The forecast: the highest probability of a collapse within the horizon over the axes, the
+  // axis it is on (-1: no forecast yet), and the monitor time, s, at which the first member of
+  // any axis is forecast to collapse (-1: none is).
+  double probability = 0.0;
+  int forecast_axis = -1;
+  double collapse_forecast_s = -1.0;
   monitor::AlarmLevel alarm = monitor::AlarmLevel::kNormal;
   monitor::AlarmLevel latched = monitor::AlarmLevel::kNormal;
   monitor::SensorHealth sensor;
@@ -236,7 +251,11 @@ class Monitor {
   Monitor(const Monitor&) = delete;
   Monitor& operator=(const Monitor&) = delete;
 
-  // `scenes[i]` is the planar model of axis i; they must outlive the monitor.
+  // `ensembles[i]` are the statues of axis i, the nominal one first (at most
+  // kMaxEnsembleMembers); they must outlive the monitor.
+  [[nodiscard]] Error start(const MonitorConfig& config,
+                            const std::array<std::span<const Scene>, kMaxAxes>& ensembles);
+  // One statue per axis: `scenes[i]` is the planar model of axis i.
   [[nodiscard]] Error start(const MonitorConfig& config,
                             const std::array<const Scene*, kMaxAxes>& scenes);
 
@@ -267,8 +286,16 @@ class Monitor {
   [[nodiscard]] const monitor::ConditioningStatus& conditioning(int sensor) const {
     return sensors_[static_cast<std::size_t>(sensor)].conditioner.status();
   }
-  [[nodiscard]] const PlanarEstimator& estimator(int axis) const {
-    return estimators_[static_cast<std::size_t>(axis)];
+  // The nominal statue's estimator of `axis`.
+  [[nodiscard]] const PlanarEstimator& estimator(int axis) const { return member(axis, 0); }
+  [[nodiscard]] const PlanarEstimator& member(int axis, int m) const {
+    return ensembles_[static_cast<std::size_t>(axis)][static_cast<std::size_t>(m)];
+  }
+  [[nodiscard]] int members(int axis) const {
+    return static_cast<int>(scenes_[static_cast<std::size_t>(axis)].size());
+  }
+  [[nodiscard]] const Forecaster& forecaster(int axis) const {
+    return forecasters_[static_cast<std::size_t>(axis)];
   }
   // The sensors as started (the single-sensor form resolved).
   [[nodiscard]] const SensorConfig& sensor_config(int sensor) const {
@@ -339,6 +366,7 @@ class Monitor {
   [[nodiscard]] bool decoded(const can::CanFrame& frame, Message& message);
   [[nodiscard]] int sensor_of_node(std::uint8_t node) const;  // -1: not configured
   void update_sensors_status();
+  void update_axis(int axis_index, AxisStatus& axis) const;
   void update_axes_status(monitor::AlarmInput& input);
   void evaluate(MonitorUpdate& update);
   void report(MonitorUpdate& update);
@@ -357,8 +385,9 @@ class Monitor {
   bool align_pending_ = false;    // the next entry continues after a failover: align by time
   std::int64_t last_fed_ns_ = 0;  // receive time of the estimators' newest sample
   Eigen::Vector3d last_ground_ = Eigen::Vector3d::Zero();  // its value, m/s2
-  std::array<const Scene*, kMaxAxes> scenes_{};
-  std::array<PlanarEstimator, kMaxAxes> estimators_{};
+  std::array<std::span<const Scene>, kMaxAxes> scenes_{};
+  std::array<std::array<PlanarEstimator, kMaxEnsembleMembers>, kMaxAxes> ensembles_{};
+  std::array<Forecaster, kMaxAxes> forecasters_{};
   std::array<EventSink*, kMaxAxes> sinks_{};
   monitor::AlarmPolicy alarm_;
   MonitorStatus status_;

@@ -96,6 +96,8 @@ enum class AlarmCause : std::uint8_t {
   kAcknowledged = 7,        // an operator acknowledged the alarm (latched alarm released)
   kBusError = 8,            // CAN bus-off or error-passive
   kInternalFault = 9,       // the monitor's own self-check failed
+  kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
+  kNotCalibrated = 11,      // no trusted sensor offset or initial state yet
 };
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.

@@ -29,6 +29,8 @@ enum class AlarmCause : std::uint8_t {
   kAcknowledged = 7,        // an operator acknowledged the alarm (latched alarm released)
   kBusError = 8,            // the bus reported errors or dropped frames
   kInternalFault = 9,       // the monitor's own self-check failed
+  kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
+  kNotCalibrated = 11,      // no trusted sensor offset or initial state yet: nothing to vouch for
 };
 
 // The names in status and alarm lines (also the DBC's VAL_ names).
@@ -40,7 +42,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 10> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 12> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -51,6 +53,8 @@ inline constexpr NameTable<AlarmCause, 10> kAlarmCauseNames{{{
     {AlarmCause::kAcknowledged, "acknowledged"},
     {AlarmCause::kBusError, "bus_error"},
     {AlarmCause::kInternalFault, "internal_fault"},
+    {AlarmCause::kCollapseForecast, "collapse_forecast"},
+    {AlarmCause::kNotCalibrated, "not_calibrated"},
 }}};
 
 [[nodiscard]] constexpr const char* alarm_level_name(AlarmLevel level) {

@@ -2,12 +2,17 @@
 // state into alarm levels and events for the building's alarm system (CAN AlarmEvent frames,
 // status lines). Levels and causes: alarm_level.h.
 //
-// Conditions, each with on/off thresholds on the risk (hysteresis: the condition starts at
-// risk >= on and ends at risk < off, off < on) and minimum durations (a condition must hold for
+// Conditions, each with on/off thresholds on the risk and on the forecast's probability of a
+// collapse (hysteresis: the condition starts at risk >= on or probability >= on, and ends when
+// both are below their off, off < on) and minimum durations (a condition must hold for
 // raise_hold_s before its level is raised, and be absent for lower_hold_s before it is lowered):
-//   advisory  risk >= advisory.on, or the block is out of full contact (motion started)
-//   warning   risk >= warning.on
-//   alarm     risk >= alarm.on; or a collapse (overturned, fell): alarm at once, no hold, latched
+//   advisory  risk >= advisory.on, probability >= advisory_forecast.on, or the block is out of
+//             full contact (motion started)
+//   warning   risk >= warning.on, or probability >= warning_forecast.on
+//   alarm     risk >= alarm.on, or probability >= alarm_forecast.on; or a collapse (overturned,
+//             fell): alarm at once, no hold, latched
+// The risk is the margin used up now (risk.h), the probability what the forecast says of the
+// next seconds (forecast.h); today's margins running out raise the level whatever the forecast.
 // The condition level is the highest level whose condition is active.
 //
 // Latching: when the condition level rises to warning (latch_warning) or alarm (latch_alarm,
@@ -29,7 +34,8 @@
 // Events: one each time the level shown or its latched flag changes (at most two per update:
 // the acknowledgement is applied first, against what the operator saw, then the new input).
 // Sequence numbers start at 0 and increment by one per event, wrapping 255 -> 0. Cause: why the
-// new level holds (kRiskThreshold, kPhaseChange, kOverturnDetected, the fault's cause), kNone
+// new level holds (kRiskThreshold; kCollapseForecast when the forecast alone holds it;
+// kPhaseChange, kOverturnDetected, the fault's cause), kNone
 // back to normal, kAcknowledged for a change an acknowledgement made.
 //
 // Heartbeat: a status is due every heartbeat_period_s, and at once after an event;
@@ -59,6 +65,11 @@ struct AlarmPolicySettings {
   RiskThresholds advisory{0.1, 0.05};  // also active while the block is out of full contact
   RiskThresholds warning{0.5, 0.4};
   RiskThresholds alarm{0.8, 0.7};
+  // On the forecast's probability of a collapse within its horizon (0 while no forecast has
+  // completed). docs/forecast.md says how these defaults were calibrated.
+  RiskThresholds advisory_forecast{0.2, 0.1};
+  RiskThresholds warning_forecast{0.5, 0.4};
+  RiskThresholds alarm_forecast{0.9, 0.8};
   double raise_hold_s = 0.1;  // s, >= 0: a condition holds this long before its level rises
   double lower_hold_s = 2.0;  // s, >= 0: a condition (or fault) is gone this long before it lowers
   bool latch_warning = true;  // a raised warning holds until acknowledged
@@ -67,8 +78,8 @@ struct AlarmPolicySettings {
 };
 
 // Checks the settings; the Error names the field at fault ("alarm_policy.warning.off", ...).
-// Thresholds: finite, in [0, 1], off < on per level, and ordered across levels (advisory <=
-// warning <= alarm, for on and for off).
+// Thresholds (risk and forecast alike): finite, in [0, 1], off < on per level, and ordered across
+// levels (advisory <= warning <= alarm, for on and for off).
 [[nodiscard]] Error validate(const AlarmPolicySettings& settings);
 
 // An operator's acknowledgement (on the bus: the Acknowledge frame, without its source id).
@@ -80,6 +91,7 @@ struct Acknowledgement {
 struct AlarmInput {
   std::int64_t time_ns = 0;          // monitor time since start, ns
   double risk = 0.0;                 // overturning risk, dimensionless, [0, 1]
+  double probability = 0.0;          // forecast probability of a collapse, [0, 1]
   bool out_of_full_contact = false;  // the block slides or rocks (motion started)
   bool collapse_detected = false;    // the block overturned or fell
   bool fault_active = false;         // sensor or bus trouble
@@ -99,7 +111,7 @@ enum class AckOutcome : std::uint8_t {
 
 enum class InputProblem : std::uint8_t {
   kNone = 0,
-  kRiskInvalid,   // risk not finite or outside [0, 1]: taken as an internal fault
+  kRiskInvalid,   // risk or probability not finite or outside [0, 1]: an internal fault
   kTimeWentBack,  // time earlier than the last update's: the update was refused
 };
 
@@ -193,6 +205,9 @@ class AlarmPolicy {
   detail::HeldCondition alarm_;
   detail::HeldCondition fault_;
   bool collapse_ = false;      // the latest input's collapse_detected
+  // The forecast alone holds the warning / alarm condition (for the cause).
+  bool warning_by_forecast_ = false;
+  bool alarm_by_forecast_ = false;
   bool out_of_contact_ = false;  // the latest input's out_of_full_contact
   AlarmCause fault_cause_ = AlarmCause::kNone;
   AlarmLevel condition_level_ = AlarmLevel::kNormal;
