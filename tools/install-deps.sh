@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libsocketcan-dev user-mode-linux kmod iproute2 can-utils  # SocketCAN, tested in UML
   python3 gnuplot-nox
+  clang-14 libclang-rt-14-dev  # the sanitize preset: ASan + UBSan and libFuzzer (docs/fuzzing.md)
 )
 
 missing=()

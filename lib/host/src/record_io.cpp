@@ -235,7 +235,9 @@ void check_sampling(const Where& where, const Sampling& sampling, std::string_vi
 std::vector<double> read_values(LineReader& reader, std::string_view pending, std::size_t count,
                                 double factor, std::string_view count_key) {
   std::vector<double> values;
-  values.reserve(count);  // bounded by kMaxRecordSamples (check_sampling)
+  // Grown as values come: a header announcing millions of samples reserves no more than this.
+  constexpr std::size_t kReserveAtMost = std::size_t{1} << 16;
+  values.reserve(std::min(count, kReserveAtMost));
   std::string_view line = pending;
   bool have_line = !pending.empty();
   const std::string count_text = std::string(count_key) + "=" + std::to_string(count);
