@@ -2,15 +2,15 @@
 # Runs one libFuzzer target (docs/fuzzing.md) on its seed corpus, with its dictionary, after
 # replaying its regression inputs.
 #
-#   tools/fuzz.sh TARGET [SECONDS]   a long run (default 600 s) of build/sanitize's fuzzer;
-#                                    new inputs accumulate in build/fuzz/TARGET/corpus
+#   tools/fuzz.sh TARGET [SECONDS]   a long run (default 600 s) of build/fuzz's fuzzer;
+#                                    new inputs accumulate in build/fuzz/work/TARGET/corpus
 #   tools/fuzz.sh --list             the targets
 #
 # Options (before TARGET):
-#   --build DIR    the build with PLINTH_FUZZ=ON (default build/sanitize: the sanitize preset)
+#   --build DIR    the build with PLINTH_FUZZ=ON (default build/fuzz: the fuzz preset)
 #   --binary PATH  the fuzzer itself (default DIR/tests/fuzz/fuzz_TARGET)
 #   --runs N       stop after N executions (ctest's short runs: fresh work folder, fixed seed)
-#   --work DIR     new inputs and crash artifacts (default build/fuzz/TARGET)
+#   --work DIR     new inputs and crash artifacts (default build/fuzz/work/TARGET)
 #   --seed N       libFuzzer's seed (default 1)
 #
 # Exit status: 0 when nothing broke; non-zero on a crash, a hang (-timeout), a leak, a sanitizer
@@ -20,7 +20,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 fuzz_dir=$root/tests/fuzz
 
-build=$root/build/sanitize
+build=$root/build/fuzz
 binary=
 runs=
 work=
@@ -47,9 +47,9 @@ seconds=${2:-600}
 [[ $seconds =~ ^[0-9]+$ ]] || { echo "fuzz.sh: SECONDS must be a whole number" >&2; exit 2; }
 binary=${binary:-$build/tests/fuzz/fuzz_$target}
 [ -x "$binary" ] || {
-  echo "fuzz.sh: $binary not built: cmake --preset sanitize && cmake --build --preset sanitize" \
+  echo "fuzz.sh: $binary not built: cmake --preset fuzz && cmake --build --preset fuzz" \
        "--target fuzz_$target" >&2; exit 2; }
-work=${work:-$root/build/fuzz/$target}
+work=${work:-$build/work/$target}
 
 # Per-target options: "max_len = N" in TARGET.options (OSS-Fuzz's layout); 4096 bytes otherwise.
 max_len=4096
