@@ -61,6 +61,7 @@ flags=(-seed="$seed" -max_len="$max_len" -timeout=10 -rss_limit_mb=2048 -print_f
 
 # Every regression input first: each must run through without a report.
 regressions=$fuzz_dir/regressions/$target
+mkdir -p "$(dirname "$work")"
 if [ -d "$regressions" ] && [ -n "$(ls -A "$regressions")" ]; then
   "$binary" -runs=1 "$regressions"/* 2>"$work.regressions.log" || {
     cat "$work.regressions.log" >&2
