@@ -1,5 +1,7 @@
 #include "plinth/host/scene_toml.h"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -7,8 +9,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <ios>
 #include <initializer_list>
 #include <map>
 #include <numbers>
@@ -18,10 +18,9 @@
 #include <system_error>
 #include <utility>
 
-#include <toml++/toml.h>
-
 #include "plinth/core/name_table.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/text_file.h"
 
 namespace plinth::host {
 namespace {
@@ -372,19 +371,7 @@ Scene load_scene_text(const std::string& text, const std::string& origin) {
 }
 
 Scene load_scene_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw InputError(path + ": cannot open scene file (it is a directory)");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open scene file");
-  std::string text;
-  std::array<char, 4096> chunk{};
-  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
-    text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
-  }
-  if (in.bad()) throw InputError(path + ": cannot open scene file (read error)");
-  return load_scene_text(text, path);
+  return load_scene_text(read_text_file(path, kMaxSceneFileBytes, "scene file"), path);
 }
 
 }  // namespace plinth::host
