@@ -4,14 +4,13 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <map>
-#include <sstream>
 #include <utility>
 #include <vector>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/text_file.h"
 
 namespace plinth::firmware {
 
@@ -373,11 +372,10 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
 }
 
 MonitorFile load_monitor_file(const std::string& path, const MonitorConfig& defaults) {
-  std::ifstream in(path);
-  if (!in) throw InputError(cat(path, ": cannot open file"));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return load_monitor_text(text.str(), path, defaults);
+  // Bounded, and a directory, FIFO or device refused rather than read as an empty file.
+  constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;  // 1 MiB
+  return load_monitor_text(host::read_text_file(path, kMaxConfigBytes, "configuration file"), path,
+                           defaults);
 }
 
 void apply_overrides(MonitorFile& file, const MonitorOverrides& o) {

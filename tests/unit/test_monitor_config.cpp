@@ -92,7 +92,29 @@ TEST(MonitorConfigFile, BadInputNamesFileLineAndKey) {
     (void)load_monitor_file("/nowhere/box.toml", MonitorConfig{});
     ADD_FAILURE();
   } catch (const host::InputError& e) {
-    EXPECT_STREQ(e.what(), "/nowhere/box.toml: cannot open file");
+    EXPECT_STREQ(e.what(), "/nowhere/box.toml: cannot open configuration file (no such file)");
+  }
+}
+
+// A directory was read as an empty file (the defaults, silently); /dev/zero grew memory.
+TEST(MonitorConfigFile, DirectoriesAndDevicesAreRefusedUnread) {
+  const std::string message_for_dir = [] {
+    try {
+      (void)load_monitor_file(kSource + "/firmware", MonitorConfig{});
+    } catch (const host::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  }();
+  EXPECT_EQ(message_for_dir,
+            kSource + "/firmware: cannot open configuration file (it is a directory)");
+  try {
+    (void)load_monitor_file("/dev/zero", MonitorConfig{});
+    ADD_FAILURE();
+  } catch (const host::InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "/dev/zero: cannot open configuration file (not a regular file: a FIFO, socket or "
+                 "device)");
   }
 }
 

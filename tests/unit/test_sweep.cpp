@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -130,7 +131,7 @@ TEST(Sweep, RockingOnsetOnTheGroundMatchesEq16) {
   for (const double epsilon : {-0.3, 0.3}) {
     SCOPED_TRACE(epsilon);
     const Scene scene = plinth::testing::make(plinth::testing::paper_block(epsilon));
-    double scale = INFINITY;  // smallest record scale at which some sample reaches Eq 16
+    double scale = std::numeric_limits<double>::infinity();  // smallest record scale at which some sample reaches Eq 16
     for (const double a : record.horizontal) {
       if (a > 0.0) scale = std::min(scale, scene.g * scene.b1 / scene.h / a);
       if (a < 0.0) scale = std::min(scale, scene.g * scene.b2 / scene.h / -a);
@@ -239,7 +240,7 @@ TEST(Sweep, BadInputsSayWhatIsWrong) {
               HasSubstr("--steps: must be at least 1"));
   EXPECT_THAT(input_error_text([] { (void)sweep_values(1.0, 0.1, 5); }),
               HasSubstr("--from 1 is greater than --to 0.1"));
-  EXPECT_THAT(input_error_text([] { (void)sweep_values(NAN, 1.0, 5); }), HasSubstr("--from"));
+  EXPECT_THAT(input_error_text([] { (void)sweep_values(std::numeric_limits<double>::quiet_NaN(), 1.0, 5); }), HasSubstr("--from"));
 
   const SceneParams ground = plinth::testing::paper_block();
   EXPECT_EQ(input_error_text([&] { (void)sweep_scene(ground, SweepParameter::kPeriod, 2.0); }),

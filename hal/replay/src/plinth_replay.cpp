@@ -80,7 +80,7 @@ std::string lowercase_extension(const std::string& path) {
 bool is_candump_log(const std::string& path) { return lowercase_extension(path) == "log"; }
 bool is_record(const std::string& path) {
   const std::string ext = lowercase_extension(path);
-  return ext == "at2" || ext == "csv";
+  return ext == "at2" || ext == "csv" || ext == "asc";  // PEER, CSV, ESM/ITACA
 }
 
 // "NODE:AXIS:PATH" or "NODE:PATH" (axis x).
@@ -151,7 +151,7 @@ std::map<int, plinth::replay::SensorNodeInput> node_inputs(
     }
     if (!is_record(c.path)) {
       const char* expected =
-          c.given_as == "--record" ? ".AT2, .csv or a candump .log" : ".AT2 or .csv";
+          c.given_as == "--record" ? ".AT2, .ASC, .csv or a candump .log" : ".AT2, .ASC or .csv";
       throw InputError(c.given_as + ": " + c.path + ": unknown input format (expected " + expected +
                        ")");
     }
@@ -469,11 +469,12 @@ int main(int argc, char** argv) {
       "(SocketCAN) or into a candump log, in real time"};
   Options opt;
   app.add_option("--record", opt.record_path,
-                 "x axis of --node: a record (.AT2, .csv), or a candump log (.log) to send again")
+                 "x axis of --node: a record (.AT2, .ASC, .csv), or a candump log (.log) to "
+                 "send again")
       ->required();
-  app.add_option("--record-y", opt.record_y_path, "y axis of --node (.AT2, .csv)");
+  app.add_option("--record-y", opt.record_y_path, "y axis of --node (.AT2, .ASC, .csv)");
   app.add_option("--record-z", opt.record_z_path,
-                 "z axis of --node: vertical ground acceleration, positive up (.AT2, .csv)");
+                 "z axis of --node: vertical ground acceleration, positive up (.AT2, .ASC, .csv)");
   app.add_option("--node-record", opt.node_records,
                  "another node's axis: NODE:AXIS:FILE or NODE:FILE (axis x); repeatable")
       ->allow_extra_args(false);

@@ -1,14 +1,13 @@
 #include "plinth/host/scene_toml.h"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <array>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <filesystem>
-#include <fstream>
-#include <ios>
 #include <initializer_list>
 #include <map>
 #include <numbers>
@@ -25,6 +24,7 @@
 #include "plinth/core/ensemble_design.h"
 #include "plinth/core/name_table.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/text_file.h"
 
 namespace plinth::host {
 namespace {
@@ -490,22 +490,6 @@ std::string describe(const std::vector<UncertainKey>& keys, const std::vector<do
   return out;
 }
 
-std::string read_text_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw InputError(path + ": cannot open scene file (it is a directory)");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open scene file");
-  std::string text;
-  std::array<char, 4096> chunk{};
-  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
-    text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
-  }
-  if (in.bad()) throw InputError(path + ": cannot open scene file (read error)");
-  return text;
-}
-
 }  // namespace
 
 Scene UncertainScene::statue(std::span<const double> u) const {
@@ -557,7 +541,7 @@ UncertainScene load_uncertain_scene_text(const std::string& text, const std::str
 }
 
 UncertainScene load_uncertain_scene_file(const std::string& path) {
-  return load_uncertain_scene_text(read_text_file(path), path);
+  return load_uncertain_scene_text(read_text_file(path, kMaxSceneFileBytes, "scene file"), path);
 }
 
 Scene load_scene_text(const std::string& text, const std::string& origin) {
