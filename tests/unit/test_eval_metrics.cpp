@@ -137,11 +137,13 @@ TEST(EvalMetrics, RunsFileRoundTrips) {
   a.scale_g = 0.4;
   a.risk_crossing_s = {10.0, -1.0};
   a.probability_crossing_s = {9.5};
+  a.nominal_risk_crossing_s = {11.0, -1.0};
   EvalRun b = standing(0.125, -1.0);
   b.record = "r.AT2";
   b.scene = "t.toml";
   b.risk_crossing_s = {-1.0, -1.0};
   b.probability_crossing_s = {-1.0};
+  b.nominal_risk_crossing_s = {-1.0, -1.0};
   const std::string path = temp_path("roundtrip.csv");
   std::FILE* f = std::fopen(path.c_str(), "w");
   ASSERT_NE(f, nullptr);
@@ -159,6 +161,7 @@ TEST(EvalMetrics, RunsFileRoundTrips) {
   EXPECT_EQ(t.runs[0].first_shown_s, a.first_shown_s);
   EXPECT_EQ(t.runs[0].risk_crossing_s, a.risk_crossing_s);
   EXPECT_EQ(t.runs[1].probability_crossing_s, b.probability_crossing_s);
+  EXPECT_EQ(t.runs[0].nominal_risk_crossing_s, a.nominal_risk_crossing_s);
   EXPECT_FALSE(t.runs[1].collapsed);
   std::filesystem::remove(path);
 }
@@ -180,24 +183,28 @@ std::string error_reading(const std::string& text) {
 TEST(EvalMetrics, RunsFileErrorsNameTheLineAndColumn) {
   const std::string header =
       "record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,first_advisory_s,"
-      "first_warning_s,first_alarm_s,risk_ge_0.5\n";
+      "first_warning_s,first_alarm_s,risk_ge_0.5,nominal_risk_ge_0.5\n";
   EXPECT_NE(error_reading("").find(":1: not a plinth-eval runs file"), std::string::npos);
   EXPECT_NE(error_reading("a,b\n").find(":1: not a plinth-eval runs file"), std::string::npos);
-  EXPECT_NE(error_reading(header + "r,s,0,0.3,1,nan,1,-1,-1,-1,-1\n")
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,1,nan,1,-1,-1,-1,-1,-1\n")
                 .find(":2: collapse_time_s: expected a finite number, got \"nan\""),
             std::string::npos);
-  EXPECT_NE(error_reading(header + "r,s,0,0.3,1,-1,1,-1,-1,-1,-1\n")
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,1,-1,1,-1,-1,-1,-1,-1\n")
                 .find(":2: collapse_time_s: must be >= 0 exactly when collapsed is 1"),
             std::string::npos);
-  EXPECT_NE(error_reading(header + "r,s,0,0.3,2,-1,1,-1,-1,-1,-1\n")
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,2,-1,1,-1,-1,-1,-1,-1\n")
                 .find(":2: collapsed: expected 0 or 1"),
             std::string::npos);
-  EXPECT_NE(error_reading(header + "r,s,0,0.3,0,-1,1,-1,-1\n").find(":2: expected 11 fields"),
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,0,-1,1,-1,-1\n").find(":2: expected 12 fields"),
             std::string::npos);
-  EXPECT_NE(error_reading(header + "r,s,0,0.3,0,-1,1,-1,-1,-1,-3\n")
+  EXPECT_NE(error_reading(header + "r,s,0,0.3,0,-1,1,-1,-1,-1,-3,-1\n")
                 .find(":2: risk crossing: expected a time >= 0 or -1"),
             std::string::npos);
   EXPECT_NE(error_reading(header + "\"r,s,0\n").find(":2: unterminated quoted field"),
+            std::string::npos);
+  EXPECT_NE(error_reading("record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,"
+                          "first_advisory_s,first_warning_s,first_alarm_s,risk_ge_0.5\n")
+                .find(":1: the nominal_risk_ge_ columns must repeat the risk_ge_ grid"),
             std::string::npos);
   EXPECT_NE(error_reading("record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,"
                           "first_advisory_s,first_warning_s,first_alarm_s,colour\n")

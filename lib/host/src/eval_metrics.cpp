@@ -213,6 +213,10 @@ void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids) {
     line += ",probability_ge_";
     line += format(v);
   }
+  for (double v : grids.risk) {
+    line += ",nominal_risk_ge_";
+    line += format(v);
+  }
   std::fprintf(out, "%s\n", line.c_str());
 }
 
@@ -231,6 +235,7 @@ void write_eval_csv_row(std::FILE* out, const EvalRun& r) {
   for (double t : r.first_shown_s) add(format(t));
   for (double t : r.risk_crossing_s) add(format(t));
   for (double t : r.probability_crossing_s) add(format(t));
+  for (double t : r.nominal_risk_crossing_s) add(format(t));
   std::fprintf(out, "%s\n", line.c_str());
 }
 
@@ -249,16 +254,22 @@ EvalTable read_eval_csv(const std::string& path) {
                        std::string(kFixedColumns[i]) + "\", got \"" + f[i] + "\"");
     }
   }
+  std::vector<double> nominal_grid;
   for (std::size_t i = kFixedColumns.size(); i < f.size(); ++i) {
     double v = 0.0;
     if (grid_value(f[i], "risk_ge_", v) && table.grids.probability.empty()) {
       table.grids.risk.push_back(v);
-    } else if (grid_value(f[i], "probability_ge_", v)) {
+    } else if (grid_value(f[i], "probability_ge_", v) && nominal_grid.empty()) {
       table.grids.probability.push_back(v);
+    } else if (grid_value(f[i], "nominal_risk_ge_", v)) {
+      nominal_grid.push_back(v);
     } else {
       throw InputError(path + ":1: column " + std::to_string(i + 1) + ": unknown column \"" +
                        f[i] + "\"");
     }
+  }
+  if (nominal_grid != table.grids.risk) {
+    throw InputError(path + ":1: the nominal_risk_ge_ columns must repeat the risk_ge_ grid");
   }
   const std::size_t columns = f.size();
   for (std::size_t n = 2; std::getline(in, line); ++n) {
@@ -297,6 +308,9 @@ EvalTable read_eval_csv(const std::string& path) {
     }
     for (std::size_t i = 0; i < table.grids.probability.size(); ++i, ++c) {
       r.probability_crossing_s.push_back(parse_time(f[c], where, "probability crossing"));
+    }
+    for (std::size_t i = 0; i < table.grids.risk.size(); ++i, ++c) {
+      r.nominal_risk_crossing_s.push_back(parse_time(f[c], where, "nominal risk crossing"));
     }
     table.runs.push_back(std::move(r));
   }

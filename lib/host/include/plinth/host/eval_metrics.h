@@ -50,6 +50,8 @@ struct EvalRun {
   // First time each grid threshold was reached (-1: never), same order as the grids.
   std::vector<double> risk_crossing_s;
   std::vector<double> probability_crossing_s;
+  // The nominal statue's reactive risk alone (today's box), on the risk grid.
+  std::vector<double> nominal_risk_crossing_s;
 
   [[nodiscard]] bool quiet() const { return !collapsed && peak_ratio < kQuietPeakRatio; }
   [[nodiscard]] bool near_miss() const { return !collapsed && peak_ratio >= kQuietPeakRatio; }
@@ -127,7 +129,7 @@ struct Choice {
 [[nodiscard]] Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& target);
 
 // CSV: one run per row (header first); the grids are written in the header's column names
-// (risk_ge_0.30, probability_ge_0.556). read_eval_csv checks the header and every field and
+// (risk_ge_0.3, probability_ge_0.5625, nominal_risk_ge_0.3). read_eval_csv checks the header and every field and
 // throws InputError naming the file and line.
 void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids);
 void write_eval_csv_row(std::FILE* out, const EvalRun& run);

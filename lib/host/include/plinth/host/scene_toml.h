@@ -2,12 +2,9 @@
 // docs/scene-format.md; unknown keys and tables are rejected.
 #pragma once
 
-<<<<<<< HEAD
+#include <cstddef>
 #include <cstdint>
 #include <span>
-=======
-#include <cstddef>
->>>>>>> main
 #include <string>
 #include <vector>
 
