@@ -14,6 +14,7 @@
 #include "plinth/host/input_error.h"
 #include "plinth/host/job_runner.h"
 #include "plinth/host/record_io.h"
+#include "plinth/host/run_progress.h"
 #include "plinth/host/scene_toml.h"
 #include "plinth/host/sweep_impulse.h"
 #include "plinth/host/sweep_plan.h"
@@ -67,23 +68,6 @@ struct PlotOptions {
   std::string plot_path;
 };
 
-// "i/N" with 1 <= i <= N.
-void parse_shard(const std::string& text, int& index, int& count) {
-  const auto fail = [&] {
-    return InputError("--shard: expected i/N with 1 <= i <= N, got '" + text + "'");
-  };
-  const std::size_t slash = text.find('/');
-  if (slash == std::string::npos) throw fail();
-  const std::string a = text.substr(0, slash);
-  const std::string b = text.substr(slash + 1);
-  const auto digits = [](const std::string& s) {
-    return !s.empty() && s.size() <= 6 && s.find_first_not_of("0123456789") == std::string::npos;
-  };
-  if (!digits(a) || !digits(b)) throw fail();
-  index = std::stoi(a);
-  count = std::stoi(b);
-  if (count < 1 || index < 1 || index > count) throw fail();
-}
 
 template <typename T>
 T required(const std::optional<T>& value, const char* option, const char* mode) {
@@ -117,7 +101,7 @@ int run_sweep_mode(const Options& opt) {
   require_text(opt.scene_path, "--scene", mode);
   require_text(opt.out_path, "--out", mode);
   plinth::host::JobRun run;
-  parse_shard(opt.shard, run.shard_index, run.shard_count);
+  plinth::host::parse_shard(opt.shard, run.shard_index, run.shard_count);
   run.jobs =
       opt.jobs ? *opt.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   plinth::host::validate(run);
@@ -172,7 +156,7 @@ int run_sweep_mode(const Options& opt) {
     }
   }
 
-  run.stop = plinth::cli::install_stop_handlers();
+  run.stop = plinth::host::install_stop_handlers("plinth-sweep");
   const plinth::cli::SweepOutcome outcome =
       plinth::cli::run_to_file(plan, run, {opt.out_path, opt.fresh});
   if (outcome.interrupted) {

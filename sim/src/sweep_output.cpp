@@ -3,7 +3,6 @@
 #include <unistd.h>
 
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,6 +11,7 @@
 #include <vector>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/run_progress.h"
 
 namespace plinth::cli {
 namespace {
@@ -19,69 +19,6 @@ namespace {
 using plinth::host::InputError;
 using plinth::host::SweepTable;
 
-std::atomic<bool> g_stop_requested{false};
-static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler stores to it");
-
-extern "C" void on_stop_signal(int signal_number) {
-  g_stop_requested.store(true);
-  constexpr char kMessage[] =
-      "\nplinth-sweep: stopping after the simulations under way (again to quit at once)\n";
-  (void)!::write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
-  struct sigaction default_action {};
-  default_action.sa_handler = SIG_DFL;
-  sigaction(signal_number, &default_action, nullptr);
-}
-
-// "[=======>      ] 12/50 rows  6.1 s, about 19 s left" on one terminal line, redrawn at most
-// ten times a second; nothing when stderr is not a terminal.
-class ProgressBar {
- public:
-  ProgressBar(std::size_t total, std::size_t done)
-      : enabled_(::isatty(STDERR_FILENO) == 1 && total > 0),
-        total_(total),
-        resumed_(done),
-        start_(Clock::now()) {
-    draw(done, true);
-  }
-
-  void update(std::size_t done) { draw(done, done == total_); }
-
-  void finish() {
-    if (enabled_ && drawn_) std::fprintf(stderr, "\r%*s\r", 79, "");
-  }
-
- private:
-  using Clock = std::chrono::steady_clock;
-
-  void draw(std::size_t done, bool force) {
-    if (!enabled_) return;
-    const auto now = Clock::now();
-    if (!force && drawn_ && now - last_ < std::chrono::milliseconds(100)) return;
-    last_ = now;
-    drawn_ = true;
-    constexpr std::size_t kWidth = 28;
-    const std::size_t filled = kWidth * done / total_;
-    char bar[kWidth + 1];
-    for (std::size_t k = 0; k < kWidth; ++k) bar[k] = k < filled ? '=' : k == filled ? '>' : ' ';
-    bar[kWidth] = '\0';
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    const std::size_t run = done - resumed_;
-    char left[48] = "";
-    if (run > 0 && done < total_) {
-      std::snprintf(left, sizeof left, ", about %.0f s left",
-                    elapsed / static_cast<double>(run) * static_cast<double>(total_ - done));
-    }
-    std::fprintf(stderr, "\r[%s] %zu/%zu rows  %.1f s%s   ", bar, done, total_, elapsed, left);
-    std::fflush(stderr);
-  }
-
-  bool enabled_;
-  std::size_t total_;
-  std::size_t resumed_;
-  Clock::time_point start_;
-  Clock::time_point last_{};
-  bool drawn_ = false;
-};
 
 // Rows of `path` that belong to this sweep, placed by key ("" elsewhere); nothing when the
 // file is absent, from another sweep, or not a sweep CSV (a note says so).
@@ -125,14 +62,6 @@ std::vector<std::string> resumable_rows(const std::string& path,
 
 }  // namespace
 
-const std::atomic<bool>* install_stop_handlers() {
-  struct sigaction action {};
-  action.sa_handler = on_stop_signal;
-  sigemptyset(&action.sa_mask);
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
-  return &g_stop_requested;
-}
 
 void write_table_file(const SweepTable& table, const std::string& path) {
   const std::string temporary = path + ".tmp";
@@ -185,7 +114,7 @@ SweepOutcome run_to_file(const plinth::host::SweepPlan& plan, plinth::host::JobR
   }
   partial.flush();
 
-  ProgressBar progress(shard.size(), outcome.rows_resumed);
+  plinth::host::ProgressBar progress(shard.size(), outcome.rows_resumed, "rows");
   std::size_t done = outcome.rows_resumed;
   run.on_done = [&](std::size_t i) {
     partial << rows[i] << '\n' << std::flush;

@@ -13,10 +13,6 @@
 
 namespace plinth::cli {
 
-// Installs SIGINT and SIGTERM handlers that raise the returned flag (and restore the default
-// action, so a second signal ends the program at once).
-const std::atomic<bool>* install_stop_handlers();
-
 struct OutputOptions {
   std::string out_path;
   bool fresh = false;  // ignore rows already in the files

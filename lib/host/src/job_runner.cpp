@@ -7,6 +7,23 @@
 
 namespace plinth::host {
 
+void parse_shard(const std::string& text, int& index, int& count) {
+  const auto fail = [&] {
+    return InputError("--shard: expected i/N with 1 <= i <= N, got '" + text + "'");
+  };
+  const std::size_t slash = text.find('/');
+  if (slash == std::string::npos) throw fail();
+  const std::string a = text.substr(0, slash);
+  const std::string b = text.substr(slash + 1);
+  const auto digits = [](const std::string& s) {
+    return !s.empty() && s.size() <= 6 && s.find_first_not_of("0123456789") == std::string::npos;
+  };
+  if (!digits(a) || !digits(b)) throw fail();
+  index = std::stoi(a);
+  count = std::stoi(b);
+  if (count < 1 || index < 1 || index > count) throw fail();
+}
+
 void validate(const JobRun& run) {
   if (run.jobs < 1) {
     throw InputError("--jobs: must be at least 1, got " + std::to_string(run.jobs));

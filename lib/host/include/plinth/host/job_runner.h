@@ -30,6 +30,10 @@ struct JobRun {
   std::function<void(std::size_t index)> on_done;
 };
 
+// Reads --shard's "i/N" (1 <= i <= N) into `index` and `count`; throws InputError naming --shard
+// and the text otherwise.
+void parse_shard(const std::string& text, int& index, int& count);
+
 // Throws InputError naming --jobs on jobs < 1, --shard on a shard i/N outside 1 <= i <= N.
 void validate(const JobRun& run);
 

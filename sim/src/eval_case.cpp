@@ -1,0 +1,170 @@
+#include "eval_case.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <span>
+#include <string>
+
+#include "plinth/core/excitation.h"
+#include "plinth/core/risk.h"
+#include "plinth/core/simulator.h"
+#include "plinth/firmware/monitor.h"
+#include "plinth/host/input_error.h"
+#include "plinth/host/record_sampling.h"
+
+namespace plinth::eval {
+namespace {
+
+namespace fw = firmware;
+using host::EvalRun;
+using host::InputError;
+
+// After the record ends the block may still rock to a collapse: the truth and the box run on
+// this long with the ground at rest.
+constexpr double kFreeRockingTailS = 3.0;
+
+struct Truth {
+  bool collapsed = false;
+  double collapse_time_s = -1.0;
+  double peak_ratio = 0.0;  // max |theta| / alpha of the corner it rocks on
+};
+
+Excitation scaled(const host::Record& record, double gamma) {
+  return Excitation::record(record.horizontal_signal(),
+                            record.vertical.empty() ? SampledSignal{} : record.vertical_signal(),
+                            gamma);
+}
+
+Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& settings) {
+  SolverSettings solver;
+  solver.step = settings.step_s;
+  Simulator sim;
+  const Error e = Simulator::create(*c.true_statue, scaled(*c.record, gamma), solver, sim);
+  if (!e.ok()) {
+    throw InputError(c.scene_name + ", statue " + std::to_string(c.statue) + ": solver: " +
+                     e.field + " " + e.reason);
+  }
+  sim.start_at_rest();
+  const Scene& s = *c.true_statue;
+  const double t_end = c.record->duration() + kFreeRockingTailS;
+  Truth truth;
+  while (sim.time() < t_end - 0.5 * solver.step && !sim.mode().terminal()) {
+    sim.step();
+    const double theta = sim.state()[kTheta];
+    const double ratio = theta >= 0.0 ? theta / s.corner1.critical_angle
+                                      : -theta / s.corner2.critical_angle;
+    truth.peak_ratio = std::max(truth.peak_ratio, ratio);
+  }
+  if (sim.mode().terminal()) {
+    truth.collapsed = true;
+    truth.collapse_time_s = sim.time();
+    truth.peak_ratio = std::max(truth.peak_ratio, 1.0);
+  }
+  return truth;
+}
+
+// The box's configuration for an ideal ground sensor in m/s2 (no bias to track, no noise: the
+// stuck-value check is off), as plinth-monitor --replay sets it for a record.
+fw::MonitorConfig box_config(const BoxSettings& box) {
+  fw::MonitorConfig config;
+  config.estimator.sample_rate_hz = box.rate_hz;
+  config.estimator.steps_per_sample = box.steps_per_sample;
+  config.forecast = box.forecast;
+  config.conditioning.unit = monitor::AccelerationUnit::kMetresPerSecondSquared;
+  config.conditioning.startup_window_s = box.startup_window_s;
+  config.conditioning.tracking_time_constant_s = 1e6;
+  config.sensor_health.stuck_samples = 0;
+  config.sensor_health.full_scale_g = 1e6;
+  config.sensor_health.max_valid_g = 1e6;
+  return config;
+}
+
+// First time each threshold of `grid` was reached by `value`.
+void note_crossings(const std::vector<double>& grid, double value, double t,
+                    std::vector<double>& first) {
+  for (std::size_t i = 0; i < grid.size(); ++i) {
+    if (first[i] < 0.0 && value >= grid[i]) first[i] = t;
+  }
+}
+
+void note_level(monitor::AlarmLevel shown, double t, std::array<double, host::kEvalLevels>& first) {
+  int rank = 0;
+  switch (shown) {
+    case monitor::AlarmLevel::kAdvisory: rank = 1; break;
+    case monitor::AlarmLevel::kWarning: rank = 2; break;
+    case monitor::AlarmLevel::kAlarm: rank = 3; break;
+    case monitor::AlarmLevel::kNormal:
+    case monitor::AlarmLevel::kFault: rank = 0; break;
+  }
+  for (int level = 0; level < rank; ++level) {
+    if (first[static_cast<std::size_t>(level)] < 0.0) first[static_cast<std::size_t>(level)] = t;
+  }
+}
+
+// The box on the case's motion; stops at `stop_s` (the true collapse: what comes after cannot
+// make a hit), else at the end of the record and its tail.
+void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
+             const host::CrossingGrids& grids, double stop_s, EvalRun& run) {
+  const fw::MonitorConfig config = box_config(box);
+  auto monitor = std::make_unique<fw::Monitor>();  // an ensemble is too big for the stack
+  const Error e = monitor->start(config, {std::span<const Scene>(c.scene->members), {}});
+  if (!e.ok()) {
+    throw InputError(c.scene_name + ": the box refuses it: " + e.field + " " + e.reason);
+  }
+  const double rate = box.rate_hz;
+  const std::size_t count = host::sample_count(c.record->duration() + kFreeRockingTailS, rate);
+  const std::vector<double> h = host::resample(c.record->horizontal_signal(), rate, count);
+  const std::vector<double> v = c.record->vertical.empty()
+                                    ? std::vector<double>()
+                                    : host::resample(c.record->vertical_signal(), rate, count);
+  const auto lead_in = static_cast<std::size_t>(std::llround(box.startup_window_s * rate) +
+                                                config.sensor_health.recovery_samples - 1);
+  run.risk_crossing_s.assign(grids.risk.size(), -1.0);
+  run.probability_crossing_s.assign(grids.probability.size(), -1.0);
+  run.nominal_risk_crossing_s.assign(grids.risk.size(), -1.0);
+  const Scene& nominal = c.scene->members.front();
+  for (std::size_t n = 0; n < lead_in + count; ++n) {
+    monitor::SensorSample s;
+    s.receive_time_ns = std::llround(static_cast<double>(n) / rate * 1e9);
+    s.sequence = static_cast<std::uint8_t>(n & 0xFF);
+    const std::size_t k = n - lead_in;
+    s.acceleration_g = n < lead_in ? Eigen::Vector3d(0.0, 0.0, kStandardGravity)
+                                   : Eigen::Vector3d(gamma * h[k], 0.0,
+                                                     kStandardGravity + (v.empty() ? 0.0 : gamma * v[k]));
+    (void)monitor->on_sample(s);
+    if (n < lead_in) continue;
+    const double t = static_cast<double>(k) / rate;
+    if (stop_s >= 0.0 && t >= stop_s) break;
+    const fw::MonitorStatus& status = monitor->status();
+    note_level(status.alarm, t, run.first_shown_s);
+    if (!status.estimating) continue;
+    note_crossings(grids.risk, status.risk, t, run.risk_crossing_s);
+    note_crossings(grids.probability, status.probability, t, run.probability_crossing_s);
+    const PlanarEstimator& est = monitor->estimator(0);
+    note_crossings(grids.risk, overturning_risk(nominal, est.mode(), est.state(), config.risk).total,
+                   t, run.nominal_risk_crossing_s);
+  }
+}
+
+}  // namespace
+
+EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings& truth_settings,
+                 const host::CrossingGrids& grids) {
+  const double peak = c.record->peak_horizontal();
+  if (!(peak > 0.0)) throw InputError(c.record_name + ": the record is all zeros");
+  const double gamma = c.scale_g * kStandardGravity / peak;
+  EvalRun run;
+  run.record = c.record_name;
+  run.scene = c.scene_name;
+  run.statue = c.statue;
+  run.scale_g = c.scale_g;
+  const Truth truth = simulate_truth(c, gamma, truth_settings);
+  run.collapsed = truth.collapsed;
+  run.collapse_time_s = truth.collapse_time_s;
+  run.peak_ratio = truth.peak_ratio;
+  run_box(c, gamma, box, grids, truth.collapse_time_s, run);
+  return run;
+}
+
+}  // namespace plinth::eval

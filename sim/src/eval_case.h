@@ -1,0 +1,46 @@
+// One plinth-eval run: a record at one scale under one true statue. The truth is the solver on
+// the true statue; the box is firmware/monitor's Monitor, started with the scene file's
+// ensemble (the nominal statue and the corners of its [uncertainty]), fed the same motion as
+// an ideal ground sensor at the box's rate after a quiet lead-in, as plinth-monitor --replay
+// feeds it.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "plinth/core/forecast.h"
+#include "plinth/core/scene.h"
+#include "plinth/host/eval_metrics.h"
+#include "plinth/host/record_io.h"
+#include "plinth/host/scene_toml.h"
+
+namespace plinth::eval {
+
+struct BoxSettings {
+  double rate_hz = 200.0;          // the ground sensor's sample rate, Hz
+  int steps_per_sample = 4;        // the estimator's solver steps per sample
+  ForecastSettings forecast;       // forecast.enabled false: the reactive box alone
+  double startup_window_s = 2.0;   // s: the quiet lead-in that estimates the sensor's offset
+};
+
+struct TruthSettings {
+  double step_s = 5e-4;  // s, the solver's fixed step on the true statue
+};
+
+// The case's inputs, shared read-only between threads.
+struct EvalCase {
+  const host::Record* record = nullptr;
+  std::string record_name;  // file name, for the runs file
+  const host::UncertainScene* scene = nullptr;
+  std::string scene_name;
+  int statue = 0;
+  const Scene* true_statue = nullptr;
+  double scale_g = 0.0;  // the record's PGA in this run, g
+};
+
+// The truth and the box's timeline for one case (times from the record's t = 0, s). Throws
+// InputError when the scaled record or the scene cannot be run (naming which).
+[[nodiscard]] host::EvalRun run_case(const EvalCase& c, const BoxSettings& box,
+                                     const TruthSettings& truth, const host::CrossingGrids& grids);
+
+}  // namespace plinth::eval

@@ -1,0 +1,58 @@
+// plinth-eval's report of a runs file: the levels the box showed, today's reactive risk and the
+// ensemble's signals as thresholds move (the ROC), and thresholds calibrated on half of the
+// records and reported on the other half.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "plinth/host/eval_metrics.h"
+
+namespace plinth::eval {
+
+// The calibration's targets per level (the issue's: alarm within 5 % false alarms, warning
+// within 15 %; advisory within 30 %), each with no missed collapse wanted.
+struct CalibrationTargets {
+  host::LevelTarget advisory{0.30, 0};
+  host::LevelTarget warning{0.15, 0};
+  host::LevelTarget alarm{0.05, 0};
+};
+
+struct FoldResult {
+  std::vector<std::string> calibration_records;
+  std::vector<std::string> report_records;
+  host::Choice chosen;           // on the calibration records
+  host::Outcome held_out;        // the same rule on the report records
+};
+
+struct LevelReport {
+  std::string level;
+  host::Outcome shown;     // as the box showed it (its configured thresholds)
+  host::Outcome reactive;  // today's box: the nominal statue's risk at the default threshold
+  std::vector<FoldResult> folds;  // two: calibrated on one half, reported on the other
+  host::Choice all_records;       // the rule chosen on every record (the shipped defaults)
+};
+
+struct Report {
+  std::size_t runs = 0;
+  std::vector<LevelReport> levels;  // advisory, warning, alarm
+};
+
+// The records split in two halves by name (alternately, sorted), the runs of each.
+[[nodiscard]] Report make_report(const host::EvalTable& table, const CalibrationTargets& targets);
+
+// The report as text (stdout) and as JSON.
+[[nodiscard]] std::string report_text(const Report& report, const host::CrossingGrids& grids);
+[[nodiscard]] std::string report_json(const Report& report, const host::CrossingGrids& grids);
+
+// A rule in words: "risk >= 0.8 or probability >= 0.5625".
+[[nodiscard]] std::string describe_rule(const host::Rule& rule, const host::CrossingGrids& grids);
+
+// The ROC as a PNG drawn by gnuplot (Debian gnuplot-nox): median lead against false-alarm rate
+// for the nominal risk, the worst member's risk and the forecast probability alone, each as its
+// threshold moves. gnuplot reads only files of a private temporary folder with fixed names; the
+// image is then moved to `png_path` (no text of the user's reaches gnuplot). Throws InputError
+// when gnuplot is missing or fails.
+void plot_roc(const host::EvalTable& table, const std::string& png_path);
+
+}  // namespace plinth::eval

@@ -1,0 +1,294 @@
+// plinth-eval: how good the box's warning is (docs/forecast.md). Over records x a PGA grid x
+// scenes x true statues drawn inside each scene's declared [uncertainty], the truth from the
+// solver on the true statue against the box's timeline (the scene file's ensemble, nominal
+// first) on the same motion; per alarm level hits, misses, false alarms, near misses, the lead
+// and the ROC; thresholds calibrated on half of the records and reported on the other half.
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "eval_case.h"
+#include "eval_report.h"
+#include "plinth/host/cli.h"
+#include "plinth/host/eval_metrics.h"
+#include "plinth/host/input_error.h"
+#include "plinth/host/job_runner.h"
+#include "plinth/host/record_io.h"
+#include "plinth/host/run_progress.h"
+#include "plinth/host/scene_toml.h"
+#include "plinth/host/units.h"
+
+namespace {
+
+using plinth::host::EvalRun;
+using plinth::host::EvalTable;
+using plinth::host::InputError;
+
+constexpr int kInterruptedExit = 130;  // 128 + SIGINT, as shells report it
+constexpr int kMaxStatues = 1000;
+constexpr int kMaxPgaSteps = 200;
+
+struct RunOptions {
+  std::vector<std::string> scene_paths;
+  std::vector<std::string> record_paths;
+  std::string out_path;
+  std::string pga_from = "0.2g";
+  std::string pga_to = "2.5g";
+  int pga_steps = 12;
+  int statues = 20;
+  unsigned seed = 2026;
+  bool all_scales = false;
+  double rate_hz = 200.0;
+  int steps_per_sample = 4;
+  std::string forecast = "strongest_window";
+  double horizon_s = 4.0;
+  double truth_step_s = 5e-4;
+  std::optional<int> jobs;
+  std::string shard = "1/1";
+};
+
+struct ReportOptions {
+  std::string runs_path;
+  std::string json_path;
+  std::string plot_path;
+};
+
+struct MergeOptions {
+  std::vector<std::string> inputs;
+  std::string out_path;
+};
+
+std::string file_name(const std::string& path) {
+  return std::filesystem::path(path).filename().string();
+}
+
+std::vector<double> pga_grid(const RunOptions& opt) {
+  const double g = plinth::kStandardGravity;
+  const double from = plinth::host::parse_acceleration(opt.pga_from, g, "--pga-from") / g;
+  const double to = plinth::host::parse_acceleration(opt.pga_to, g, "--pga-to") / g;
+  if (!(from > 0.0)) throw InputError("--pga-from: must be above 0 g, got " + opt.pga_from);
+  if (!(to >= from)) throw InputError("--pga-to " + opt.pga_to + " is below --pga-from " + opt.pga_from);
+  if (to > 10.0) throw InputError("--pga-to: at most 10 g, got " + opt.pga_to);
+  if (opt.pga_steps < 1 || opt.pga_steps > kMaxPgaSteps) {
+    throw InputError("--pga-steps: expected 1 to " + std::to_string(kMaxPgaSteps) + ", got " +
+                     std::to_string(opt.pga_steps));
+  }
+  std::vector<double> grid;
+  for (int i = 0; i < opt.pga_steps; ++i) {
+    grid.push_back(opt.pga_steps == 1 ? from : from + (to - from) * i / (opt.pga_steps - 1));
+  }
+  return grid;
+}
+
+plinth::eval::BoxSettings box_settings(const RunOptions& opt) {
+  plinth::eval::BoxSettings box;
+  box.rate_hz = opt.rate_hz;
+  box.steps_per_sample = opt.steps_per_sample;
+  if (opt.forecast == "off") {
+    box.forecast.enabled = false;
+  } else if (!plinth::kContinuationNames.parse(opt.forecast, box.forecast.continuation)) {
+    throw InputError("--forecast: expected strongest_window, recent_window or off, got '" +
+                     opt.forecast + "'");
+  }
+  box.forecast.horizon_s = opt.horizon_s;
+  box.forecast.rate_hz = std::min(box.forecast.rate_hz, opt.rate_hz);
+  return box;
+}
+
+// The true statues of a scene: `count` points drawn uniformly inside its declared ranges (the
+// same statues for every record), each a valid scene.
+std::vector<plinth::Scene> draw_statues(const plinth::host::UncertainScene& scene, int count,
+                                        unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<plinth::Scene> statues;
+  for (int j = 0; j < count; ++j) {
+    std::vector<double> u(scene.uncertain.size());
+    for (double& x : u) x = unit(rng);
+    statues.push_back(scene.statue(u));
+  }
+  return statues;
+}
+
+void write_runs(const std::string& path, const plinth::host::CrossingGrids& grids,
+                const std::vector<std::vector<EvalRun>>& results) {
+  const std::string temporary = path + ".tmp";
+  std::FILE* out = std::fopen(temporary.c_str(), "w");
+  if (out == nullptr) throw InputError(path + ": cannot write (does its folder exist?)");
+  plinth::host::write_eval_csv_header(out, grids);
+  for (const std::vector<EvalRun>& job : results) {
+    for (const EvalRun& run : job) plinth::host::write_eval_csv_row(out, run);
+  }
+  const bool ok = std::fflush(out) == 0 && std::ferror(out) == 0;
+  std::fclose(out);
+  std::error_code ec;
+  if (ok) std::filesystem::rename(temporary, path, ec);
+  if (!ok || ec) {
+    std::filesystem::remove(temporary, ec);
+    throw InputError(path + ": cannot write");
+  }
+}
+
+int run_eval(const RunOptions& opt) {
+  const std::vector<double> pgas = pga_grid(opt);
+  if (opt.statues < 1 || opt.statues > kMaxStatues) {
+    throw InputError("--statues: expected 1 to " + std::to_string(kMaxStatues) + ", got " +
+                     std::to_string(opt.statues));
+  }
+  const plinth::eval::BoxSettings box = box_settings(opt);
+  plinth::eval::TruthSettings truth;
+  truth.step_s = opt.truth_step_s;
+  std::vector<plinth::host::UncertainScene> scenes;
+  std::vector<std::vector<plinth::Scene>> statues;
+  for (std::size_t s = 0; s < opt.scene_paths.size(); ++s) {
+    scenes.push_back(plinth::host::load_uncertain_scene_file(opt.scene_paths[s]));
+    statues.push_back(draw_statues(scenes.back(), opt.statues, opt.seed + 7919U * static_cast<unsigned>(s)));
+  }
+  std::vector<plinth::host::Record> records;
+  for (const std::string& path : opt.record_paths) {
+    records.push_back(plinth::host::read_record(path, plinth::kStandardGravity));
+  }
+  plinth::host::JobRun run;
+  plinth::host::parse_shard(opt.shard, run.shard_index, run.shard_count);
+  run.jobs = opt.jobs ? *opt.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  plinth::host::validate(run);
+  // One job: a record, a scene and a statue over the PGA grid, up to its first collapse.
+  const std::size_t per_record = scenes.size() * static_cast<std::size_t>(opt.statues);
+  const std::size_t job_count = records.size() * per_record;
+  const std::vector<std::size_t> indices = plinth::host::shard_indices(job_count, run);
+  const plinth::host::CrossingGrids grids = plinth::host::default_crossing_grids();
+  std::vector<std::vector<EvalRun>> results(job_count);
+  const auto case_of = [&](std::size_t index, double pga) {
+    const std::size_t r = index / per_record;
+    const std::size_t s = index % per_record / static_cast<std::size_t>(opt.statues);
+    const auto j = static_cast<int>(index % static_cast<std::size_t>(opt.statues));
+    return plinth::eval::EvalCase{&records[r], file_name(opt.record_paths[r]), &scenes[s],
+                                  file_name(opt.scene_paths[s]), j,
+                                  &statues[s][static_cast<std::size_t>(j)], pga};
+  };
+  run.stop = plinth::host::install_stop_handlers("plinth-eval");
+  plinth::host::ProgressBar progress(indices.size(), 0, "cases");
+  std::size_t done = 0;
+  run.on_done = [&](std::size_t) { progress.update(++done); };
+  const auto start = std::chrono::steady_clock::now();
+  const bool finished = plinth::host::run_jobs(
+      indices, run,
+      [&](std::size_t index) {
+        std::vector<EvalRun> job;
+        for (const double pga : pgas) {
+          if (run.stop->load()) throw plinth::host::JobCancelled();
+          job.push_back(plinth::eval::run_case(case_of(index, pga), box, truth, grids));
+          if (job.back().collapsed && !opt.all_scales) break;
+        }
+        results[index] = std::move(job);
+      },
+      [&](std::size_t index) {
+        const plinth::eval::EvalCase c = case_of(index, 0.0);
+        return c.record_name + ", " + c.scene_name + ", statue " + std::to_string(c.statue);
+      });
+  progress.finish();
+  if (!finished) {
+    std::fprintf(stderr, "plinth-eval: stopped; nothing written\n");
+    return kInterruptedExit;
+  }
+  write_runs(opt.out_path, grids, results);
+  std::size_t runs = 0;
+  for (const auto& job : results) runs += job.size();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  std::printf("plinth-eval: %zu runs of %zu cases (shard %d/%d), %d jobs, wall time %.1f s -> %s\n",
+              runs, indices.size(), run.shard_index, run.shard_count, run.jobs, wall,
+              opt.out_path.c_str());
+  return 0;
+}
+
+int run_report(const ReportOptions& opt) {
+  const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
+  if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
+  const plinth::eval::Report report = plinth::eval::make_report(table, {});
+  std::fputs(plinth::eval::report_text(report, table.grids).c_str(), stdout);
+  if (!opt.json_path.empty()) {
+    const std::string temporary = opt.json_path + ".tmp";
+    std::FILE* out = std::fopen(temporary.c_str(), "w");
+    if (out == nullptr) throw InputError(opt.json_path + ": cannot write (does its folder exist?)");
+    std::fputs(plinth::eval::report_json(report, table.grids).c_str(), out);
+    const bool ok = std::fclose(out) == 0;
+    std::error_code ec;
+    if (ok) std::filesystem::rename(temporary, opt.json_path, ec);
+    if (!ok || ec) throw InputError(opt.json_path + ": cannot write");
+  }
+  if (!opt.plot_path.empty()) plinth::eval::plot_roc(table, opt.plot_path);
+  return 0;
+}
+
+int run_merge(const MergeOptions& opt) {
+  EvalTable merged;
+  for (std::size_t i = 0; i < opt.inputs.size(); ++i) {
+    EvalTable part = plinth::host::read_eval_csv(opt.inputs[i]);
+    if (i == 0) {
+      merged.grids = part.grids;
+    } else if (part.grids.risk != merged.grids.risk ||
+               part.grids.probability != merged.grids.probability) {
+      throw InputError(opt.inputs[i] + ": its threshold columns differ from " + opt.inputs[0] +
+                       "'s (another plinth-eval version)");
+    }
+    for (EvalRun& r : part.runs) merged.runs.push_back(std::move(r));
+  }
+  write_runs(opt.out_path, merged.grids, {merged.runs});
+  std::printf("plinth-eval merge: %zu runs from %zu files -> %s\n", merged.runs.size(),
+              opt.inputs.size(), opt.out_path.c_str());
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using plinth::host::kFinitePositive;
+  CLI::App app{"plinth-eval: the box's warning measured against the solver's truth (docs/forecast.md)"};
+  app.require_subcommand(1);
+  RunOptions opt;
+  CLI::App* run = app.add_subcommand("run", "run the cases and write one row per run");
+  run->add_option("--scene", opt.scene_paths, "scene files with their [uncertainty] (repeat)")
+      ->required();
+  run->add_option("--record", opt.record_paths, "records: AT2, ESM or CSV (repeat)")->required();
+  run->add_option("--out", opt.out_path, "runs CSV")->required();
+  run->add_option("--pga-from", opt.pga_from, "smallest PGA of the grid (default 0.2g)");
+  run->add_option("--pga-to", opt.pga_to, "largest PGA of the grid (default 2.5g)");
+  run->add_option("--pga-steps", opt.pga_steps, "PGA grid points (default 12)");
+  run->add_option("--statues", opt.statues, "true statues per scene (default 20)");
+  run->add_option("--seed", opt.seed, "seed of the statues' draw (default 2026)");
+  run->add_flag("--all-scales", opt.all_scales, "go on past a case's first collapse");
+  run->add_option("--rate", opt.rate_hz, "the box's sample rate, Hz (default 200)")
+      ->check(kFinitePositive);
+  run->add_option("--steps", opt.steps_per_sample, "the box's solver steps per sample (default 4)");
+  run->add_option("--forecast", opt.forecast,
+                  "strongest_window, recent_window or off (default strongest_window)");
+  run->add_option("--horizon", opt.horizon_s, "forecast horizon, s (default 4)")
+      ->check(kFinitePositive);
+  run->add_option("--truth-step", opt.truth_step_s, "the truth's solver step, s (default 5e-4)")
+      ->check(kFinitePositive);
+  run->add_option("--jobs", opt.jobs, "threads (default: the hardware's)");
+  run->add_option("--shard", opt.shard, "run only part i of N of the cases, as i/N");
+  ReportOptions report;
+  CLI::App* report_command = app.add_subcommand("report", "levels, ROC and calibration of a runs CSV");
+  report_command->add_option("runs", report.runs_path, "a plinth-eval runs CSV")->required();
+  report_command->add_option("--json", report.json_path, "also write the report as JSON");
+  report_command->add_option("--plot", report.plot_path, "also draw the ROC as a PNG");
+  MergeOptions merge;
+  CLI::App* merge_command = app.add_subcommand("merge", "join the runs CSVs of shards");
+  merge_command->add_option("--out", merge.out_path, "merged CSV")->required();
+  merge_command->add_option("inputs", merge.inputs, "the shards' CSV files")->required();
+  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+    return *exit_code;
+  }
+  return plinth::host::run_tool("plinth-eval", [&] {
+    if (report_command->parsed()) return run_report(report);
+    if (merge_command->parsed()) return run_merge(merge);
+    return run_eval(opt);
+  });
+}
