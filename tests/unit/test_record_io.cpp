@@ -110,6 +110,28 @@ INSTANTIATE_TEST_SUITE_P(
       return name;
     });
 
+// plinth-eval's records from other earthquakes (sim/data/records/eval/SOURCES.md).
+INSTANTIATE_TEST_SUITE_P(
+    SimDataEvalRecords, BundledRecordTest,
+    ::testing::Values(
+        BundledRecord{"eval/RSN547_CHALFANT.B_B-ZAK270.AT2", "Chalfant Valley-01, 7/20/1986, Zack Brothers Ranch, 270", 7973, 0.005, 0.2719, 3.78},
+        BundledRecord{"eval/RSN407_COALINGA_D-OLC270.AT2", "Coalinga-05, 7/22/1983, Oil City, 270", 4248, 0.005, 0.8412, 3.73},
+        BundledRecord{"eval/RSN1605_DUZCE_DZC270.AT2", "Duzce Turkey, 11/12/1999, Duzce, 270", 5177, 0.005, 0.5150, 3.42},
+        BundledRecord{"eval/RSN183_IMPVALL.H_H-E08140.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #8, 140", 7554, 0.005, 0.6101, 5.67},
+        BundledRecord{"eval/RSN1158_KOCAELI_DZC270.AT2", "Kocaeli Turkey, 8/17/1999, Duzce, 270", 5437, 0.005, 0.3642, 9.14},
+        BundledRecord{"eval/RSN231_MAMMOTH.I_I-LUL000.AT2", "Mammoth Lakes-01, 5/25/1980, Long Valley Dam (Upr L Abut), 0", 5999, 0.005, 0.4303, 10.26},
+        BundledRecord{"eval/RSN983_NORTHR_JGB292.AT2", "Northridge-01, 1/17/1994, Jensen Filter Plant Generator Building, 292", 5727, 0.005, 0.9949, 6.71},
+        BundledRecord{"eval/RSN4107_PARK2004_COW360.AT2", "Parkfield-02 CA, 9/28/2004, Parkfield - Fault Zone 1, 360", 4195, 0.005, 0.8332, 3.60},
+        BundledRecord{"eval/RSN723_SUPER.B_B-PTS225.AT2", "Superstition Hills-02, 11/24/1987, Parachute Test Site, 225", 2235, 0.01, 0.4318, 12.59},
+        BundledRecord{"eval/RSN700_WHITTIER.A_A-TAR090.AT2", "Whittier Narrows-01, 10/1/1987, Tarzana - Cedar Hill, 90", 7998, 0.005, 0.5988, 6.97}),
+    [](const ::testing::TestParamInfo<BundledRecord>& param_info) {
+      std::string name = std::filesystem::path(param_info.param.file).stem().string();
+      for (char& c : name) {
+        if (std::isalnum(static_cast<unsigned char>(c)) == 0) c = '_';
+      }
+      return name;
+    });
+
 TEST(BundledRecords, BrienzaFirstAndLastValuesConvertFromG) {
   const Record record = read_at2(kRecordsDir + "irpinia1980_brienza_000.AT2", kGravity);
   ASSERT_EQ(record.horizontal.size(), 12064U);
