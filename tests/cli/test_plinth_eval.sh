@@ -1,0 +1,109 @@
+#!/usr/bin/env bash
+# plinth-eval run as a user would (docs/forecast.md), kept short: a small run writes one row
+# per case and scale up to each case's first collapse, shards merged hold the same rows, the
+# report counts what the rows say (recounted here from the CSV), its JSON parses, the ROC is
+# drawn (or a missing gnuplot is named), and bad inputs end with exit code 1 or 2 and a
+# message naming the problem. Prints "ok - <name>" or "not ok - <name>: <why>" per check, then
+# "N passed, M failed".
+#
+# Environment: PLINTH_EVAL, the plinth-eval binary; PLINTH_SOURCE_DIR, the repository root.
+set -u
+
+PLINTH_SIM=${PLINTH_EVAL:-}
+# shellcheck source=tests/cli/harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
+EVAL=$SIM
+EVAL_SCENES=$SRC/sim/scenes/eval
+RECORDS=(--record "$AT2" --record "$SRC/sim/data/records/eval/RSN1605_DUZCE_DZC270.AT2")
+CASES=(--scene "$EVAL_SCENES/isolated.toml" --scene "$EVAL_SCENES/ground-slender.toml"
+  "${RECORDS[@]}" --pga-steps 4 --jobs 2)
+SMALL=("${CASES[@]}" --statues 2 --pga-from 0.3g --pga-to 1.5g)
+
+# ok_if NAME CONDITION...: passes when the command CONDITION succeeds.
+ok_if() {
+  local name=$1
+  shift
+  if "$@"; then pass "$name"; else fail "$name" "$(head -c 300 "$TMP/stderr")"; fi
+}
+
+expect_success "a small run" run "${SMALL[@]}" --out all.csv
+mv "$TMP/stdout" run.txt
+# Each case (2 records x 2 scenes x 2 statues) has rows up to its first collapse only.
+ok_if "rows stop at each case's first collapse" python3 - all.csv <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+cases = {}
+for r in rows:
+    cases.setdefault((r["record"], r["scene"], r["statue"]), []).append(r)
+assert len(cases) == 8, len(cases)
+for key, rs in cases.items():
+    scales = [float(r["scale_g"]) for r in rs]
+    assert scales == sorted(scales) and scales[0] == 0.3, scales
+    collapsed = [r["collapsed"] == "1" for r in rs]
+    assert all(not c for c in collapsed[:-1]), key
+    assert collapsed[-1] or len(rs) == 4, key
+    for r in rs:
+        if r["collapsed"] == "1":
+            assert float(r["collapse_time_s"]) > 0 and float(r["peak_ratio"]) >= 1
+PY
+
+expect_success "shard 1/2" run "${SMALL[@]}" --shard 1/2 --out s1.csv
+expect_success "shard 2/2" run "${SMALL[@]}" --shard 2/2 --out s2.csv
+expect_success "merge" merge --out merged.csv s1.csv s2.csv
+ok_if "the shards hold the runs of the whole" \
+  bash -c 'diff <(tail -n +2 all.csv | sort) <(tail -n +2 merged.csv | sort) >/dev/null'
+
+expect_success "report" report all.csv --json report.json
+mv "$TMP/stdout" report.txt
+ok_if "the report's alarm counts are the rows'" python3 - all.csv report.json <<'PY'
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+report = json.load(open(sys.argv[2]))
+assert report["runs"] == len(rows)
+alarm = [l for l in report["levels"] if l["level"] == "alarm"][0]["shown"]
+collapses = [r for r in rows if r["collapsed"] == "1"]
+quiet = [r for r in rows if r["collapsed"] == "0" and float(r["peak_ratio"]) < 0.5]
+hits = [r for r in collapses
+        if 0 <= float(r["first_alarm_s"]) < float(r["collapse_time_s"])]
+false_alarms = [r for r in quiet if float(r["first_alarm_s"]) >= 0]
+assert alarm["collapses"] == len(collapses), (alarm, len(collapses))
+assert alarm["hits"] == len(hits) and alarm["misses"] == len(collapses) - len(hits)
+assert alarm["quiet_runs"] == len(quiet) and alarm["false_alarms"] == len(false_alarms)
+PY
+ok_if "the report names the two folds" grep -q "fold 2: chosen" report.txt
+
+if command -v gnuplot >/dev/null 2>&1; then
+  expect_success "the ROC as a PNG" report all.csv --plot roc.png
+  ok_if "the PNG is a PNG" bash -c '[[ "$(head -c 4 roc.png | tail -c 3)" == PNG ]]'
+  # A file name that would be gnuplot code if it reached gnuplot: it does not.
+  hostile=$'x\'\nsystem "touch pwned"\n#.png'
+  expect_success "a hostile plot name is only a name" report all.csv --plot "$hostile"
+  ok_if "no command ran" test ! -e pwned
+  ok_if "the hostile name holds the PNG" test -s "$hostile"
+else
+  expect_failure "a missing gnuplot is named" "gnuplot" -- report all.csv --plot roc.png
+fi
+
+expect_failure "no scene" "--scene" -- run --record "$AT2" --out x.csv
+expect_failure "a scene that is not there" "nothing.toml" -- run --scene nothing.toml \
+  "${RECORDS[@]}" --out x.csv
+expect_failure "a PGA grid upside down" "--pga-to.*below --pga-from" -- run "${CASES[@]}" \
+  --statues 2 --pga-from 1g --pga-to 0.5g --out x.csv
+expect_failure "a PGA of zero" "--pga-from: must be above 0" -- run "${CASES[@]}" \
+  --statues 2 --pga-from 0g --out x.csv
+expect_failure "a PGA without a unit" "--pga-from" -- run "${CASES[@]}" --statues 2 \
+  --pga-from 0.3 --out x.csv
+expect_failure "too many statues" "--statues: expected 1 to 1000" -- run "${CASES[@]}" \
+  --statues 0 --out x.csv
+expect_failure "an unknown forecaster" "--forecast: expected" -- run "${SMALL[@]}" \
+  --forecast crystal_ball --out x.csv
+expect_failure "a bad shard" "--shard" -- run "${SMALL[@]}" --shard 3/2 --out x.csv
+expect_failure "an output folder that does not exist" "cannot write" -- run "${SMALL[@]}" \
+  --out /nonexistent/x.csv
+printf 'record,scene\n' >bad.csv
+expect_failure "a runs file that is not one" "bad.csv:1" -- report bad.csv
+expect_failure "merging files of other grids" "threshold columns differ" -- merge --out m.csv \
+  all.csv <(head -1 all.csv | sed 's/risk_ge_0.05,//; s/nominal_risk_ge_0.05,//')
+
+echo "$PASSED passed, $FAILED failed"
+((FAILED == 0))
