@@ -108,12 +108,18 @@ TEST(EvalMetrics, RocCoversEverySignalAloneAndEveryPair) {
 TEST(EvalMetrics, ChoosesTheLongestLeadWithinTheTarget) {
   const CrossingGrids grids{{0.2, 0.5, 0.8}, {0.5, 1.0}};
   const std::vector<RocPoint> points = roc(roc_runs(), grids);
-  // Within 0 false alarms and 0 misses: risk 0.8 misses one; probability 1.0 misses one;
-  // "risk 0.8 or probability 1.0": misses one too. Nothing meets it: the fewest misses with
-  // no false alarm (1), longest lead among them.
+  // Within 0 false alarms and 0 misses: nothing; the rules without a false alarm all miss one.
+  // Safety first: of the rules that miss none, the fewest false alarms (one in two), then the
+  // longest lead: "probability 0.5" (leads 6 and 7).
   Choice c = choose_rule(points, {0.0, 0});
   ASSERT_TRUE(c.found);
   EXPECT_FALSE(c.meets_target);
+  EXPECT_EQ(c.point.outcome.misses, 0);
+  EXPECT_EQ(c.point.outcome.false_alarms, 1);
+  EXPECT_DOUBLE_EQ(c.point.outcome.lead_quantile(0.5), 6.5);
+  // Allowing a miss but no false alarm: the fewest misses within the rate, then the lead.
+  c = choose_rule(points, {0.0, 1});
+  ASSERT_TRUE(c.meets_target);
   EXPECT_EQ(c.point.outcome.false_alarms, 0);
   EXPECT_EQ(c.point.outcome.misses, 1);
   // Allowing one false alarm in two: "probability 0.5" (leads 6 and 7) beats the others.

@@ -165,34 +165,38 @@ std::vector<RocPoint> roc(const std::vector<EvalRun>& runs, const CrossingGrids&
 }
 
 Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& target) {
-  Choice best;
-  // Ranks: within the rate and the misses; within the rate, fewest misses; lowest rate.
+  // Safety first: 0 meets both; 1 misses no more than allowed, too many false alarms; 2 within
+  // the rate, more misses; 3 neither.
   const auto rank = [&](const Outcome& o) {
-    if (o.false_alarm_rate() > target.max_false_alarm_rate) return 2;
-    return o.misses <= target.max_misses ? 0 : 1;
+    const bool misses_ok = o.misses <= target.max_misses;
+    const bool rate_ok = o.false_alarm_rate() <= target.max_false_alarm_rate;
+    return misses_ok ? (rate_ok ? 0 : 1) : (rate_ok ? 2 : 3);
   };
+  const auto lead = [](const Outcome& o) { return o.lead_quantile(0.5); };
+  Choice best;
   for (const RocPoint& p : points) {
+    const int ra = rank(p.outcome);
     if (!best.found) {
-      best = {true, rank(p.outcome) == 0, p};
+      best = {true, ra == 0, p};
       continue;
     }
     const Outcome& a = p.outcome;
     const Outcome& b = best.point.outcome;
-    const int ra = rank(a);
     const int rb = rank(b);
     bool better = false;
     if (ra != rb) {
       better = ra < rb;
     } else if (ra == 0) {
-      const double la = a.lead_quantile(0.5);
-      const double lb = b.lead_quantile(0.5);
-      better = la > lb || (la == lb && a.false_alarm_rate() < b.false_alarm_rate());
+      better = lead(a) > lead(b) ||
+               (lead(a) == lead(b) && a.false_alarm_rate() < b.false_alarm_rate());
     } else if (ra == 1) {
-      better = a.misses < b.misses ||
-               (a.misses == b.misses && a.lead_quantile(0.5) > b.lead_quantile(0.5));
-    } else {
       better = a.false_alarm_rate() < b.false_alarm_rate() ||
-               (a.false_alarm_rate() == b.false_alarm_rate() && a.misses < b.misses);
+               (a.false_alarm_rate() == b.false_alarm_rate() && lead(a) > lead(b));
+    } else if (ra == 2) {
+      better = a.misses < b.misses || (a.misses == b.misses && lead(a) > lead(b));
+    } else {
+      better = a.misses < b.misses ||
+               (a.misses == b.misses && a.false_alarm_rate() < b.false_alarm_rate());
     }
     if (better) best = {true, ra == 0, p};
   }

@@ -118,9 +118,9 @@ struct LevelTarget {
   int max_misses = 0;  // tried first; relaxed upward when no rule meets both
 };
 // The rule that meets the target with the longest median lead (ties: the lower false-alarm
-// rate). Among rules that miss at most max_misses collapses and stay within the false-alarm
-// rate; when none does, the one with the fewest misses within the rate; when none stays within
-// the rate, the one with the lowest rate. `found` false only without runs or rules.
+// rate). When none does, safety first: among the rules that miss at most max_misses collapses,
+// the lowest false-alarm rate; when none misses that few, the fewest misses (within the rate
+// if any rule is). `found` false only without runs or rules.
 struct Choice {
   bool found = false;
   bool meets_target = false;
