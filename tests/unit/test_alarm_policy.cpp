@@ -15,9 +15,16 @@ namespace {
 
 constexpr std::int64_t kMs = 1'000'000;  // ns
 
-// Settings with no holds and no latches: levels follow the thresholds at once.
+// Settings with no holds and no latches: levels follow the thresholds at once. The thresholds
+// are the tests' own (the defaults are calibrated, docs/forecast.md, and may move).
 AlarmPolicySettings immediate() {
   AlarmPolicySettings s;
+  s.advisory = {0.1, 0.05};
+  s.warning = {0.5, 0.4};
+  s.alarm = {0.8, 0.7};
+  s.advisory_forecast = {0.2, 0.1};
+  s.warning_forecast = {0.5, 0.4};
+  s.alarm_forecast = {0.9, 0.8};
   s.raise_hold_s = 0.0;
   s.lower_hold_s = 0.0;
   s.latch_warning = false;
@@ -100,7 +107,7 @@ TEST(AlarmPolicySettings, DefaultsAreValidAndThresholdsAreChecked) {
   s.advisory.on = std::numeric_limits<double>::quiet_NaN();
   expect_refused(s, "alarm_policy.advisory.on", ErrorCode::kNotFinite);
   s = {};
-  s.warning.on = 0.85;  // above alarm.on 0.8
+  s.warning.on = 0.85;  // above alarm.on
   expect_refused(s, "alarm_policy.alarm.on", ErrorCode::kInconsistent);
   s = {};
   s.advisory.off = 0.09;  // just below its on, 0.1
@@ -108,7 +115,7 @@ TEST(AlarmPolicySettings, DefaultsAreValidAndThresholdsAreChecked) {
   s.warning = {0.5, 0.04};  // off below advisory.off 0.09
   expect_refused(s, "alarm_policy.warning.off", ErrorCode::kInconsistent);
   s = {};
-  s.warning_forecast = {0.95, 0.4};  // above alarm_forecast.on 0.9
+  s.warning_forecast = {0.95, 0.4};  // above alarm_forecast.on
   expect_refused(s, "alarm_policy.alarm_forecast.on", ErrorCode::kInconsistent);
   s = {};
   s.advisory_forecast.off = 0.2;  // equal to its on

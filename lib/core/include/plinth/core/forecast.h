@@ -53,7 +53,7 @@ inline constexpr NameTable<Continuation, 2> kContinuationNames{{{
 
 struct ForecastSettings {
   bool enabled = true;
-  Continuation continuation = Continuation::kStrongestWindow;
+  Continuation continuation = Continuation::kRecentWindow;  // docs/forecast.md: it won
   double horizon_s = 4.0;   // s, (0, 10]: how far ahead
   double window_s = 2.0;    // s: the measured motion repeated, at least 0.5 s
   double growth = 1.0;      // the continuation is the window times this, in [0.5, 4]
