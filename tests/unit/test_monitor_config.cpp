@@ -30,11 +30,30 @@ TEST(MonitorConfigFile, TheExampleSetsEveryField) {
   EXPECT_EQ(f.config.conditioning.sensor_to_statue(1, 0), 1.0);
   EXPECT_EQ(f.config.conditioning.startup_window_s, 10.0);
   EXPECT_EQ(f.config.alarm.warning.on, 0.5);
-  EXPECT_EQ(f.config.alarm.alarm.off, 0.7);
+  EXPECT_EQ(f.config.alarm.alarm.off, 0.55);
+  EXPECT_EQ(f.config.alarm.alarm_forecast.on, 0.375);
+  EXPECT_EQ(f.config.forecast.continuation, Continuation::kRecentWindow);
+  EXPECT_EQ(f.config.forecast.work_steps_per_s, 200000.0);
   EXPECT_EQ(f.config.sensor_health.max_valid_g, 8.192);
   EXPECT_EQ(f.config.status_interval_s, 0.1);
   EXPECT_EQ(f.config.axis_count, 1);
   EXPECT_TRUE(f.second_scene_path.empty());
+}
+
+TEST(MonitorConfigFile, TheForecastsKeys) {
+  const MonitorFile f = load_monitor_text(
+      "[forecast]\nenabled = false\ncontinuation = \"strongest_window\"\nhorizon_s = 3\n"
+      "[alarm_policy]\nalarm_forecast = { on = 0.6, off = 0.5 }\n",
+      "/etc/plinth/box.toml", MonitorConfig{});
+  EXPECT_FALSE(f.config.forecast.enabled);
+  EXPECT_EQ(f.config.forecast.continuation, Continuation::kStrongestWindow);
+  EXPECT_EQ(f.config.forecast.horizon_s, 3.0);
+  EXPECT_EQ(f.config.alarm.alarm_forecast.on, 0.6);
+  EXPECT_EQ(f.config.alarm.alarm_forecast.off, 0.5);
+  EXPECT_NE(error_of("[forecast]\ncontinuation = \"crystal_ball\"\n")
+                .find("box.toml:2: forecast.continuation: expected \"recent_window\" or "
+                      "\"strongest_window\""),
+            std::string::npos);
 }
 
 TEST(MonitorConfigFile, ValuesOverTheDefaults) {
