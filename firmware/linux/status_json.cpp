@@ -115,9 +115,11 @@ std::string frame_counters(const FrameCounters& f) {
       .count("other_nodes", f.other_nodes)
       .count("heartbeats", f.heartbeats)
       .count("acknowledgements", f.acknowledgements)
+      .count("monitor_frames", f.monitor_frames)
       .count("rejected", f.rejected)
       .count("unknown_identifiers", f.unknown_identifiers)
       .text("last_error", can::codec_error_text(f.last_error))
+      .count("not_encoded", f.not_encoded)
       .close();
 }
 

@@ -101,6 +101,35 @@ assert s["max_risk"] > 0.0, s
     if [[ -z "$problem" ]]; then pass "candump log replay: every frame a sample, none missing"
     else fail "candump log replay" "$problem"; fi
   fi
+  # Another box's CollapseForecast frames in the log (0x350 + axis): two valid ones counted as
+  # monitor frames, a probability above 1 and a worst member beyond the members rejected; the
+  # status lines carry the forecast (probability, collapse_forecast_t, members, worst_member).
+  python3 - "$log" "$TMP/forecast.log" <<'PY'
+import sys
+lines = open(sys.argv[1]).read().splitlines()
+iface = lines[0].split()[1]
+t = float(lines[len(lines) // 2].split()[0].strip("()"))
+extra = ["351#C90D0C11290928FE", "350#0000FF09FFFF6400", "350#1127000100000000",
+         "351#E803050364002800"]
+out = lines[: len(lines) // 2 + 1] + ["(%.6f) %s %s" % (t, iface, f) for f in extra]
+open(sys.argv[2], "w").write("\n".join(out + lines[len(lines) // 2 + 1:]) + "\n")
+PY
+  if expect_success "candump log with CollapseForecast frames" --scene "$ISOLATED" \
+      --replay "$TMP/forecast.log" --rate 344.8275862068966 --startup-window 1 \
+      --status-interval 1 --stuck-samples 0; then
+    problem=$(check_output "$TMP/stdout" '
+s = summary[0]
+f = s["frames"]
+assert f["sensor_samples"] == '"$frames"' and f["monitor_frames"] == 2 and f["rejected"] == 2, f
+assert f["not_encoded"] == 0, f
+assert all(0.0 <= x["probability"] <= 1.0 for x in status), status[-1]
+assert all(x["collapse_forecast_t"] is None or x["collapse_forecast_t"] >= 0.0 for x in status)
+assert all(x["state"]["members"] == 1 and x["state"]["worst_member"] == 0 for x in status)
+')
+    if [[ -z "$problem" ]]; then
+      pass "candump log: CollapseForecast frames counted or rejected, forecast in the status"
+    else fail "candump log: CollapseForecast frames" "$problem"; fi
+  fi
   # Two ground sensors (node 2: node 1's frames 0.5 ms later); node 1 falls silent at 60 % of
   # the log: the estimators fail over to node 2 and continue, the summary reports each sensor.
   python3 - "$log" "$TMP/two.log" <<'PY'

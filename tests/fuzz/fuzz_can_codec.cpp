@@ -37,6 +37,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     round_trip<can::MonitorStatus>(frame);
     round_trip<can::AlarmEvent>(frame);
     round_trip<can::Acknowledge>(frame);
+    round_trip<can::CollapseForecast>(frame);
   }
   return 0;
 }

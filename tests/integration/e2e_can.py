@@ -33,10 +33,13 @@ ACCEL_ID = 0x300 + SENSOR_NODE
 HEARTBEAT_ID = 0x310 + SENSOR_NODE
 STATUS_IDS = (0x320, 0x321)
 ALARM_ID = 0x330
+FORECAST_IDS = (0x350, 0x351)  # CollapseForecast, with each status while forecasting
+NO_COLLAPSE_MS = 65535  # CollapseIn: none forecast
 PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "fell"]
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
-          "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault"]
+          "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
+          "collapse_forecast", "not_calibrated"]
 SCENARIOS = ("main", "stop", "garbage", "burst")
 # Sent by canplayer in the garbage case, each one refused by the DBC (or not for the monitor).
 GARBAGE = (
@@ -46,7 +49,9 @@ GARBAGE = (
     "320#00F0000000000000", "320#0600000000000000",  # MonitorStatus: bits 12-15; phase 6
     "320#0000112700000000", "320#0000000000000001",  # risk 10001 (> 1); bits 56-63
     "330#0000FE0000000000", "330#0500000000000000",  # AlarmEvent: bits 17-23; level 5
-    "330#000A000000000000",  # cause 10
+    "330#000C000000000000",  # cause 12
+    "350#1127000100000000", "351#E803050364002800",  # CollapseForecast: probability 10001;
+    "350#0000110100000000",  # worst member 5 of 3 members; worst member 17
     "340#F000000000000000", "340#00",  # Acknowledge: bits 4-7; short
     "300#0000000000000000", "322#0000000000000000", "35A#11", "37F#", "331#00", "341#00",  # unknown
     "301#R", "00000301#00000000A00F0000",  # RTR, extended: the kernel filter keeps them away
@@ -146,14 +151,17 @@ class Signal:
         self.factor, self.offset = factor, offset
         self.raw_min = round((minimum - offset) / factor)
         self.raw_max = round((maximum - offset) / factor)
-        self.values = None  # the VAL_ table's raw values, for an enumeration
+        # The VAL_ table's raw values: an enumeration's (its whole range), or a quantity's
+        # special value outside its range (255 "none")
+        self.values = None
         self.reserved_mask = 0  # flag bits the comment reserves ("bits 4-7 reserved, must be 0")
 
 
 class Dbc:
     """The messages of plinth.dbc, read from the file itself, and a decoder that refuses what
-    the DBC makes invalid: a length other than the message's, raw values outside [min|max] or
-    missing from a VAL_ table, bits no signal covers, flag bits a comment reserves."""
+    the DBC makes invalid: a length other than the message's, raw values outside [min|max] and
+    missing from the signal's VAL_ table (an enumeration's table is its range; a quantity's
+    names a special value outside it), bits no signal covers, flag bits a comment reserves."""
 
     def __init__(self, path):
         self.messages = {}  # id -> (name, length, [Signal])
@@ -205,15 +213,26 @@ class Dbc:
             raw = (word >> s.start) & mask
             if s.signed and raw >> (s.length - 1):
                 raw -= 1 << s.length
-            if not s.raw_min <= raw <= s.raw_max:
-                return None, f"{s.name} {raw} out of range"
-            if s.values is not None and raw not in s.values:
+            enumeration = s.values is not None and \
+                s.values == set(range(s.raw_min, s.raw_max + 1))
+            if enumeration and raw not in s.values:
                 return None, f"{s.name} {raw} not in its VAL_ table"
+            if not s.raw_min <= raw <= s.raw_max and not (s.values and raw in s.values):
+                return None, f"{s.name} {raw} out of range"
             if raw & s.reserved_mask:
                 return None, f"{s.name} reserved flags {raw:#x}"
             raw_values[s.name] = raw
         if word & ~used:
             return None, "reserved bits set"
+        if name.startswith("CollapseForecast"):
+            # Its comment: the worst member is one of the members, and "none collapses" is said
+            # by all of Probability (0), WorstMember (255) and CollapseIn (65535) or by none.
+            r = raw_values
+            none = r["WorstMember"] == 255
+            if not none and r["WorstMember"] >= r["Members"]:
+                return None, "WorstMember not below Members"
+            if none != (r["CollapseIn"] == NO_COLLAPSE_MS) or none != (r["Probability"] == 0):
+                return None, "contradicting none"
         return raw_values, ""
 
 
@@ -324,16 +343,17 @@ class Scenario:
         self.epoch_us = self.sensor[0][0].t_us if self.sensor else 0
 
     def own(self, index):
-        """A frame plinth-monitor sent: a valid MonitorStatus or AlarmEvent (the tests never
-        inject valid ones)."""
+        """A frame plinth-monitor sent: a valid MonitorStatus, CollapseForecast or AlarmEvent
+        (the tests never inject valid ones)."""
         f = self.frames[index]
-        return f.plinth() and (f.ident in STATUS_IDS or f.ident == ALARM_ID) \
+        return f.plinth() and (f.ident in STATUS_IDS or f.ident in FORECAST_IDS
+                               or f.ident == ALARM_ID) \
             and self.decoded[index][0] is not None
 
     def expected_counters(self):
         """The summary's frame counters, from the bus, as the DBC says (frames after ready)."""
         c = dict(received=0, sensor_samples=0, other_nodes=0, heartbeats=0, acknowledgements=0,
-                 rejected=0, unknown_identifiers=0)
+                 monitor_frames=0, rejected=0, unknown_identifiers=0)
         for i in range(self.ready + 1, len(self.frames)):
             f = self.frames[i]
             if not f.plinth() or self.own(i):
@@ -352,6 +372,8 @@ class Scenario:
                 c["heartbeats"] += 1
             elif f.ident == 0x340:
                 c["acknowledgements"] += 1
+            elif f.ident in STATUS_IDS or f.ident in FORECAST_IDS or f.ident == ALARM_ID:
+                c["monitor_frames"] += 1
         return c
 
     def streaming(self, index):
@@ -523,7 +545,50 @@ def monitor_frames_checks(check, s, config):
           "cause, latched, sequence, time in ms): " +
           ", ".join(f"{a['level']}/{a['cause']}@{a['t']:.3f}" for a in s.alarm_lines)
           + (f": {mismatch[:3]}" if mismatch else ""))
+    forecast_frames_checks(check, s, raw_status)
     return raw_status
+
+
+def forecast_frames_checks(check, s, raw_status):
+    """CollapseForecast frames (one axis): each valid per the DBC, its signals consistent, and
+    the same as the status line it goes with (the MonitorStatus of the same sequence)."""
+    frames = [(i, f) for i, f in enumerate(s.frames) if f.plinth() and f.ident in FORECAST_IDS]
+    bad = [f"{f.ident:03X}#{f.data.hex()}: {s.decoded[i][1]}" for i, f in frames
+           if s.decoded[i][0] is None]
+    # The n-th status line goes with the n-th MonitorStatus frame; its forecast frame follows
+    # that frame on the bus, with the same sequence.
+    mismatch = []
+    statuses = 0
+    for i, f in enumerate(s.frames):
+        if f.plinth() and f.ident in STATUS_IDS and s.decoded[i][0] is not None:
+            statuses += 1
+        if not (f.plinth() and f.ident in FORECAST_IDS) or s.decoded[i][0] is None:
+            continue
+        r = s.decoded[i][0]
+        if statuses == 0 or statuses > min(len(raw_status), len(s.status_lines)):
+            mismatch.append(f"no status before frame {r}")
+            continue
+        line = s.status_lines[statuses - 1]
+        if r["Sequence"] != raw_status[statuses - 1]["Sequence"]:
+            mismatch.append(f"sequence {r['Sequence']}, its status's "
+                            f"{raw_status[statuses - 1]['Sequence']}")
+        state = line["state"]
+        if "members" not in state:  # two axes: the line's values are over both
+            continue
+        at = line["collapse_forecast_t"]
+        if (abs(r["Probability"] * 1e-4 - line["probability"]) > 1.5e-4
+                or r["Members"] != state["members"]
+                or (at is None) != (r["CollapseIn"] == NO_COLLAPSE_MS)
+                or (at is not None and abs(line["t"] + r["CollapseIn"] * 1e-3 - max(at, line["t"]))
+                    > 1.5e-3)):
+            mismatch.append(f"frame {r} vs line t {line['t']} probability {line['probability']} "
+                            f"collapse_forecast_t {at} members {state['members']}")
+    check(not bad and not mismatch,
+          f"{len(frames)} CollapseForecast frames decode per the DBC (probability <= 1, worst "
+          f"member below the members or none, none said by all of probability, worst member and "
+          f"collapse time or by none) and match their status lines (probability, members, "
+          f"collapse time = t + CollapseIn, sequence)"
+          + (f": {(bad + mismatch)[:3]}" if bad or mismatch else ""))
 
 
 def monitor_events(lines, frames_sensor, start_index, rate):

@@ -201,6 +201,46 @@ TEST(CanGolden, Acknowledge) {
   EXPECT_EQ(d.event_sequence, 0x42);
 }
 
+TEST(CanGolden, CollapseForecast) {
+  // Axis 1: identifier 0x350 + 1 = 0x351.
+  // Probability 0|16 (0.0001,0): 0.3529 (6 of 17) -> raw 3529 = 0x0DC9 -> bytes 0-1: C9 0D
+  // WorstMember 16|8 = 12 -> byte 2: 0C; Members 24|8 = 17 -> byte 3: 11
+  // CollapseIn 32|16 (1,0) ms: 2345 = 0x0929 -> bytes 4-5: 29 09
+  // Horizon 48|8 (0.1,0) s: 4.0 -> raw 40 = 0x28 -> byte 6; Sequence 56|8 = 0xFE -> byte 7
+  const Bytes golden{0xC9, 0x0D, 0x0C, 0x11, 0x29, 0x09, 0x28, 0xFE};
+  CollapseForecast m;
+  m.axis = 1;
+  m.probability = 0.3529;
+  m.worst_member = 12;
+  m.members = 17;
+  m.collapse_in_ms = 2345;
+  m.horizon_s = 4.0;
+  m.sequence = 0xFE;
+  CollapseForecast d;
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x351, golden, d));
+  EXPECT_EQ(d.axis, 1);
+  EXPECT_DOUBLE_EQ(d.probability, 0.3529);
+  EXPECT_EQ(d.worst_member, 12);
+  EXPECT_EQ(d.members, 17);
+  EXPECT_EQ(d.collapse_in_ms, 2345);
+  EXPECT_DOUBLE_EQ(d.horizon_s, 4.0);
+  EXPECT_EQ(d.sequence, 0xFE);
+
+  // None collapses (axis 0, 0x350): Probability 0, WorstMember 255, Members 9, CollapseIn 65535,
+  // Horizon 10 s (raw 100 = 0x64), Sequence 0.
+  const Bytes none{0x00, 0x00, 0xFF, 0x09, 0xFF, 0xFF, 0x64, 0x00};
+  CollapseForecast n;
+  n.members = 9;
+  n.horizon_s = 10.0;
+  ASSERT_NO_FATAL_FAILURE(expect_golden(n, 0x350, none, d));
+  EXPECT_EQ(d.axis, 0);
+  EXPECT_EQ(d.probability, 0.0);
+  EXPECT_EQ(d.worst_member, kNoWorstMember);
+  EXPECT_EQ(d.members, 9);
+  EXPECT_EQ(d.collapse_in_ms, kNoCollapseForecast);
+  EXPECT_DOUBLE_EQ(d.horizon_s, 10.0);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Round trips over every signal's range
 
@@ -427,12 +467,95 @@ TEST(CanRoundTrip, AcknowledgeEveryValue) {
   }
 }
 
+// A collapse forecast of `members` members, member `worst` collapsing first in `in_ms`.
+CollapseForecast forecast_of(std::uint8_t members, std::uint8_t worst, std::uint16_t in_ms) {
+  CollapseForecast m;
+  m.members = members;
+  m.worst_member = worst;
+  m.collapse_in_ms = in_ms;
+  m.probability = 1.0 / members;
+  m.horizon_s = 4.0;
+  return m;
+}
+
+TEST(CanRoundTrip, CollapseForecastEveryMembersWorstMemberAndAxis) {
+  for (std::uint8_t axis = 0; axis < kMonitorAxisCount; ++axis) {
+    for (unsigned members = 1; members <= kMaxForecastMembers; ++members) {
+      for (unsigned worst = 0; worst <= members; ++worst) {  // worst == members: none collapses
+        const bool none = worst == members;
+        CollapseForecast m = forecast_of(static_cast<std::uint8_t>(members),
+                                         none ? kNoWorstMember : static_cast<std::uint8_t>(worst),
+                                         none ? kNoCollapseForecast : 100);
+        m.axis = axis;
+        if (none) m.probability = 0.0;
+        CanFrame f;
+        ASSERT_TRUE(encode(m, f).ok()) << members << " " << worst;
+        EXPECT_EQ(f.id, 0x350U + axis);
+        EXPECT_EQ(classify(f.id), MessageKind::kCollapseForecast);
+        EXPECT_EQ(raw_at(f, 16, 8), none ? 255U : worst);
+        EXPECT_EQ(raw_at(f, 24, 8), members);
+        CollapseForecast d;
+        ASSERT_TRUE(decode(f, d).ok());
+        EXPECT_EQ(d.axis, axis);
+        EXPECT_EQ(d.members, m.members);
+        EXPECT_EQ(d.worst_member, m.worst_member);
+        EXPECT_EQ(d.collapse_in_ms, m.collapse_in_ms);
+        EXPECT_LE(std::fabs(d.probability - m.probability), 0.5 * kRiskStep + 1e-12);
+      }
+    }
+  }
+}
+
+TEST(CanRoundTrip, CollapseForecastEveryProbabilityCollapseInHorizonAndSequence) {
+  for (std::uint32_t raw = 1; raw <= 10000; ++raw) {
+    CollapseForecast m = forecast_of(17, 3, 500);
+    m.probability = raw * kRiskStep;
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok()) << raw;
+    ASSERT_EQ(raw_at(f, 0, 16), raw);
+    CollapseForecast d;
+    ASSERT_TRUE(decode(f, d).ok());
+    ASSERT_EQ(d.probability, m.probability);
+  }
+  for (std::uint32_t ms = 0; ms <= 65534; ++ms) {
+    CollapseForecast m = forecast_of(5, 4, static_cast<std::uint16_t>(ms));
+    m.sequence = static_cast<std::uint8_t>(ms & 0xFF);
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok()) << ms;
+    ASSERT_EQ(raw_at(f, 32, 16), ms);
+    CollapseForecast d;
+    ASSERT_TRUE(decode(f, d).ok());
+    ASSERT_EQ(d.collapse_in_ms, ms);
+    ASSERT_EQ(d.sequence, ms & 0xFF);
+  }
+  for (std::uint32_t raw = 0; raw <= 255; ++raw) {
+    CollapseForecast m = forecast_of(2, 0, 0);
+    m.horizon_s = raw * 0.1;
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok()) << raw;
+    ASSERT_EQ(raw_at(f, 48, 8), raw);
+    CollapseForecast d;
+    ASSERT_TRUE(decode(f, d).ok());
+    ASSERT_NEAR(d.horizon_s, m.horizon_s, 1e-12);
+  }
+  // Horizons between the steps round to the nearest one.
+  for (const double h : {0.04, 1e-3, 4.04, 4.06, 25.54}) {
+    CollapseForecast m = forecast_of(2, 1, 7);
+    m.horizon_s = h;
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok()) << h;
+    CollapseForecast d;
+    ASSERT_TRUE(decode(f, d).ok());
+    EXPECT_LE(std::fabs(d.horizon_s - h), 0.05 + 1e-12) << h;
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Rejections
 
 // A valid frame of every message kind.
 std::vector<CanFrame> valid_frames() {
-  std::vector<CanFrame> frames(5);
+  std::vector<CanFrame> frames(6);
   SensorAcceleration a;
   a.ax_g = 0.1;
   EXPECT_TRUE(encode(a, frames[0]).ok());
@@ -448,12 +571,13 @@ std::vector<CanFrame> valid_frames() {
   Acknowledge k;
   k.level = AlarmLevel::kAlarm;
   EXPECT_TRUE(encode(k, frames[4]).ok());
+  EXPECT_TRUE(encode(forecast_of(9, 2, 1500), frames[5]).ok());
   return frames;
 }
 
 // Decodes `f` as every message type; the result of the one `f.id` classifies as, or of all.
 struct AllDecodes {
-  DecodeResult acceleration, heartbeat, status, event, acknowledge;
+  DecodeResult acceleration, heartbeat, status, event, acknowledge, forecast;
 };
 AllDecodes decode_all(const CanFrame& f) {
   SensorAcceleration a;
@@ -461,7 +585,8 @@ AllDecodes decode_all(const CanFrame& f) {
   MonitorStatus s;
   AlarmEvent e;
   Acknowledge k;
-  return {decode(f, a), decode(f, h), decode(f, s), decode(f, e), decode(f, k)};
+  CollapseForecast c;
+  return {decode(f, a), decode(f, h), decode(f, s), decode(f, e), decode(f, k), decode(f, c)};
 }
 DecodeResult decode_as_own_kind(const CanFrame& f) {
   const AllDecodes all = decode_all(f);
@@ -471,6 +596,7 @@ DecodeResult decode_as_own_kind(const CanFrame& f) {
     case MessageKind::kMonitorStatus: return all.status;
     case MessageKind::kAlarmEvent: return all.event;
     case MessageKind::kAcknowledge: return all.acknowledge;
+    case MessageKind::kCollapseForecast: return all.forecast;
     case MessageKind::kUnknown: break;
   }
   ADD_FAILURE() << "unknown identifier " << f.id;
@@ -494,7 +620,7 @@ TEST(CanReject, EveryLengthButEight) {
 TEST(CanReject, UnknownIdentifiers) {
   std::set<std::uint32_t> known;
   for (std::uint32_t n = 1; n <= 15; ++n) known.insert({0x300 + n, 0x310 + n});
-  known.insert({0x320, 0x321, 0x330, 0x340});
+  known.insert({0x320, 0x321, 0x330, 0x340, 0x350, 0x351});
   std::vector<std::uint32_t> ids;
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) ids.push_back(id);
   // Identifiers with flag bits (SocketCAN's extended / RTR flags) or beyond 11 bits.
@@ -512,8 +638,9 @@ TEST(CanReject, UnknownIdentifiers) {
     EXPECT_EQ(all.status.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.event.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.acknowledge.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.forecast.error, CodecError::kUnknownIdentifier) << id;
   }
-  EXPECT_EQ(known.size(), 34U);
+  EXPECT_EQ(known.size(), 36U);
 }
 
 TEST(CanReject, AnotherMessagesIdentifier) {
@@ -528,6 +655,8 @@ TEST(CanReject, AnotherMessagesIdentifier) {
     EXPECT_EQ(all.event.error == CodecError::kWrongMessage, kind != MessageKind::kAlarmEvent);
     EXPECT_EQ(all.acknowledge.error == CodecError::kWrongMessage,
               kind != MessageKind::kAcknowledge);
+    EXPECT_EQ(all.forecast.error == CodecError::kWrongMessage,
+              kind != MessageKind::kCollapseForecast);
   }
 }
 
@@ -665,6 +794,119 @@ TEST(CanReject, RiskAboveOne) {
   }
 }
 
+// Every raw value of a CollapseForecast signal outside its range and special value, each refused
+// naming the signal; encoding refuses the same values.
+TEST(CanReject, CollapseForecastEveryInvalidRawValue) {
+  CanFrame valid;
+  ASSERT_TRUE(encode(forecast_of(17, 16, 1000), valid).ok());
+  const auto with = [&valid](unsigned start, unsigned length, std::uint64_t raw) {
+    CanFrame f = valid;
+    store_le64(insert_bits(load_le64(f.data), start, length, raw), f.data);
+    return f;
+  };
+  const auto expect_refused = [](const CanFrame& f, const char* signal, std::uint64_t raw) {
+    CollapseForecast d;
+    d.sequence = 77;
+    const DecodeResult r = decode(f, d);
+    ASSERT_EQ(r.error, CodecError::kOutOfRange) << signal << " " << raw;
+    ASSERT_STREQ(r.signal, signal) << raw;
+    ASSERT_EQ(d.sequence, 77);  // untouched
+  };
+  for (std::uint64_t raw = 10001; raw <= 65535; ++raw) {
+    ASSERT_NO_FATAL_FAILURE(expect_refused(with(0, 16, raw), "Probability", raw));
+  }
+  for (std::uint64_t raw = 17; raw <= 254; ++raw) {
+    ASSERT_NO_FATAL_FAILURE(expect_refused(with(16, 8, raw), "WorstMember", raw));
+  }
+  for (std::uint64_t raw = 0; raw <= 255; ++raw) {
+    if (raw >= 1 && raw <= 17) continue;
+    ASSERT_NO_FATAL_FAILURE(expect_refused(with(24, 8, raw), "Members", raw));
+  }
+  // Encode: the same values.
+  CanFrame f;
+  for (const double p : {1.00005, 1.5, -0.00005, -1.0, 1e300}) {
+    CollapseForecast m = forecast_of(17, 16, 1000);
+    m.probability = p;
+    const EncodeResult r = encode(m, f);
+    EXPECT_EQ(r.error, CodecError::kOutOfRange) << p;
+    EXPECT_STREQ(r.signal, "Probability");
+  }
+  for (const double p :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    CollapseForecast m = forecast_of(17, 16, 1000);
+    m.probability = p;
+    EXPECT_EQ(encode(m, f).error, CodecError::kNotFinite);
+    m = forecast_of(17, 16, 1000);
+    m.horizon_s = p;
+    EXPECT_STREQ(encode(m, f).signal, "Horizon");
+  }
+  for (unsigned worst = 17; worst <= 254; ++worst) {
+    const EncodeResult r = encode(forecast_of(17, static_cast<std::uint8_t>(worst), 1), f);
+    EXPECT_EQ(r.error, CodecError::kOutOfRange) << worst;
+    EXPECT_STREQ(r.signal, "WorstMember");
+  }
+  for (const unsigned members : {0U, 18U, 200U, 255U}) {
+    CollapseForecast m = forecast_of(1, 0, 1);
+    m.members = static_cast<std::uint8_t>(members);
+    EXPECT_STREQ(encode(m, f).signal, "Members") << members;
+  }
+  for (const double h : {25.55, 26.0, -0.05, -1.0}) {
+    CollapseForecast m = forecast_of(2, 0, 1);
+    m.horizon_s = h;
+    const EncodeResult r = encode(m, f);
+    EXPECT_EQ(r.error, CodecError::kOutOfRange) << h;
+    EXPECT_STREQ(r.signal, "Horizon");
+  }
+  CollapseForecast m = forecast_of(2, 0, 1);
+  m.axis = 2;
+  EXPECT_STREQ(encode(m, f).signal, "axis");
+}
+
+// Signals that contradict each other: each valid alone, refused together naming the signal.
+TEST(CanReject, CollapseForecastContradictions) {
+  struct Case {
+    std::uint64_t probability, worst, members, collapse_in;
+    const char* signal;
+  };
+  const Case cases[] = {
+      {1000, 5, 5, 100, "WorstMember"},  // the worst member is not one of the members
+      {1000, 16, 1, 100, "WorstMember"},
+      {1000, 3, 5, 65535, "CollapseIn"},     // a worst member without a collapse time
+      {0, 255, 5, 100, "CollapseIn"},        // a collapse time without a worst member
+      {0, 3, 5, 100, "Probability"},         // a member collapses, probability 0
+      {1000, 255, 5, 65535, "Probability"},  // none collapses, probability not 0
+  };
+  for (const Case& c : cases) {
+    std::uint64_t word = 0;
+    word = insert_bits(word, 0, 16, c.probability);
+    word = insert_bits(word, 16, 8, c.worst);
+    word = insert_bits(word, 24, 8, c.members);
+    word = insert_bits(word, 32, 16, c.collapse_in);
+    CanFrame f = make_frame(0x350, Bytes{});
+    store_le64(word, f.data);
+    CollapseForecast d;
+    const DecodeResult r = decode(f, d);
+    EXPECT_EQ(r.error, CodecError::kOutOfRange) << c.signal;
+    EXPECT_STREQ(r.signal, c.signal);
+
+    CollapseForecast m;
+    m.probability = static_cast<double>(c.probability) * kRiskStep;
+    m.worst_member = static_cast<std::uint8_t>(c.worst);
+    m.members = static_cast<std::uint8_t>(c.members);
+    m.collapse_in_ms = static_cast<std::uint16_t>(c.collapse_in);
+    const EncodeResult e = encode(m, f);
+    EXPECT_EQ(e.error, CodecError::kOutOfRange) << c.signal;
+    EXPECT_STREQ(e.signal, c.signal);
+  }
+  // A probability that rounds to 0 says none collapses; one that rounds to 1e-4 does not.
+  CanFrame f;
+  CollapseForecast m;
+  m.probability = 0.00004;
+  EXPECT_TRUE(encode(m, f).ok());
+  m.probability = 0.00006;
+  EXPECT_STREQ(encode(m, f).signal, "Probability");
+}
+
 TEST(CanReject, AccelerationNotFiniteOrOutOfRange) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
@@ -749,7 +991,7 @@ TEST(CanReject, ErrorTexts) {
 
 TEST(CanDbc, EveryIdentifierTheCodecKnowsIsAMessageAndNoOther) {
   const Dbc& dbc = plinth_dbc();
-  ASSERT_EQ(dbc.messages.size(), 34U);
+  ASSERT_EQ(dbc.messages.size(), 36U);
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) {
     const MessageKind kind = classify(id);
     const auto it = dbc.messages.find(id);
@@ -796,6 +1038,12 @@ TEST(CanDbc, EverySignalMatchesTheCodecsLayout) {
         EXPECT_LE(c.raw_max, (std::int64_t{1} << c.length) - 1);
       }
       EXPECT_LE(c.start_bit + c.length, 64U);
+      // A special value fits the bits and lies outside the range.
+      if (c.special_raw != kNoSpecialRaw) {
+        EXPECT_FALSE(c.is_signed);
+        EXPECT_LE(c.special_raw, (std::int64_t{1} << c.length) - 1);
+        EXPECT_TRUE(c.special_raw < c.raw_min || c.special_raw > c.raw_max);
+      }
     }
     // Signals do not overlap.
     std::uint64_t used = 0;
@@ -814,7 +1062,15 @@ TEST(CanDbc, ValueTablesMatchTheCodecsEnumerations) {
     for (const SignalLayout& c : signal_layouts(classify(id))) {
       SCOPED_TRACE(message.name + "." + c.name);
       const auto it = dbc.values.find({id, c.name});
-      ASSERT_EQ(it != dbc.values.end(), c.has_value_table);
+      ASSERT_EQ(it != dbc.values.end(), c.has_value_table || c.special_raw != kNoSpecialRaw);
+      if (c.special_raw != kNoSpecialRaw) {
+        // A quantity's table names its special value only.
+        ASSERT_FALSE(c.has_value_table);
+        ASSERT_EQ(it->second.size(), 1U);
+        EXPECT_EQ(static_cast<std::int64_t>(it->second.begin()->first), c.special_raw);
+        EXPECT_EQ(it->second.begin()->second, "none");
+        continue;
+      }
       if (!c.has_value_table) continue;
       const auto& table = it->second;
       // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names.

@@ -6,10 +6,14 @@
 
 #include <array>
 #include <cmath>
+#include <span>
 #include <string>
+#include <vector>
 
 #include "dbc_file.h"
+#include "monitor_input.h"
 #include "plinth/firmware/monitor.h"
+#include "plinth/host/record_io.h"
 #include "test_support.h"
 
 namespace plinth::firmware {
@@ -53,6 +57,12 @@ std::string domain_name(const std::string& signal, unsigned raw) {
     }
   } else if (signal == "Latched") {
     return raw == 0 ? "not_latched" : "latched";  // a flag: the DBC names its two values
+  } else if (signal == "WorstMember" || signal == "CollapseIn") {
+    MonitorStatus s;  // a forecast in which no member collapses
+    s.axes[0].forecast.valid = true;
+    s.axes[0].forecast.members = 5;
+    const can::CollapseForecast m = forecast_message(s, 0, 4.0, 0);
+    if (raw == (signal == "WorstMember" ? m.worst_member : m.collapse_in_ms)) return "none";
   }
   return "?";
 }
@@ -74,6 +84,7 @@ TEST(CanFrames, TheDbcsValueNamesAreTheDomainNames) {
     if (signal == "AlarmLevel" || signal == "Level" || signal == "PreviousLevel") {
       values = monitor::kAlarmLevelNames.size();
     }
+    if (signal == "WorstMember" || signal == "CollapseIn") values = 1;  // none
     EXPECT_EQ(table.size(), values);
   }
   EXPECT_GT(tables, 5);  // MonitorStatus x2 (Phase, Corner, AlarmLevel), AlarmEvent, Acknowledge
@@ -129,6 +140,43 @@ TEST(CanFrames, StatusCarriesPhaseCornerLevelRiskAndSampleAge) {
   EXPECT_EQ(status_message(s, 0, 0).sample_age_ms, 65535);
 }
 
+TEST(CanFrames, ForecastCarriesProbabilityWorstMemberAndTimeToCollapse) {
+  MonitorStatus s;
+  s.axis_count = 2;
+  s.time_ns = 12'000 * kMs;
+  ForecastOutcome& f = s.axes[1].forecast;
+  f.valid = true;
+  f.members = 17;
+  f.collapsing = 6;
+  f.probability = 6.0 / 17.0;
+  f.worst_member = 16;
+  s.axes[1].collapse_forecast_s = 13.2345;  // monitor time
+  const can::CollapseForecast m = forecast_message(s, 1, 4.0, 99);
+  EXPECT_EQ(m.axis, 1);
+  EXPECT_EQ(m.probability, 6.0 / 17.0);
+  EXPECT_EQ(m.worst_member, 16);
+  EXPECT_EQ(m.members, 17);
+  EXPECT_EQ(m.collapse_in_ms, 1235);  // 1.2345 s from the status's time, to the nearest ms
+  EXPECT_EQ(m.horizon_s, 4.0);
+  EXPECT_EQ(m.sequence, 99);
+  can::CanFrame frame;
+  ASSERT_TRUE(can::encode(m, frame).ok());
+  EXPECT_EQ(frame.id, can::kCollapseForecastBaseId + 1);
+  // A collapse forecast for a time now past is due now.
+  s.time_ns = 13'500 * kMs;
+  EXPECT_EQ(forecast_message(s, 1, 4.0, 0).collapse_in_ms, 0);
+  // No member collapses: none, probability 0.
+  f.collapsing = 0;
+  f.probability = 0.0;
+  f.worst_member = -1;
+  s.axes[1].collapse_forecast_s = -1.0;
+  const can::CollapseForecast none = forecast_message(s, 1, 4.0, 0);
+  EXPECT_EQ(none.worst_member, can::kNoWorstMember);
+  EXPECT_EQ(none.collapse_in_ms, can::kNoCollapseForecast);
+  EXPECT_EQ(none.members, 17);
+  EXPECT_TRUE(can::encode(none, frame).ok());
+}
+
 TEST(CanFrames, SamplesAndAcknowledgementsFromTheWire) {
   monitor::SensorSample in;
   in.receive_time_ns = 123;
@@ -173,7 +221,9 @@ TEST(CanFrames, UpdatesCarryTheFramesToSend) {
     s.sequence = static_cast<std::uint8_t>(n);
     s.acceleration_g = Eigen::Vector3d(1e-4 * std::sin(n), 0.0, 1.0);
     const MonitorUpdate u = monitor.on_sample(s);
-    ASSERT_EQ(u.frame_count, u.event_count + (u.status_due ? 2U : 0U)) << n;
+    // A MonitorStatus per axis, and a CollapseForecast per axis once a forecast completed.
+    const bool forecast = monitor.status().axes[0].forecast.valid;
+    ASSERT_EQ(u.frame_count, u.event_count + (u.status_due ? (forecast ? 4U : 2U) : 0U)) << n;
     for (std::size_t i = 0; i < u.event_count; ++i, ++alarm_frames) {
       can::AlarmEvent e;
       ASSERT_TRUE(can::decode(u.frames[i], e).ok());
@@ -194,6 +244,14 @@ TEST(CanFrames, UpdatesCarryTheFramesToSend) {
       EXPECT_EQ(m.sequence, next_sequence);
       EXPECT_EQ(from_wire(m.alarm_level), monitor.status().alarm);
       EXPECT_EQ(m.phase, to_wire(monitor.status().axes[axis].mode.phase));
+      if (!forecast) continue;
+      can::CollapseForecast c;  // at rest: none collapses
+      ASSERT_TRUE(can::decode(u.frames[u.event_count + 2 + axis], c).ok());
+      EXPECT_EQ(c.axis, axis);
+      EXPECT_EQ(c.sequence, next_sequence);
+      EXPECT_EQ(c.worst_member, can::kNoWorstMember);
+      EXPECT_EQ(c.members, 1);
+      EXPECT_NEAR(c.horizon_s, config.forecast.horizon_s, 0.05);
     }
     ++next_sequence;
   }
@@ -215,6 +273,85 @@ TEST(CanFrames, AStatusIsDueBeforeTheFirstSample) {
   EXPECT_TRUE(first.status_due);
   EXPECT_EQ(first.frame_count, 1U);
   EXPECT_FALSE(monitor.on_frame({heartbeat, 2000}).status_due);  // the time did not move
+}
+
+// An ensemble in an earthquake that overturns it: with each status a CollapseForecast (one axis)
+// once a forecast completed, saying what the status says (probability, worst member, the time
+// to its collapse from the status's time), a collapse forecast before the overturn; none with the
+// forecast disabled.
+struct ForecastFrames {
+  int statuses = 0;
+  int forecasts = 0;
+  int collapsing = 0;                       // forecasts with a worst member
+  double first_collapse_forecast_t = -1.0;  // monitor time, s, of the first such frame
+  double overturn_t = -1.0;
+};
+
+ForecastFrames run_forecast_frames(bool enabled) {
+  std::vector<Scene> statues;
+  for (const double height_factor : {1.0, 0.9, 1.1}) {
+    SceneParams p = plinth::testing::paper_isolated(0.0);
+    p.block.com_height *= height_factor;
+    statues.push_back(plinth::testing::make(p));
+  }
+  MonitorConfig config;
+  config.estimator.sample_rate_hz = 200.0;
+  config.forecast.enabled = enabled;
+  Monitor monitor;
+  EXPECT_TRUE(monitor.start(config, {std::span<const Scene>(statues), {}}).ok());
+  const host::Record record = host::read_at2(
+      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
+      kStandardGravity);
+  plinth::testing::QuietThenQuake input(200.0, 12.0, record, 20.0);  // after the 10 s start-up
+  ForecastFrames out;
+  for (long n = 0; n < input.size() && out.overturn_t < 0.0; ++n) {
+    const MonitorUpdate u = monitor.on_sample(input.sample(n));
+    const MonitorStatus& st = monitor.status();
+    if (st.axes[0].mode.terminal()) out.overturn_t = static_cast<double>(st.time_ns) * 1e-9;
+    if (!u.status_due) continue;
+    ++out.statuses;
+    const std::size_t at = u.event_count + 1;  // after the events and the MonitorStatus
+    can::MonitorStatus status;
+    EXPECT_TRUE(can::decode(u.frames[at - 1], status).ok());
+    const bool expected = enabled && st.axes[0].forecast.valid;
+    EXPECT_EQ(u.frame_count, at + (expected ? 1U : 0U)) << n;
+    if (!expected || u.frame_count != at + 1) continue;
+    can::CollapseForecast c;
+    EXPECT_TRUE(can::decode(u.frames[at], c).ok()) << n;
+    ++out.forecasts;
+    const AxisStatus& axis = st.axes[0];
+    EXPECT_EQ(c.sequence, status.sequence);
+    EXPECT_EQ(c.members, 3);
+    EXPECT_NEAR(c.probability, st.probability, 0.5e-4);
+    EXPECT_NEAR(c.probability, axis.forecast.probability, 0.5e-4);
+    if (axis.forecast.worst_member < 0) {
+      EXPECT_EQ(c.worst_member, can::kNoWorstMember);
+      EXPECT_EQ(c.collapse_in_ms, can::kNoCollapseForecast);
+      continue;
+    }
+    ++out.collapsing;
+    EXPECT_EQ(c.worst_member, axis.forecast.worst_member);
+    const double in_s = st.collapse_forecast_s - static_cast<double>(st.time_ns) * 1e-9;
+    EXPECT_NEAR(c.collapse_in_ms * 1e-3, in_s < 0.0 ? 0.0 : in_s, 0.5e-3 + 1e-9) << n;
+    if (out.first_collapse_forecast_t < 0.0) {
+      out.first_collapse_forecast_t = static_cast<double>(st.time_ns) * 1e-9;
+    }
+  }
+  EXPECT_EQ(monitor.frames().not_encoded, 0U);
+  return out;
+}
+
+TEST(CanFrames, ForecastFramesGoWithTheStatusWhileForecasting) {
+  const ForecastFrames on = run_forecast_frames(true);
+  ASSERT_GT(on.overturn_t, 0.0);  // the quake overturns the nominal statue
+  EXPECT_GT(on.forecasts, 50);    // about 10 statuses a second from the estimator's start
+  EXPECT_GT(on.collapsing, 0);
+  EXPECT_LT(on.collapsing, on.forecasts);  // quiet at first: none collapses
+  EXPECT_GT(on.first_collapse_forecast_t, 0.0);
+  EXPECT_LT(on.first_collapse_forecast_t, on.overturn_t);
+  const ForecastFrames off = run_forecast_frames(false);
+  EXPECT_GT(off.statuses, 0);
+  EXPECT_EQ(off.forecasts, 0);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "plinth/firmware/can_frames.h"
 
+#include <cmath>
+
 namespace plinth::firmware {
 namespace {
 
@@ -49,7 +51,12 @@ static_assert(monitor::sensor_flags::kCalibrationInvalid ==
               can::sensor_status::kCalibrationInvalid);
 static_assert(monitor::sensor_flags::kDefinedMask == can::sensor_status::kDefinedMask);
 
+// The wire's member indices: the largest ensemble this build holds fits the frame's Members.
+static_assert(kMaxEnsembleMembers <= can::kMaxForecastMembers);
+static_assert(kMaxEnsembleMembers - 1 < can::kNoWorstMember);
+
 constexpr std::int64_t kNanosecondsPerMillisecond = 1'000'000;
+constexpr double kLargestCollapseInMs = can::kNoCollapseForecast - 1;  // CollapseIn, 16 bits
 constexpr std::int64_t kLargestSampleAgeMs = 65535;  // the frame's SampleAge, 16 bits
 
 }  // namespace
@@ -83,6 +90,26 @@ can::MonitorStatus status_message(const MonitorStatus& status, int axis, std::ui
                                                 : kLargestSampleAgeMs;
   m.sample_age_ms = static_cast<std::uint16_t>(
       age_ms < 0 ? 0 : (age_ms > kLargestSampleAgeMs ? kLargestSampleAgeMs : age_ms));
+  return m;
+}
+
+can::CollapseForecast forecast_message(const MonitorStatus& status, int axis, double horizon_s,
+                                       std::uint8_t sequence) {
+  const AxisStatus& a = status.axes[static_cast<std::size_t>(axis)];
+  const ForecastOutcome& f = a.forecast;
+  can::CollapseForecast m;
+  m.axis = static_cast<std::uint8_t>(axis);
+  m.probability = f.probability;
+  m.members = static_cast<std::uint8_t>(f.members);
+  m.horizon_s = horizon_s;
+  m.sequence = sequence;
+  if (f.worst_member < 0 || a.collapse_forecast_s < 0.0) return m;  // none collapses
+  m.worst_member = static_cast<std::uint8_t>(f.worst_member);
+  // From the frame's time (the status's): a collapse forecast for a time now past is due now.
+  const double in_ms =
+      std::round((a.collapse_forecast_s - static_cast<double>(status.time_ns) * 1e-9) * 1e3);
+  m.collapse_in_ms = static_cast<std::uint16_t>(
+      in_ms < 0.0 ? 0.0 : (in_ms > kLargestCollapseInMs ? kLargestCollapseInMs : in_ms));
   return m;
 }
 

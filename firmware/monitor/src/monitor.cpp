@@ -578,6 +578,7 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
     moving = moving || axis.mode.phase != Phase::kFullContact;
     collapse = collapse || axis.mode.terminal();
     const ForecastOutcome& f = axis.forecast;
+    axis.collapse_forecast_s = -1.0;
     if (!f.valid) continue;
     if (status_.forecast_axis < 0 || f.probability > status_.probability) {
       status_.probability = f.probability;
@@ -586,6 +587,7 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
     if (f.worst_member >= 0) {
       const double at_s = static_cast<double>(status_.estimator_start_ns) * 1e-9 +
                           f.start_time_s + f.collapse_in_s;
+      axis.collapse_forecast_s = at_s;
       if (status_.collapse_forecast_s < 0.0 || at_s < status_.collapse_forecast_s) {
         status_.collapse_forecast_s = at_s;
       }
@@ -635,8 +637,9 @@ void Monitor::add_frame(MonitorUpdate& update, const Message& message) {
   ++update.frame_count;
 }
 
-// The update's alarm events, then the status when it is due (one frame per axis): at every
-// alarm change, at the alarm policy's heartbeat, and at status_interval_s.
+// The update's alarm events, then the status when it is due (a MonitorStatus per axis, then,
+// while forecasting, a CollapseForecast per axis that has a completed forecast, with the same
+// sequence): at every alarm change, at the alarm policy's heartbeat, and at status_interval_s.
 void Monitor::report(MonitorUpdate& update) {
   update.status_due = update.event_count > 0 || alarm_.heartbeat_due(status_.time_ns) ||
                       status_.time_ns >= next_status_ns_;
@@ -646,6 +649,10 @@ void Monitor::report(MonitorUpdate& update) {
   if (!update.status_due) return;
   for (int i = 0; i < status_.axis_count; ++i) {
     add_frame(update, status_message(status_, i, status_sequence_));
+  }
+  for (int i = 0; config_.forecast.enabled && i < status_.axis_count; ++i) {
+    if (!status_.axes[static_cast<std::size_t>(i)].forecast.valid) continue;
+    add_frame(update, forecast_message(status_, i, config_.forecast.horizon_s, status_sequence_));
   }
   ++status_sequence_;
   alarm_.heartbeat_sent(status_.time_ns);
@@ -730,6 +737,11 @@ bool Monitor::take_frame(const hal::TimedFrame& timed, MonitorUpdate& update) {
     }
     case can::MessageKind::kAlarmEvent: {
       can::AlarmEvent message;
+      if (decoded(frame, message)) ++frames_.monitor_frames;
+      return false;
+    }
+    case can::MessageKind::kCollapseForecast: {
+      can::CollapseForecast message;
       if (decoded(frame, message)) ++frames_.monitor_frames;
       return false;
     }

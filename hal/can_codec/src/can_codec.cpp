@@ -19,11 +19,11 @@ constexpr std::int64_t kU32Max = 4294967295;
 // SensorAcceleration (0x300 + node)
 enum AccelerationSignal : std::size_t { kAx, kAy, kAz, kAccSequence, kAccStatus };
 constexpr std::array<SignalLayout, 5> kAccelerationSignals{{
-    {"Ax", 0, 16, true, 0.00025, 0.0, -32768, 32767, "g", false},
-    {"Ay", 16, 16, true, 0.00025, 0.0, -32768, 32767, "g", false},
-    {"Az", 32, 16, true, 0.00025, 0.0, -32768, 32767, "g", false},
-    {"Sequence", 48, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
-    {"Status", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+    {"Ax", 0, 16, true, 0.00025, 0.0, -32768, 32767, "g", false, kNoSpecialRaw},
+    {"Ay", 16, 16, true, 0.00025, 0.0, -32768, 32767, "g", false, kNoSpecialRaw},
+    {"Az", 32, 16, true, 0.00025, 0.0, -32768, 32767, "g", false, kNoSpecialRaw},
+    {"Sequence", 48, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"Status", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
 }};
 
 // SensorHeartbeat (0x310 + node)
@@ -36,46 +36,70 @@ enum HeartbeatSignal : std::size_t {
   kCanRxErrors
 };
 constexpr std::array<SignalLayout, 6> kHeartbeatSignals{{
-    {"Uptime", 0, 32, false, 1.0, 0.0, 0, kU32Max, "s", false},
-    {"FirmwareMajor", 32, 4, false, 1.0, 0.0, 0, 15, "", false},
-    {"FirmwareMinor", 36, 4, false, 1.0, 0.0, 0, 15, "", false},
-    {"Status", 40, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
-    {"CanTxErrors", 48, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
-    {"CanRxErrors", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+    {"Uptime", 0, 32, false, 1.0, 0.0, 0, kU32Max, "s", false, kNoSpecialRaw},
+    {"FirmwareMajor", 32, 4, false, 1.0, 0.0, 0, 15, "", false, kNoSpecialRaw},
+    {"FirmwareMinor", 36, 4, false, 1.0, 0.0, 0, 15, "", false, kNoSpecialRaw},
+    {"Status", 40, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"CanTxErrors", 48, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"CanRxErrors", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
 }};
 
 // MonitorStatus (0x320 + axis)
 enum StatusSignal : std::size_t { kPhase, kCorner, kAlarmLevel, kRisk, kStSequence, kSampleAge };
 constexpr std::array<SignalLayout, 6> kStatusSignals{{
-    {"Phase", 0, 4, false, 1.0, 0.0, 0, 5, "", true},
-    {"Corner", 4, 4, false, 1.0, 0.0, 0, 2, "", true},
-    {"AlarmLevel", 8, 4, false, 1.0, 0.0, 0, 4, "", true},
-    {"Risk", 16, 16, false, 0.0001, 0.0, 0, 10000, "", false},
-    {"Sequence", 32, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
-    {"SampleAge", 40, 16, false, 1.0, 0.0, 0, kU16Max, "ms", false},
+    {"Phase", 0, 4, false, 1.0, 0.0, 0, 5, "", true, kNoSpecialRaw},
+    {"Corner", 4, 4, false, 1.0, 0.0, 0, 2, "", true, kNoSpecialRaw},
+    {"AlarmLevel", 8, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
+    {"Risk", 16, 16, false, 0.0001, 0.0, 0, 10000, "", false, kNoSpecialRaw},
+    {"Sequence", 32, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"SampleAge", 40, 16, false, 1.0, 0.0, 0, kU16Max, "ms", false, kNoSpecialRaw},
 }};
 
 // AlarmEvent (0x330)
 enum EventSignal : std::size_t { kLevel, kPreviousLevel, kCause, kLatched, kTime, kEvSequence };
 constexpr std::array<SignalLayout, 6> kEventSignals{{
-    {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true},
-    {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true},
-    {"Cause", 8, 8, false, 1.0, 0.0, 0, 11, "", true},
-    {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true},
-    {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false},
-    {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+    {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
+    {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 11, "", true, kNoSpecialRaw},
+    {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true, kNoSpecialRaw},
+    {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false, kNoSpecialRaw},
+    {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
 }};
 
 // Acknowledge (0x340)
 enum AcknowledgeSignal : std::size_t { kAckLevel, kSourceId, kEventSequence };
 constexpr std::array<SignalLayout, 3> kAcknowledgeSignals{{
-    {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true},
-    {"SourceId", 8, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
-    {"EventSequence", 16, 8, false, 1.0, 0.0, 0, kU8Max, "", false},
+    {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
+    {"SourceId", 8, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"EventSequence", 16, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+}};
+
+// CollapseForecast (0x350 + axis)
+enum ForecastSignal : std::size_t {
+  kProbability,
+  kWorstMember,
+  kMembers,
+  kCollapseIn,
+  kHorizon,
+  kFcSequence
+};
+constexpr std::array<SignalLayout, 6> kForecastSignals{{
+    {"Probability", 0, 16, false, 0.0001, 0.0, 0, 10000, "", false, kNoSpecialRaw},
+    {"WorstMember", 16, 8, false, 1.0, 0.0, 0, kMaxForecastMembers - 1, "", false, kNoWorstMember},
+    {"Members", 24, 8, false, 1.0, 0.0, 1, kMaxForecastMembers, "", false, kNoSpecialRaw},
+    {"CollapseIn", 32, 16, false, 1.0, 0.0, 0, kU16Max - 1, "ms", false, kNoCollapseForecast},
+    {"Horizon", 48, 8, false, 0.1, 0.0, 0, kU8Max, "s", false, kNoSpecialRaw},
+    {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
 }};
 
 // ---------------------------------------------------------------------------------------------
 // Packing with the first error kept.
+
+// Inside the signal's DBC range, or its special value.
+constexpr bool valid_raw(std::int64_t raw, const SignalLayout& signal) {
+  return (raw >= signal.raw_min && raw <= signal.raw_max) ||
+         (signal.special_raw != kNoSpecialRaw && raw == signal.special_raw);
+}
 
 // |raw| below this converts to int64 exactly and safely (2^53).
 constexpr double kMaxConvertible = 9007199254740992.0;
@@ -100,7 +124,9 @@ class Packer {
 
   void integer(std::uint64_t value, const SignalLayout& signal) {
     if (!result_.ok()) return;
-    if (value > static_cast<std::uint64_t>(signal.raw_max)) {
+    if (value > static_cast<std::uint64_t>(signal.raw_max) &&
+        !(signal.special_raw != kNoSpecialRaw &&
+          value == static_cast<std::uint64_t>(signal.special_raw))) {
       fail(CodecError::kOutOfRange, signal);
       return;
     }
@@ -129,7 +155,7 @@ class Packer {
   void fail(CodecError error, const SignalLayout& signal) { fail(error, signal.name); }
 
   void put(std::int64_t raw, const SignalLayout& signal, CodecError out_of_range) {
-    if (raw < signal.raw_min || raw > signal.raw_max) {
+    if (!valid_raw(raw, signal)) {
       fail(out_of_range, signal);
       return;
     }
@@ -186,7 +212,7 @@ class Unpacker {
     const std::uint64_t bits = extract_bits(word_, signal.start_bit, signal.length);
     const std::int64_t value =
         signal.is_signed ? sign_extend(bits, signal.length) : static_cast<std::int64_t>(bits);
-    if (value < signal.raw_min || value > signal.raw_max) {
+    if (!valid_raw(value, signal)) {
       fail(out_of_range, signal.name);
       return 0;
     }
@@ -202,12 +228,13 @@ constexpr bool undefined_status_flags(std::uint8_t status) {
 }
 
 // The DBC message names, without node or axis suffix.
-constexpr NameTable<MessageKind, 5> kMessageKindNames{{{
+constexpr NameTable<MessageKind, 6> kMessageKindNames{{{
     {MessageKind::kSensorAcceleration, "SensorAcceleration"},
     {MessageKind::kSensorHeartbeat, "SensorHeartbeat"},
     {MessageKind::kMonitorStatus, "MonitorStatus"},
     {MessageKind::kAlarmEvent, "AlarmEvent"},
     {MessageKind::kAcknowledge, "Acknowledge"},
+    {MessageKind::kCollapseForecast, "CollapseForecast"},
 }}};
 
 constexpr NameTable<CodecError, 8> kCodecErrorTexts{{{
@@ -241,6 +268,8 @@ MessageKind classify(std::uint32_t id) {
       return index == 0 ? MessageKind::kAlarmEvent : MessageKind::kUnknown;
     case kAcknowledgeId:
       return index == 0 ? MessageKind::kAcknowledge : MessageKind::kUnknown;
+    case kCollapseForecastBaseId:
+      return index < kMonitorAxisCount ? MessageKind::kCollapseForecast : MessageKind::kUnknown;
     default:
       return MessageKind::kUnknown;
   }
@@ -259,6 +288,7 @@ std::span<const SignalLayout> signal_layouts(MessageKind kind) {
     case MessageKind::kMonitorStatus: return kStatusSignals;
     case MessageKind::kAlarmEvent: return kEventSignals;
     case MessageKind::kAcknowledge: return kAcknowledgeSignals;
+    case MessageKind::kCollapseForecast: return kForecastSignals;
     case MessageKind::kUnknown: break;
   }
   return {};
@@ -442,6 +472,63 @@ DecodeResult decode(const CanFrame& frame, Acknowledge& message) {
   m.level = unpacker.enumeration<AlarmLevel>(s[kAckLevel]);
   m.source_id = unpacker.integer<std::uint8_t>(s[kSourceId]);
   m.event_sequence = unpacker.integer<std::uint8_t>(s[kEventSequence]);
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+namespace {
+
+// The signals of a CollapseForecast that must agree: the worst member is one of the members, and
+// "none collapses" is said by all of Probability (raw 0), WorstMember and CollapseIn or by none.
+CodecResult contradiction(const CollapseForecast& m, bool probability_zero) {
+  const bool none = m.worst_member == kNoWorstMember;
+  if (!none && m.worst_member >= m.members) return {CodecError::kOutOfRange, "WorstMember"};
+  if (none != (m.collapse_in_ms == kNoCollapseForecast)) {
+    return {CodecError::kOutOfRange, "CollapseIn"};
+  }
+  if (none != probability_zero) return {CodecError::kOutOfRange, "Probability"};
+  return {};
+}
+
+// Whether `value` encodes to raw 0 (a value that does not encode at all is refused elsewhere).
+bool encodes_to_zero(double value, const SignalLayout& signal) {
+  const double scaled = (value - signal.offset) / signal.factor;
+  return std::isfinite(scaled) && std::fabs(scaled) < 1.0 && std::llround(scaled) == 0;
+}
+
+}  // namespace
+
+EncodeResult encode(const CollapseForecast& message, CanFrame& frame) {
+  const auto& s = kForecastSignals;
+  Packer packer;
+  if (message.axis >= kMonitorAxisCount) packer.fail(CodecError::kOutOfRange, "axis");
+  packer.physical(message.probability, s[kProbability]);
+  packer.integer(message.worst_member, s[kWorstMember]);
+  packer.integer(message.members, s[kMembers]);
+  packer.integer(message.collapse_in_ms, s[kCollapseIn]);
+  packer.physical(message.horizon_s, s[kHorizon]);
+  packer.integer(message.sequence, s[kFcSequence]);
+  const CodecResult agree =
+      contradiction(message, encodes_to_zero(message.probability, s[kProbability]));
+  if (!agree.ok()) packer.fail(agree.error, agree.signal);
+  return packer.finish(kCollapseForecastBaseId + message.axis, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, CollapseForecast& message) {
+  const auto& s = kForecastSignals;
+  Unpacker unpacker(frame, MessageKind::kCollapseForecast, s);
+  CollapseForecast m;
+  m.axis = static_cast<std::uint8_t>(frame.id - kCollapseForecastBaseId);
+  m.probability = unpacker.physical(s[kProbability]);
+  m.worst_member = unpacker.integer<std::uint8_t>(s[kWorstMember]);
+  m.members = unpacker.integer<std::uint8_t>(s[kMembers]);
+  m.collapse_in_ms = unpacker.integer<std::uint16_t>(s[kCollapseIn]);
+  m.horizon_s = unpacker.physical(s[kHorizon]);
+  m.sequence = unpacker.integer<std::uint8_t>(s[kFcSequence]);
+  if (unpacker.result().ok()) {
+    const CodecResult agree = contradiction(m, m.probability == 0.0);
+    if (!agree.ok()) unpacker.fail(agree.error, agree.signal);
+  }
   if (unpacker.result().ok()) message = m;
   return unpacker.result();
 }

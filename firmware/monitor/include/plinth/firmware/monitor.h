@@ -11,7 +11,8 @@
 //     of the scene's declared uncertainty)--> phase, state per member --overturning_risk--> the
 //     worst member's risk; --Forecaster per axis (forecast.h)--> the probability of a collapse
 //     within the horizon, its worst member and time --AlarmPolicy--> level, events
-//   events, and the status at status_interval_s --can_frames.h--> frames ready to send
+//   events, and the status at status_interval_s --can_frames.h--> frames ready to send (with
+//     each status, while forecasting, a CollapseForecast per axis that has a forecast)
 //   the other ground sensors' samples --cross-check against the primary--> disagreement
 //   the plate sensor's samples --compared with the model's base acceleration--> residual
 //
@@ -157,6 +158,8 @@ struct AxisStatus {
   int members = 1;       // the ensemble's size
   int worst_member = 0;  // whose risk that is
   ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
+  // Monitor time, s, of that forecast's first collapse (its worst member's); -1: none forecast.
+  double collapse_forecast_s = -1.0;
 };
 
 // Frames that were not sensor samples of a configured node, or could not be decoded.
@@ -166,7 +169,7 @@ struct FrameCounters {
   std::uint64_t other_nodes = 0;          // SensorAcceleration of other nodes (not used)
   std::uint64_t heartbeats = 0;           // SensorHeartbeat of any node
   std::uint64_t acknowledgements = 0;     // Acknowledge frames, decoded
-  std::uint64_t monitor_frames = 0;       // MonitorStatus / AlarmEvent (ours or another box's)
+  std::uint64_t monitor_frames = 0;  // MonitorStatus / AlarmEvent / CollapseForecast (any box's)
   std::uint64_t rejected = 0;             // failed to decode (length, range, reserved bits)
   std::uint64_t unknown_identifiers = 0;  // not a plinth identifier
   can::CodecError last_error = can::CodecError::kOk;  // of the latest rejected frame
@@ -228,9 +231,9 @@ struct MonitorStatus {
 
 // An update's alarm events: each update evaluates the alarm policy once.
 inline constexpr std::size_t kMaxUpdateEvents = monitor::kMaxEventsPerUpdate;
-// An AlarmEvent per event, then a MonitorStatus per axis.
+// An AlarmEvent per event, then a MonitorStatus per axis, then a CollapseForecast per axis.
 inline constexpr std::size_t kMaxFramesPerUpdate =
-    kMaxUpdateEvents + static_cast<std::size_t>(kMaxAxes);
+    kMaxUpdateEvents + 2 * static_cast<std::size_t>(kMaxAxes);
 
 // What one input did, and the frames to send for it, in order.
 struct MonitorUpdate {

@@ -9,8 +9,11 @@
 // rounds to a raw value outside the signal's DBC range, an enum value outside its VAL_ table,
 // status flags the protocol does not define. Decoding refuses a frame whose length is not 8,
 // whose identifier is not this message's (or no plinth message's), whose raw values lie outside
-// the DBC range or VAL_ table, or whose reserved bits are not zero. On refusal the output message
-// is left untouched.
+// the DBC range or VAL_ table, or whose reserved bits are not zero. A quantity's VAL_ table names
+// a special value outside its range ("none"), valid as well. Both refuse a CollapseForecast whose
+// signals contradict each other (a worst member beyond the members; "none" in one of
+// Probability (0), WorstMember, CollapseIn but not in all). On refusal the output message is
+// left untouched.
 #pragma once
 
 #include <array>
@@ -41,6 +44,7 @@ inline constexpr std::uint32_t kSensorHeartbeatBaseId = 0x310;     // + node (1.
 inline constexpr std::uint32_t kMonitorStatusBaseId = 0x320;       // + axis (0..1)
 inline constexpr std::uint32_t kAlarmEventId = 0x330;
 inline constexpr std::uint32_t kAcknowledgeId = 0x340;
+inline constexpr std::uint32_t kCollapseForecastBaseId = 0x350;  // + axis (0..1)
 
 inline constexpr std::uint8_t kFirstSensorNode = 1;
 inline constexpr std::uint8_t kLastSensorNode = 15;
@@ -53,6 +57,7 @@ enum class MessageKind : std::uint8_t {
   kMonitorStatus,
   kAlarmEvent,
   kAcknowledge,
+  kCollapseForecast,
 };
 
 // Which plinth message an identifier carries; kUnknown outside the table (node 0, axis 2, ...).
@@ -161,6 +166,25 @@ struct Acknowledge {
   std::uint8_t event_sequence = 0;         // AlarmEvent.sequence of the event acknowledged
 };
 
+// 0x350 + axis: the forecast of one rocking plane, sent with its MonitorStatus while the
+// monitor forecasts (docs/monitor.md).
+inline constexpr std::uint8_t kMaxForecastMembers = 17;       // the ensemble's largest size
+inline constexpr std::uint8_t kNoWorstMember = 255;           // WorstMember: no member collapses
+inline constexpr std::uint16_t kNoCollapseForecast = 0xFFFF;  // CollapseIn: none forecast
+struct CollapseForecast {
+  std::uint8_t axis = 0;     // 0..1
+  double probability = 0.0;  // of a collapse within the horizon, 0..1, resolution 1e-4
+  // The member forecast to collapse first, 0..members-1 (0: the nominal statue), or
+  // kNoWorstMember exactly when the probability is 0.
+  std::uint8_t worst_member = kNoWorstMember;
+  std::uint8_t members = 1;  // the ensemble's size, 1..kMaxForecastMembers
+  // ms from the frame's time to that member's forecast collapse (0: due now or overdue),
+  // 0..65534; kNoCollapseForecast exactly when worst_member is kNoWorstMember.
+  std::uint16_t collapse_in_ms = kNoCollapseForecast;
+  double horizon_s = 0.0;     // how far ahead the forecast looks, 0..25.5 s at 0.1 s
+  std::uint8_t sequence = 0;  // the MonitorStatus.Sequence it goes out with
+};
+
 // ---------------------------------------------------------------------------------------------
 // Results
 
@@ -193,6 +217,7 @@ using DecodeResult = CodecResult;
 [[nodiscard]] EncodeResult encode(const MonitorStatus& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const AlarmEvent& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const Acknowledge& message, CanFrame& frame);
+[[nodiscard]] EncodeResult encode(const CollapseForecast& message, CanFrame& frame);
 
 // On success `message` holds the decoded values (node / axis from the identifier); on failure
 // it is left untouched.
@@ -201,6 +226,7 @@ using DecodeResult = CodecResult;
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, MonitorStatus& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, AlarmEvent& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, Acknowledge& message);
+[[nodiscard]] DecodeResult decode(const CanFrame& frame, CollapseForecast& message);
 
 // ---------------------------------------------------------------------------------------------
 // Signal layouts (as in the DBC) and Intel bit packing
@@ -217,7 +243,11 @@ struct SignalLayout {
   std::int64_t raw_max;
   const char* unit;       // the DBC unit string ("" for none)
   bool has_value_table;  // an enumeration: the DBC has a VAL_ table for it
+  // A raw value outside raw_min..raw_max that is valid too: the DBC's VAL_ table names it
+  // "none" (a quantity's "not available"); kNoSpecialRaw when there is none.
+  std::int64_t special_raw;
 };
+inline constexpr std::int64_t kNoSpecialRaw = INT64_MIN;
 
 // The signals of one message kind in frame order; empty for kUnknown.
 [[nodiscard]] std::span<const SignalLayout> signal_layouts(MessageKind kind);
