@@ -26,7 +26,7 @@ set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 set(CMAKE_C_FLAGS_INIT "${PLINTH_MCU_CPU_FLAGS} -ffunction-sections -fdata-sections")
 set(CMAKE_CXX_FLAGS_INIT
     "${PLINTH_MCU_CPU_FLAGS} -ffunction-sections -fdata-sections -fno-unwind-tables -fno-asynchronous-unwind-tables")
-set(CMAKE_EXE_LINKER_FLAGS_INIT "${PLINTH_MCU_CPU_FLAGS} -nostartfiles -Wl,--gc-sections")
+set(CMAKE_EXE_LINKER_FLAGS_INIT "${PLINTH_MCU_CPU_FLAGS} --specs=nano.specs -nostartfiles -Wl,--gc-sections")
 
 # Libraries and headers of the target come from the toolchain; Eigen (header-only) and CMake
 # package files from the host.
