@@ -9,23 +9,17 @@
 #include "plinth/hal/can_codec.h"
 #include "plinth/hal/semihosting.h"
 #include "plinth/hal/semihosting_can.h"
+#include "plinth/hal/text_line.h"
 
 namespace {
 
 namespace semihosting = plinth::hal::semihosting;
 
-void print_number(const char* label, std::uint32_t value) {
-  char digits[12];
-  int n = 0;
-  do {
-    digits[n++] = static_cast<char>('0' + value % 10);
-    value /= 10;
-  } while (value != 0);
-  char text[12];
-  for (int i = 0; i < n; ++i) text[i] = digits[n - 1 - i];
-  text[n] = '\n';
-  semihosting::write(label);
-  semihosting::write(text, static_cast<std::size_t>(n) + 1);
+void print_number(const char* label, std::size_t value) {
+  char text[96];
+  plinth::hal::TextLine line(text, sizeof text);
+  line.put(label).decimal(static_cast<std::uint64_t>(value)).put('\n');
+  semihosting::write(line.c_str(), line.length());
 }
 
 // Two instructions per iteration (subs, bne).
@@ -57,10 +51,8 @@ extern "C" int plinth_board_main() {
   const std::size_t before = plinth::hal::board::stack_used_bytes();
   (void)use_stack();
   const std::size_t after = plinth::hal::board::stack_used_bytes();
-  print_number("board_check: stack used before the probe, bytes: ",
-               static_cast<std::uint32_t>(before));
-  print_number("board_check: stack used after a 1024-byte frame, bytes: ",
-               static_cast<std::uint32_t>(after));
+  print_number("board_check: stack used before the probe, bytes: ", before);
+  print_number("board_check: stack used after a 1024-byte frame, bytes: ", after);
   // The probe's frame starts at this frame's depth, which is at most `before`.
   ok = ok && after >= kStackProbeBytes && after <= before + kStackProbeBytes + 64 &&
        after < plinth::hal::board::stack_size_bytes();
