@@ -17,6 +17,8 @@
 #include "event_recorder.h"
 #include "monitor_config.h"
 #include "plinth/firmware/monitor.h"
+#include "plinth/firmware/monitor_frames.h"
+#include "plinth/firmware/record_replay.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/hal/pacing.h"
@@ -56,6 +58,7 @@ struct Options {
   std::optional<double> startup_window;
   double duration = 0.0;
   std::string record_dir;
+  std::string frames_out;
   double pre_trigger = 30.0;
   double post_trigger = 60.0;
   bool quiet_events = false;
@@ -213,8 +216,8 @@ class Outputs {
  public:
   Outputs(fw::Monitor& monitor, double t_origin, double status_interval,
           fw::EventRecorder* recorder, plinth::hal::FrameSink* bus)
-      : monitor_(monitor), t_origin_(t_origin), interval_ns_(std::llround(status_interval * 1e9)),
-        recorder_(recorder), bus_(bus) {}
+      : monitor_(monitor), t_origin_(t_origin), recorder_(recorder),
+        frames_(monitor, std::llround(status_interval * 1e9), bus) {}
 
   void handle(const fw::MonitorUpdate& u) {
     const fw::MonitorStatus& s = monitor_.status();
@@ -228,7 +231,7 @@ class Outputs {
         max_level = e.level;
       }
       if (e.level == can::AlarmLevel::kFault) ++fault_events;
-      send_alarm(e);
+      frames_.send_alarm(e);
       if (recorder_ != nullptr && (e.level == can::AlarmLevel::kWarning ||
                                    e.level == can::AlarmLevel::kAlarm)) {
         fw::TriggerInfo info;
@@ -243,61 +246,25 @@ class Outputs {
       }
     }
     // At the status interval, at every alarm change, and at the alarm policy's heartbeat.
-    if (u.event_count > 0 || u.status_due || s.time_ns >= next_status_ns_) {
+    if (frames_.status_due(u)) {
       print_line(status_json(monitor_, t_origin_));
-      send_status();
-      monitor_.status_sent();
-      while (next_status_ns_ <= s.time_ns) next_status_ns_ += interval_ns_;
+      frames_.send_status();
     }
   }
+
+  [[nodiscard]] std::uint64_t bus_send_errors() const { return frames_.send_errors(); }
 
   double max_risk = 0.0;
   can::AlarmLevel max_level = can::AlarmLevel::kNormal;
   std::uint64_t alarm_events = 0;
   std::uint64_t fault_events = 0;
-  std::uint64_t bus_send_errors = 0;
   std::int64_t last_frame_ns = 0;  // receive time of the newest frame (the recorder's clock)
 
  private:
-  void send_status() {
-    if (bus_ == nullptr) return;
-    const fw::MonitorStatus& s = monitor_.status();
-    for (int i = 0; i < s.axis_count; ++i) {
-      const fw::AxisStatus& a = s.axes[static_cast<std::size_t>(i)];
-      can::MonitorStatus m;
-      m.axis = static_cast<std::uint8_t>(i);
-      m.phase = static_cast<can::Phase>(a.mode.phase);
-      m.corner = a.mode.rocking() ? static_cast<can::Corner>(a.mode.corner) : can::Corner::kNone;
-      m.alarm_level = s.alarm;
-      m.risk = a.risk.total;
-      m.sequence = status_sequence_;
-      // Not estimating yet: no sample was used, the age is the largest the frame can say.
-      const std::int64_t age_ms =
-          s.estimating ? (s.time_ns - s.newest_sample_time_ns) / 1'000'000 : 65535;
-      m.sample_age_ms = static_cast<std::uint16_t>(age_ms < 0 ? 0 : (age_ms > 65535 ? 65535 : age_ms));
-      send(m);
-    }
-    ++status_sequence_;
-  }
-  void send_alarm(const mon::AlarmEventRecord& e) {
-    if (bus_ == nullptr) return;
-    send(mon::to_can_event(e));
-  }
-  template <typename Message>
-  void send(const Message& m) {
-    can::CanFrame frame;
-    if (!can::encode(m, frame).ok() || bus_->send(frame) != plinth::hal::IoStatus::kOk) {
-      ++bus_send_errors;
-    }
-  }
-
   fw::Monitor& monitor_;
   double t_origin_;
-  std::int64_t interval_ns_;
-  std::int64_t next_status_ns_ = 0;
   fw::EventRecorder* recorder_;
-  plinth::hal::FrameSink* bus_;
-  std::uint8_t status_sequence_ = 0;
+  fw::MonitorFrames frames_;
 };
 
 // A record resampled to the sensor rate, as the ground sensor (m/s2, z reads g + v).
@@ -395,7 +362,7 @@ void print_summary(const fw::Monitor& monitor, const Outputs& outputs, const Sum
       static_cast<unsigned long long>(c.saturated), static_cast<unsigned long long>(c.timeouts),
       static_cast<unsigned long long>(c.faults),
       static_cast<unsigned long long>(s.estimator_restarts),
-      static_cast<unsigned long long>(outputs.bus_send_errors),
+      static_cast<unsigned long long>(outputs.bus_send_errors()),
       static_cast<unsigned long long>(summary.bus_errors),
       static_cast<unsigned long long>(summary.dropped_frames));
   std::string line = text;
@@ -444,8 +411,7 @@ int run(const Options& opt) {
   if (sources != 1) throw InputError("give exactly one input: --replay FILE or --can INTERFACE");
   const double speed = parse_speed(opt.speed);
   // Defaults, then the configuration file, then the command line.
-  fw::MonitorConfig config;
-  config.conditioning.startup_window_s = 2.0;
+  fw::MonitorConfig config = fw::box_defaults();
   std::string scene_y_path = opt.scene_y_path;
   if (!opt.config_path.empty()) {
     const fw::MonitorFile file = fw::load_monitor_file(opt.config_path, config);
@@ -498,27 +464,8 @@ int run(const Options& opt) {
   double t_origin = 0.0;
   if (replay_record) {
     record = record_samples(opt, gravity);
-    config.estimator.sample_rate_hz = record.rate_hz;
-    // One ideal ground sensor: a [[sensor]] list is reduced to its first ground sensor.
-    for (int i = config.sensor_count - 1; i >= 0; --i) {
-      const fw::SensorConfig& sensor = config.sensors[static_cast<std::size_t>(i)];
-      if (sensor.role != fw::SensorRole::kGround) continue;
-      config.ground_node = sensor.node;
-      config.conditioning = sensor.conditioning;
-      config.sensor_health = sensor.sensor_health;
-    }
-    config.sensor_count = 0;
-    // The record is the ground's exact motion in m/s2, in the statue's frame: no bias to track,
-    // no sensor noise (the stuck-value check needs noise), and the quiet lead-in estimates the
-    // zero offset. The file's sensor settings describe the real sensor, not this one.
-    config.conditioning.unit = mon::AccelerationUnit::kMetresPerSecondSquared;
-    config.conditioning.sensor_to_statue.setIdentity();
-    config.conditioning.tracking_time_constant_s = 1e6;
-    config.sensor_health.stuck_samples = 0;
-    config.sensor_health.full_scale_g = 1e6;
-    config.sensor_health.max_valid_g = 1e6;
-    t_origin = (std::round(config.conditioning.startup_window_s * record.rate_hz) +
-                config.sensor_health.recovery_samples - 1) / record.rate_hz;
+    fw::configure_record_replay(config, record.rate_hz);
+    t_origin = fw::record_replay_origin_s(config);
   } else {
     if (opt.rate) config.estimator.sample_rate_hz = *opt.rate;
   }
@@ -552,8 +499,18 @@ int run(const Options& opt) {
     rs.frame_rate_hz = 2.0 * config.estimator.sample_rate_hz + 100.0;
     recorder = std::make_unique<fw::EventRecorder>(rs);
   }
+  // --frames-out: the frames the replay sends, stamped with the time of the input that caused
+  // them (the bus's candump would show the same).
+  const Outputs* frames_clock = nullptr;
+  std::optional<plinth::hal::CandumpLogWriter> frames_log;
+  if (!opt.frames_out.empty()) {
+    frames_log.emplace(opt.frames_out, "can0",
+                       [&frames_clock] { return frames_clock->last_frame_ns; });
+  }
   Outputs outputs(monitor, t_origin, opt.status_interval, recorder.get(),
-                  port ? &*port : nullptr);
+                  port ? static_cast<plinth::hal::FrameSink*>(&*port)
+                       : (frames_log ? &*frames_log : nullptr));
+  frames_clock = &outputs;
   Summary summary;
   const std::int64_t wall_start = plinth::hal::monotonic_now_ns();
   const auto pace = [&](std::int64_t stream_ns) {
@@ -566,19 +523,13 @@ int run(const Options& opt) {
 
   if (replay_record) {
     summary.source = opt.replay_path;
-    const double period = 1.0 / record.rate_hz;
-    // Quiet lead-in: the health tracker's recovery (it starts in fault, no data yet) and the
-    // conditioner's start-up window, so that the estimator starts at the record's first sample.
-    const auto lead_in =
-        static_cast<std::size_t>(std::llround(config.conditioning.startup_window_s * record.rate_hz)) +
-        static_cast<std::size_t>(config.sensor_health.recovery_samples) - 1;
+    // Quiet lead-in, then the record (record_replay.h).
+    const auto lead_in = static_cast<std::size_t>(fw::record_replay_lead_in(config));
     const std::size_t total = lead_in + record.samples.size();
     for (std::size_t n = 0; n < total && !g_stop; ++n) {
-      mon::SensorSample sample;
-      sample.receive_time_ns = std::llround(static_cast<double>(n) * period * 1e9);
-      sample.sequence = static_cast<std::uint8_t>(n & 0xFF);
-      sample.acceleration_g = n < lead_in ? Eigen::Vector3d(0.0, 0.0, gravity)
-                                          : record.samples[n - lead_in];
+      const mon::SensorSample sample = fw::record_replay_sample(
+          config, static_cast<std::int64_t>(n),
+          n < lead_in ? Eigen::Vector3d::Zero() : record.samples[n - lead_in], gravity);
       pace(sample.receive_time_ns);
       if (recorder) {
         can::SensorAcceleration m;
@@ -669,6 +620,7 @@ int run(const Options& opt) {
     summary.dropped_frames = port->total_dropped_frames();
   }
   if (recorder) recorder->close();  // every capture is on disk before the summary
+  if (frames_log && !frames_log->flush()) throw InputError(frames_log->error());
   print_summary(monitor, outputs, summary, recorder.get(), t_origin, sinks);
   std::fflush(stdout);
   return 0;
@@ -702,6 +654,9 @@ int main(int argc, char** argv) {
   app.add_option("--duration", opt.duration, "live: stop after this many seconds")
       ->check(plinth::host::kFinitePositive);
   app.add_option("--record-dir", opt.record_dir, "event recorder: write captures here");
+  app.add_option("--frames-out", opt.frames_out,
+                 "replay: write the status and alarm frames sent to this candump log")
+      ->excludes("--can");
   app.add_option("--pre-trigger", opt.pre_trigger, "s kept before an alarm (default 30)")
       ->check(plinth::host::kFinite);
   app.add_option("--post-trigger", opt.post_trigger, "s kept after an alarm (default 60)")
