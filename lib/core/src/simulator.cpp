@@ -11,6 +11,18 @@
 #include "plinth/core/guards.h"
 #include "plinth/core/resets.h"
 
+// Build-time choices for small targets (lib/core/CMakeLists.txt, docs/microcontroller.md): every
+// stepper and flattened intervals by default; a microcontroller keeps the estimator's stepper
+// alone and calls what the host inlines, to fit its flash.
+#ifndef PLINTH_CORE_RK4_ONLY
+#define PLINTH_CORE_RK4_ONLY 0
+#endif
+#if !defined(PLINTH_CORE_FLATTEN) || PLINTH_CORE_FLATTEN
+#define PLINTH_FLATTEN [[gnu::flatten]]
+#else
+#define PLINTH_FLATTEN
+#endif
+
 namespace plinth {
 
 const char* phase_name(Phase phase) {
@@ -98,6 +110,10 @@ Error validate(const SolverSettings& st) {
   if (!known_stepper) {
     return {ErrorCode::kOutOfRange, "solver.stepper",
             "must be one of rk4_located, rk4_step_end, heun_located, semi_implicit_euler"};
+  }
+  if (PLINTH_CORE_RK4_ONLY && st.stepper != Stepper::kRk4Located) {
+    return {ErrorCode::kOutOfRange, "solver.stepper",
+            "must be rk4_located: this build has no other (PLINTH_CORE_RK4_ONLY)"};
   }
   if (!std::isfinite(st.rest_energy_ratio) || st.rest_energy_ratio <= 0.0 ||
       st.rest_energy_ratio >= 1.0) {
@@ -647,6 +663,7 @@ struct Hybrid {
       case Stepper::kRk4Located:
         bind_intervals<methods::Rk4>(sim, settings.exact_full_contact);
         return;
+#if !PLINTH_CORE_RK4_ONLY
       case Stepper::kRk4StepEnd:
         bind_intervals<methods::Rk4StepEnd>(sim, settings.exact_full_contact);
         return;
@@ -656,6 +673,10 @@ struct Hybrid {
       case Stepper::kSemiImplicitEuler:
         bind_intervals<methods::SemiImplicitEuler>(sim, settings.exact_full_contact);
         return;
+#else
+      default:  // validate() refused the others: not compiled in
+        return;
+#endif
     }
   }
 };
@@ -789,8 +810,8 @@ struct Interval {
     return first;
   }
 
-  [[gnu::flatten]] static bool run(Simulator& sim, double& t0, double t_end, bool guards_live,
-                                   bool full_step) {
+  PLINTH_FLATTEN static bool run(Simulator& sim, double& t0, double t_end, bool guards_live,
+                                 bool full_step) {
     const Scene& s = *sim.scene_;
     const Mode mode = sim.mode_;
     const State& y0 = sim.y_;  // replaced only once y1 (or the event's state) is complete
