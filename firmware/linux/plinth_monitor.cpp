@@ -16,6 +16,7 @@
 
 #include "event_recorder.h"
 #include "monitor_config.h"
+#include "record_input.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/firmware/monitor_frames.h"
 #include "plinth/firmware/record_replay.h"
@@ -54,7 +55,7 @@ struct Options {
   std::string config_path;
   std::optional<int> steps;
   std::optional<int> node;
-  double status_interval = 0.1;
+  double status_interval = fw::kDefaultStatusIntervalS;
   std::optional<double> startup_window;
   double duration = 0.0;
   std::string record_dir;
@@ -267,54 +268,6 @@ class Outputs {
   fw::MonitorFrames frames_;
 };
 
-// A record resampled to the sensor rate, as the ground sensor (m/s2, z reads g + v).
-struct RecordSamples {
-  double rate_hz = 0.0;
-  std::vector<Eigen::Vector3d> samples;
-};
-
-RecordSamples record_samples(const Options& opt, double gravity) {
-  const plinth::host::Record h = plinth::host::read_record(opt.replay_path, gravity);
-  std::optional<plinth::host::Record> y;
-  if (!opt.replay_y_path.empty()) y = plinth::host::read_record(opt.replay_y_path, gravity);
-  std::optional<plinth::host::Record> v;
-  if (!opt.vertical_path.empty()) v = plinth::host::read_record(opt.vertical_path, gravity);
-  double gamma = 1.0;
-  if (opt.scale) gamma = *opt.scale;
-  if (!opt.pga.empty()) {
-    const double pga = plinth::host::parse_acceleration(opt.pga, gravity, "--pga");
-    if (h.peak_horizontal() <= 0.0) throw InputError(opt.replay_path + ": the record is all zeros");
-    gamma = pga / h.peak_horizontal();
-  }
-  RecordSamples out;
-  const double native = 1.0 / h.dt;
-  out.rate_hz = opt.rate ? *opt.rate : (native >= 100.0 && native <= 1000.0 ? native : 200.0);
-  const bool resample = std::fabs(out.rate_hz * h.dt - 1.0) > 1e-9;
-  const auto signal_at = [&](const plinth::host::Record& r, std::size_t n, bool vertical) {
-    const std::vector<double>& values = vertical && !r.vertical.empty() ? r.vertical : r.horizontal;
-    if (!resample) return n < values.size() ? values[n] : 0.0;
-    const plinth::SampledSignal s{values.data(), values.size(), r.dt};
-    return s.at(static_cast<double>(n) / out.rate_hz);
-  };
-  const std::size_t count =
-      static_cast<std::size_t>(std::floor(h.duration() * out.rate_hz + 1e-9)) + 1;
-  out.samples.reserve(count);
-  for (std::size_t n = 0; n < count; ++n) {
-    Eigen::Vector3d a;
-    a.x() = gamma * signal_at(h, n, false);
-    a.y() = y ? gamma * signal_at(*y, n, false) : 0.0;
-    double vertical = 0.0;
-    if (v) {
-      vertical = gamma * signal_at(*v, n, false);
-    } else if (!h.vertical.empty()) {
-      vertical = gamma * signal_at(h, n, true);
-    }
-    a.z() = gravity + vertical;
-    out.samples.push_back(a);
-  }
-  return out;
-}
-
 struct Summary {
   std::uint64_t samples = 0;
   std::string source;
@@ -460,10 +413,12 @@ int run(const Options& opt) {
   }
 
   config.axis_count = scene_y ? 2 : 1;
-  RecordSamples record;
+  fw::RecordSamples record;
   double t_origin = 0.0;
   if (replay_record) {
-    record = record_samples(opt, gravity);
+    record = fw::record_samples({opt.replay_path, opt.replay_y_path, opt.vertical_path, opt.pga,
+                                 opt.scale, opt.rate},
+                                gravity);
     fw::configure_record_replay(config, record.rate_hz);
     t_origin = fw::record_replay_origin_s(config);
   } else {

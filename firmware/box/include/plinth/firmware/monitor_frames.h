@@ -12,6 +12,9 @@
 
 namespace plinth::firmware {
 
+// s between status frames (and plinth-monitor's status lines) unless configured otherwise.
+inline constexpr double kDefaultStatusIntervalS = 0.1;
+
 class MonitorFrames {
  public:
   // `bus` may be null (nothing is sent; the schedule still runs). Both must outlive this.
