@@ -9,6 +9,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libsocketcan-dev user-mode-linux kmod iproute2 can-utils  # SocketCAN, tested in UML
   python3 gnuplot-nox
+  gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib  # Cortex-M4F image
+  qemu-system-arm                                                            # runs it
 )
 
 missing=()
