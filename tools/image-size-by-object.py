@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Flash and RAM of a linked image per object file, from its GNU ld link map.
 
-    image-size-by-object.py IMAGE.map [--top N]
+    image-size-by-object.py IMAGE.map [--top N] [--summary]
 
 Counts the input sections placed in the output sections that occupy flash (.vectors, .text,
 .ARM.exidx, .init_array, .data's load image) and RAM (.data, .bss), grouped by archive member
@@ -18,6 +18,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("map")
     parser.add_argument("--top", type=int, default=25)
+    parser.add_argument("--summary", action="store_true", help="the totals' line only")
     args = parser.parse_args()
     text = open(args.map).read()
     text = text[text.index("Linker script and memory map"):]
@@ -46,7 +47,9 @@ def main():
         if output in RAM:
             ram[obj] += size
     print("flash %d bytes, RAM (data + bss, without the stack) %d bytes, record %d bytes" % (
-        sum(flash.values()), sum(ram.values()) - ram["(stack)"], record))
+        sum(flash.values()), sum(ram.values()), record))
+    if args.summary:
+        return
     print("flash by object:")
     for obj, size in flash.most_common(args.top):
         print("  %7d  %s" % (size, obj))
