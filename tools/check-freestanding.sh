@@ -8,7 +8,7 @@
 #                                                   says were pulled in, and why
 # NM selects nm (NM=arm-none-eabi-nm for a cross build).
 set -euo pipefail
-forbidden='^(malloc|calloc|realloc|free|aligned_alloc|posix_memalign|_sbrk|_sbrk_r|_malloc_r|_calloc_r|_realloc_r|_free_r)$|operator new|operator delete|__cxa_throw|__cxa_allocate_exception|__cxa_begin_catch|__gxx_personality|_Unwind_|__aeabi_unwind_cpp_pr|typeinfo|std::ios_base|std::basic_ostream|std::cout|std::cerr|printf|puts|fwrite'
+forbidden='^(malloc|calloc|realloc|free|aligned_alloc|posix_memalign|_sbrk|_sbrk_r|_malloc_r|_calloc_r|_realloc_r|_free_r)$|operator new|operator delete|__cxa_throw|__cxa_allocate_exception|__cxa_begin_catch|__gxx_personality|_Unwind_|__aeabi_unwind_cpp_pr|typeinfo|std::ios_base|std::basic_ostream|std::cout|std::cerr|printf|(^|[^A-Za-z])f?puts|fwrite'
 
 report_bad() {  # WHAT BAD-SYMBOLS
   echo "check-freestanding: $1 references hosted runtime symbols:" >&2
@@ -20,7 +20,8 @@ if [ "${1:-}" = "--image" ]; then
   image=${2:?usage: check-freestanding.sh --image IMAGE.elf [IMAGE.map]}
   map=${3:-}
   [ -f "$image" ] || { echo "check-freestanding: no such image: $image" >&2; exit 2; }
-  symbols=$("${NM:-nm}" -C "$image" | awk '{ if (NF >= 3) { $1 = ""; $2 = "" } else { $1 = "" } print }' | sed 's/^ *//' | sort -u)
+  # "ADDRESS TYPE NAME" or, undefined, "TYPE NAME"; a demangled NAME may hold spaces.
+  symbols=$("${NM:-nm}" -C "$image" | sed -E 's/^ *([0-9a-fA-F]+ )?[A-Za-z?-] //' | sort -u)
   bad=$(grep -E "$forbidden" <<<"$symbols" || true)
   [ -z "$bad" ] || report_bad "$image" "$bad"
   if [ -n "$map" ]; then
