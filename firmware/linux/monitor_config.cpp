@@ -1,15 +1,16 @@
 #include "monitor_config.h"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
 #include <functional>
 #include <map>
-#include <sstream>
-#include <toml++/toml.h>
+#include <utility>
 #include <vector>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/text_file.h"
 
 namespace plinth::firmware {
 
@@ -131,6 +132,7 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit) {
   std::vector<Binding> b = {
       {"monitor.ground_node", integer_into(node), "an integer"},
       {"monitor.quiet_risk", number_into(c.quiet_risk), "a number"},
+      {"monitor.status_interval_s", number_into(c.status_interval_s), "a number"},
       {"monitor.second_scene", string_into(f.second_scene_path), "a string (a scene file)"},
       {"estimator.sample_rate_hz", number_into(c.estimator.sample_rate_hz), "a number"},
       {"estimator.steps_per_sample", integer_into(c.estimator.steps_per_sample), "an integer"},
@@ -173,17 +175,120 @@ void flatten(const toml::table& table, const std::string& prefix,
   }
 }
 
-
-// "g" or "m/s2"; false otherwise.
-bool parse_unit(const std::string& text, monitor::AccelerationUnit& unit) {
-  if (text == "g") {
-    unit = monitor::AccelerationUnit::kStandardGravity;
-  } else if (text == "m/s2") {
-    unit = monitor::AccelerationUnit::kMetresPerSecondSquared;
-  } else {
-    return false;
+// The file's keys and where each stands, for messages: "box.toml:12".
+class KeyLines {
+ public:
+  explicit KeyLines(std::string origin) : origin_(std::move(origin)) {}
+  void note(const std::string& key, std::uint32_t line) { lines_[key] = line; }
+  [[nodiscard]] bool has(const std::string& key) const { return lines_.count(key) > 0; }
+  // "origin:line" of `key`, or the origin alone when the key is not in the file.
+  [[nodiscard]] std::string where(const std::string& key) const {
+    const auto it = lines_.find(key);
+    return it != lines_.end() && it->second > 0 ? cat(origin_, ":", std::to_string(it->second))
+                                                : origin_;
   }
-  return true;
+  // Stores `value` through `key`'s binding; `name` is how messages call it.
+  void store(std::vector<Binding>& table, const std::string& key, const std::string& name,
+             const toml::node& value) const {
+    const auto binding =
+        std::find_if(table.begin(), table.end(), [&](const Binding& b) { return b.key == key; });
+    if (binding == table.end()) {
+      throw InputError(cat(where(name), ": ", name, ": unknown key (docs/monitor.md lists them)"));
+    }
+    if (!binding->store(value)) {
+      throw InputError(cat(where(name), ": ", name, ": expected ", binding->expected));
+    }
+  }
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const {
+    throw InputError(cat(where(key), ": ", message));
+  }
+
+ private:
+  std::string origin_;
+  std::map<std::string, std::uint32_t> lines_;
+};
+
+toml::table parse_toml(const std::string& text, const std::string& origin) {
+  try {
+    return toml::parse(text, origin);
+  } catch (const toml::parse_error& error) {
+    const toml::source_position where = error.source().begin;
+    throw InputError(cat(origin, ":", std::to_string(where.line), ":", std::to_string(where.column),
+                         ": TOML syntax error: ", error.description()));
+  }
+}
+
+// The unit's name (conditioning.h), into `target` when not empty.
+void store_unit(const std::string& text, const KeyLines& lines, const std::string& key,
+                monitor::AccelerationUnit& target) {
+  if (!text.empty() && !monitor::kAccelerationUnitNames.parse(text, target)) {
+    lines.fail(key, cat(key, ": expected \"g\" or \"m/s2\", got \"", text, "\""));
+  }
+}
+
+// One [[sensor]] table (sensor[index]) over the file's top-level sensor settings.
+SensorConfig read_sensor(const toml::table& table, int index, const MonitorConfig& config,
+                         KeyLines& lines) {
+  const std::string head = cat("sensor[", std::to_string(index), "]");
+  lines.note(head, table.source().begin.line);
+  SensorConfig sc;
+  sc.conditioning = config.conditioning;
+  sc.sensor_health = config.sensor_health;
+  int node = 0;
+  std::string role = "ground";
+  std::string unit;
+  std::vector<Binding> keys = {
+      {"node", integer_into(node), "an integer"},
+      {"role", string_into(role), "a string, \"ground\" or \"plate\""},
+  };
+  sensor_bindings(keys, "", sc.conditioning, sc.sensor_health, unit);
+  std::vector<std::pair<std::string, const toml::node*>> leaves;
+  flatten(table, "", leaves);
+  for (const auto& [key, node_ptr] : leaves) {
+    const std::string name = cat(head, ".", key);
+    lines.note(name, node_ptr->source().begin.line);
+    lines.store(keys, key, name, *node_ptr);
+  }
+  const std::string node_key = cat(head, ".node");
+  if (!lines.has(node_key)) {
+    lines.fail(head, cat(head, ": no node (each [[sensor]] gives its CAN node)"));
+  }
+  if (node < 1 || node > 15) lines.fail(node_key, cat(node_key, ": must lie in [1, 15]"));
+  sc.node = static_cast<std::uint8_t>(node);
+  for (int j = 0; j < index; ++j) {
+    if (config.sensors[static_cast<std::size_t>(j)].node == sc.node) {
+      lines.fail(node_key, cat(node_key, ": node ", std::to_string(node), " is already sensor[",
+                               std::to_string(j), "]'s"));
+    }
+  }
+  if (!kSensorRoleNames.parse(role, sc.role)) {
+    lines.fail(cat(head, ".role"),
+               cat(head, ".role: expected \"ground\" or \"plate\", got \"", role, "\""));
+  }
+  store_unit(unit, lines, cat(head, ".unit"), sc.conditioning.unit);
+  return sc;
+}
+
+// The [[sensor]] tables, read after the top-level tables (whose [conditioning] and
+// [sensor_health] are every sensor's defaults).
+void read_sensors(const toml::node& list, MonitorConfig& config, KeyLines& lines) {
+  const toml::array* tables = list.as_array();
+  if (tables == nullptr || !tables->is_array_of_tables()) {
+    lines.fail("sensor", "sensor: expected [[sensor]] tables");
+  }
+  if (lines.has("monitor.ground_node")) {
+    lines.fail("monitor.ground_node",
+               "monitor.ground_node: not with [[sensor]] tables (each gives its node)");
+  }
+  if (tables->size() > static_cast<std::size_t>(kMaxSensors)) {
+    const std::string name = cat("sensor[", std::to_string(kMaxSensors), "]");
+    lines.note(name, (*tables)[static_cast<std::size_t>(kMaxSensors)].source().begin.line);
+    lines.fail(name, cat(name, ": at most ", std::to_string(kMaxSensors), " sensors"));
+  }
+  config.sensor_count = static_cast<int>(tables->size());
+  for (std::size_t i = 0; i < tables->size(); ++i) {
+    config.sensors[i] = read_sensor(*(*tables)[i].as_table(), static_cast<int>(i), config, lines);
+  }
 }
 
 // The file's key of a field validate() reports for sensor `index` of a [[sensor]] list.
@@ -196,125 +301,45 @@ std::string sensor_key(int index, const std::string& field) {
   return cat(head, field);
 }
 
+// validate(MonitorConfig), its field named as the file's key.
+void check(const MonitorConfig& config, const KeyLines& lines) {
+  int sensor_index = -1;
+  const Error e = validate(config, &sensor_index);
+  if (e.ok()) return;
+  if (sensor_index < 0) lines.fail(e.field, cat(e.field, ": ", e.reason));
+  // A sensor's field: its own key if the [[sensor]] table sets it, else the default's line.
+  const std::string key = sensor_key(sensor_index, e.field);
+  const std::string head = cat("sensor[", std::to_string(sensor_index), "]");
+  const std::string at = lines.has(key) ? key : lines.has(e.field) ? e.field : head;
+  lines.fail(at, cat(key, ": ", e.reason));
+}
+
 }  // namespace
 
 MonitorFile load_monitor_text(const std::string& text, const std::string& origin,
                               const MonitorConfig& defaults) {
-  toml::table doc;
-  try {
-    doc = toml::parse(text, origin);
-  } catch (const toml::parse_error& error) {
-    const toml::source_position where = error.source().begin;
-    throw InputError(cat(origin, ":", std::to_string(where.line), ":", std::to_string(where.column),
-                         ": TOML syntax error: ", error.description()));
-  }
+  const toml::table doc = parse_toml(text, origin);
   MonitorFile file;
   file.config = defaults;
   int node = defaults.ground_node;
   std::string unit;
   std::vector<Binding> known = bindings(file, node, unit);
-  // [[sensor]] tables: read after the top-level tables, whose [conditioning] and
-  // [sensor_health] are every sensor's defaults.
   const toml::node* sensor_list = doc.get("sensor");
-  const toml::array* sensor_tables = sensor_list != nullptr ? sensor_list->as_array() : nullptr;
+  const bool sensor_tables = sensor_list != nullptr && sensor_list->is_array();
   std::vector<std::pair<std::string, const toml::node*>> leaves;
   flatten(doc, "", leaves);
-  std::map<std::string, std::uint32_t> lines;
-  const auto where = [&](const std::string& key) {
-    const auto it = lines.find(key);
-    return it != lines.end() && it->second > 0 ? cat(origin, ":", std::to_string(it->second)) : origin;
-  };
-  const auto store = [&](std::vector<Binding>& table, const std::string& key, const std::string& name,
-                         const toml::node& value) {
-    const auto binding = std::find_if(table.begin(), table.end(),
-                                      [&](const Binding& b) { return b.key == key; });
-    if (binding == table.end()) {
-      throw InputError(cat(where(name), ": ", name, ": unknown key (docs/monitor.md lists them)"));
-    }
-    if (!binding->store(value)) {
-      throw InputError(cat(where(name), ": ", name, ": expected ", binding->expected));
-    }
-  };
+  KeyLines lines(origin);
   for (const auto& [key, node_ptr] : leaves) {
-    lines[key] = node_ptr->source().begin.line;
-    if (key == "sensor" && sensor_tables != nullptr) continue;
-    store(known, key, key, *node_ptr);
+    lines.note(key, node_ptr->source().begin.line);
+    if (key == "sensor" && sensor_tables) continue;
+    lines.store(known, key, key, *node_ptr);
   }
   if (node < 1 || node > 15) {
-    throw InputError(cat(where("monitor.ground_node"), ": monitor.ground_node: must lie in [1, 15]"));
+    lines.fail("monitor.ground_node", "monitor.ground_node: must lie in [1, 15]");
   }
   file.config.ground_node = static_cast<std::uint8_t>(node);
-  if (!unit.empty() && !parse_unit(unit, file.config.conditioning.unit)) {
-    throw InputError(cat(where("conditioning.unit"),
-                         ": conditioning.unit: expected \"g\" or \"m/s2\", got \"", unit, "\""));
-  }
-  if (sensor_list != nullptr) {
-    if (sensor_tables == nullptr || !sensor_tables->is_array_of_tables()) {
-      throw InputError(cat(where("sensor"), ": sensor: expected [[sensor]] tables"));
-    }
-    if (lines.count("monitor.ground_node") > 0) {
-      throw InputError(cat(where("monitor.ground_node"),
-                           ": monitor.ground_node: not with [[sensor]] tables (each gives its node)"));
-    }
-    if (sensor_tables->size() > static_cast<std::size_t>(kMaxSensors)) {
-      const std::string name = cat("sensor[", std::to_string(kMaxSensors), "]");
-      lines[name] = (*sensor_tables)[static_cast<std::size_t>(kMaxSensors)].source().begin.line;
-      throw InputError(cat(where(name), ": ", name, ": at most ", std::to_string(kMaxSensors),
-                           " sensors"));
-    }
-    file.config.sensor_count = static_cast<int>(sensor_tables->size());
-    for (std::size_t i = 0; i < sensor_tables->size(); ++i) {
-      const int index = static_cast<int>(i);
-      const std::string head = cat("sensor[", std::to_string(index), "]");
-      const toml::table& table = *(*sensor_tables)[i].as_table();
-      lines[head] = table.source().begin.line;
-      SensorConfig& sc = file.config.sensors[i];
-      sc = SensorConfig{};
-      sc.conditioning = file.config.conditioning;
-      sc.sensor_health = file.config.sensor_health;
-      int sensor_node = 0;
-      std::string role = "ground";
-      std::string sensor_unit;
-      std::vector<Binding> keys = {
-          {"node", integer_into(sensor_node), "an integer"},
-          {"role", string_into(role), "a string, \"ground\" or \"plate\""},
-      };
-      sensor_bindings(keys, "", sc.conditioning, sc.sensor_health, sensor_unit);
-      std::vector<std::pair<std::string, const toml::node*>> sensor_leaves;
-      flatten(table, "", sensor_leaves);
-      for (const auto& [key, node_ptr] : sensor_leaves) {
-        const std::string name = cat(head, ".", key);
-        lines[name] = node_ptr->source().begin.line;
-        store(keys, key, name, *node_ptr);
-      }
-      if (lines.count(cat(head, ".node")) == 0) {
-        throw InputError(cat(where(head), ": ", head, ": no node (each [[sensor]] gives its CAN node)"));
-      }
-      if (sensor_node < 1 || sensor_node > 15) {
-        throw InputError(cat(where(cat(head, ".node")), ": ", head, ".node: must lie in [1, 15]"));
-      }
-      sc.node = static_cast<std::uint8_t>(sensor_node);
-      for (std::size_t j = 0; j < i; ++j) {
-        if (file.config.sensors[j].node == sc.node) {
-          throw InputError(cat(where(cat(head, ".node")), ": ", head, ".node: node ",
-                               std::to_string(sensor_node), " is already sensor[",
-                               std::to_string(j), "]'s"));
-        }
-      }
-      if (role == "ground") {
-        sc.role = SensorRole::kGround;
-      } else if (role == "plate") {
-        sc.role = SensorRole::kPlate;
-      } else {
-        throw InputError(cat(where(cat(head, ".role")), ": ", head,
-                             ".role: expected \"ground\" or \"plate\", got \"", role, "\""));
-      }
-      if (!sensor_unit.empty() && !parse_unit(sensor_unit, sc.conditioning.unit)) {
-        throw InputError(cat(where(cat(head, ".unit")), ": ", head,
-                             ".unit: expected \"g\" or \"m/s2\", got \"", sensor_unit, "\""));
-      }
-    }
-  }
+  store_unit(unit, lines, "conditioning.unit", file.config.conditioning.unit);
+  if (sensor_list != nullptr) read_sensors(*sensor_list, file.config, lines);
   if (!file.second_scene_path.empty()) {
     const std::filesystem::path p(file.second_scene_path);
     if (p.is_relative()) {
@@ -322,25 +347,56 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     }
     file.config.axis_count = 2;
   }
-  int sensor_index = -1;
-  if (const Error e = validate(file.config, &sensor_index); !e.ok()) {
-    if (sensor_index < 0) throw InputError(cat(where(e.field), ": ", e.field, ": ", e.reason));
-    // A sensor's field: its own key if the [[sensor]] table sets it, else the default's line.
-    const std::string key = sensor_key(sensor_index, e.field);
-    const std::string head = cat("sensor[", std::to_string(sensor_index), "]");
-    const std::string line = lines.count(key) > 0 ? where(key)
-                             : lines.count(e.field) > 0 ? where(e.field) : where(head);
-    throw InputError(cat(line, ": ", key, ": ", e.reason));
-  }
+  check(file.config, lines);
   return file;
 }
 
 MonitorFile load_monitor_file(const std::string& path, const MonitorConfig& defaults) {
-  std::ifstream in(path);
-  if (!in) throw InputError(cat(path, ": cannot open file"));
-  std::ostringstream text;
-  text << in.rdbuf();
-  return load_monitor_text(text.str(), path, defaults);
+  // Bounded, and a directory, FIFO or device refused rather than read as an empty file.
+  constexpr std::size_t kMaxConfigBytes = std::size_t{1} << 20;  // 1 MiB
+  return load_monitor_text(host::read_text_file(path, kMaxConfigBytes, "configuration file"), path,
+                           defaults);
+}
+
+void apply_overrides(MonitorFile& file, const MonitorOverrides& o) {
+  MonitorConfig& config = file.config;
+  if (!o.scene_y_path.empty()) file.second_scene_path = o.scene_y_path;
+  if (o.steps) config.estimator.steps_per_sample = *o.steps;
+  if (o.rate_hz) config.estimator.sample_rate_hz = *o.rate_hz;
+  if (o.status_interval_s) config.status_interval_s = *o.status_interval_s;
+  if (o.node) {
+    if (config.sensor_count > 0) {
+      throw InputError(cat("--node names the single ground sensor; ", o.config_path,
+                           " lists [[sensor]] tables (give the nodes there)"));
+    }
+    config.ground_node = static_cast<std::uint8_t>(*o.node);
+  }
+  // The command line's sensor settings apply to every sensor.
+  const auto each_sensor = [&config](auto apply) {
+    apply(config.conditioning, config.sensor_health);
+    for (int i = 0; i < config.sensor_count && i < kMaxSensors; ++i) {
+      SensorConfig& sensor = config.sensors[static_cast<std::size_t>(i)];
+      apply(sensor.conditioning, sensor.sensor_health);
+    }
+  };
+  if (o.startup_window_s) {
+    each_sensor([&](monitor::ConditioningSettings& c, monitor::SensorHealthSettings&) {
+      c.startup_window_s = *o.startup_window_s;
+    });
+  }
+  if (o.stuck_samples) {
+    each_sensor([&](monitor::ConditioningSettings&, monitor::SensorHealthSettings& h) {
+      h.stuck_samples = *o.stuck_samples;
+    });
+  }
+}
+
+MonitorFile configure_monitor(const MonitorOverrides& overrides) {
+  MonitorFile file;
+  file.config = box_defaults();
+  if (!overrides.config_path.empty()) file = load_monitor_file(overrides.config_path, file.config);
+  apply_overrides(file, overrides);
+  return file;
 }
 
 }  // namespace plinth::firmware

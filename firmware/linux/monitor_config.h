@@ -3,9 +3,11 @@
 // allocate and throw.
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "plinth/firmware/monitor.h"
+#include "plinth/firmware/record_replay.h"
 
 namespace plinth::firmware {
 
@@ -22,5 +24,25 @@ struct MonitorFile {
 // The same from text; `origin` names it in messages and resolves relative paths.
 [[nodiscard]] MonitorFile load_monitor_text(const std::string& text, const std::string& origin,
                                             const MonitorConfig& defaults);
+
+// What plinth-monitor's command line says about the configuration; unset: the file's value, or
+// the default.
+struct MonitorOverrides {
+  std::string config_path;        // --config: the file, read over the defaults
+  std::string scene_y_path;       // --scene-y: replaces the file's monitor.second_scene
+  std::optional<int> steps;       // --steps: estimator.steps_per_sample
+  std::optional<int> node;        // --node: the single ground sensor's (not with [[sensor]] tables)
+  std::optional<double> rate_hz;  // --rate: estimator.sample_rate_hz
+  std::optional<double> status_interval_s;  // --status-interval: monitor.status_interval_s
+  std::optional<double> startup_window_s;   // --startup-window: every sensor's
+  std::optional<int> stuck_samples;         // --stuck-samples: every sensor's
+};
+
+// The command line over `file` (throws host::InputError for --node with [[sensor]] tables).
+void apply_overrides(MonitorFile& file, const MonitorOverrides& overrides);
+
+// plinth-monitor's configuration: the box's defaults (box_defaults(), record_replay.h), then
+// the configuration file, then the command line.
+[[nodiscard]] MonitorFile configure_monitor(const MonitorOverrides& overrides);
 
 }  // namespace plinth::firmware

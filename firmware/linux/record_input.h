@@ -1,7 +1,7 @@
-// The record replay's input (record_replay.h): the ground records resampled to the sensor rate
-// and scaled, as the ideal ground sensor's samples in m/s2. plinth-monitor --replay feeds them
-// to the box's loop; plinth-embed-record compiles them into the microcontroller image. Host code
-// (reads files, allocates, throws plinth::host::InputError).
+// The record replay's input (record_replay.h): the ground records read at the sensor rate and
+// scaled, as the ideal ground sensor's samples in m/s2. plinth-monitor --replay feeds them to
+// the box's loop (inputs.cpp); plinth-embed-record compiles them into the microcontroller image.
+// Host code (reads files, allocates, throws plinth::host::InputError).
 #pragma once
 
 #include <Eigen/Core>
@@ -11,7 +11,7 @@
 
 namespace plinth::firmware {
 
-struct RecordInput {
+struct RecordReplayOptions {
   std::string path;               // horizontal record of the statue's axis 1 (x): .AT2 or .csv
   std::string y_path;             // axis 2 (y); empty: none
   std::string vertical_path;      // vertical record; empty: the x file's vertical column, if any
@@ -22,13 +22,11 @@ struct RecordInput {
 
 struct RecordSamples {
   double rate_hz = 0.0;
-  double scale = 1.0;                    // the factor applied (from --pga or --scale)
   std::vector<Eigen::Vector3d> samples;  // m/s2; z = gravity + the vertical acceleration
 };
 
-// Sample n is each record at n / rate_hz (linear interpolation, SampledSignal::at), times the
-// scale; from 0 to the x record's duration. The error messages name the options as the
-// command lines do ("--pga").
-[[nodiscard]] RecordSamples record_samples(const RecordInput& input, double gravity);
+// Sample k is each record at k / rate_hz (host::resample), times the scale; from 0 to the x
+// record's duration. The error messages name the options as the command lines do ("--pga").
+[[nodiscard]] RecordSamples record_samples(const RecordReplayOptions& options, double gravity);
 
 }  // namespace plinth::firmware

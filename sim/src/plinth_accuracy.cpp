@@ -40,15 +40,19 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 struct Variant {
   plinth::Stepper stepper;
   bool exact_full_contact;
-  const char* name;
+
+  // The stepper's name (stepper.h), "+exact" with exact full contact.
+  [[nodiscard]] std::string name() const {
+    return std::string(plinth::stepper_name(stepper)) + (exact_full_contact ? "+exact" : "");
+  }
 };
 
 constexpr std::array<Variant, 5> kVariants = {{
-    {plinth::Stepper::kRk4Located, false, "rk4_located"},
-    {plinth::Stepper::kRk4Located, true, "rk4_located+exact"},
-    {plinth::Stepper::kRk4StepEnd, false, "rk4_step_end"},
-    {plinth::Stepper::kHeunLocated, false, "heun_located"},
-    {plinth::Stepper::kSemiImplicitEuler, false, "semi_implicit_euler"},
+    {plinth::Stepper::kRk4Located, false},
+    {plinth::Stepper::kRk4Located, true},
+    {plinth::Stepper::kRk4StepEnd, false},
+    {plinth::Stepper::kHeunLocated, false},
+    {plinth::Stepper::kSemiImplicitEuler, false},
 }};
 
 // A scene under an input.
@@ -340,11 +344,11 @@ std::vector<Summary> summarize(const std::vector<Row>& rows, const std::vector<d
   for (const Variant& v : kVariants) {
     for (const double dt : steps) {
       Summary s;
-      s.variant = v.name;
+      s.variant = v.name();
       s.dt = dt;
       std::vector<double> ns, speed;
       for (const Row& r : rows) {
-        if (r.variant != v.name || r.dt != dt || (aligned_only && !r.aligned)) continue;
+        if (r.variant != v.name() || r.dt != dt || (aligned_only && !r.aligned)) continue;
         if (r.refused) {
           ++s.refused;
           continue;
@@ -440,7 +444,7 @@ void plot(const Options& opt, const std::vector<Summary>& summary) {
     body += std::string("set title '") + p[2] + "'\nset ylabel '" + p[1] + "'\nplot ";
     for (std::size_t i = 0; i < kVariants.size(); ++i) {
       body += "'" + data + "' index " + std::to_string(i) + " using 2:" + p[0] +
-              " with linespoints pt " + std::to_string(i + 4) + " title '" + kVariants[i].name +
+              " with linespoints pt " + std::to_string(i + 4) + " title '" + kVariants[i].name() +
               "' noenhanced" + (i + 1 < kVariants.size() ? ", " : "\n");
     }
   }
@@ -554,7 +558,7 @@ int run(const Options& opt) {
       for (const double dt : steps) {
         Row r;
         r.case_name = c.name;
-        r.variant = v.name;
+        r.variant = v.name();
         r.dt = dt;
         if (!c.record.empty()) {
           const double steps_per_sample = in.record.dt / dt;
@@ -595,7 +599,7 @@ int run(const Options& opt) {
       for (const double dt : steps) {
         Row r;
         r.case_name = tc.input.name;
-        r.variant = v.name;
+        r.variant = v.name();
         r.dt = dt;
         plinth::Simulator probe;
         if (!plinth::Simulator::create(in.scene, in.excitation(1.0), settings_of(v, dt), probe)
@@ -628,7 +632,7 @@ int run(const Options& opt) {
   // The smoke check: RK4 with located events converges (its errors at the finer step are
   // smaller), and agrees with the reference on collapse.
   for (const Summary& s : summary) {
-    if (s.variant != std::string(reference_variant.name) || s.dt != steps.back()) continue;
+    if (s.variant != reference_variant.name() || s.dt != steps.back()) continue;
     for (const Summary& coarser : summary) {
       if (coarser.variant != s.variant || coarser.dt != steps.front()) continue;
       if (!(s.peak_theta.value < coarser.peak_theta.value) || s.collapse_differs != 0 ||
@@ -653,10 +657,5 @@ int main(int argc, char** argv) {
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
     return *exit_code;
   }
-  try {
-    return run(opt);
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "plinth-accuracy: %s\n", e.what());
-    return 1;
-  }
+  return plinth::host::run_tool("plinth-accuracy", [&] { return run(opt); });
 }

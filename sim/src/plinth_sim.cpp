@@ -16,6 +16,7 @@
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
+#include "plinth/host/record_sampling.h"
 #include "plinth/host/run_output.h"
 #include "plinth/host/scene_toml.h"
 #include "plinth/host/units.h"
@@ -177,18 +178,7 @@ int run(const Options& opt) {
       }
     }
     const double peak = record.peak_horizontal();
-    double gamma = 1.0;
-    if (!opt.pga.empty()) {
-      if (peak <= 0.0) throw InputError(opt.record_path + ": record is all zeros, cannot scale to --pga");
-      const double pga = plinth::host::parse_acceleration(opt.pga, g, "--pga");
-      if (pga <= 0.0) {
-        throw InputError("--pga: must be greater than zero (use --scale with a negative factor "
-                         "to mirror the record)");
-      }
-      gamma = pga / peak;
-    } else if (opt.scale) {
-      gamma = *opt.scale;
-    }
+    const double gamma = plinth::host::record_scale(record, opt.record_path, opt.pga, opt.scale, g);
     excitation = plinth::Excitation::record(
         record.horizontal_signal(),
         opt.vertical_path.empty() ? plinth::SampledSignal{} : vertical.horizontal_signal(), gamma);
@@ -314,13 +304,5 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "plinth-sim: --pulse needs --amplitude and --period\n");
     return 2;
   }
-  try {
-    return run(opt);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "plinth-sim: %s\n", e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "plinth-sim: error: %s\n", e.what());
-    return 1;
-  }
+  return plinth::host::run_tool("plinth-sim", [&] { return run(opt); });
 }

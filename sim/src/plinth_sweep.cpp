@@ -12,10 +12,11 @@
 
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/job_runner.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
-#include "plinth/host/sweep.h"
 #include "plinth/host/sweep_impulse.h"
+#include "plinth/host/sweep_plan.h"
 #include "plinth/host/sweep_table.h"
 #include "plinth/host/units.h"
 #include "sweep_output.h"
@@ -115,7 +116,7 @@ int run_sweep_mode(const Options& opt) {
                                          : "for a PGA sweep";
   require_text(opt.scene_path, "--scene", mode);
   require_text(opt.out_path, "--out", mode);
-  plinth::host::SweepRun run;
+  plinth::host::JobRun run;
   parse_shard(opt.shard, run.shard_index, run.shard_count);
   run.jobs =
       opt.jobs ? *opt.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -308,15 +309,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "plinth-sweep: --jobs: must be at least 1, got %d\n", *opt.jobs);
     return 2;
   }
-  try {
+  return plinth::host::run_tool("plinth-sweep", [&] {
     if (merge_command->parsed()) return run_merge(merge);
     if (plot_command->parsed()) return run_plot(plot);
     return run_sweep_mode(opt);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "plinth-sweep: %s\n", e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "plinth-sweep: error: %s\n", e.what());
-    return 1;
-  }
+  });
 }

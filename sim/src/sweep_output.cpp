@@ -148,7 +148,7 @@ void write_table_file(const SweepTable& table, const std::string& path) {
   if (error) throw InputError(path + ": cannot write (" + error.message() + ")");
 }
 
-SweepOutcome run_to_file(const plinth::host::SweepPlan& plan, plinth::host::SweepRun run,
+SweepOutcome run_to_file(const plinth::host::SweepPlan& plan, plinth::host::JobRun run,
                          const OutputOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   const std::vector<std::size_t> shard = plinth::host::shard_indices(plan.keys.size(), run);

@@ -7,7 +7,8 @@
 #include <cstddef>
 #include <string>
 
-#include "plinth/host/sweep.h"
+#include "plinth/host/job_runner.h"
+#include "plinth/host/sweep_plan.h"
 #include "plinth/host/sweep_table.h"
 
 namespace plinth::cli {
@@ -33,7 +34,7 @@ struct SweepOutcome {
 // Runs the jobs of the run's shard that the files do not hold yet. Throws InputError on bad
 // files (a row of another shard, a row twice) and the plan's errors, after writing the rows
 // finished so far.
-SweepOutcome run_to_file(const plinth::host::SweepPlan& plan, plinth::host::SweepRun run,
+SweepOutcome run_to_file(const plinth::host::SweepPlan& plan, plinth::host::JobRun run,
                          const OutputOptions& options);
 
 // Writes `table` to `path` through a temporary file renamed over it.

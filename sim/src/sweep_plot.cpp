@@ -19,8 +19,9 @@
 #include <vector>
 
 #include "plinth/host/input_error.h"
-#include "plinth/host/sweep.h"
 #include "plinth/host/sweep_impulse.h"
+#include "plinth/host/sweep_parameter.h"
+#include "plinth/host/sweep_search.h"
 
 extern char** environ;
 
@@ -265,8 +266,7 @@ void thresholds_plot(Script& s, const Columns& c,
   s.block("collapse", collapse);
   std::vector<std::string> curves;
   for (std::size_t e = 0; e < plinth::host::kSweepEventCount; ++e) {
-    const std::string name =
-        plinth::host::sweep_event_name(static_cast<plinth::host::SweepEvent>(e));
+    const std::string name = plinth::host::kSweepEventNames.entries[e].name;  // the CSV's order
     const auto points = c.curve(c.index(name));
     if (points.empty()) continue;  // not up to pga_max anywhere: no entry in the key
     s.block(name, points);
@@ -281,8 +281,7 @@ void thresholds_plot(Script& s, const Columns& c,
   // With --compare-ground: the block on the ground, thin (or on the axis).
   std::vector<GroundCurve> ground;
   for (std::size_t e = 0; e < plinth::host::kSweepEventCount; ++e) {
-    const std::string name =
-        plinth::host::sweep_event_name(static_cast<plinth::host::SweepEvent>(e));
+    const std::string name = plinth::host::kSweepEventNames.entries[e].name;
     ground.push_back({name, title_of(name), "with linespoints " + style(e, c.text.size(), true),
                       "pt " + std::to_string(e + 4) + " ps 2 lw 2 lc rgb '" +
                           kColours[e % kColours.size()] + "'"});
@@ -382,9 +381,7 @@ void impulse_map_plot(Script& s, const Columns& c) {
     if (const Field cs = c.at(r, c.index("c_s")); cs && *cs > 0.0) slope = *m / *cs;
     if (const Field rs = c.at(r, c.index("c_rs")); rs && c_r && *i >= *c_r) c_rs[*i] = *rs;
   }
-  using plinth::host::ImpulseStart;
-  const std::array<ImpulseStart, 4> starts = {ImpulseStart::kFullContact, ImpulseStart::kSliding,
-                                              ImpulseStart::kRocking, ImpulseStart::kSlideRocking};
+  const auto starts = plinth::host::kImpulseStartNames.values();
   const std::array<const char*, 4> colours = {"#b0b0b0", "#1f77b4", "#ff7f0e", "#2ca02c"};
   const std::array<int, 4> points = {1, 5, 7, 9};
   std::string plot = "plot ";

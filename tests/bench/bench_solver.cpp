@@ -5,7 +5,7 @@
 #include <exception>
 #include <string>
 
-#include "plinth/core/flows.h"
+#include "plinth/core/internal/flows.h"
 #include "plinth/core/simulator.h"
 #include "plinth/host/record_io.h"
 #include "test_support.h"
@@ -13,6 +13,11 @@
 namespace {
 
 using namespace plinth;
+using plinth::internal::full_contact_flow;
+using plinth::internal::Pivot;
+using plinth::internal::pivot_of;
+using plinth::internal::rocking_flow;
+using plinth::internal::slide_rocking_flow;
 
 SceneParams with_stops(SceneParams p) {
   p.has_base_stops = true;

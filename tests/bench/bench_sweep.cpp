@@ -7,8 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "plinth/host/job_runner.h"
 #include "plinth/host/record_io.h"
-#include "plinth/host/sweep.h"
+#include "plinth/host/sweep_parameter.h"
+#include "plinth/host/sweep_plan.h"
+#include "plinth/host/sweep_search.h"
 #include "test_support.h"
 
 namespace {
@@ -36,8 +39,7 @@ void BM_SweepSimulation(benchmark::State& state, double pga_g) {
     state.SkipWithError("cannot read the Brienza record");
     return;
   }
-  const Scene scene = testing::make(
-      host::with_parameter(testing::paper_isolated(), host::SweepParameter::kMuS, 0.5));
+  const Scene scene = host::sweep_scene(testing::paper_isolated(), host::SweepParameter::kMuS, 0.5);
   const host::SweepSettings settings;
   for (auto _ : state) {
     benchmark::DoNotOptimize(
@@ -62,7 +64,7 @@ void BM_Fig12Map(benchmark::State& state, double pga_max_g) {
   const host::SweepPlan plan =
       host::plan_thresholds(testing::paper_isolated(), *brienza(), host::SweepParameter::kMuS,
                             {"mu_s", 0.1, 1.5, 50}, settings);
-  host::SweepRun run;
+  host::JobRun run;
   run.jobs = 2;
   const std::vector<std::size_t> all = host::shard_indices(plan.keys.size(), run);
   std::size_t simulations = 0;

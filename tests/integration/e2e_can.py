@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """End-to-end test on a real CAN bus: the input before, every check and measurement after.
 
-tools/e2e-can.sh runs this twice around the bus runs inside user-mode Linux (its guest part):
+tools/e2e-can.sh runs this twice around the bus runs in the guest kernel (its guest part):
 
     e2e_can.py prepare --work DIR --record R.AT2 --scale 20 ...   # DIR/input.csv, DIR/config.*
     e2e_can.py check --work DIR                                   # exit 1 on a failed check
@@ -753,7 +753,7 @@ def run_checks(args):
         print(f"  plinth-monitor's own work: {figures['host_cpu_us_per_frame']:.1f} us of CPU per "
               f"frame (plinth-monitor --replay main.bus.log on the host, start-up included); "
               f"inside user-mode Linux add its system calls (poll, recvmsg, clock_gettime, "
-              f"sendmsg) at ~16 us each")
+              f"sendmsg) at ~16 us each (not measured on the qemu route)")
     if "fault_delay_s" in figures:
         json_delay, bus_delay = figures["fault_delay_s"]
         print(f"  sensor stop -> fault: {ms(json_delay)} (monitor time), AlarmEvent on the bus "

@@ -1,8 +1,8 @@
 // The SocketCAN backend on a real (virtual) CAN bus.
 //
-// Suites named Vcan* need vcan0 and vcan1 up, as tools/uml-vcan.sh --vcan 2 provides inside
-// user-mode Linux (the ctest entry socketcan_uml). The others run anywhere; on a kernel without
-// CAN (the host, ctest entry socketcan_host) they check the "no CAN support" error.
+// Suites named Vcan* need vcan0 and vcan1 up, as tools/vcan-bus.sh --vcan 2 provides in a guest
+// kernel (the ctest entries socketcan_uml, socketcan_qemu). The others run anywhere; on a kernel
+// without CAN (the host, ctest entry socketcan_host) they check the "no CAN support" error.
 #include "plinth/hal/can_supervisor.h"
 #include "plinth/hal/socketcan.h"
 

@@ -64,9 +64,9 @@ void expect_event(const AlarmOutput& out, std::size_t index, AlarmLevel level,
                   AlarmLevel previous, AlarmCause cause, bool latched) {
   ASSERT_GT(out.event_count, index);
   const AlarmEventRecord& e = out.events[index];
-  EXPECT_EQ(e.level, level) << can::alarm_level_name(e.level);
-  EXPECT_EQ(e.previous_level, previous) << can::alarm_level_name(e.previous_level);
-  EXPECT_EQ(e.cause, cause) << can::alarm_cause_name(e.cause);
+  EXPECT_EQ(e.level, level) << alarm_level_name(e.level);
+  EXPECT_EQ(e.previous_level, previous) << alarm_level_name(e.previous_level);
+  EXPECT_EQ(e.cause, cause) << alarm_cause_name(e.cause);
   EXPECT_EQ(e.latched, latched);
 }
 
@@ -400,25 +400,16 @@ TEST(AlarmPolicy, HeartbeatIsDueEveryPeriodAndAtOnceAfterAnEvent) {
   EXPECT_EQ(p.policy.next_heartbeat_ns(), 1700 * kMs);
 }
 
-TEST(AlarmPolicy, EventsBecomeCanFrames) {
-  AlarmEventRecord r;
-  r.level = AlarmLevel::kAlarm;
-  r.previous_level = AlarmLevel::kWarning;
-  r.cause = AlarmCause::kOverturnDetected;
-  r.latched = true;
-  r.time_ns = 5'000'123'456;
-  r.sequence = 200;
-  const can::AlarmEvent e = to_can_event(r);
-  EXPECT_EQ(e.time_since_start_ms, 5000U);
-  EXPECT_EQ(e.level, AlarmLevel::kAlarm);
-  EXPECT_EQ(e.previous_level, AlarmLevel::kWarning);
-  EXPECT_EQ(e.cause, AlarmCause::kOverturnDetected);
-  EXPECT_TRUE(e.latched);
-  EXPECT_EQ(e.sequence, 200);
-  can::CanFrame frame;
-  EXPECT_TRUE(can::encode(e, frame).ok());
-  r.time_ns = ((std::int64_t{1} << 32) + 7) * kMs;  // the frame's millisecond counter wraps
-  EXPECT_EQ(to_can_event(r).time_since_start_ms, 7U);
+TEST(AlarmPolicy, NamesReadBothWays) {
+  EXPECT_STREQ(alarm_level_name(AlarmLevel::kWarning), "warning");
+  EXPECT_STREQ(alarm_cause_name(AlarmCause::kOverturnDetected), "overturn_detected");
+  EXPECT_STREQ(alarm_level_name(static_cast<AlarmLevel>(9)), "invalid");
+  AlarmLevel level = AlarmLevel::kNormal;
+  EXPECT_TRUE(kAlarmLevelNames.parse("fault", level));
+  EXPECT_EQ(level, AlarmLevel::kFault);
+  AlarmCause cause = AlarmCause::kNone;
+  EXPECT_FALSE(kAlarmCauseNames.parse("overturned", cause));
+  EXPECT_EQ(cause, AlarmCause::kNone);
   EXPECT_STREQ(ack_outcome_name(AckOutcome::kStale), "stale sequence");
   EXPECT_STREQ(input_problem_name(InputProblem::kTimeWentBack), "time went back");
 }

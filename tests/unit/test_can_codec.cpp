@@ -15,8 +15,14 @@
 #include <string>
 #include <vector>
 
+#include "dbc_file.h"
+
 namespace plinth::can {
 namespace {
+
+using testing::Dbc;
+using testing::DbcSignal;
+using testing::plinth_dbc;
 
 using Bytes = std::array<std::uint8_t, 8>;
 
@@ -741,109 +747,6 @@ TEST(CanReject, ErrorTexts) {
 // ---------------------------------------------------------------------------------------------
 // The codec against plinth.dbc
 
-struct DbcSignal {
-  std::string name;
-  unsigned start = 0, length = 0;
-  char byte_order = '?';  // '1' Intel, '0' Motorola
-  char sign = '?';        // '+' unsigned, '-' signed
-  double factor = 0, offset = 0, minimum = 0, maximum = 0;
-  std::string unit;
-};
-struct DbcMessage {
-  std::string name;
-  unsigned dlc = 0;
-  std::vector<DbcSignal> signals;
-};
-struct Dbc {
-  std::map<std::uint32_t, DbcMessage> messages;
-  std::map<std::pair<std::uint32_t, std::string>, std::map<unsigned, std::string>> values;
-  std::set<std::uint32_t> message_comments;
-  std::set<std::pair<std::uint32_t, std::string>> signal_comments;
-  bool network_comment = false;
-};
-
-// Reads the subset of the DBC grammar plinth.dbc uses (one statement per line).
-Dbc parse_dbc(const std::string& path) {
-  Dbc dbc;
-  std::ifstream in(path);
-  EXPECT_TRUE(in) << "cannot open " << path;
-  std::string line;
-  std::uint32_t current = 0;
-  bool in_symbols = false;  // the NS_ block: one keyword a line, up to a blank line
-  while (std::getline(in, line)) {
-    std::istringstream ls(line);
-    std::string keyword;
-    ls >> keyword;
-    if (keyword == "NS_") {
-      in_symbols = true;
-      continue;
-    }
-    if (in_symbols) {
-      in_symbols = !keyword.empty();
-      continue;
-    }
-    if (keyword == "BO_") {
-      std::string name, sender;
-      unsigned dlc = 0;
-      ls >> current >> name >> dlc >> sender;
-      EXPECT_FALSE(ls.fail()) << line;
-      EXPECT_EQ(name.back(), ':') << line;
-      name.pop_back();
-      EXPECT_EQ(dbc.messages.count(current), 0U) << "duplicate identifier: " << line;
-      dbc.messages[current] = DbcMessage{name, dlc, {}};
-    } else if (keyword == "SG_") {
-      // SG_ Name : start|length@order sign (factor,offset) [min|max] "unit" receivers
-      DbcSignal s;
-      std::string colon, layout, scaling, range, unit;
-      ls >> s.name >> colon >> layout >> scaling >> range >> unit;
-      EXPECT_EQ(colon, ":") << line;
-      char bar = 0, at = 0, lp = 0, comma = 0, rp = 0, lb = 0, rb = 0;
-      std::istringstream(layout) >> s.start >> bar >> s.length >> at >> s.byte_order >> s.sign;
-      EXPECT_TRUE(bar == '|' && at == '@') << line;
-      std::istringstream(scaling) >> lp >> s.factor >> comma >> s.offset >> rp;
-      EXPECT_TRUE(lp == '(' && comma == ',' && rp == ')') << line;
-      std::istringstream(range) >> lb >> s.minimum >> bar >> s.maximum >> rb;
-      EXPECT_TRUE(lb == '[' && bar == '|' && rb == ']') << line;
-      EXPECT_TRUE(unit.size() >= 2 && unit.front() == '"' && unit.back() == '"') << line;
-      s.unit = unit.substr(1, unit.size() - 2);
-      dbc.messages[current].signals.push_back(s);
-    } else if (keyword == "VAL_") {
-      std::uint32_t id = 0;
-      std::string signal, token;
-      ls >> id >> signal;
-      auto& table = dbc.values[{id, signal}];
-      while (ls >> token && token != ";") {
-        const auto value = static_cast<unsigned>(std::stoul(token));
-        std::string quoted;
-        ls >> quoted;
-        table[value] = quoted.substr(1, quoted.size() - 2);
-      }
-      EXPECT_EQ(token, ";") << line;
-    } else if (keyword == "CM_") {
-      std::string what;
-      ls >> what;
-      if (what == "BO_") {
-        std::uint32_t id = 0;
-        ls >> id;
-        dbc.message_comments.insert(id);
-      } else if (what == "SG_") {
-        std::uint32_t id = 0;
-        std::string signal;
-        ls >> id >> signal;
-        dbc.signal_comments.insert({id, signal});
-      } else if (!what.empty() && what.front() == '"') {
-        dbc.network_comment = true;
-      }
-    }
-  }
-  return dbc;
-}
-
-const Dbc& plinth_dbc() {
-  static const Dbc dbc = parse_dbc(std::string(PLINTH_SOURCE_DIR) + "/hal/can_codec/plinth.dbc");
-  return dbc;
-}
-
 TEST(CanDbc, EveryIdentifierTheCodecKnowsIsAMessageAndNoOther) {
   const Dbc& dbc = plinth_dbc();
   ASSERT_EQ(dbc.messages.size(), 34U);
@@ -903,17 +806,8 @@ TEST(CanDbc, EverySignalMatchesTheCodecsLayout) {
   }
 }
 
-std::string value_name(const std::string& signal, unsigned value) {
-  if (signal == "Phase") return phase_name(static_cast<Phase>(value));
-  if (signal == "Corner") return corner_name(static_cast<Corner>(value));
-  if (signal == "AlarmLevel" || signal == "Level" || signal == "PreviousLevel") {
-    return alarm_level_name(static_cast<AlarmLevel>(value));
-  }
-  if (signal == "Cause") return alarm_cause_name(static_cast<AlarmCause>(value));
-  if (signal == "Latched") return value == 0 ? "not_latched" : "latched";
-  return "?";
-}
-
+// The names of the values are the domain types' (firmware's test_can_frames.cpp checks them
+// against these tables); the codec's part is the range.
 TEST(CanDbc, ValueTablesMatchTheCodecsEnumerations) {
   const Dbc& dbc = plinth_dbc();
   for (const auto& [id, message] : dbc.messages) {
@@ -928,11 +822,10 @@ TEST(CanDbc, ValueTablesMatchTheCodecsEnumerations) {
       for (const auto& [value, name] : table) {
         EXPECT_GE(static_cast<std::int64_t>(value), c.raw_min);
         EXPECT_LE(static_cast<std::int64_t>(value), c.raw_max);
-        EXPECT_EQ(name, value_name(c.name, value)) << value;
+        EXPECT_FALSE(name.empty()) << value;
       }
     }
   }
-  EXPECT_EQ(phase_name(static_cast<Phase>(6)), std::string("invalid"));
 }
 
 TEST(CanDbc, EveryMessageAndSignalIsDocumented) {

@@ -7,6 +7,7 @@
 
 #include "plinth/core/estimator.h"
 #include "plinth/core/risk.h"
+#include "plinth/core/stability.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
 #include "test_support.h"

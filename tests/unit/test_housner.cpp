@@ -8,13 +8,15 @@
 
 #include "plinth/core/closed_forms.h"
 #include "plinth/core/energy.h"
-#include "plinth/core/resets.h"
+#include "plinth/core/internal/resets.h"
 #include "plinth/host/record_io.h"
 #include "test_support.h"
 
 namespace plinth {
 namespace {
 
+using internal::impact_velocity_ratio;
+using internal::opposite;
 using testing::make;
 using testing::paper_block;
 using testing::RecordingSink;

@@ -8,15 +8,17 @@
 #include <cstdio>
 #include <numbers>
 
-#include "plinth/core/closed_forms.h"
-#include "plinth/core/guards.h"
-#include "plinth/host/sweep_impulse.h"
 #include "bisection_support.h"
+#include "plinth/core/closed_forms.h"
+#include "plinth/core/internal/guards.h"
+#include "plinth/host/sweep_impulse.h"
 #include "test_support.h"
 
 namespace plinth {
 namespace {
 
+using internal::ContactForce;
+using internal::sticking_contact_force;
 using testing::make;
 using testing::paper_isolated;
 using testing::RecordingSink;

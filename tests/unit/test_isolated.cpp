@@ -6,13 +6,20 @@
 #include <string>
 
 #include "plinth/core/energy.h"
-#include "plinth/core/resets.h"
+#include "plinth/core/internal/resets.h"
 #include "plinth/host/record_io.h"
 #include "test_support.h"
 
 namespace plinth {
 namespace {
 
+using internal::base_stop_hold_reset;
+using internal::base_stop_reset;
+using internal::impact_velocity_ratio;
+using internal::lever_arms;
+using internal::LeverArms;
+using internal::opposite;
+using internal::rocking_impact_reset;
 using testing::make;
 using testing::paper_isolated;
 using testing::RecordingSink;

@@ -70,7 +70,7 @@ TEST(Monitor, RecordReplayGivesTheSimulatorsEvents) {
     // 1e-8 s: the offset tracking (time constant 1e6 s) still moves by ~1e-9 m/s2 while quiet.
     EXPECT_NEAR(estimated.events[i].t, reference.events[i].t, 1e-8);
   }
-  EXPECT_EQ(monitor.status().alarm, can::AlarmLevel::kAlarm);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kAlarm);
 }
 
 can::CanFrame sensor_frame(std::uint8_t node, std::uint8_t sequence, double ax_g) {
@@ -149,7 +149,7 @@ TEST(Monitor, SensorSilenceIsAFaultAndTheEstimatorRestartsAfterIt) {
   };
   feed_for(4.0);
   ASSERT_TRUE(monitor.status().estimating);
-  EXPECT_EQ(monitor.status().alarm, can::AlarmLevel::kNormal);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kNormal);
   EXPECT_EQ(monitor.status().estimator_restarts, 1U);
   // Silence: ticks every 10 ms; the fault comes within timeout_s (+ one tick).
   const std::int64_t last = t - ns(0.005);
@@ -157,8 +157,8 @@ TEST(Monitor, SensorSilenceIsAFaultAndTheEstimatorRestartsAfterIt) {
   for (int k = 1; k <= 30 && fault_at < 0; ++k) {
     const fw::MonitorUpdate u = monitor.on_tick(last + ns(0.01 * k));
     for (std::size_t i = 0; i < u.event_count; ++i) {
-      if (u.events[i].level == can::AlarmLevel::kFault) {
-        EXPECT_EQ(u.events[i].cause, can::AlarmCause::kSensorTimeout);
+      if (u.events[i].level == monitor::AlarmLevel::kFault) {
+        EXPECT_EQ(u.events[i].cause, monitor::AlarmCause::kSensorTimeout);
         fault_at = last + ns(0.01 * k);
       }
     }
@@ -168,7 +168,7 @@ TEST(Monitor, SensorSilenceIsAFaultAndTheEstimatorRestartsAfterIt) {
   t = fault_at + ns(1.0);
   feed_for(4.0);
   EXPECT_EQ(monitor.status().estimator_restarts, 2U);
-  EXPECT_EQ(monitor.status().alarm, can::AlarmLevel::kNormal);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kNormal);
   EXPECT_EQ(monitor.status().sensor.counters.timeouts, 1U);
 }
 
@@ -189,8 +189,8 @@ TEST(Monitor, AcknowledgeFrameReleasesTheLatch) {
     t += ns(0.005);
   }
   ASSERT_EQ(monitor.status().axes[0].mode.phase, Phase::kOverturned);
-  ASSERT_EQ(monitor.status().alarm, can::AlarmLevel::kAlarm);
-  ASSERT_EQ(monitor.status().latched, can::AlarmLevel::kAlarm);
+  ASSERT_EQ(monitor.status().alarm, monitor::AlarmLevel::kAlarm);
+  ASSERT_EQ(monitor.status().latched, monitor::AlarmLevel::kAlarm);
   can::CanFrame ack;
   ASSERT_TRUE(can::encode(can::Acknowledge{can::AlarmLevel::kAlarm, 7,
                                            static_cast<std::uint8_t>(last_event + 1)}, ack).ok());
@@ -198,7 +198,7 @@ TEST(Monitor, AcknowledgeFrameReleasesTheLatch) {
   ASSERT_TRUE(can::encode(can::Acknowledge{can::AlarmLevel::kAlarm, 7, last_event}, ack).ok());
   EXPECT_EQ(monitor.on_frame({ack, t}).acknowledgement,
             monitor::AckOutcome::kReleasedConditionHolds);
-  EXPECT_EQ(monitor.status().alarm, can::AlarmLevel::kAlarm);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kAlarm);
   EXPECT_EQ(monitor.frames().acknowledgements, 2U);
 }
 
@@ -243,12 +243,12 @@ void quiet_then_quake(double quiet_s) {
     const fw::MonitorUpdate u = monitor.on_sample(input.sample(n));
     const bool quiet = n < input.quiet_samples();
     for (std::size_t i = 0; i < u.event_count; ++i) {
-      const can::AlarmLevel level = u.events[i].level;
-      if (quiet && level != can::AlarmLevel::kNormal && level != can::AlarmLevel::kFault &&
+      const monitor::AlarmLevel level = u.events[i].level;
+      if (quiet && level != monitor::AlarmLevel::kNormal && level != monitor::AlarmLevel::kFault &&
           false_alarm_t < 0.0) {
         false_alarm_t = input.time(n);
       }
-      if (!quiet && level == can::AlarmLevel::kAlarm && alarm_t < 0.0) alarm_t = input.time(n);
+      if (!quiet && level == monitor::AlarmLevel::kAlarm && alarm_t < 0.0) alarm_t = input.time(n);
     }
     if (quiet && monitor.status().estimating) {
       peak_quiet_u = std::fmax(peak_quiet_u, std::fabs(monitor.status().axes[0].state[kU]));

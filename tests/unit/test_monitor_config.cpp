@@ -32,6 +32,7 @@ TEST(MonitorConfigFile, TheExampleSetsEveryField) {
   EXPECT_EQ(f.config.alarm.warning.on, 0.5);
   EXPECT_EQ(f.config.alarm.alarm.off, 0.7);
   EXPECT_EQ(f.config.sensor_health.max_valid_g, 8.192);
+  EXPECT_EQ(f.config.status_interval_s, 0.1);
   EXPECT_EQ(f.config.axis_count, 1);
   EXPECT_TRUE(f.second_scene_path.empty());
 }
@@ -91,8 +92,90 @@ TEST(MonitorConfigFile, BadInputNamesFileLineAndKey) {
     (void)load_monitor_file("/nowhere/box.toml", MonitorConfig{});
     ADD_FAILURE();
   } catch (const host::InputError& e) {
-    EXPECT_STREQ(e.what(), "/nowhere/box.toml: cannot open file");
+    EXPECT_STREQ(e.what(), "/nowhere/box.toml: cannot open configuration file (no such file)");
   }
+}
+
+// A directory was read as an empty file (the defaults, silently); /dev/zero grew memory.
+TEST(MonitorConfigFile, DirectoriesAndDevicesAreRefusedUnread) {
+  const std::string message_for_dir = [] {
+    try {
+      (void)load_monitor_file(kSource + "/firmware", MonitorConfig{});
+    } catch (const host::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  }();
+  EXPECT_EQ(message_for_dir,
+            kSource + "/firmware: cannot open configuration file (it is a directory)");
+  try {
+    (void)load_monitor_file("/dev/zero", MonitorConfig{});
+    ADD_FAILURE();
+  } catch (const host::InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "/dev/zero: cannot open configuration file (not a regular file: a FIFO, socket or "
+                 "device)");
+  }
+}
+
+TEST(MonitorConfigFile, StatusInterval) {
+  const MonitorFile f = load_monitor_text("[monitor]\nstatus_interval_s = 0.5\n",
+                                          "/etc/plinth/box.toml", MonitorConfig{});
+  EXPECT_EQ(f.config.status_interval_s, 0.5);
+  EXPECT_EQ(MonitorConfig{}.status_interval_s, 0.1);
+  EXPECT_EQ(error_of("[monitor]\nstatus_interval_s = 0\n"),
+            "/etc/plinth/box.toml:2: monitor.status_interval_s: must lie in [1e-9, 1e6] s");
+}
+
+// plinth-monitor's command line over the file, over the defaults.
+TEST(MonitorOverrides, TheCommandLineOverTheFile) {
+  MonitorFile f = load_monitor_text(
+      "[estimator]\nsteps_per_sample = 2\nsample_rate_hz = 500\n"
+      "[monitor]\nstatus_interval_s = 0.5\nsecond_scene = \"y.toml\"\n"
+      "[sensor_health]\nstuck_samples = 20\n"
+      "[[sensor]]\nnode = 1\n[[sensor]]\nnode = 2\nsensor_health.stuck_samples = 30\n",
+      "/etc/plinth/box.toml", MonitorConfig{});
+  MonitorOverrides o;
+  o.steps = 8;
+  o.startup_window_s = 3.0;
+  o.stuck_samples = 0;
+  o.scene_y_path = "other.toml";
+  apply_overrides(f, o);
+  EXPECT_EQ(f.config.estimator.steps_per_sample, 8);
+  EXPECT_EQ(f.config.estimator.sample_rate_hz, 500.0);  // not given: the file's
+  EXPECT_EQ(f.config.status_interval_s, 0.5);
+  EXPECT_EQ(f.second_scene_path, "other.toml");
+  EXPECT_EQ(f.config.sensor_health.stuck_samples, 0);
+  for (int i = 0; i < 2; ++i) {  // every sensor's
+    EXPECT_EQ(f.config.sensors[static_cast<std::size_t>(i)].conditioning.startup_window_s, 3.0);
+    EXPECT_EQ(f.config.sensors[static_cast<std::size_t>(i)].sensor_health.stuck_samples, 0);
+  }
+  o = MonitorOverrides{};
+  o.config_path = "/etc/plinth/box.toml";
+  o.node = 3;
+  try {
+    apply_overrides(f, o);
+    ADD_FAILURE() << "--node with [[sensor]] tables accepted";
+  } catch (const host::InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "--node names the single ground sensor; /etc/plinth/box.toml lists [[sensor]] "
+                 "tables (give the nodes there)");
+  }
+}
+
+TEST(MonitorOverrides, WithoutAFileTheCommandLinesDefaults) {
+  MonitorOverrides o;
+  o.rate_hz = 1000.0;
+  o.status_interval_s = 0.02;
+  o.node = 5;
+  const MonitorFile f = configure_monitor(o);
+  EXPECT_EQ(f.config.conditioning.startup_window_s, kBoxStartupWindowS);
+  EXPECT_EQ(f.config.estimator.sample_rate_hz, 1000.0);
+  EXPECT_EQ(f.config.status_interval_s, 0.02);
+  EXPECT_EQ(f.config.ground_node, 5);
+  EXPECT_EQ(f.config.sensor_count, 0);
+  o.config_path = "/nowhere/box.toml";
+  EXPECT_THROW((void)configure_monitor(o), host::InputError);
 }
 
 }  // namespace

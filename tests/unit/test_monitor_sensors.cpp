@@ -132,8 +132,8 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
          {monitor.on_sensor_sample(0, sample(n, ground_g(n))),
           monitor.on_sensor_sample(1, sample(n, ground_g(n) + drift_g, 1'000'000))}) {
       for (std::size_t i = 0; i < u.event_count; ++i) {
-        if (n > drift_from && u.events[i].level == can::AlarmLevel::kFault) {
-          EXPECT_EQ(u.events[i].cause, can::AlarmCause::kSensorDisagreement);
+        if (n > drift_from && u.events[i].level == monitor::AlarmLevel::kFault) {
+          EXPECT_EQ(u.events[i].cause, monitor::AlarmCause::kSensorDisagreement);
           fault_event = true;
         }
       }
@@ -147,7 +147,7 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   EXPECT_LT(reported - drift_from, std::lround(0.5 * kRate));
   EXPECT_TRUE(fault_event);
   const fw::MonitorStatus& s = monitor.status();
-  EXPECT_EQ(s.alarm, can::AlarmLevel::kFault);
+  EXPECT_EQ(s.alarm, monitor::AlarmLevel::kFault);
   EXPECT_TRUE(s.sensors[1].disagreeing);
   EXPECT_EQ(s.sensors[1].disagreements, 1U);
   EXPECT_GT(s.sensors[1].rms_m_s2, 0.3);
@@ -163,7 +163,7 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   EXPECT_FALSE(monitor.status().disagreement);
   EXPECT_FALSE(monitor.status().sensors[1].disagreeing);
   EXPECT_EQ(monitor.status().sensors_state, monitor::HealthState::kDegraded);
-  EXPECT_NE(monitor.status().alarm, can::AlarmLevel::kFault);
+  EXPECT_NE(monitor.status().alarm, monitor::AlarmLevel::kFault);
 }
 
 // The primary goes silent at t = 2.5 s: the second sensor (same values, 1 ms later on the bus)
@@ -183,12 +183,12 @@ TEST(MonitorSensors, PrimarySilentFailsOverAndTheEstimatorContinues) {
     if (n < silent_from) u = monitor.on_sensor_sample(0, sample(n, ground_g(n)));
     for (std::size_t i = 0; i < u.event_count; ++i) {
       fault_after_start = fault_after_start || (monitor.status().estimating &&
-                                                u.events[i].level == can::AlarmLevel::kFault);
+                                                u.events[i].level == monitor::AlarmLevel::kFault);
     }
     u = monitor.on_sensor_sample(1, sample(n, ground_g(n), 1'000'000));
     for (std::size_t i = 0; i < u.event_count; ++i) {
       fault_after_start = fault_after_start || (monitor.status().estimating &&
-                                                u.events[i].level == can::AlarmLevel::kFault);
+                                                u.events[i].level == monitor::AlarmLevel::kFault);
     }
     if (n % 2 == 0) (void)monitor.on_tick(static_cast<std::int64_t>(n) * kPeriodNs + 2'000'000);
   }
@@ -201,7 +201,7 @@ TEST(MonitorSensors, PrimarySilentFailsOverAndTheEstimatorContinues) {
   EXPECT_EQ(s.failovers, 1U);
   EXPECT_EQ(s.failovers_continued, 1U);
   EXPECT_EQ(s.estimator_restarts, 1U);
-  EXPECT_EQ(s.alarm, can::AlarmLevel::kNormal);
+  EXPECT_EQ(s.alarm, monitor::AlarmLevel::kNormal);
   EXPECT_EQ(s.sensors_state, monitor::HealthState::kDegraded);
   EXPECT_EQ(s.sensors[0].health.state, monitor::HealthState::kFault);
   EXPECT_EQ(s.sensors[0].health.cause, monitor::HealthCause::kTimeout);
@@ -214,14 +214,14 @@ TEST(MonitorSensors, PrimarySilentFailsOverAndTheEstimatorContinues) {
     t += 10'000'000;
     const fw::MonitorUpdate u = monitor.on_tick(t);
     for (std::size_t i = 0; i < u.event_count; ++i) {
-      if (u.events[i].level == can::AlarmLevel::kFault) {
-        EXPECT_EQ(u.events[i].cause, can::AlarmCause::kSensorTimeout);
+      if (u.events[i].level == monitor::AlarmLevel::kFault) {
+        EXPECT_EQ(u.events[i].cause, monitor::AlarmCause::kSensorTimeout);
         timeout_fault = true;
       }
     }
   }
   EXPECT_TRUE(timeout_fault);
-  EXPECT_EQ(monitor.status().alarm, can::AlarmLevel::kFault);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kFault);
   EXPECT_EQ(monitor.status().sensors_state, monitor::HealthState::kFault);
   // The second sensor back after the gap: beyond the bridge limit, the estimators restart.
   for (long n = 1040; n < 1100; ++n) (void)monitor.on_sensor_sample(1, sample(n, 0.0));
@@ -255,9 +255,9 @@ double run_plate(double gain, bool raises_fault, fw::MonitorStatus& out, bool& f
     }
     const fw::MonitorUpdate u = monitor.on_sensor_sample(1, sample(n, gain * plate_g));
     for (std::size_t i = 0; i < u.event_count; ++i) {
-      if (u.events[i].level == can::AlarmLevel::kFault && monitor.status().estimating &&
+      if (u.events[i].level == monitor::AlarmLevel::kFault && monitor.status().estimating &&
           n > 300) {
-        EXPECT_EQ(u.events[i].cause, can::AlarmCause::kSensorDisagreement);
+        EXPECT_EQ(u.events[i].cause, monitor::AlarmCause::kSensorDisagreement);
         fault_seen = true;
       }
     }
@@ -281,7 +281,7 @@ TEST(MonitorSensors, PlateSensorMatchingTheModelHasASmallResidual) {
   EXPECT_FALSE(s.sensors[1].primary);
   EXPECT_GT(s.sensors[1].pairs, 500U);
   EXPECT_EQ(s.sensors_state, monitor::HealthState::kOk);
-  EXPECT_EQ(s.alarm, can::AlarmLevel::kNormal);
+  EXPECT_EQ(s.alarm, monitor::AlarmLevel::kNormal);
 }
 
 TEST(MonitorSensors, PlateSensorMountedBackwardsOrScaledIsAMismatch) {
@@ -294,11 +294,11 @@ TEST(MonitorSensors, PlateSensorMountedBackwardsOrScaledIsAMismatch) {
     EXPECT_GE(s.sensors[1].disagreements, 1U) << gain;
     EXPECT_EQ(s.sensors_state, monitor::HealthState::kDegraded) << gain;
     EXPECT_FALSE(fault) << gain;  // reported, not the fault level
-    EXPECT_NE(s.alarm, can::AlarmLevel::kFault) << gain;
+    EXPECT_NE(s.alarm, monitor::AlarmLevel::kFault) << gain;
     EXPECT_FALSE(s.disagreement) << gain;  // the ground sensors' cross-check is another matter
     (void)run_plate(gain, true, s, fault);
     EXPECT_TRUE(fault) << gain;
-    EXPECT_EQ(s.alarm, can::AlarmLevel::kFault) << gain;
+    EXPECT_EQ(s.alarm, monitor::AlarmLevel::kFault) << gain;
   }
 }
 

@@ -109,11 +109,11 @@ TEST(NoAllocation, MonitorRunsAnHourWithoutAllocating) {
     if (n % 2 == 0) (void)monitor.on_tick(input.sample(n).receive_time_ns);
     const bool quiet = n < input.quiet_samples();
     for (std::size_t i = 0; i < u.event_count; ++i) {
-      const can::AlarmLevel level = u.events[i].level;
-      if (quiet && level != can::AlarmLevel::kNormal && level != can::AlarmLevel::kFault) {
+      const monitor::AlarmLevel level = u.events[i].level;
+      if (quiet && level != monitor::AlarmLevel::kNormal && level != monitor::AlarmLevel::kFault) {
         ++quiet_alarms;
       }
-      if (!quiet && level == can::AlarmLevel::kAlarm && alarm_t < 0.0) alarm_t = input.time(n);
+      if (!quiet && level == monitor::AlarmLevel::kAlarm && alarm_t < 0.0) alarm_t = input.time(n);
     }
     if (quiet) peak_quiet_u = std::fmax(peak_quiet_u, std::fabs(monitor.status().axes[0].state[kU]));
     if (n == input.quiet_samples() - 1) {

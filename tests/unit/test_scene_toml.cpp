@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <numbers>
@@ -497,7 +498,19 @@ TEST(SceneTomlErrors, SyntaxErrorGivesLineAndColumn) {
 
 TEST(SceneTomlErrors, MissingFile) {
   const std::string path = scene_path("no-such-scene.toml");
-  EXPECT_EQ(error_of([&] { (void)load_scene_file(path); }), path + ": cannot open scene file");
+  EXPECT_EQ(error_of([&] { (void)load_scene_file(path); }),
+            path + ": cannot open scene file (no such file)");
+}
+
+TEST(SceneTomlErrors, EndlessAndOversizedFilesAreRefusedUnread) {
+  EXPECT_EQ(error_of([&] { (void)load_scene_file("/dev/zero"); }),
+            "/dev/zero: cannot open scene file (not a regular file: a FIFO, socket or device)");
+  const std::string path = ::testing::TempDir() + "plinth_test_scene_oversized.toml";
+  std::ofstream(path) << "[block]\nhalf_width = 0.3\n";
+  std::filesystem::resize_file(path, kMaxSceneFileBytes + 1);  // sparse: costs no disk
+  EXPECT_EQ(error_of([&] { (void)load_scene_file(path); }),
+            path + ": the scene file is longer than the 1 MiB limit");
+  std::filesystem::remove(path);
 }
 
 TEST(SceneTomlErrors, FileErrorsNameTheFile) {

@@ -418,7 +418,7 @@ TEST(SensorHealth, OutOfRangeIsRejectedAndFullScaleIsSaturated) {
   const SensorUpdate below = st.next_with({7.9999, 0.0, 1.0});
   ASSERT_EQ(below.fed_count, 1U);
   EXPECT_FALSE(below.fed[0].saturated);
-  const SensorUpdate flagged = st.next(can::sensor_status::kSaturated);
+  const SensorUpdate flagged = st.next(sensor_flags::kSaturated);
   ASSERT_EQ(flagged.fed_count, 1U);
   EXPECT_TRUE(flagged.fed[0].saturated);
   EXPECT_EQ(st.counters().saturated, 3U);
@@ -437,15 +437,15 @@ TEST(SensorHealth, UndefinedStatusBitsAreRejected) {
 TEST(SensorHealth, SelfTestAndCalibrationFlagsAreFaultsOverTemperatureDegrades) {
   Stream st(with_recovery(2));
   st.warm_up();
-  const SensorUpdate hot = st.next(can::sensor_status::kOverTemperature);
+  const SensorUpdate hot = st.next(sensor_flags::kOverTemperature);
   EXPECT_EQ(hot.verdict, SampleVerdict::kFed);
   EXPECT_EQ(hot.health.state, HealthState::kDegraded);
   EXPECT_EQ(hot.health.cause, HealthCause::kOverTemperature);
 
-  const SensorUpdate self_test = st.next(can::sensor_status::kSelfTestFailed);
+  const SensorUpdate self_test = st.next(sensor_flags::kSelfTestFailed);
   EXPECT_EQ(self_test.verdict, SampleVerdict::kHeldInFault);
   EXPECT_EQ(self_test.health.cause, HealthCause::kSelfTestFailed);
-  const SensorUpdate calibration = st.next(can::sensor_status::kCalibrationInvalid);
+  const SensorUpdate calibration = st.next(sensor_flags::kCalibrationInvalid);
   EXPECT_EQ(calibration.verdict, SampleVerdict::kHeldInFault);
   EXPECT_EQ(calibration.health.cause, HealthCause::kCalibrationInvalid);
   EXPECT_EQ(st.next().verdict, SampleVerdict::kHeldInFault);  // clean run 1 of 2
@@ -504,10 +504,10 @@ TEST(SensorHealth, NamesAndAlarmCauses) {
   EXPECT_STREQ(health_cause_name(HealthCause::kSequenceGap), "sequence gap");
   EXPECT_STREQ(health_cause_name(HealthCause::kStuck), "stuck values");
   EXPECT_STREQ(health_cause_name(static_cast<HealthCause>(99)), "invalid");
-  EXPECT_EQ(to_alarm_cause(HealthCause::kTimeout), can::AlarmCause::kSensorTimeout);
-  EXPECT_EQ(to_alarm_cause(HealthCause::kNoData), can::AlarmCause::kSensorTimeout);
-  EXPECT_EQ(to_alarm_cause(HealthCause::kStuck), can::AlarmCause::kSensorFault);
-  EXPECT_EQ(to_alarm_cause(HealthCause::kNone), can::AlarmCause::kNone);
+  EXPECT_EQ(to_alarm_cause(HealthCause::kTimeout), AlarmCause::kSensorTimeout);
+  EXPECT_EQ(to_alarm_cause(HealthCause::kNoData), AlarmCause::kSensorTimeout);
+  EXPECT_EQ(to_alarm_cause(HealthCause::kStuck), AlarmCause::kSensorFault);
+  EXPECT_EQ(to_alarm_cause(HealthCause::kNone), AlarmCause::kNone);
 }
 
 }  // namespace

@@ -8,13 +8,25 @@
 #include <vector>
 
 #include "plinth/core/energy.h"
-#include "plinth/core/flows.h"
-#include "plinth/core/resets.h"
+#include "plinth/core/internal/flows.h"
+#include "plinth/core/internal/resets.h"
+#include "plinth/core/stability.h"
 #include "test_support.h"
 
 namespace plinth {
 namespace {
 
+using internal::base_stop_reset;
+using internal::contact_kinematics;
+using internal::ContactKinematics;
+using internal::coulomb_impact_reset;
+using internal::CoulombImpact;
+using internal::lever_arms;
+using internal::Pivot;
+using internal::pivot_of;
+using internal::rocking_impact_reset;
+using internal::slide_rocking_flow;
+using internal::sliding_stop_hit_reset;
 using testing::make;
 using testing::RecordingSink;
 

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "plinth/core/stability.h"
 #include "test_support.h"
 
 namespace plinth {

@@ -11,15 +11,34 @@
 #include <string>
 #include <vector>
 
-#include "plinth/core/flows.h"
-#include "plinth/core/full_contact_propagator.h"
-#include "plinth/core/resets.h"
+#include "plinth/core/internal/flows.h"
+#include "plinth/core/internal/full_contact_propagator.h"
+#include "plinth/core/internal/resets.h"
+#include "plinth/core/stability.h"
 #include "plinth/host/record_io.h"
 #include "test_support.h"
 
 namespace plinth {
 namespace {
 
+using internal::contact_kinematics;
+using internal::ContactKinematics;
+using internal::coulomb_impact_reset;
+using internal::CoulombImpact;
+using internal::FullContactPropagator;
+using internal::kStageAngle;
+using internal::lever_arms;
+using internal::lever_arms_turned;
+using internal::LeverArms;
+using internal::Pivot;
+using internal::pivot_of;
+using internal::rocking_flow;
+using internal::sin_cos;
+using internal::SinCos;
+using internal::slide_rocking_flow;
+using internal::slide_rocking_matrices;
+using internal::SlideRockingMatrices;
+using internal::sliding_consistency;
 using testing::make;
 using testing::RecordingSink;
 
@@ -54,6 +73,8 @@ TEST(Steppers, ValidateNamesTheStepperField) {
   const Error e = validate(s);
   EXPECT_EQ(e.code, ErrorCode::kOutOfRange);
   EXPECT_STREQ(e.field, "solver.stepper");
+  EXPECT_STREQ(e.reason,
+               "must be one of rk4_located, rk4_step_end, heun_located, semi_implicit_euler");
   Simulator sim;
   const Scene scene = make(testing::paper_isolated());
   EXPECT_STREQ(Simulator::create(scene, Excitation::none(), s, sim).field, "solver.stepper");
@@ -277,7 +298,9 @@ TEST(ExactFullContact, OnsetIsLocatedOnTheExactSolution) {
 
 // Reaches the simulator's quiet full-contact step (simulator.h befriends it).
 struct SimulatorTestPeer {
-  static void take_every_step_by_intervals(Simulator& sim) { sim.full_contact_fn_ = nullptr; }
+  static void take_every_step_by_intervals(Simulator& sim) {
+    sim.quiet_full_contact_step_fn_ = nullptr;
+  }
 };
 
 namespace {

@@ -1,19 +1,23 @@
-// plinth-sweep's library: first-occurrence thresholds, parameters, sharding, cancellation,
-// two-parameter maps, the CSV map.
-#include "plinth/host/sweep.h"
-
+// plinth-sweep's library: first-occurrence thresholds (sweep_search.h), parameters
+// (sweep_parameter.h), jobs, shards and cancellation (job_runner.h), the plans plinth-sweep runs
+// and their rows (sweep_plan.h), two-parameter maps, the ground's columns.
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <sstream>
+#include <limits>
+#include <numbers>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/job_runner.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
+#include "plinth/host/sweep_plan.h"
 #include "test_support.h"
 #include "test_sweep_support.h"
 
@@ -51,18 +55,30 @@ SweepSettings coarse() {
 TEST(Sweep, Names) {
   const char* expected[] = {"sliding",       "rocking",        "slide_rocking", "out_of_base",
                             "base_stop_hit", "slide_stop_hit", "fell",          "overturned"};
+  ASSERT_EQ(kSweepEventNames.size(), kSweepEventCount);
   for (std::size_t i = 0; i < kSweepEventCount; ++i) {
     EXPECT_STREQ(sweep_event_name(static_cast<SweepEvent>(i)), expected[i]);
+    EXPECT_EQ(static_cast<std::size_t>(kSweepEventNames.values()[i]), i);  // the CSV order
+    EXPECT_EQ(parse_sweep_event(expected[i]), static_cast<SweepEvent>(i));
   }
   for (const char* name : {"mu_s", "epsilon", "lambda", "T", "xi", "u_max", "mass_ratio"}) {
     EXPECT_STREQ(sweep_parameter_name(parse_sweep_parameter(name)), name);
   }
+  EXPECT_EQ(kSweepParameterNames.size(), 7u);
+}
+
+// The thresholds as a row's fields: ",<threshold in g>" per event.
+std::string fields(const Thresholds& thresholds) {
+  std::string text;
+  for (const std::optional<double>& t : thresholds) {
+    text += ',';
+    text += format_result(t);
+  }
+  return text;
 }
 
 // Each reported threshold: the event occurs there and not one tolerance below.
-std::array<std::optional<double>, kSweepEventCount> expect_thresholds_hold(const Scene& scene,
-                                                                           std::size_t& found,
-                                                                           std::size_t& runs) {
+Thresholds expect_thresholds_hold(const Scene& scene, std::size_t& found, std::size_t& runs) {
   const SweepSettings settings = coarse();
   const auto thresholds = first_occurrence_thresholds(scene, brienza(), settings, &runs);
   for (std::size_t e = 0; e < kSweepEventCount; ++e) {
@@ -115,7 +131,7 @@ TEST(Sweep, RockingOnsetOnTheGroundMatchesEq16) {
   for (const double epsilon : {-0.3, 0.3}) {
     SCOPED_TRACE(epsilon);
     const Scene scene = plinth::testing::make(plinth::testing::paper_block(epsilon));
-    double scale = INFINITY;  // smallest record scale at which some sample reaches Eq 16
+    double scale = std::numeric_limits<double>::infinity();  // smallest record scale at which some sample reaches Eq 16
     for (const double a : record.horizontal) {
       if (a > 0.0) scale = std::min(scale, scene.g * scene.b1 / scene.h / a);
       if (a < 0.0) scale = std::min(scale, scene.g * scene.b2 / scene.h / -a);
@@ -143,44 +159,38 @@ TEST(Sweep, RockingOnsetOnTheGroundMatchesEq16) {
   }
 }
 
-void expect_same_rows(const std::vector<SweepRow>& a, const std::vector<SweepRow>& b) {
-  ASSERT_EQ(a.size(), b.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    EXPECT_EQ(a[i].value, b[i].value);
-    for (std::size_t e = 0; e < kSweepEventCount; ++e) {
-      EXPECT_EQ(a[i].thresholds_g[e].has_value(), b[i].thresholds_g[e].has_value());
-      if (a[i].thresholds_g[e] && b[i].thresholds_g[e]) {
-        EXPECT_EQ(*a[i].thresholds_g[e], *b[i].thresholds_g[e]);  // bit-identical
-      }
-    }
-  }
-}
-
+// The rows of a plan do not depend on the threads or the shards that run them, and each is
+// the thresholds of its own scene.
 TEST(Sweep, RowsDoNotDependOnJobsOrShards) {
   const SceneParams base = isolated_with_friction();
   SweepSettings settings = coarse();
   settings.scan_points = 8;
   settings.pga_max_g = 2.0;
   settings.tolerance_g = 0.02;
-  const std::vector<double> values = sweep_values(0.2, 0.6, 3);
-  SweepStats stats;
-  const auto one =
-      run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 1, 1, 1, &stats);
-  EXPECT_GT(stats.simulations, 3u * 8u);
-  const auto two = run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 2, 1, 1);
-  expect_same_rows(one, two);
+  const SweepPlan plan =
+      plan_thresholds(base, brienza(), SweepParameter::kMuS, {"mu_s", 0.2, 0.6, 3}, settings);
+  JobRun run;
+  std::size_t simulations = 0;
+  std::vector<std::string> one;
+  ASSERT_TRUE(run_plan(plan, {0, 1, 2}, run, one, &simulations));
+  EXPECT_GT(simulations, 3u * 8u);
+  EXPECT_EQ(testing::run_whole_plan(plan, 2), one);
 
-  const auto first = run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 2, 1, 2);
-  const auto second = run_sweep(base, SweepParameter::kMuS, values, brienza(), settings, 2, 2, 2);
-  ASSERT_EQ(first.size(), 2u);   // values 0 and 2
-  ASSERT_EQ(second.size(), 1u);  // value 1
-  const std::vector<SweepRow> merged = {first[0], second[0], first[1]};
-  expect_same_rows(one, merged);
+  run.jobs = 2;
+  run.shard_count = 2;
+  std::vector<std::string> merged;
+  ASSERT_EQ(shard_indices(3, run), (std::vector<std::size_t>{0, 2}));
+  ASSERT_TRUE(run_plan(plan, shard_indices(3, run), run, merged));
+  EXPECT_TRUE(merged[1].empty());
+  run.shard_index = 2;
+  std::vector<std::string> second;
+  ASSERT_EQ(shard_indices(3, run), (std::vector<std::size_t>{1}));
+  ASSERT_TRUE(run_plan(plan, shard_indices(3, run), run, second));
+  merged[1] = second[1];
+  EXPECT_EQ(merged, one);
 
-  // Each row is the thresholds of its own scene.
-  const Scene scene = plinth::testing::make(with_parameter(base, SweepParameter::kMuS, values[1]));
-  const auto direct = first_occurrence_thresholds(scene, brienza(), settings);
-  expect_same_rows({one[1]}, {SweepRow{values[1], direct}});
+  const Scene scene = sweep_scene(base, SweepParameter::kMuS, 0.4);
+  EXPECT_EQ(one[1], "0.4" + fields(first_occurrence_thresholds(scene, brienza(), settings)));
 }
 
 TEST(Sweep, ValuesAreEvenlySpacedAndInclusive) {
@@ -193,27 +203,33 @@ TEST(Sweep, ValuesAreEvenlySpacedAndInclusive) {
   EXPECT_THAT(sweep_values(2.0, 2.0, 3), ::testing::ElementsAre(2.0, 2.0, 2.0));
 }
 
-TEST(Sweep, WithParameterSetsTheSceneInSI) {
+// The scene of a value: the parameter set in SI, the scene's derived quantities made from it.
+TEST(Sweep, SweepSceneSetsTheParameterInSI) {
   const SceneParams ground = plinth::testing::paper_block();
-  const SceneParams mu = with_parameter(ground, SweepParameter::kMuS, 0.5);
-  EXPECT_TRUE(mu.has_friction);
-  EXPECT_DOUBLE_EQ(mu.friction.static_coefficient, 0.5);
-  EXPECT_DOUBLE_EQ(mu.friction.kinetic_coefficient, 0.4);
-  EXPECT_DOUBLE_EQ(with_parameter(ground, SweepParameter::kEpsilon, 0.2).block.eccentricity, 0.06);
+  const Scene mu = sweep_scene(ground, SweepParameter::kMuS, 0.5);
+  EXPECT_TRUE(mu.params.has_friction);
+  EXPECT_DOUBLE_EQ(mu.params.friction.static_coefficient, 0.5);
+  EXPECT_DOUBLE_EQ(mu.params.friction.kinetic_coefficient, 0.4);
+  const Scene eccentric = sweep_scene(ground, SweepParameter::kEpsilon, 0.2);
+  EXPECT_DOUBLE_EQ(eccentric.params.block.eccentricity, 0.06);
+  EXPECT_DOUBLE_EQ(eccentric.b1, 0.36);  // derived by make_scene: b1 = b + e
 
   const SceneParams iso = plinth::testing::paper_isolated();
-  const SceneParams tall = with_parameter(iso, SweepParameter::kLambda, 4.0);
+  const SceneParams tall = sweep_scene(iso, SweepParameter::kLambda, 4.0).params;
   EXPECT_DOUBLE_EQ(tall.block.com_height, 1.2);
   EXPECT_DOUBLE_EQ(tall.block.mass, iso.block.mass * 4.0 / 3.0);
   EXPECT_DOUBLE_EQ(tall.block.inertia, homogeneous_rectangle_inertia(tall.block.mass, 0.3, 1.2));
   EXPECT_DOUBLE_EQ(tall.base.mass, tall.block.mass);  // the mass ratio is kept
-  EXPECT_DOUBLE_EQ(with_parameter(iso, SweepParameter::kPeriod, 3.0).base.period, 3.0);
-  EXPECT_DOUBLE_EQ(with_parameter(iso, SweepParameter::kXi, 0.1).base.damping_ratio, 0.1);
-  EXPECT_DOUBLE_EQ(with_parameter(iso, SweepParameter::kMassRatio, 0.5).base.mass,
+  EXPECT_DOUBLE_EQ(sweep_scene(iso, SweepParameter::kPeriod, 3.0).params.base.period, 3.0);
+  EXPECT_DOUBLE_EQ(sweep_scene(iso, SweepParameter::kXi, 0.1).params.base.damping_ratio, 0.1);
+  EXPECT_DOUBLE_EQ(sweep_scene(iso, SweepParameter::kMassRatio, 0.5).params.base.mass,
                    0.5 * iso.block.mass);
-  EXPECT_DOUBLE_EQ(with_parameter(isolated_with_friction(), SweepParameter::kUMax, 0.3)
-                       .base_stops.max_displacement,
+  EXPECT_DOUBLE_EQ(sweep_scene(isolated_with_friction(), SweepParameter::kUMax, 0.3)
+                       .params.base_stops.max_displacement,
                    0.3);
+  const std::vector<Scene> scenes = sweep_scenes(iso, SweepParameter::kPeriod, {1.0, 2.0});
+  ASSERT_EQ(scenes.size(), 2u);
+  EXPECT_DOUBLE_EQ(scenes[1].omega, 2.0 * std::numbers::pi / 2.0);  // Eq 26
 }
 
 TEST(Sweep, BadInputsSayWhatIsWrong) {
@@ -224,65 +240,54 @@ TEST(Sweep, BadInputsSayWhatIsWrong) {
               HasSubstr("--steps: must be at least 1"));
   EXPECT_THAT(input_error_text([] { (void)sweep_values(1.0, 0.1, 5); }),
               HasSubstr("--from 1 is greater than --to 0.1"));
-  EXPECT_THAT(input_error_text([] { (void)sweep_values(NAN, 1.0, 5); }), HasSubstr("--from"));
+  EXPECT_THAT(input_error_text([] { (void)sweep_values(std::numeric_limits<double>::quiet_NaN(), 1.0, 5); }), HasSubstr("--from"));
 
   const SceneParams ground = plinth::testing::paper_block();
-  EXPECT_EQ(input_error_text([&] { (void)with_parameter(ground, SweepParameter::kPeriod, 2.0); }),
+  EXPECT_EQ(input_error_text([&] { (void)sweep_scene(ground, SweepParameter::kPeriod, 2.0); }),
             "--param T = 2: the scene has no [base] (a block on the ground)");
-  EXPECT_THAT(input_error_text([&] { (void)with_parameter(ground, SweepParameter::kXi, 0.1); }),
+  EXPECT_THAT(input_error_text([&] { (void)sweep_scene(ground, SweepParameter::kXi, 0.1); }),
               HasSubstr("no [base]"));
-  EXPECT_THAT(
-      input_error_text([&] { (void)with_parameter(ground, SweepParameter::kMassRatio, 1.0); }),
-      HasSubstr("no [base]"));
+  EXPECT_THAT(input_error_text([&] { (void)sweep_scene(ground, SweepParameter::kMassRatio, 1.0); }),
+              HasSubstr("no [base]"));
   const SceneParams iso = plinth::testing::paper_isolated();
-  EXPECT_THAT(input_error_text([&] { (void)with_parameter(iso, SweepParameter::kUMax, 0.2); }),
+  EXPECT_THAT(input_error_text([&] { (void)sweep_scene(iso, SweepParameter::kUMax, 0.2); }),
               HasSubstr("--param u_max = 0.2: the scene has no [base_stops]"));
   // make_scene's refusal names the parameter, the value and the field.
   const std::string negative =
-      input_error_text([&] { (void)with_parameter(iso, SweepParameter::kMuS, -0.1); });
+      input_error_text([&] { (void)sweep_scene(iso, SweepParameter::kMuS, -0.1); });
   EXPECT_THAT(negative, HasSubstr("--param mu_s = -0.1: friction."));
-  EXPECT_THAT(input_error_text([&] { (void)with_parameter(iso, SweepParameter::kPeriod, 0.0); }),
+  EXPECT_THAT(input_error_text([&] { (void)sweep_scene(iso, SweepParameter::kPeriod, 0.0); }),
               HasSubstr("--param T = 0: base.period"));
 
-  // run_sweep checks every value of its shard before simulating, and its own arguments.
-  const std::vector<double> values = {0.5, -1.0};
+  // A plan checks every value before it is returned, and a run its own arguments.
   EXPECT_THAT(input_error_text([&] {
-                (void)run_sweep(iso, SweepParameter::kMuS, values, brienza(), coarse(), 1, 1, 1);
+                (void)plan_thresholds(iso, brienza(), SweepParameter::kMuS, {"mu_s", -1.0, 0.5, 2},
+                                      coarse());
               }),
               HasSubstr("--param mu_s = -1"));
-  EXPECT_THAT(input_error_text([&] {
-                (void)run_sweep(iso, SweepParameter::kMuS, {0.5}, brienza(), coarse(), 1, 3, 2);
-              }),
-              HasSubstr("--shard"));
-  EXPECT_THAT(input_error_text([&] {
-                (void)run_sweep(iso, SweepParameter::kMuS, {0.5}, brienza(), coarse(), 0, 1, 1);
-              }),
-              HasSubstr("--jobs"));
+  const SweepPlan plan =
+      plan_thresholds(iso, brienza(), SweepParameter::kMuS, {"mu_s", 0.5, 0.5, 1}, coarse());
+  std::vector<std::string> rows;
+  JobRun bad_shard;
+  bad_shard.shard_index = 3;
+  bad_shard.shard_count = 2;
+  EXPECT_EQ(input_error_text([&] { (void)run_plan(plan, {0}, bad_shard, rows); }),
+            "--shard: must be i/N with 1 <= i <= N, got 3/2");
+  EXPECT_THAT(input_error_text([&] { (void)shard_indices(1, bad_shard); }), HasSubstr("--shard"));
+  JobRun no_jobs;
+  no_jobs.jobs = 0;
+  EXPECT_EQ(input_error_text([&] { (void)run_plan(plan, {0}, no_jobs, rows); }),
+            "--jobs: must be at least 1, got 0");
   // A simulation's error names the value it ran for.
   SweepSettings big_step = coarse();
   big_step.dt = 0.01;
-  EXPECT_THAT(input_error_text([&] {
-                (void)run_sweep(iso, SweepParameter::kPeriod, {0.01}, brienza(), big_step, 1, 1, 1);
-              }),
+  const SweepPlan stiff =
+      plan_thresholds(iso, brienza(), SweepParameter::kPeriod, {"T", 0.01, 0.01, 1}, big_step);
+  EXPECT_THAT(input_error_text([&] { (void)testing::run_whole_plan(stiff); }),
               HasSubstr("--param T = 0.01: --dt: "));
   SweepSettings bad = coarse();
   bad.tolerance_g = 0.0;
   EXPECT_THAT(input_error_text([&] { validate(bad); }), HasSubstr("--tol"));
-}
-
-TEST(Sweep, CsvMap) {
-  std::vector<SweepRow> rows(2);
-  rows[0].value = 0.1;
-  rows[0].thresholds_g[0] = 0.123456789;
-  rows[0].thresholds_g[7] = 2.0;
-  rows[1].value = 0.25;
-  std::ostringstream out;
-  write_sweep_csv(out, SweepParameter::kMuS, rows);
-  EXPECT_EQ(out.str(),
-            "mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,"
-            "overturned\n"
-            "0.1,0.123457,,,,,,,2\n"
-            "0.25,,,,,,,,\n");
 }
 
 // The scan points skipped below quiet_pga_g are points where nothing happens: the thresholds
@@ -297,7 +302,7 @@ TEST(Sweep, SkippingTheQuietScanChangesNothing) {
     const auto fast = first_occurrence_thresholds(scene, brienza(), settings, &skipping);
     settings.skip_quiet_scan = false;
     const auto slow = first_occurrence_thresholds(scene, brienza(), settings, &all);
-    expect_same_rows({SweepRow{0.0, fast}}, {SweepRow{0.0, slow}});
+    EXPECT_EQ(fast, slow);  // bit for bit
     EXPECT_LE(skipping, all);
     // Below the quiet PGA the block stays in full contact: no event at all.
     const double quiet = quiet_pga_g(scene, brienza(), settings.dt);
@@ -354,16 +359,16 @@ TEST(Sweep, PossibleEventsFollowTheSceneFeatures) {
               HasSubstr("--event: unknown event 'toppled' (one of sliding, rocking,"));
 }
 
-// A raised stop flag ends a search (SweepCancelled) and a run (run_plan returns false, and
-// no row is reported).
+// A raised stop flag ends a search (JobCancelled) and a run (run_plan returns false, and no
+// row is reported).
 TEST(Sweep, AStopFlagEndsTheRunWithoutRows) {
   const Scene scene = plinth::testing::make(isolated_with_friction());
   std::atomic<bool> stop{true};
   EXPECT_THROW((void)first_occurrence_thresholds(scene, brienza(), coarse(), nullptr, &stop),
-               SweepCancelled);
+               JobCancelled);
   const SweepPlan plan = plan_thresholds(isolated_with_friction(), brienza(), SweepParameter::kMuS,
                                          {"mu_s", 0.2, 0.6, 3}, coarse());
-  SweepRun run;
+  JobRun run;
   run.jobs = 2;
   run.stop = &stop;
   std::size_t reported = 0;
@@ -392,13 +397,14 @@ TEST(Sweep, TwoParameterMapMatchesOneParameterSweeps) {
   std::size_t found = 0;
   for (std::size_t j = 0; j < 2; ++j) {
     const double eps = j == 0 ? -0.3 : 0.3;
-    const std::vector<SweepRow> rows =
-        run_sweep(with_parameter(base, SweepParameter::kEpsilon, eps), SweepParameter::kLambda,
-                  sweep_values(3.0, 5.0, 2), brienza(), settings, 2, 1, 1);
+    const std::vector<std::string> rows = testing::run_whole_plan(
+        plan_thresholds(sweep_scene(base, SweepParameter::kEpsilon, eps).params, brienza(),
+                        SweepParameter::kLambda, lambda, settings));
     for (std::size_t i = 0; i < 2; ++i) {
-      const auto& t = rows[i].thresholds_g[static_cast<std::size_t>(SweepEvent::kOverturned)];
-      found += t.has_value() ? 1u : 0u;
-      EXPECT_EQ(cells[2 * i + j], map.keys[2 * i + j] + "," + format_result(t));
+      const std::string& t =
+          csv_fields(rows[i])[1 + static_cast<std::size_t>(SweepEvent::kOverturned)];
+      found += t.empty() ? 0u : 1u;
+      EXPECT_EQ(cells[2 * i + j], map.keys[2 * i + j] + "," + t);
     }
   }
   EXPECT_GE(found, 2u);
@@ -416,20 +422,24 @@ TEST(Sweep, TwoParameterMapMatchesOneParameterSweeps) {
               HasSubstr("--from2 2 is greater than --to2 1"));
 }
 
-// The plan of a one-parameter sweep writes the rows write_sweep_csv writes.
+// The CSV map of a one-parameter sweep: the header names the parameter and every event, a row
+// is the value and its thresholds in g (%.6g, empty where the event does not occur).
 TEST(Sweep, ThresholdPlanRowsAreTheCsvMap) {
   SweepSettings settings = coarse();
   const SweepPlan plan = plan_thresholds(isolated_with_friction(), brienza(), SweepParameter::kMuS,
                                          {"mu_s", 0.2, 0.6, 2}, settings);
-  EXPECT_EQ(plan.header, sweep_csv_header(SweepParameter::kMuS));
+  EXPECT_EQ(plan.header,
+            "mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,"
+            "overturned");
   EXPECT_THAT(plan.settings,
               ::testing::StartsWith("# plinth-sweep thresholds grid=mu_s:0.2:0.6:2 "));
-  SweepRun run;
+  JobRun run;
   std::vector<std::string> rows;
   ASSERT_TRUE(run_plan(plan, {1}, run, rows));
-  const auto direct = run_sweep(isolated_with_friction(), SweepParameter::kMuS, {0.6}, brienza(),
-                                settings, 1, 1, 1);
-  EXPECT_EQ(rows[1], sweep_csv_row(direct[0]));
+  const Thresholds direct = first_occurrence_thresholds(
+      sweep_scene(isolated_with_friction(), SweepParameter::kMuS, 0.6), brienza(), settings);
+  EXPECT_EQ(rows[1], "0.6" + fields(direct));
+  EXPECT_EQ(csv_fields(rows[1]).size(), 1 + kSweepEventCount);
   EXPECT_TRUE(rows[0].empty());
 }
 
@@ -530,7 +540,7 @@ TEST(SweepGround, BaseParameterGivesOneGroundRowSearchedOnce) {
   EXPECT_EQ(compared.header, own.header + ",rocking_ground,overturned_ground");
   std::size_t compared_runs = 0;
   std::size_t own_runs = 0;
-  SweepRun run;
+  JobRun run;
   run.jobs = 2;
   std::vector<std::string> rows;
   std::vector<std::string> own_rows;

@@ -40,7 +40,7 @@ TEST(SweepImpulse, MapAgreesWithTheClosedFormsAwayFromTheCurves) {
     const double i_rock = rocking_impulse_threshold(plinth::testing::make(base), Corner::kLeft);
     for (int m = 0; m < kMu; ++m) {
       const double mu_s = 0.05 + 0.75 * m / (kMu - 1);
-      const Scene scene = plinth::testing::make(with_parameter(base, SweepParameter::kMuS, mu_s));
+      const Scene scene = sweep_scene(base, SweepParameter::kMuS, mu_s);
       for (int k = 0; k < kImpulse; ++k) {
         const double impulse = i_rock * (0.15 + 2.85 * k / (kImpulse - 1));
         if (near_criteria_curves(scene, impulse, 0.05)) continue;
@@ -70,8 +70,7 @@ TEST(SweepImpulse, MapAgreesWithTheClosedFormsAwayFromTheCurves) {
 }
 
 TEST(SweepImpulse, ClosedFormsOfTheCriteria) {
-  const Scene scene = plinth::testing::make(
-      with_parameter(plinth::testing::paper_isolated(), SweepParameter::kMuS, 0.2));
+  const Scene scene = sweep_scene(plinth::testing::paper_isolated(), SweepParameter::kMuS, 0.2);
   const ImpulseCriteria c = impulse_criteria(scene, 2.0);
   EXPECT_DOUBLE_EQ(c.sliding_impulse, sliding_impulse_threshold(scene));
   EXPECT_DOUBLE_EQ(c.rocking_impulse, rocking_impulse_threshold(scene, Corner::kLeft));
@@ -128,8 +127,8 @@ TEST(SweepImpulse, CurveOnTheGroundMatchesTheEnergyBound) {
   ImpulseSearchSettings settings = search_settings(4.0, 8, 2e-3);
   for (const double epsilon : {0.0, 0.2, -0.2}) {
     const double lambda = epsilon == 0.0 ? 5.0 : 2.0;
-    const Scene scene = plinth::testing::make(
-        with_parameter(plinth::testing::paper_block(epsilon), SweepParameter::kLambda, lambda));
+    const Scene scene =
+        sweep_scene(plinth::testing::paper_block(epsilon), SweepParameter::kLambda, lambda);
     const double bound = ground_overturning_impulse(scene);
     const ImpulseThresholds found = impulse_thresholds(scene, settings);
     EXPECT_EQ(found.rocking, 0.0);
@@ -178,7 +177,7 @@ TEST(SweepImpulse, CurveComparesTheBlockOnTheGround) {
   const GridAxis period{"T", 1.0, 3.0, 3};
   const SweepPlan by_period = plan_impulse_curve(plinth::testing::paper_isolated(),
                                                  SweepParameter::kPeriod, period, settings, true);
-  SweepRun run;
+  JobRun run;
   run.jobs = 2;
   std::vector<std::string> period_rows;
   std::size_t runs = 0;

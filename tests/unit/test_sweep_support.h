@@ -7,8 +7,9 @@
 #include <vector>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/job_runner.h"
 #include "plinth/host/record_io.h"
-#include "plinth/host/sweep.h"
+#include "plinth/host/sweep_plan.h"
 
 namespace plinth::host::testing {
 
@@ -32,7 +33,7 @@ std::string input_error_text(F&& f) {
 
 // Every row of `plan`, on `jobs` threads.
 inline std::vector<std::string> run_whole_plan(const SweepPlan& plan, int jobs = 2) {
-  SweepRun run;
+  JobRun run;
   run.jobs = jobs;
   std::vector<std::string> rows;
   EXPECT_TRUE(run_plan(plan, shard_indices(plan.keys.size(), run), run, rows));

@@ -5,14 +5,13 @@
 namespace plinth::firmware {
 
 namespace {
-constexpr double kStartupWindowS = 2.0;           // s: quiet input to estimate the sensor offset
 constexpr double kIdealSensorRangeG = 1e6;        // g: an ideal sensor neither saturates nor clips
 constexpr double kNoTrackingTimeConstantS = 1e6;  // s: the offset is never tracked
 }  // namespace
 
 MonitorConfig box_defaults() {
   MonitorConfig config;
-  config.conditioning.startup_window_s = kStartupWindowS;
+  config.conditioning.startup_window_s = kBoxStartupWindowS;
   return config;
 }
 

@@ -33,7 +33,7 @@ struct Options {
   std::string name;
   std::string scene_path;
   std::string scene_y_path;
-  fw::RecordInput input;
+  fw::RecordReplayOptions input;
   std::optional<int> steps;
   std::string out_path;
 };

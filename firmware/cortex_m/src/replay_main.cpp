@@ -1,8 +1,8 @@
 // The box on the board: the compiled-in record (replay_case.h) replayed through the box's loop
-// exactly as plinth-monitor --replay replays it (record_replay.h); the status and alarm frames go
-// out through the CAN stand-in, a candump log on the semihosting console; phase events, the cost
-// per sample and the stack's high-water mark follow as '#' comment lines (docs/microcontroller.md).
-// Exit status 0 when the replay ran to its end and every frame went out.
+// exactly as plinth-monitor --replay replays it (record_replay.h); the status and alarm frames the
+// monitor hands over go out through the CAN stand-in, a candump log on the semihosting console;
+// phase events, the cost per sample and the stack's high-water mark follow as '#' comment lines
+// (docs/microcontroller.md). Exit status 0 when the replay ran to its end and every frame went out.
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -10,7 +10,6 @@
 #include "plinth/core/events.h"
 #include "plinth/core/scene.h"
 #include "plinth/firmware/monitor.h"
-#include "plinth/firmware/monitor_frames.h"
 #include "plinth/firmware/record_replay.h"
 #include "plinth/firmware/replay_case.h"
 #include "plinth/hal/board.h"
@@ -158,7 +157,7 @@ extern "C" int plinth_board_main() {
 
   std::int64_t now_ns = 0;  // the CAN stand-in's clock: the receive time of the latest sample
   hal::SemihostingCanPort can("can0", &now_ns);
-  fw::MonitorFrames frames(g_monitor, std::llround(fw::kDefaultStatusIntervalS * 1e9), &can);
+  std::uint64_t send_errors = 0;  // frames the CAN stand-in did not take
   std::array<Cost, 3> costs{};
   Cost all;
   const double gravity = kStandardGravity;
@@ -176,8 +175,9 @@ extern "C" int plinth_board_main() {
       all.add(ticks, record_ns);
       costs[static_cast<std::size_t>(kind_of(g_monitor.status()))].add(ticks, record_ns);
     }
-    for (std::size_t i = 0; i < update.event_count; ++i) frames.send_alarm(update.events[i]);
-    if (frames.status_due(update)) frames.send_status();
+    for (std::size_t i = 0; i < update.frame_count; ++i) {
+      if (can.send(update.frames[i]) != hal::IoStatus::kOk) ++send_errors;
+    }
   }
 
   const fw::MonitorStatus& s = g_monitor.status();
@@ -186,12 +186,12 @@ extern "C" int plinth_board_main() {
   line.put("# summary samples=").decimal(static_cast<std::uint64_t>(lead_in + record.count));
   line.put(" record_samples=").decimal(static_cast<std::uint64_t>(record.count));
   line.put(" final_phase=").put(phase_name(s.axes[0].mode.phase));
-  line.put(" alarm=").put(can::alarm_level_name(s.alarm));
+  line.put(" alarm=").put(monitor::alarm_level_name(s.alarm));
   line.put(" phase_events=").decimal(events_x.count + events_y.count);
   line.put(" frames=")
       .decimal(can.frames_sent())
       .put(" send_errors=")
-      .decimal(frames.send_errors());
+      .decimal(send_errors + g_monitor.frames().not_encoded);
   print(line);
   all.print_as("per_sample");
   costs[0].print_as("per_sample_quiet");
@@ -200,7 +200,7 @@ extern "C" int plinth_board_main() {
   hal::TextLine stack(text, sizeof text);
   stack.put("# stack used_bytes=").decimal(static_cast<std::uint64_t>(board::stack_used_bytes()));
   print(stack.put(" size_bytes=").decimal(static_cast<std::uint64_t>(board::stack_size_bytes())));
-  const bool ok = frames.send_errors() == 0;
+  const bool ok = send_errors + g_monitor.frames().not_encoded == 0;
   hal::semihosting::write(ok ? "# end: ok\n" : "# end: FAILED: frames not sent\n");
   return ok ? 0 : 1;
 }

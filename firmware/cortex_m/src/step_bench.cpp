@@ -10,7 +10,7 @@
 #include <cstdint>
 
 #include "plinth/core/estimator.h"
-#include "plinth/core/full_contact_propagator.h"
+#include "plinth/core/internal/full_contact_propagator.h"
 #include "plinth/core/simulator.h"
 #include "plinth/firmware/replay_case.h"
 #include "plinth/hal/board.h"
@@ -89,7 +89,8 @@ extern "C" int plinth_board_main() {
   double sink = 0.0;
   start = board::ticks();
   for (int i = 0; i < kPropagatorRuns; ++i) {
-    sink += FullContactPropagator::make(g_scene, settings.step * (0.5 + 0.01 * i)).phi[0][0];
+    sink +=
+        internal::FullContactPropagator::make(g_scene, settings.step * (0.5 + 0.01 * i)).phi[0][0];
   }
   const std::uint32_t propagator_ticks = board::ticks() - start;
   ok = report("propagator_make", propagator_ticks, kPropagatorRuns, "calls") && ok && sink > 0.0;

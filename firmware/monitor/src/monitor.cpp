@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "plinth/firmware/can_frames.h"
+
 namespace plinth::firmware {
 
 namespace {
@@ -33,16 +35,6 @@ int window_length(double window_s, double rate_hz) {
 
 }  // namespace
 
-const char* sensor_role_name(SensorRole role) {
-  switch (role) {
-    case SensorRole::kGround:
-      return "ground";
-    case SensorRole::kPlate:
-      return "plate";
-  }
-  return "invalid";
-}
-
 int resolved_sensors(const MonitorConfig& c, std::array<SensorConfig, kMaxSensors>& out) {
   if (c.sensor_count <= 0) {
     out[0].node = c.ground_node;
@@ -58,8 +50,10 @@ int resolved_sensors(const MonitorConfig& c, std::array<SensorConfig, kMaxSensor
   return count;
 }
 
-Error validate(const MonitorConfig& c, int* sensor_index) {
-  if (sensor_index != nullptr) *sensor_index = -1;
+namespace {
+
+// The [monitor] fields.
+Error validate_monitor_fields(const MonitorConfig& c) {
   if (c.axis_count < 1 || c.axis_count > kMaxAxes) {
     return {ErrorCode::kOutOfRange, "monitor.axis_count", "must be 1 or 2"};
   }
@@ -74,18 +68,17 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
   if (!std::isfinite(c.quiet_risk) || c.quiet_risk < 0.0 || c.quiet_risk > 1.0) {
     return {ErrorCode::kOutOfRange, "monitor.quiet_risk", "must lie in [0, 1]"};
   }
-  PLINTH_TRY(validate(c.risk));
-  PLINTH_TRY(monitor::validate(c.alarm));
-  // The sensor's period is the estimator's sample period: checked with the values start() uses.
-  if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz < 100.0 ||
-      c.estimator.sample_rate_hz > 1000.0) {
-    return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
+  // At least 1 ns, and room for hours of monitor time (int64 ns).
+  if (!std::isfinite(c.status_interval_s) || c.status_interval_s < 1e-9 ||
+      c.status_interval_s > 1e6) {
+    return {ErrorCode::kOutOfRange, "monitor.status_interval_s", "must lie in [1e-9, 1e6] s"};
   }
-  PLINTH_TRY(validate_check(c.redundancy.window_s, c.redundancy.tolerance_m_s2,
-                            c.estimator.sample_rate_hz, "redundancy.window_s",
-                            "redundancy.tolerance_m_s2"));
-  PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
-                            "plate.window_s", "plate.threshold_m_s2"));
+  return ok_error();
+}
+
+// Every sensor: node, role, its conditioning and health at the estimator's sample period; at
+// least one ground sensor. `sensor_index` receives the index of the sensor at fault.
+Error validate_sensors(const MonitorConfig& c, int* sensor_index) {
   std::array<SensorConfig, kMaxSensors> sensors{};
   const int count = resolved_sensors(c, sensors);
   int grounds = 0;
@@ -124,6 +117,26 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
   }
   if (sensor_index != nullptr) *sensor_index = -1;
   return ok_error();
+}
+
+}  // namespace
+
+Error validate(const MonitorConfig& c, int* sensor_index) {
+  if (sensor_index != nullptr) *sensor_index = -1;
+  PLINTH_TRY(validate_monitor_fields(c));
+  PLINTH_TRY(validate(c.risk));
+  PLINTH_TRY(monitor::validate(c.alarm));
+  // The sensor's period is the estimator's sample period: checked with the values start() uses.
+  if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz < 100.0 ||
+      c.estimator.sample_rate_hz > 1000.0) {
+    return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
+  }
+  PLINTH_TRY(validate_check(c.redundancy.window_s, c.redundancy.tolerance_m_s2,
+                            c.estimator.sample_rate_hz, "redundancy.window_s",
+                            "redundancy.tolerance_m_s2"));
+  PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
+                            "plate.window_s", "plate.threshold_m_s2"));
+  return validate_sensors(c, sensor_index);
 }
 
 void Monitor::RmsWindow::add(double square) {
@@ -201,6 +214,9 @@ Error Monitor::start(const MonitorConfig& config,
   have_epoch_ = false;
   bus_fault_ = false;
   pending_ack_ = false;
+  status_interval_ns_ = std::llround(config.status_interval_s * 1e9);
+  next_status_ns_ = 0;
+  status_sequence_ = 0;
   return ok_error();
 }
 
@@ -237,7 +253,15 @@ bool Monitor::usable(int sensor) const {
 
 MonitorUpdate Monitor::on_sensor_sample(int sensor, const monitor::SensorSample& sample) {
   MonitorUpdate update;
-  if (sensor < 0 || sensor >= sensor_count_) return update;
+  take_sample(sensor, sample, update);
+  return update;
+}
+
+void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update) {
+  if (sensor < 0 || sensor >= sensor_count_) {
+    report(update);
+    return;
+  }
   status_.time_ns = monitor_time(sample.receive_time_ns);
   // The other sensors' silence shows on this one's clock (a silent primary fails over without
   // waiting for a tick).
@@ -250,7 +274,6 @@ MonitorUpdate Monitor::on_sensor_sample(int sensor, const monitor::SensorSample&
   drain_primary();
   cross_check();
   evaluate(update);
-  return update;
 }
 
 // One fed sample of `sensor`: conditioned, kept in its history; the primary's goes on to the
@@ -461,7 +484,8 @@ void Monitor::cross_check() {
   }
 }
 
-void Monitor::evaluate(MonitorUpdate& update) {
+// The sensors' part of the status: each sensor's health, the primary's, the sensors' state.
+void Monitor::update_sensors_status() {
   const int reported = status_.primary >= 0 ? status_.primary : 0;
   status_.sensor = sensors_[static_cast<std::size_t>(reported)].health.health();
   bool others_degraded = false;
@@ -482,16 +506,18 @@ void Monitor::evaluate(MonitorUpdate& update) {
     status_.plate_residual_m_s2 = plate.rms_m_s2;
     status_.plate_mismatch = plate.disagreeing;
   }
-  const bool sensor_fault = status_.sensor.state == monitor::HealthState::kFault;
-  if (sensor_fault) {
+  if (status_.sensor.state == monitor::HealthState::kFault) {
     status_.sensors_state = monitor::HealthState::kFault;
-  } else if (status_.sensor.state != monitor::HealthState::kOk || others_degraded ||
-             disagreement || status_.plate_mismatch) {
+  } else if (status_.sensor.state != monitor::HealthState::kOk || others_degraded || disagreement ||
+             status_.plate_mismatch) {
     status_.sensors_state = monitor::HealthState::kDegraded;
   } else {
     status_.sensors_state = monitor::HealthState::kOk;
   }
+}
 
+// The axes' part of the status (mode, state, risk), and the alarm policy's input from them.
+void Monitor::update_axes_status(monitor::AlarmInput& input) {
   double risk = 0.0;
   bool moving = false;
   bool collapse = false;
@@ -508,17 +534,23 @@ void Monitor::evaluate(MonitorUpdate& update) {
     collapse = collapse || axis.mode.terminal();
   }
   status_.risk = risk;
-
-  monitor::AlarmInput input;
-  input.time_ns = status_.time_ns;
   input.risk = risk;
   input.out_of_full_contact = moving;
   input.collapse_detected = collapse;
+}
+
+void Monitor::evaluate(MonitorUpdate& update) {
+  update_sensors_status();
+  monitor::AlarmInput input;
+  input.time_ns = status_.time_ns;
+  update_axes_status(input);
+  const bool sensor_fault = status_.sensor.state == monitor::HealthState::kFault;
+  const bool disagreement = status_.disagreement;
   const bool mismatch_fault = status_.plate_mismatch && config_.plate.raises_fault;
   input.fault_active = sensor_fault || disagreement || mismatch_fault || bus_fault_;
   input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status_.sensor.cause)
-                      : (disagreement || mismatch_fault) ? can::AlarmCause::kSensorDisagreement
-                                                         : can::AlarmCause::kBusError;
+                      : (disagreement || mismatch_fault) ? monitor::AlarmCause::kSensorDisagreement
+                                                         : monitor::AlarmCause::kBusError;
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
   pending_ack_ = false;
@@ -526,10 +558,42 @@ void Monitor::evaluate(MonitorUpdate& update) {
   for (std::size_t i = 0; i < out.event_count && update.event_count < update.events.size(); ++i) {
     update.events[update.event_count++] = out.events[i];
   }
-  if (out.acknowledgement != monitor::AckOutcome::kNone) update.acknowledgement = out.acknowledgement;
+  if (out.acknowledgement != monitor::AckOutcome::kNone) {
+    update.acknowledgement = out.acknowledgement;
+  }
   status_.alarm = out.level;
   status_.latched = out.latched_level;
-  update.status_due = update.status_due || out.event_count > 0 || alarm_.heartbeat_due(status_.time_ns);
+  report(update);
+}
+
+template <typename Message>
+void Monitor::add_frame(MonitorUpdate& update, const Message& message) {
+  if (update.frame_count >= update.frames.size()) return;  // sized for the most an update has
+  if (!can::encode(message, update.frames[update.frame_count]).ok()) {
+    ++frames_.not_encoded;
+    return;
+  }
+  ++update.frame_count;
+}
+
+// The update's alarm events, then the status when it is due (one frame per axis): at every
+// alarm change, at the alarm policy's heartbeat, and at status_interval_s.
+void Monitor::report(MonitorUpdate& update) {
+  update.status_due = update.event_count > 0 || alarm_.heartbeat_due(status_.time_ns) ||
+                      status_.time_ns >= next_status_ns_;
+  for (std::size_t i = 0; i < update.event_count; ++i) {
+    add_frame(update, alarm_event_message(update.events[i]));
+  }
+  if (!update.status_due) return;
+  for (int i = 0; i < status_.axis_count; ++i) {
+    add_frame(update, status_message(status_, i, status_sequence_));
+  }
+  ++status_sequence_;
+  alarm_.heartbeat_sent(status_.time_ns);
+  if (next_status_ns_ <= status_.time_ns) {  // the first interval boundary after now
+    next_status_ns_ +=
+        ((status_.time_ns - next_status_ns_) / status_interval_ns_ + 1) * status_interval_ns_;
+  }
 }
 
 MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
@@ -547,82 +611,74 @@ MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
   return update;
 }
 
+template <typename Message>
+bool Monitor::decoded(const can::CanFrame& frame, Message& message) {
+  const can::DecodeResult r = can::decode(frame, message);
+  if (r.ok()) return true;
+  ++frames_.rejected;
+  frames_.last_error = r.error;
+  frames_.last_error_signal = r.signal;
+  return false;
+}
+
+int Monitor::sensor_of_node(std::uint8_t node) const {
+  for (int i = 0; i < sensor_count_; ++i) {
+    if (sensor_configs_[static_cast<std::size_t>(i)].node == node) return i;
+  }
+  return -1;
+}
+
 MonitorUpdate Monitor::on_frame(const hal::TimedFrame& timed) {
   ++frames_.received;
+  MonitorUpdate update;
+  if (!take_frame(timed, update)) report(update);  // nothing evaluated: a status may be due
+  return update;
+}
+
+bool Monitor::take_frame(const hal::TimedFrame& timed, MonitorUpdate& update) {
   const can::CanFrame& frame = timed.frame;
-  const auto reject = [&](const can::DecodeResult& r) {
-    ++frames_.rejected;
-    frames_.last_error = r.error;
-    frames_.last_error_signal = r.signal;
-  };
   switch (can::classify(frame.id)) {
     case can::MessageKind::kSensorAcceleration: {
       can::SensorAcceleration message;
-      if (const can::DecodeResult r = can::decode(frame, message); !r.ok()) {
-        reject(r);
-        return {};
-      }
-      int sensor = -1;
-      for (int i = 0; i < sensor_count_ && sensor < 0; ++i) {
-        if (sensor_configs_[static_cast<std::size_t>(i)].node == message.node) sensor = i;
-      }
+      if (!decoded(frame, message)) return false;
+      const int sensor = sensor_of_node(message.node);
       if (sensor < 0) {
         ++frames_.other_nodes;
-        return {};
+        return false;
       }
       ++frames_.sensor_samples;
-      monitor::SensorSample sample;
-      sample.receive_time_ns = timed.timestamp_ns;
-      sample.sequence = message.sequence;
-      sample.status = message.status;
-      sample.acceleration_g = Eigen::Vector3d(message.ax_g, message.ay_g, message.az_g);
-      return on_sensor_sample(sensor, sample);
+      take_sample(sensor, sample_of(message, timed.timestamp_ns), update);
+      return true;
     }
     case can::MessageKind::kSensorHeartbeat: {
       can::SensorHeartbeat message;
-      if (const can::DecodeResult r = can::decode(frame, message); !r.ok()) {
-        reject(r);
-      } else {
-        ++frames_.heartbeats;
-      }
-      return {};
+      if (decoded(frame, message)) ++frames_.heartbeats;
+      return false;
     }
     case can::MessageKind::kAcknowledge: {
       can::Acknowledge message;
-      if (const can::DecodeResult r = can::decode(frame, message); !r.ok()) {
-        reject(r);
-        return {};
-      }
+      if (!decoded(frame, message)) return false;
       ++frames_.acknowledgements;
       pending_ack_ = true;
-      ack_ = {message.level, message.event_sequence};
-      MonitorUpdate update;
+      ack_ = acknowledgement_of(message);
       evaluate(update);  // at once, at the current monitor time
-      return update;
+      return true;
     }
     case can::MessageKind::kMonitorStatus: {
       can::MonitorStatus message;
-      if (const can::DecodeResult r = can::decode(frame, message); !r.ok()) {
-        reject(r);
-      } else {
-        ++frames_.monitor_frames;
-      }
-      return {};
+      if (decoded(frame, message)) ++frames_.monitor_frames;
+      return false;
     }
     case can::MessageKind::kAlarmEvent: {
       can::AlarmEvent message;
-      if (const can::DecodeResult r = can::decode(frame, message); !r.ok()) {
-        reject(r);
-      } else {
-        ++frames_.monitor_frames;
-      }
-      return {};
+      if (decoded(frame, message)) ++frames_.monitor_frames;
+      return false;
     }
     case can::MessageKind::kUnknown:
       ++frames_.unknown_identifiers;
-      return {};
+      return false;
   }
-  return {};
+  return false;
 }
 
 }  // namespace plinth::firmware

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "plinth/core/name_table.h"
+
 namespace plinth::can {
 
 namespace {
@@ -199,6 +201,26 @@ constexpr bool undefined_status_flags(std::uint8_t status) {
   return (status & static_cast<std::uint8_t>(~sensor_status::kDefinedMask)) != 0;
 }
 
+// The DBC message names, without node or axis suffix.
+constexpr NameTable<MessageKind, 5> kMessageKindNames{{{
+    {MessageKind::kSensorAcceleration, "SensorAcceleration"},
+    {MessageKind::kSensorHeartbeat, "SensorHeartbeat"},
+    {MessageKind::kMonitorStatus, "MonitorStatus"},
+    {MessageKind::kAlarmEvent, "AlarmEvent"},
+    {MessageKind::kAcknowledge, "Acknowledge"},
+}}};
+
+constexpr NameTable<CodecError, 8> kCodecErrorTexts{{{
+    {CodecError::kOk, "ok"},
+    {CodecError::kWrongLength, "frame length is not 8 bytes"},
+    {CodecError::kUnknownIdentifier, "identifier is not a plinth message"},
+    {CodecError::kWrongMessage, "identifier belongs to another message"},
+    {CodecError::kNotFinite, "value is NaN or infinite"},
+    {CodecError::kOutOfRange, "value outside the signal's range"},
+    {CodecError::kInvalidEnum, "value not in the signal's value table"},
+    {CodecError::kReservedBitsSet, "reserved bits or undefined flags set"},
+}}};
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -224,78 +246,10 @@ MessageKind classify(std::uint32_t id) {
   }
 }
 
-const char* message_kind_name(MessageKind kind) {
-  switch (kind) {
-    case MessageKind::kSensorAcceleration: return "SensorAcceleration";
-    case MessageKind::kSensorHeartbeat: return "SensorHeartbeat";
-    case MessageKind::kMonitorStatus: return "MonitorStatus";
-    case MessageKind::kAlarmEvent: return "AlarmEvent";
-    case MessageKind::kAcknowledge: return "Acknowledge";
-    case MessageKind::kUnknown: break;
-  }
-  return "unknown";
-}
-
-const char* phase_name(Phase phase) {
-  switch (phase) {
-    case Phase::kFullContact: return "full_contact";
-    case Phase::kSliding: return "sliding";
-    case Phase::kRocking: return "rocking";
-    case Phase::kSlideRocking: return "slide_rocking";
-    case Phase::kOverturned: return "overturned";
-    case Phase::kFell: return "fell";
-  }
-  return "invalid";
-}
-
-const char* corner_name(Corner corner) {
-  switch (corner) {
-    case Corner::kNone: return "none";
-    case Corner::kLeft: return "left";
-    case Corner::kRight: return "right";
-  }
-  return "invalid";
-}
-
-const char* alarm_level_name(AlarmLevel level) {
-  switch (level) {
-    case AlarmLevel::kNormal: return "normal";
-    case AlarmLevel::kAdvisory: return "advisory";
-    case AlarmLevel::kWarning: return "warning";
-    case AlarmLevel::kAlarm: return "alarm";
-    case AlarmLevel::kFault: return "fault";
-  }
-  return "invalid";
-}
-
-const char* alarm_cause_name(AlarmCause cause) {
-  switch (cause) {
-    case AlarmCause::kNone: return "none";
-    case AlarmCause::kRiskThreshold: return "risk_threshold";
-    case AlarmCause::kPhaseChange: return "phase_change";
-    case AlarmCause::kOverturnDetected: return "overturn_detected";
-    case AlarmCause::kSensorTimeout: return "sensor_timeout";
-    case AlarmCause::kSensorFault: return "sensor_fault";
-    case AlarmCause::kSensorDisagreement: return "sensor_disagreement";
-    case AlarmCause::kAcknowledged: return "acknowledged";
-    case AlarmCause::kBusError: return "bus_error";
-    case AlarmCause::kInternalFault: return "internal_fault";
-  }
-  return "invalid";
-}
+const char* message_kind_name(MessageKind kind) { return kMessageKindNames.name(kind, "unknown"); }
 
 const char* codec_error_text(CodecError error) {
-  switch (error) {
-    case CodecError::kOk: return "ok";
-    case CodecError::kWrongLength: return "frame length is not 8 bytes";
-    case CodecError::kUnknownIdentifier: return "identifier is not a plinth message";
-    case CodecError::kWrongMessage: return "identifier belongs to another message";
-    case CodecError::kNotFinite: return "value is NaN or infinite";
-    case CodecError::kOutOfRange: return "value outside the signal's range";
-    case CodecError::kInvalidEnum: return "value not in the signal's value table";
-    case CodecError::kReservedBitsSet: return "reserved bits or undefined flags set";
-  }
-  return "unknown error";
+  return kCodecErrorTexts.name(error, "unknown error");
 }
 
 std::span<const SignalLayout> signal_layouts(MessageKind kind) {

@@ -5,8 +5,6 @@
 #include <limits>
 #include <utility>
 
-#include "plinth/host/input_error.h"
-
 namespace plinth::hal {
 namespace {
 
@@ -117,13 +115,9 @@ std::string parse_data(std::string_view text, std::size_t max_length, std::uint8
   return {};
 }
 
-// The frame after the interface name: "<id>#<data>", "<id>#R[dlc]", "<id>##<flags><data>".
-std::string parse_frame(std::string_view token, CandumpLine& out) {
-  const std::size_t hash = token.find('#');
-  if (hash == std::string_view::npos) {
-    return join({"frame ", quoted(token), " has no '#' between identifier and data"});
-  }
-  const std::string_view id_text = token.substr(0, hash);
+// The identifier before '#': 3 hex digits (standard) or 8 (extended, or an error frame with
+// CAN_ERR_FLAG). Sets out.id, out.extended and `error_frame`; "" or the reason.
+std::string parse_identifier(std::string_view id_text, CandumpLine& out, bool& error_frame) {
   if (id_text.size() != 3 && id_text.size() != 8) {
     return join(
         {"identifier ", quoted(id_text), " must have 3 (standard) or 8 (extended) hex digits"});
@@ -138,7 +132,7 @@ std::string parse_frame(std::string_view token, CandumpLine& out) {
   if (!out.extended && id > kStandardIdMask) {
     return join({"standard identifier ", quoted(id_text), " is above 7FF"});
   }
-  bool error_frame = false;
+  error_frame = false;
   if (out.extended && id > kExtendedIdMask) {
     if ((id & ~(kCanErrorFlag | kExtendedIdMask)) != 0) {
       return join({"extended identifier ", quoted(id_text), " is above 1FFFFFFF"});
@@ -147,24 +141,39 @@ std::string parse_frame(std::string_view token, CandumpLine& out) {
     id &= kExtendedIdMask;
   }
   out.id = id;
+  return {};
+}
 
+// A remote request after "R": an optional DLC; "" or the reason.
+std::string parse_remote(std::string_view rest, const std::string& in_frame, CandumpLine& out) {
+  out.kind = CandumpFrameKind::kRemote;
+  if (!rest.empty()) {
+    const int dlc = hex_value(rest.front());
+    if (dlc < 0 || static_cast<std::size_t>(dlc) > kMaxClassicLength) {
+      return join({"remote request length ", quoted(rest), " is not 0-8", in_frame});
+    }
+    out.length = static_cast<std::uint8_t>(dlc);
+    rest.remove_prefix(1);
+  }
+  if (!rest.empty()) {
+    return join({"unexpected ", quoted(rest), " after the remote request", in_frame});
+  }
+  return {};
+}
+
+// The frame after the interface name: "<id>#<data>", "<id>#R[dlc]", "<id>##<flags><data>".
+std::string parse_frame(std::string_view token, CandumpLine& out) {
+  const std::size_t hash = token.find('#');
+  if (hash == std::string_view::npos) {
+    return join({"frame ", quoted(token), " has no '#' between identifier and data"});
+  }
+  bool error_frame = false;
+  std::string problem = parse_identifier(token.substr(0, hash), out, error_frame);
+  if (!problem.empty()) return problem;
   std::string_view rest = token.substr(hash + 1);
   const std::string in_frame = join({" in frame ", quoted(token)});
   if (!rest.empty() && (rest.front() == 'R' || rest.front() == 'r')) {
-    out.kind = CandumpFrameKind::kRemote;
-    rest.remove_prefix(1);
-    if (!rest.empty()) {
-      const int dlc = hex_value(rest.front());
-      if (dlc < 0 || static_cast<std::size_t>(dlc) > kMaxClassicLength) {
-        return join({"remote request length ", quoted(rest), " is not 0-8", in_frame});
-      }
-      out.length = static_cast<std::uint8_t>(dlc);
-      rest.remove_prefix(1);
-    }
-    if (!rest.empty()) {
-      return join({"unexpected ", quoted(rest), " after the remote request", in_frame});
-    }
-    return {};
+    return parse_remote(rest.substr(1), in_frame, out);
   }
 
   std::size_t max_length = kMaxClassicLength;
@@ -183,7 +192,7 @@ std::string parse_frame(std::string_view token, CandumpLine& out) {
   }
   std::size_t length = 0;
   std::size_t consumed = 0;
-  std::string problem = parse_data(rest, max_length, out.data.data(), length, consumed);
+  problem = parse_data(rest, max_length, out.data.data(), length, consumed);
   if (!problem.empty()) return join({problem, in_frame});
   out.length = static_cast<std::uint8_t>(length);
   rest.remove_prefix(consumed);
@@ -200,18 +209,6 @@ std::string parse_frame(std::string_view token, CandumpLine& out) {
 }
 
 }  // namespace
-
-const char* candump_frame_kind_name(CandumpFrameKind kind) {
-  switch (kind) {
-    case CandumpFrameKind::kComment: return "comment";
-    case CandumpFrameKind::kClassic: return "classic";
-    case CandumpFrameKind::kExtended: return "extended";
-    case CandumpFrameKind::kRemote: return "remote request";
-    case CandumpFrameKind::kFd: return "CAN FD";
-    case CandumpFrameKind::kErrorFrame: return "error frame";
-  }
-  return "invalid";
-}
 
 std::string parse_candump_line(std::string_view line, CandumpLine& out) {
   out = CandumpLine{};
@@ -260,9 +257,19 @@ std::string format_candump_line(std::int64_t timestamp_ns, std::string_view inte
   return std::string(line, length);
 }
 
-CandumpLogReader::CandumpLogReader(std::string path) : path_(std::move(path)), in_(path_) {
-  if (!in_) throw host::InputError(path_ + ": cannot open file");
+CandumpLogReaderOpenResult CandumpLogReader::open(std::string path) {
+  CandumpLogReaderOpenResult result;
+  std::ifstream in(path);
+  if (!in) {
+    result.message = path + ": cannot open file";
+    return result;
+  }
+  result.reader.emplace(CandumpLogReader(std::move(path), std::move(in)));
+  return result;
 }
+
+CandumpLogReader::CandumpLogReader(std::string path, std::ifstream in)
+    : path_(std::move(path)), in_(std::move(in)) {}
 
 IoStatus CandumpLogReader::receive(TimedFrame& out, int /*timeout_ms*/) {
   error_.clear();
@@ -294,17 +301,32 @@ IoStatus CandumpLogReader::receive(TimedFrame& out, int /*timeout_ms*/) {
   return IoStatus::kEndOfInput;
 }
 
-CandumpLogWriter::CandumpLogWriter(std::string path, std::string interface_name, Clock clock)
-    : path_(std::move(path)), interface_name_(std::move(interface_name)), clock_(std::move(clock)) {
+CandumpLogWriterOpenResult CandumpLogWriter::open(std::string path, std::string interface_name,
+                                                  Clock clock) {
+  CandumpLogWriterOpenResult result;
   bool has_blank = false;
-  for (const char c : interface_name_) has_blank = has_blank || is_blank(c) || c == '\n';
-  if (interface_name_.empty() || interface_name_.size() > kCandumpMaxInterfaceLength || has_blank) {
-    throw host::InputError(join({"log interface name ", quoted(interface_name_),
-                                 ": must be 1 to 15 characters without spaces"}));
+  for (const char c : interface_name) has_blank = has_blank || is_blank(c) || c == '\n';
+  if (interface_name.empty() || interface_name.size() > kCandumpMaxInterfaceLength || has_blank) {
+    result.message = join({"log interface name ", quoted(interface_name),
+                           ": must be 1 to 15 characters without spaces"});
+    return result;
   }
-  out_.open(path_, std::ios::out | std::ios::trunc);
-  if (!out_) throw host::InputError(path_ + ": cannot open the log for writing");
+  std::ofstream out(path, std::ios::out | std::ios::trunc);
+  if (!out) {
+    result.message = path + ": cannot open the log for writing";
+    return result;
+  }
+  result.writer.emplace(CandumpLogWriter(std::move(path), std::move(interface_name),
+                                         std::move(clock), std::move(out)));
+  return result;
 }
+
+CandumpLogWriter::CandumpLogWriter(std::string path, std::string interface_name, Clock clock,
+                                   std::ofstream out)
+    : path_(std::move(path)),
+      interface_name_(std::move(interface_name)),
+      clock_(std::move(clock)),
+      out_(std::move(out)) {}
 
 IoStatus CandumpLogWriter::send(const can::CanFrame& frame) {
   if (frame.id > kStandardIdMask || frame.length > kMaxClassicLength) {

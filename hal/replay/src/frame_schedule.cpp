@@ -5,8 +5,10 @@
 #include <stdexcept>
 #include <utility>
 
+#include "plinth/core/scene.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/record_sampling.h"
 
 namespace plinth::replay {
 namespace {
@@ -18,10 +20,8 @@ constexpr double kFullScaleMax_g = 8.19175;
 // plinth-replay speaks as firmware 0.1 (the project's version).
 constexpr std::uint8_t kFirmwareMajor = 0;
 constexpr std::uint8_t kFirmwareMinor = 1;
-// Sample counts come from products like 34.9827 s * 200 Hz: forgive rounding below a sample.
+// Heartbeats: a sample time within this fraction of a sample of a whole second is at it.
 constexpr double kSampleCountTolerance = 1e-6;
-// Relative: how close to the record's last sample position (in samples) counts as on it.
-constexpr double kLastSampleTolerance = 1e-9;
 
 std::int64_t sample_time_ns(std::int64_t sample, double rate_hz) {
   return std::llround(static_cast<double>(sample) * kNsPerSecond / rate_hz);
@@ -43,38 +43,25 @@ void encode_or_throw(const can::CodecResult& result, const char* what) {
   }
 }
 
-// SampledSignal::at (the solver's linear interpolation), except that a time within rounding of
-// the last sample reads that sample: k / rate may land on the record's end in exact arithmetic
-// and just past it in floating point, where at() reads zero.
-double sample_at(const SampledSignal& signal, double t) {
-  if (signal.count > 0) {
-    const auto last = static_cast<double>(signal.count - 1);
-    if (std::fabs(t / signal.dt - last) <= kLastSampleTolerance * std::max(1.0, last)) {
-      return signal.values[signal.count - 1];
-    }
-  }
-  return signal.at(t);
-}
-
 }  // namespace
 
 SensorNodeSamples resample(const SensorNodeInput& input, double scale, double rate_hz,
                            double duration_s) {
   SensorNodeSamples out;
   out.node = input.node;
-  const auto last =
-      static_cast<std::int64_t>(std::floor(duration_s * rate_hz + kSampleCountTolerance));
-  const auto count = static_cast<std::size_t>(last + 1);
+  const std::size_t count = host::sample_count(duration_s, rate_hz);
+  const std::vector<double> x = host::resample(input.x, rate_hz, count);
+  const std::vector<double> y = host::resample(input.y, rate_hz, count);
+  const std::vector<double> z = host::resample(input.z, rate_hz, count);
   out.acceleration_g.reserve(count);
   out.status.reserve(count);
   for (std::size_t k = 0; k < count; ++k) {
-    const double t = static_cast<double>(k) / rate_hz;
     std::uint8_t status = 0;
     // An accelerometer reads specific force: at rest, +1 g along z (up); ground motion adds.
     const std::array<double, 3> reading_g{
-        scale * sample_at(input.x, t) / kStandardGravity,
-        scale * sample_at(input.y, t) / kStandardGravity,
-        1.0 + scale * sample_at(input.z, t) / kStandardGravity,
+        scale * x[k] / kStandardGravity,
+        scale * y[k] / kStandardGravity,
+        1.0 + scale * z[k] / kStandardGravity,
     };
     std::array<double, 3> clamped_g{};
     for (std::size_t axis = 0; axis < 3; ++axis) {
@@ -145,7 +132,9 @@ bool RecordSchedule::next(ScheduledFrame& out) {
 }
 
 LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s) {
-  hal::CandumpLogReader reader(path);
+  hal::CandumpLogReaderOpenResult opened = hal::CandumpLogReader::open(path);
+  if (!opened.ok()) throw host::InputError(opened.message);
+  hal::CandumpLogReader& reader = *opened.reader;
   LoggedFrames out;
   std::int64_t first_ns = 0;
   std::int64_t previous_ns = 0;

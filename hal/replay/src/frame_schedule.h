@@ -12,8 +12,6 @@
 
 namespace plinth::replay {
 
-inline constexpr double kStandardGravity = 9.80665;  // m/s2: the DBC's 1 g
-
 enum class FrameKind : std::uint8_t { kAcceleration, kHeartbeat };
 
 struct ScheduledFrame {
@@ -47,8 +45,9 @@ struct SensorNodeSamples {
   std::vector<std::uint8_t> status;                   // per sample
 };
 
-// Samples at t = k / rate_hz, k = 0 .. floor(duration_s * rate_hz) (the solver's convention:
-// linear interpolation between record samples), each signal multiplied by `scale`.
+// Samples at t = k / rate_hz, k = 0 .. floor(duration_s * rate_hz) (host::resample: the
+// record's own samples at its rate, else the solver's linear interpolation), each signal
+// multiplied by `scale`; 1 g is plinth::kStandardGravity, the DBC's.
 [[nodiscard]] SensorNodeSamples resample(const SensorNodeInput& input, double scale, double rate_hz,
                                          double duration_s);
 

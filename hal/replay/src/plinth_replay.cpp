@@ -16,18 +16,19 @@
 #include <vector>
 
 #include "frame_schedule.h"
+#include "plinth/core/scene.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/hal/pacing.h"
 #include "plinth/hal/socketcan.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
-#include "plinth/host/units.h"
+#include "plinth/host/record_sampling.h"
 
 namespace {
 
+using plinth::kStandardGravity;
 using plinth::host::InputError;
-using plinth::replay::kStandardGravity;
 
 constexpr double kMinRateHz = 100.0;
 constexpr double kMaxRateHz = 1000.0;
@@ -79,7 +80,7 @@ std::string lowercase_extension(const std::string& path) {
 bool is_candump_log(const std::string& path) { return lowercase_extension(path) == "log"; }
 bool is_record(const std::string& path) {
   const std::string ext = lowercase_extension(path);
-  return ext == "at2" || ext == "csv";
+  return ext == "at2" || ext == "csv" || ext == "asc";  // PEER, CSV, ESM/ITACA
 }
 
 // "NODE:AXIS:PATH" or "NODE:PATH" (axis x).
@@ -124,7 +125,7 @@ struct RecordPlan {
   std::string description;
 };
 
-RecordPlan plan_records(const Options& opt) {
+std::vector<Component> components_of(const Options& opt) {
   std::vector<Component> components;
   components.push_back({opt.node, kX, opt.record_path, "--record"});
   if (!opt.record_y_path.empty())
@@ -132,9 +133,14 @@ RecordPlan plan_records(const Options& opt) {
   if (!opt.record_z_path.empty())
     components.push_back({opt.node, kZ, opt.record_z_path, "--record-z"});
   for (const std::string& text : opt.node_records) components.push_back(parse_node_record(text));
+  return components;
+}
 
-  // Each file read once; the signals point into these records.
-  std::map<std::string, plinth::host::Record> records;
+// Each node's axes from the components' files, each file read once into `records` (the signals
+// point into them).
+std::map<int, plinth::replay::SensorNodeInput> node_inputs(
+    const std::vector<Component>& components,
+    std::map<std::string, plinth::host::Record>& records) {
   std::map<int, plinth::replay::SensorNodeInput> inputs;
   std::map<int, std::array<std::string, 3>> given;  // node -> the option per axis
   for (const Component& c : components) {
@@ -145,7 +151,7 @@ RecordPlan plan_records(const Options& opt) {
     }
     if (!is_record(c.path)) {
       const char* expected =
-          c.given_as == "--record" ? ".AT2, .csv or a candump .log" : ".AT2 or .csv";
+          c.given_as == "--record" ? ".AT2, .ASC, .csv or a candump .log" : ".AT2, .ASC or .csv";
       throw InputError(c.given_as + ": " + c.path + ": unknown input format (expected " + expected +
                        ")");
     }
@@ -172,23 +178,16 @@ RecordPlan plan_records(const Options& opt) {
     if (c.axis == kX && input.z.empty() && !record.vertical.empty())
       input.z = record.vertical_signal();
   }
+  return inputs;
+}
 
-  double scale = 1.0;
+RecordPlan plan_records(const Options& opt) {
+  std::map<std::string, plinth::host::Record> records;
+  const std::map<int, plinth::replay::SensorNodeInput> inputs =
+      node_inputs(components_of(opt), records);
   const plinth::host::Record& main_record = records.at(opt.record_path);
-  if (!opt.pga.empty()) {
-    const double pga = plinth::host::parse_acceleration(opt.pga, kStandardGravity, "--pga");
-    if (pga <= 0.0) {
-      throw InputError(
-          "--pga: must be greater than zero (use --scale with a negative factor to "
-          "mirror the record)");
-    }
-    const double peak = main_record.peak_horizontal();
-    if (peak <= 0.0)
-      throw InputError(opt.record_path + ": record is all zeros, cannot scale to --pga");
-    scale = pga / peak;
-  } else if (opt.scale) {
-    scale = *opt.scale;
-  }
+  const double scale = plinth::host::record_scale(main_record, opt.record_path, opt.pga, opt.scale,
+                                                  kStandardGravity);
 
   double duration_s = 0.0;
   double peak_g = 0.0;
@@ -359,61 +358,61 @@ void install_stop_handlers() {
   sigaction(SIGTERM, &action, nullptr);
 }
 
-int run(const Options& opt, const CLI::App& app) {
-  const double speed = parse_speed(opt.speed);
+// What to send: a candump log's sensor frames, or frames made from records.
+struct Input {
   std::unique_ptr<plinth::replay::FrameSchedule> schedule;
   std::string description;
   std::int64_t skipped_log_lines = 0;
-  if (is_candump_log(opt.record_path)) {
-    for (const char* option :
-         {"--pga", "--scale", "--rate", "--record-y", "--record-z", "--node-record", "--node"}) {
-      if (app.count(option) > 0) {
-        throw InputError(std::string(option) + ": does not apply to a candump log input (" +
-                         opt.record_path + "): its sensor frames are sent again as logged");
-      }
-    }
-    plinth::replay::LoggedFrames logged =
-        plinth::replay::read_logged_sensor_frames(opt.record_path, opt.t_end_s.value_or(-1.0));
-    skipped_log_lines = logged.skipped;
-    char text[200];
-    std::snprintf(text, sizeof text, "%s: %zu sensor frames over %.4g s", opt.record_path.c_str(),
-                  logged.frames.size(),
-                  static_cast<double>(logged.frames.back().virtual_ns) * 1e-9);
-    description = text;
-    schedule = std::make_unique<plinth::replay::LogSchedule>(std::move(logged.frames), opt.loops);
-  } else {
+};
+
+Input open_input(const Options& opt, const CLI::App& app) {
+  Input input;
+  if (!is_candump_log(opt.record_path)) {
     RecordPlan plan = plan_records(opt);
-    description = plan.description;
-    schedule = std::make_unique<plinth::replay::RecordSchedule>(std::move(plan.nodes), opt.rate_hz,
-                                                                opt.loops);
+    input.description = plan.description;
+    input.schedule = std::make_unique<plinth::replay::RecordSchedule>(std::move(plan.nodes),
+                                                                      opt.rate_hz, opt.loops);
+    return input;
   }
+  for (const char* option :
+       {"--pga", "--scale", "--rate", "--record-y", "--record-z", "--node-record", "--node"}) {
+    if (app.count(option) > 0) {
+      throw InputError(std::string(option) + ": does not apply to a candump log input (" +
+                       opt.record_path + "): its sensor frames are sent again as logged");
+    }
+  }
+  plinth::replay::LoggedFrames logged =
+      plinth::replay::read_logged_sensor_frames(opt.record_path, opt.t_end_s.value_or(-1.0));
+  input.skipped_log_lines = logged.skipped;
+  char text[200];
+  std::snprintf(text, sizeof text, "%s: %zu sensor frames over %.4g s", opt.record_path.c_str(),
+                logged.frames.size(), static_cast<double>(logged.frames.back().virtual_ns) * 1e-9);
+  input.description = text;
+  input.schedule =
+      std::make_unique<plinth::replay::LogSchedule>(std::move(logged.frames), opt.loops);
+  return input;
+}
 
-  // The log's timestamps are the frames' virtual send times (at speed 1) from now, so that
-  // canplayer -I replays the log in real time whatever --speed wrote it.
-  std::int64_t current_virtual_ns = 0;
-  const std::int64_t log_epoch_ns = plinth::hal::realtime_now_ns();
+// The log (stamped by `clock`) or the bus.
+Destination open_destination(const Options& opt, plinth::hal::CandumpLogWriter::Clock clock) {
+  if (opt.log_path.empty()) return open_bus(opt.can_interface);
+  plinth::hal::CandumpLogWriterOpenResult opened =
+      plinth::hal::CandumpLogWriter::open(opt.log_path, opt.log_interface, std::move(clock));
+  if (!opened.ok()) throw InputError(opened.message);
+  auto writer = std::make_unique<plinth::hal::CandumpLogWriter>(std::move(*opened.writer));
   Destination destination;
-  if (!opt.log_path.empty()) {
-    auto writer = std::make_unique<plinth::hal::CandumpLogWriter>(
-        opt.log_path, opt.log_interface,
-        [&current_virtual_ns, log_epoch_ns] { return log_epoch_ns + current_virtual_ns; });
-    destination.sink = writer.get();
-    destination.log = std::move(writer);
-    destination.name = opt.log_path;
-  } else {
-    destination = open_bus(opt.can_interface);
-  }
+  destination.sink = writer.get();
+  destination.log = std::move(writer);
+  destination.name = opt.log_path;
+  return destination;
+}
 
-  std::fprintf(stderr, "plinth-replay: %s; %lld loop%s to %s\n", description.c_str(),
-               static_cast<long long>(opt.loops), opt.loops == 1 ? "" : "s",
-               destination.name.c_str());
-  install_stop_handlers();
-  Report report;
-  report.skipped_log_lines = skipped_log_lines;
-  plinth::hal::Pacer pacer(speed);
-  pacer.start();
+// Every frame of the schedule at its deadline; `current_virtual_ns` follows the frame being sent
+// (the log's clock).
+void send_all(plinth::replay::FrameSchedule& schedule, const Destination& destination,
+              plinth::hal::Pacer& pacer, std::int64_t& current_virtual_ns, Report& report) {
   plinth::replay::ScheduledFrame next;
-  while (schedule->next(next)) {
+  while (schedule.next(next)) {
     if (!pacer.wait_until(next.virtual_ns, g_stop)) {
       report.interrupted = true;
       break;
@@ -431,6 +430,27 @@ int run(const Options& opt, const CLI::App& app) {
     ++(next.kind == plinth::replay::FrameKind::kHeartbeat ? report.heartbeat_frames
                                                           : report.acceleration_frames);
   }
+}
+
+int run(const Options& opt, const CLI::App& app) {
+  const double speed = parse_speed(opt.speed);
+  const Input input = open_input(opt, app);
+  // The log's timestamps are the frames' virtual send times (at speed 1) from now, so that
+  // canplayer -I replays the log in real time whatever --speed wrote it.
+  std::int64_t current_virtual_ns = 0;
+  const std::int64_t log_epoch_ns = plinth::hal::realtime_now_ns();
+  const Destination destination = open_destination(
+      opt, [&current_virtual_ns, log_epoch_ns] { return log_epoch_ns + current_virtual_ns; });
+
+  std::fprintf(stderr, "plinth-replay: %s; %lld loop%s to %s\n", input.description.c_str(),
+               static_cast<long long>(opt.loops), opt.loops == 1 ? "" : "s",
+               destination.name.c_str());
+  install_stop_handlers();
+  Report report;
+  report.skipped_log_lines = input.skipped_log_lines;
+  plinth::hal::Pacer pacer(speed);
+  pacer.start();
+  send_all(*input.schedule, destination, pacer, current_virtual_ns, report);
   report.wall_time_s = pacer.elapsed_s();
   if (destination.log != nullptr && !destination.log->flush()) {
     ++report.send_errors;
@@ -449,11 +469,12 @@ int main(int argc, char** argv) {
       "(SocketCAN) or into a candump log, in real time"};
   Options opt;
   app.add_option("--record", opt.record_path,
-                 "x axis of --node: a record (.AT2, .csv), or a candump log (.log) to send again")
+                 "x axis of --node: a record (.AT2, .ASC, .csv), or a candump log (.log) to "
+                 "send again")
       ->required();
-  app.add_option("--record-y", opt.record_y_path, "y axis of --node (.AT2, .csv)");
+  app.add_option("--record-y", opt.record_y_path, "y axis of --node (.AT2, .ASC, .csv)");
   app.add_option("--record-z", opt.record_z_path,
-                 "z axis of --node: vertical ground acceleration, positive up (.AT2, .csv)");
+                 "z axis of --node: vertical ground acceleration, positive up (.AT2, .ASC, .csv)");
   app.add_option("--node-record", opt.node_records,
                  "another node's axis: NODE:AXIS:FILE or NODE:FILE (axis x); repeatable")
       ->allow_extra_args(false);
@@ -488,13 +509,5 @@ int main(int argc, char** argv) {
                  "plinth-replay: give --can INTERFACE (a bus) or --log FILE (a candump log)\n");
     return 2;
   }
-  try {
-    return run(opt, app);
-  } catch (const InputError& e) {
-    std::fprintf(stderr, "plinth-replay: %s\n", e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "plinth-replay: error: %s\n", e.what());
-    return 1;
-  }
+  return plinth::host::run_tool("plinth-replay", [&] { return run(opt, app); });
 }

@@ -16,6 +16,8 @@
 #include <cstring>
 #include <utility>
 
+#include "plinth/core/name_table.h"
+
 namespace plinth::hal {
 
 namespace {
@@ -124,13 +126,14 @@ ControllerState from_libsocketcan(int state) {
 
 }  // namespace
 
+constexpr NameTable<SupervisionStatus, 3> kSupervisionStatusNames{{{
+    {SupervisionStatus::kOk, "ok"},
+    {SupervisionStatus::kNotSupported, "not supported on this interface"},
+    {SupervisionStatus::kFailed, "failed"},
+}}};
+
 const char* supervision_status_name(SupervisionStatus status) {
-  switch (status) {
-    case SupervisionStatus::kOk: return "ok";
-    case SupervisionStatus::kNotSupported: return "not supported on this interface";
-    case SupervisionStatus::kFailed: return "failed";
-  }
-  return "invalid";
+  return kSupervisionStatusNames.name(status);
 }
 
 CanInterfaceSupervisor::CanInterfaceSupervisor(std::string_view interface_name)

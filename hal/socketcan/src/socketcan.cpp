@@ -19,6 +19,7 @@
 #include <ctime>
 #include <utility>
 
+#include "plinth/core/name_table.h"
 #include "plinth/hal/pacing.h"
 
 namespace plinth::hal {
@@ -199,16 +200,17 @@ int set_filter_option(int fd, std::span<const CanIdFilter> filters) {
 // ---------------------------------------------------------------------------------------------
 // Error frames
 
+constexpr NameTable<ControllerState, 6> kControllerStateNames{{{
+    {ControllerState::kErrorActive, "error-active"},
+    {ControllerState::kErrorWarning, "error-warning"},
+    {ControllerState::kErrorPassive, "error-passive"},
+    {ControllerState::kBusOff, "bus-off"},
+    {ControllerState::kStopped, "stopped"},
+    {ControllerState::kSleeping, "sleeping"},
+}}};
+
 const char* controller_state_name(ControllerState state) {
-  switch (state) {
-    case ControllerState::kErrorActive: return "error-active";
-    case ControllerState::kErrorWarning: return "error-warning";
-    case ControllerState::kErrorPassive: return "error-passive";
-    case ControllerState::kBusOff: return "bus-off";
-    case ControllerState::kStopped: return "stopped";
-    case ControllerState::kSleeping: return "sleeping";
-  }
-  return "invalid";
+  return kControllerStateNames.name(state);
 }
 
 CanBusError decode_error_frame(std::uint32_t can_id, const std::array<std::uint8_t, 8>& data) {

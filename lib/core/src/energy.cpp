@@ -1,12 +1,19 @@
 #include "plinth/core/energy.h"
 
-#include "plinth/core/flows.h"
+#include "plinth/core/internal/flows.h"
 
 namespace plinth {
 
+using internal::contact_kinematics;
+using internal::ContactKinematics;
+using internal::lever_arms;
+using internal::LeverArms;
+using internal::Pivot;
+using internal::pivot_of;
+
 double mechanical_energy(const Scene& s, const Mode& mode, const State& y) {
-  // Eqs 2 and 7: T = m |v_C|^2 / 2 + m_b u'^2 / 2 + I_C theta'^2 / 2, v_C = J q' (flows.h),
-  // V = k u^2 / 2 + m g (h'_i - h).
+  // Eqs 2 and 7: T = m |v_C|^2 / 2 + m_b u'^2 / 2 + I_C theta'^2 / 2, v_C = J q'
+  // (internal/flows.h), V = k u^2 / 2 + m g (h'_i - h).
   const Pivot pivot = pivot_of(s, mode, y);
   const ContactKinematics k = contact_kinematics(s, pivot.geometry, pivot.overhanging, y);
   const Eigen::Vector3d rates(y[kUDot], y[kXDot], y[kThetaDot]);

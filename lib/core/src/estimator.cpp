@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "plinth/core/stability.h"
+
 namespace plinth {
 
 Error validate(const EstimatorSettings& st, const Scene& scene) {

@@ -1,9 +1,9 @@
-#include "plinth/core/full_contact_propagator.h"
+#include "plinth/core/internal/full_contact_propagator.h"
 
 #include <Eigen/Core>
 #include <cmath>
 
-namespace plinth {
+namespace plinth::internal {
 namespace {
 
 using Matrix4 = Eigen::Matrix4d;
@@ -53,4 +53,4 @@ FullContactPropagator FullContactPropagator::make(const Scene& s, double h) {
   return p;
 }
 
-}  // namespace plinth
+}  // namespace plinth::internal

@@ -1,16 +1,17 @@
-// The continuous dynamics of each phase as the one-step methods see them (steppers.h): the
-// ground at t, dy/dt at a Runge-Kutta stage, and the full FlowPoint at a point where guards are
-// evaluated. A kernel is made for one interval of a step, its mode fixed, so what the mode fixes
-// (the pivot, the direction, whether the base moves) is computed once.
+// Private to plinth_core. The continuous dynamics of each phase as the one-step methods see them
+// (internal/steppers.h): the ground at t, dy/dt at a Runge-Kutta stage, and the full FlowPoint at
+// a point where guards are evaluated. A kernel is made for one interval of a step, its mode
+// fixed, so what the mode fixes (the pivot, the direction, whether the base moves) is computed
+// once.
 #pragma once
 
 #include "plinth/core/excitation.h"
-#include "plinth/core/flows.h"
-#include "plinth/core/full_contact_propagator.h"
+#include "plinth/core/internal/flows.h"
+#include "plinth/core/internal/full_contact_propagator.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 
-namespace plinth::kernels {
+namespace plinth::internal::kernels {
 
 struct Context {
   const Scene& scene;
@@ -188,4 +189,4 @@ struct SlideRocking : Turning {
   }
 };
 
-}  // namespace plinth::kernels
+}  // namespace plinth::internal::kernels

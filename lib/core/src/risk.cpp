@@ -3,7 +3,7 @@
 #include <cmath>
 
 #include "plinth/core/energy.h"
-#include "plinth/core/flows.h"
+#include "plinth/core/internal/flows.h"
 
 namespace plinth {
 
@@ -16,7 +16,7 @@ double sliding_fall_risk(const Scene& s, const Mode& mode, const State& y) {
   const double x_hat = s.params.support.clearance;
   double risk = 0.0;
   for (const int side : {-1, 1}) {
-    // C passes the edge on `side` when side * x reaches x_hat + b_side (guards.h, kFall).
+    // C passes the edge on `side` when side * x reaches x_hat + b_side (internal/guards.h, kFall).
     const double reach = x_hat + (side < 0 ? s.b1 : s.b2);
     const double left = reach - side * y[kX];
     if (left <= 0.0) return 1.0;
@@ -46,7 +46,7 @@ Risk overturning_risk(const Scene& s, const Mode& mode, const State& y, const Ri
   if (mode.phase == Phase::kFell) r.falling = 1.0;
   if (!mode.terminal()) {
     if (mode.rocking()) {
-      const Pivot pivot = pivot_of(s, mode, y);
+      const internal::Pivot pivot = internal::pivot_of(s, mode, y);
       const double barrier = s.m * s.g * (pivot.geometry.radius - s.h);
       const double ratio = barrier > 0.0 ? rocking_energy(s, mode, y) / barrier : 1.0;
       (pivot.overhanging ? r.falling : r.overturning) = unit_clamp(ratio);

@@ -1,6 +1,8 @@
 #include "plinth/host/cli.h"
 
 #include <cmath>
+#include <cstdio>
+#include <exception>
 #include <string>
 
 namespace plinth::host {
@@ -32,6 +34,15 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   return std::nullopt;
+}
+
+int run_tool(const char* name, const std::function<int()>& run) {
+  try {
+    return run();
+  } catch (const std::exception& error) {  // InputError (the user's input) and anything else
+    std::fprintf(stderr, "%s: error: %s\n", name, error.what());
+    return 1;
+  }
 }
 
 }  // namespace plinth::host

@@ -32,18 +32,6 @@ void TimeHistoryCsv::write_row(double t, double ag, const State& y, Phase phase)
   out_ << buffer;
 }
 
-const char* outcome_name(Outcome outcome) {
-  switch (outcome) {
-    case Outcome::kSurvived:
-      return "survived";
-    case Outcome::kOverturned:
-      return "overturned";
-    case Outcome::kFell:
-      return "fell";
-  }
-  return "survived";
-}
-
 Outcome outcome_of(Phase final_phase) {
   if (final_phase == Phase::kOverturned) return Outcome::kOverturned;
   if (final_phase == Phase::kFell) return Outcome::kFell;  // fell off the base

@@ -1,5 +1,7 @@
 #include "plinth/host/scene_toml.h"
 
+#include <toml++/toml.h>
+
 #include <algorithm>
 #include <array>
 #include <charconv>
@@ -7,8 +9,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <ios>
 #include <initializer_list>
 #include <map>
 #include <numbers>
@@ -18,9 +18,9 @@
 #include <system_error>
 #include <utility>
 
-#include <toml++/toml.h>
-
+#include "plinth/core/name_table.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/text_file.h"
 
 namespace plinth::host {
 namespace {
@@ -33,20 +33,22 @@ std::string format_number(double value) {
   return std::string(buffer.data(), result.ptr);
 }
 
+// What a TOML value is, for messages ("expected a number, got a string").
+constexpr NameTable<toml::node_type, 10> kNodeTypeNames{{{
+    {toml::node_type::none, "nothing"},
+    {toml::node_type::table, "a table"},
+    {toml::node_type::array, "an array"},
+    {toml::node_type::string, "a string"},
+    {toml::node_type::integer, "an integer"},
+    {toml::node_type::floating_point, "a float"},
+    {toml::node_type::boolean, "a boolean"},
+    {toml::node_type::date, "a date"},
+    {toml::node_type::time, "a time"},
+    {toml::node_type::date_time, "a date-time"},
+}}};
+
 std::string_view type_name(toml::node_type type) {
-  switch (type) {
-    case toml::node_type::none: return "nothing";
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a float";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-  }
-  return "an unknown type";
+  return kNodeTypeNames.name(type, "an unknown type");
 }
 
 std::string join(std::initializer_list<std::string_view> words) {
@@ -369,19 +371,7 @@ Scene load_scene_text(const std::string& text, const std::string& origin) {
 }
 
 Scene load_scene_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw InputError(path + ": cannot open scene file (it is a directory)");
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": cannot open scene file");
-  std::string text;
-  std::array<char, 4096> chunk{};
-  while (in.read(chunk.data(), static_cast<std::streamsize>(chunk.size())) || in.gcount() > 0) {
-    text.append(chunk.data(), static_cast<std::size_t>(in.gcount()));
-  }
-  if (in.bad()) throw InputError(path + ": cannot open scene file (read error)");
-  return load_scene_text(text, path);
+  return load_scene_text(read_text_file(path, kMaxSceneFileBytes, "scene file"), path);
 }
 
 }  // namespace plinth::host

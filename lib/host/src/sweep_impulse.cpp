@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <utility>
 
 #include "plinth/core/closed_forms.h"
 #include "plinth/core/events.h"
@@ -87,16 +88,6 @@ bool curve_crosses(double i_lo, double i_hi, double mu_lo, double mu_hi, double 
 }
 
 }  // namespace
-
-const char* impulse_start_name(ImpulseStart start) {
-  switch (start) {
-    case ImpulseStart::kFullContact: return "full_contact";
-    case ImpulseStart::kSliding: return "sliding";
-    case ImpulseStart::kRocking: return "rocking";
-    case ImpulseStart::kSlideRocking: return "slide_rocking";
-  }
-  return "?";
-}
 
 SimulatedStart simulate_impulse_start(const Scene& scene, double impulse, double dt) {
   require_base(scene, "--impulse-map");
@@ -198,7 +189,7 @@ SweepPlan plan_impulse_map(const SceneParams& base, const GridAxis& mu_axis,
   const std::vector<std::string> keys = plan.keys;
   plan.row = [scenes, impulses, columns, dt, keys](std::size_t i, const std::atomic<bool>* stop,
                                                    std::size_t* simulations) {
-    if (stop != nullptr && stop->load()) throw SweepCancelled();
+    if (stop != nullptr && stop->load()) throw JobCancelled();
     const Scene& scene = (*scenes)[i / columns];
     const double impulse = impulses[i % columns];
     const SimulatedStart simulated = simulate_impulse_start(scene, -impulse, dt);
@@ -309,14 +300,15 @@ SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,
   for (const Scene& scene : *scenes) (void)impulse_simulator(scene, settings.dt, nullptr);
   // The counterparts on the ground, and their thresholds, searched once per distinct scene.
   struct Ground {
+    explicit Ground(GroundScenes scenes)
+        : on_ground(std::move(scenes)), thresholds(on_ground.distinct.size()) {}
     GroundScenes on_ground;
     OnceCache<ImpulseThresholds> thresholds;
   };
   std::shared_ptr<Ground> ground;
   if (compare_ground) {
-    ground = std::make_shared<Ground>();
-    ground->on_ground = ground_scenes(*scenes);
-    for (const Scene& scene : ground->on_ground.scenes) {
+    ground = std::make_shared<Ground>(ground_scenes(*scenes));
+    for (const Scene& scene : ground->on_ground.distinct) {
       (void)impulse_simulator(scene, settings.dt, nullptr);
     }
   }
@@ -350,8 +342,9 @@ SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,
                       format_result(found.overturned) + "," + format_result(rocking_closed_form) +
                       "," + format_result(overturned_closed_form);
     if (ground) {
-      const Scene& on_ground = ground->on_ground.scenes[i];
-      const ImpulseThresholds g = ground->thresholds.get(ground->on_ground.keys[i], [&] {
+      const std::size_t k = ground->on_ground.of[i];
+      const Scene& on_ground = ground->on_ground.distinct[k];
+      const ImpulseThresholds g = ground->thresholds.get(k, [&] {
         try {
           return impulse_thresholds(on_ground, settings, simulations, stop);
         } catch (const InputError& e) {

@@ -12,8 +12,6 @@ constexpr int rank(AlarmLevel level) { return static_cast<int>(level); }
 
 constexpr AlarmLevel higher(AlarmLevel a, AlarmLevel b) { return rank(a) >= rank(b) ? a : b; }
 
-constexpr std::int64_t kNanosecondsPerMillisecond = 1'000'000;
-
 Error check_thresholds(const RiskThresholds& t, const char* on_field, const char* off_field) {
   if (!std::isfinite(t.on)) return {ErrorCode::kNotFinite, on_field, "must be finite"};
   if (!std::isfinite(t.off)) return {ErrorCode::kNotFinite, off_field, "must be finite"};
@@ -77,40 +75,6 @@ Error validate(const AlarmPolicySettings& s) {
       detail::check_duration(s.lower_hold_s, "alarm_policy.lower_hold_s", true),
       detail::check_duration(s.heartbeat_period_s, "alarm_policy.heartbeat_period_s", false),
   });
-}
-
-const char* ack_outcome_name(AckOutcome outcome) {
-  switch (outcome) {
-    case AckOutcome::kNone: return "none";
-    case AckOutcome::kReleased: return "released";
-    case AckOutcome::kReleasedConditionHolds: return "released, condition holds";
-    case AckOutcome::kStale: return "stale sequence";
-    case AckOutcome::kWrongLevel: return "wrong level";
-    case AckOutcome::kNothingLatched: return "nothing latched";
-  }
-  return "invalid";
-}
-
-const char* input_problem_name(InputProblem problem) {
-  switch (problem) {
-    case InputProblem::kNone: return "none";
-    case InputProblem::kRiskInvalid: return "risk not finite or outside [0, 1]";
-    case InputProblem::kTimeWentBack: return "time went back";
-  }
-  return "invalid";
-}
-
-can::AlarmEvent to_can_event(const AlarmEventRecord& record) {
-  can::AlarmEvent event;
-  event.level = record.level;
-  event.previous_level = record.previous_level;
-  event.cause = record.cause;
-  event.latched = record.latched;
-  // Modulo 2^32 ms, as the frame's counter wraps.
-  const std::int64_t ms = record.time_ns / kNanosecondsPerMillisecond;
-  event.time_since_start_ms = static_cast<std::uint32_t>(static_cast<std::uint64_t>(ms));
-  event.sequence = record.sequence;
-  return event;
 }
 
 Error AlarmPolicy::create(const AlarmPolicySettings& settings, AlarmPolicy& out) {

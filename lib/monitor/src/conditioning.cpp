@@ -69,26 +69,6 @@ Error validate(const ConditioningSettings& s) {
   return ok_error();
 }
 
-const char* startup_rejection_name(StartupRejection rejection) {
-  switch (rejection) {
-    case StartupRejection::kNone: return "none";
-    case StartupRejection::kTooNoisy: return "start-up window too noisy";
-    case StartupRejection::kOffsetTooLarge: return "offset too large (mounting or unit?)";
-  }
-  return "invalid";
-}
-
-const char* offset_tracking_name(OffsetTracking tracking) {
-  switch (tracking) {
-    case OffsetTracking::kStartup: return "start-up";
-    case OffsetTracking::kNotQuiet: return "not quiet";
-    case OffsetTracking::kGated: return "gated";
-    case OffsetTracking::kTracked: return "tracked";
-    case OffsetTracking::kInvalidInput: return "invalid input";
-  }
-  return "invalid";
-}
-
 Error Conditioner::create(const ConditioningSettings& settings, Conditioner& out) {
   PLINTH_TRY(validate(settings));
   out = Conditioner{};

@@ -62,41 +62,12 @@ Error validate(const SensorHealthSettings& s) {
   return ok_error();
 }
 
-const char* health_state_name(HealthState state) {
-  switch (state) {
-    case HealthState::kOk: return "ok";
-    case HealthState::kDegraded: return "degraded";
-    case HealthState::kFault: return "fault";
-  }
-  return "invalid";
-}
-
-const char* health_cause_name(HealthCause cause) {
+AlarmCause to_alarm_cause(HealthCause cause) {
   switch (cause) {
-    case HealthCause::kNone: return "none";
-    case HealthCause::kNoData: return "no data yet";
-    case HealthCause::kTimeout: return "timeout";
-    case HealthCause::kSequenceGap: return "sequence gap";
-    case HealthCause::kDuplicate: return "duplicate sequence number";
-    case HealthCause::kOutOfOrder: return "sequence number out of order";
-    case HealthCause::kNonFinite: return "non-finite value";
-    case HealthCause::kOutOfRange: return "value out of range";
-    case HealthCause::kUndefinedStatus: return "undefined status bits";
-    case HealthCause::kSaturated: return "saturated";
-    case HealthCause::kStuck: return "stuck values";
-    case HealthCause::kSelfTestFailed: return "self-test failed";
-    case HealthCause::kOverTemperature: return "over temperature";
-    case HealthCause::kCalibrationInvalid: return "calibration invalid";
-  }
-  return "invalid";
-}
-
-can::AlarmCause to_alarm_cause(HealthCause cause) {
-  switch (cause) {
-    case HealthCause::kNone: return can::AlarmCause::kNone;
+    case HealthCause::kNone: return AlarmCause::kNone;
     case HealthCause::kNoData:
-    case HealthCause::kTimeout: return can::AlarmCause::kSensorTimeout;
-    default: return can::AlarmCause::kSensorFault;
+    case HealthCause::kTimeout: return AlarmCause::kSensorTimeout;
+    default: return AlarmCause::kSensorFault;
   }
 }
 
@@ -170,14 +141,14 @@ HealthCause SensorHealthTracker::value_problem(const SensorSample& sample) const
   if (sample.acceleration_g.cwiseAbs().maxCoeff() > settings_.max_valid_g) {
     return HealthCause::kOutOfRange;
   }
-  if ((sample.status & ~can::sensor_status::kDefinedMask) != 0) {
+  if ((sample.status & ~sensor_flags::kDefinedMask) != 0) {
     return HealthCause::kUndefinedStatus;
   }
   return HealthCause::kNone;
 }
 
 void SensorHealthTracker::check_flags_and_stuck(const SensorSample& sample, bool& saturated) {
-  namespace flag = can::sensor_status;
+  namespace flag = sensor_flags;
   SensorCounters& c = health_.counters;
   saturated = (sample.status & flag::kSaturated) != 0 ||
               sample.acceleration_g.cwiseAbs().maxCoeff() >= settings_.full_scale_g;

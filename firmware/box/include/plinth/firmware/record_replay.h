@@ -14,8 +14,11 @@
 
 namespace plinth::firmware {
 
-// The box's settings before its configuration file: MonitorConfig's, with a 2 s start-up
-// window for the sensor's offset.
+// The box's start-up window, s: shorter than MonitorConfig's (a replay's quiet lead-in).
+inline constexpr double kBoxStartupWindowS = 2.0;
+
+// The box's settings before its configuration file (plinth-monitor's and the microcontroller
+// image's): MonitorConfig's, with a kBoxStartupWindowS start-up window for the sensor's offset.
 [[nodiscard]] MonitorConfig box_defaults();
 
 // Turns `config` into the record replay's: the sample rate `sample_rate_hz`; a [[sensor]] list

@@ -8,6 +8,7 @@
 //     sensor's history (its last kSensorHistory samples)
 //   the primary ground sensor's samples --PlanarEstimator per axis (x: statue axis 1, y: axis 2;
 //     z feeds g + v_G'')--> phase, state --overturning_risk--> risk --AlarmPolicy--> level, events
+//   events, and the status at status_interval_s --can_frames.h--> frames ready to send
 //   the other ground sensors' samples --cross-check against the primary--> disagreement
 //   the plate sensor's samples --compared with the model's base acceleration--> residual
 //
@@ -56,10 +57,12 @@
 #include "plinth/core/error.h"
 #include "plinth/core/estimator.h"
 #include "plinth/core/events.h"
+#include "plinth/core/name_table.h"
 #include "plinth/core/risk.h"
 #include "plinth/core/scene.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/hal/frame_io.h"
+#include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/conditioning.h"
 #include "plinth/monitor/sensor_health.h"
@@ -97,7 +100,14 @@ enum class SensorRole : std::uint8_t {
   kGround = 0,  // on the ground (the foundation): may drive the estimators
   kPlate = 1,   // on the isolation plate: checks the model, never drives it
 };
-[[nodiscard]] const char* sensor_role_name(SensorRole role);  // "ground", "plate"
+// The roles' names in the configuration file and the status lines.
+inline constexpr NameTable<SensorRole, 2> kSensorRoleNames{{{
+    {SensorRole::kGround, "ground"},
+    {SensorRole::kPlate, "plate"},
+}}};
+[[nodiscard]] constexpr const char* sensor_role_name(SensorRole role) {
+  return kSensorRoleNames.name(role);
+}
 
 struct SensorConfig {
   std::uint8_t node = 1;  // CAN node id, 1..15, one per sensor
@@ -132,6 +142,9 @@ struct MonitorConfig {
   monitor::AlarmPolicySettings alarm;
   // Quiet (offset tracking allowed): every axis at rest in full contact with risk below this.
   double quiet_risk = 1e-3;
+  // s, > 0: a status (its frames, and the application's status line) goes out at least this
+  // often, besides at every alarm change and at the alarm policy's heartbeat.
+  double status_interval_s = 0.1;
   // The sensor list, sensors[0 .. sensor_count): replaces ground_node, conditioning and
   // sensor_health when sensor_count > 0. At least one ground sensor, at most one plate sensor,
   // distinct nodes; the configured order is the order of preference for the primary.
@@ -169,6 +182,7 @@ struct FrameCounters {
   std::uint64_t unknown_identifiers = 0;  // not a plinth identifier
   can::CodecError last_error = can::CodecError::kOk;  // of the latest rejected frame
   const char* last_error_signal = "";
+  std::uint64_t not_encoded = 0;  // frames to send that the codec refused (left out)
 };
 
 // One sensor's part of the status.
@@ -217,12 +231,22 @@ struct MonitorStatus {
   double plate_residual_m_s2 = 0.0;  // the plate's RMS residual (valid when its window is full)
 };
 
-// What one input did.
+// An update's alarm events: each update evaluates the alarm policy once.
+inline constexpr std::size_t kMaxUpdateEvents = monitor::kMaxEventsPerUpdate;
+// An AlarmEvent per event, then a MonitorStatus per axis.
+inline constexpr std::size_t kMaxFramesPerUpdate =
+    kMaxUpdateEvents + static_cast<std::size_t>(kMaxAxes);
+
+// What one input did, and the frames to send for it, in order.
 struct MonitorUpdate {
-  std::array<monitor::AlarmEventRecord, 2 * monitor::kMaxEventsPerUpdate> events{};
+  std::array<monitor::AlarmEventRecord, kMaxUpdateEvents> events{};
   std::size_t event_count = 0;
-  bool status_due = false;  // the heartbeat period passed or an event happened: send a status
+  // A status is due (status_interval_s, an alarm change or the alarm policy's heartbeat): its
+  // frames are in `frames`, and status() is what it reports.
+  bool status_due = false;
   monitor::AckOutcome acknowledgement = monitor::AckOutcome::kNone;
+  std::array<can::CanFrame, kMaxFramesPerUpdate> frames{};  // frames[0 .. frame_count)
+  std::size_t frame_count = 0;
 };
 
 class Monitor {
@@ -271,8 +295,6 @@ class Monitor {
     return sensor_configs_[static_cast<std::size_t>(sensor)];
   }
   [[nodiscard]] const MonitorConfig& config() const { return config_; }
-  // Records that a status went out (resets the heartbeat).
-  void status_sent() { alarm_.heartbeat_sent(status_.time_ns); }
 
  private:
   // A conditioned sample, statue frame, m/s2, at its receive time.
@@ -329,7 +351,19 @@ class Monitor {
                                   Eigen::Vector3d& value) const;
   [[nodiscard]] bool usable(int sensor) const;
   [[nodiscard]] bool quiet() const;
+  void take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update);
+  // Decodes one frame and acts on it; true when that evaluated the state (and reported).
+  [[nodiscard]] bool take_frame(const hal::TimedFrame& timed, MonitorUpdate& update);
+  // Decodes `frame`; a refusal is counted (rejected, last_error).
+  template <typename Message>
+  [[nodiscard]] bool decoded(const can::CanFrame& frame, Message& message);
+  [[nodiscard]] int sensor_of_node(std::uint8_t node) const;  // -1: not configured
+  void update_sensors_status();
+  void update_axes_status(monitor::AlarmInput& input);
   void evaluate(MonitorUpdate& update);
+  void report(MonitorUpdate& update);
+  template <typename Message>
+  void add_frame(MonitorUpdate& update, const Message& message);
   [[nodiscard]] std::int64_t monitor_time(std::int64_t receive_time_ns);
 
   MonitorConfig config_;
@@ -354,6 +388,9 @@ class Monitor {
   bool bus_fault_ = false;
   bool pending_ack_ = false;
   monitor::Acknowledgement ack_;
+  std::int64_t status_interval_ns_ = 100'000'000;
+  std::int64_t next_status_ns_ = 0;   // monitor time of the next status at the interval
+  std::uint8_t status_sequence_ = 0;  // of the next MonitorStatus frames
 };
 
 }  // namespace plinth::firmware

@@ -62,8 +62,12 @@ enum class MessageKind : std::uint8_t {
 
 // ---------------------------------------------------------------------------------------------
 // Enumerations (the DBC's VAL_ tables)
+//
+// The wire's numbering only: the names are the domain types' (plinth::Phase and Corner in
+// lib/core, monitor::AlarmLevel and AlarmCause in lib/monitor), which firmware/monitor maps to
+// and from these (src/can_frames.cpp, numbering pinned by static_assert).
 
-// The block's phase of motion; same numbering as plinth::Phase in lib/core (state.h).
+// The block's phase of motion.
 enum class Phase : std::uint8_t {
   kFullContact = 0,
   kSliding = 1,
@@ -72,8 +76,7 @@ enum class Phase : std::uint8_t {
   kOverturned = 4,
   kFell = 5,
 };
-// The corner the block rocks about; kNone when it does not rock. Left/right have the values of
-// plinth::Corner in lib/core (scene.h).
+// The corner the block rocks about; kNone when it does not rock.
 enum class Corner : std::uint8_t { kNone = 0, kLeft = 1, kRight = 2 };
 enum class AlarmLevel : std::uint8_t {
   kNormal = 0,
@@ -94,12 +97,6 @@ enum class AlarmCause : std::uint8_t {
   kBusError = 8,            // CAN bus-off or error-passive
   kInternalFault = 9,       // the monitor's own self-check failed
 };
-
-// Names exactly as in the DBC's VAL_ tables (e.g. "slide_rocking"); "invalid" otherwise.
-[[nodiscard]] const char* phase_name(Phase phase);
-[[nodiscard]] const char* corner_name(Corner corner);
-[[nodiscard]] const char* alarm_level_name(AlarmLevel level);
-[[nodiscard]] const char* alarm_cause_name(AlarmCause cause);
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.
 namespace sensor_status {

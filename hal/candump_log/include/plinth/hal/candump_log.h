@@ -15,16 +15,18 @@
 // comments. Anything else is malformed and reported with its file and line; canplayer would
 // silently skip a line not starting with '(', this reader refuses it so a wrong file is noticed.
 //
-// Host code: allocates, and the constructors throw plinth::host::InputError.
+// Host code: allocates (never throws for a bad file: open() and receive() say what is wrong).
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 
+#include "plinth/core/name_table.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/hal/candump_format.h"
 #include "plinth/hal/frame_io.h"
@@ -40,7 +42,18 @@ enum class CandumpFrameKind : std::uint8_t {
   kErrorFrame,  // error frame (8-digit identifier with CAN_ERR_FLAG 0x20000000)
 };
 
-[[nodiscard]] const char* candump_frame_kind_name(CandumpFrameKind kind);
+inline constexpr NameTable<CandumpFrameKind, 6> kCandumpFrameKindNames{{{
+    {CandumpFrameKind::kComment, "comment"},
+    {CandumpFrameKind::kClassic, "classic"},
+    {CandumpFrameKind::kExtended, "extended"},
+    {CandumpFrameKind::kRemote, "remote request"},
+    {CandumpFrameKind::kFd, "CAN FD"},
+    {CandumpFrameKind::kErrorFrame, "error frame"},
+}}};
+
+[[nodiscard]] constexpr const char* candump_frame_kind_name(CandumpFrameKind kind) {
+  return kCandumpFrameKindNames.name(kind);
+}
 
 inline constexpr std::size_t kCandumpMaxFdLength = 64;  // bytes
 inline constexpr std::uint32_t kStandardIdMask = 0x7FF;
@@ -81,10 +94,11 @@ struct CandumpLine {
 //   kIoError     a malformed line or a read error: error() says "file:line: what"; the next
 //                call goes on with the following line;
 //   kEndOfInput  at the end of the file (and on every later call).
+struct CandumpLogReaderOpenResult;
 class CandumpLogReader final : public FrameSource {
  public:
-  // Throws plinth::host::InputError "<path>: cannot open file" when the file cannot be read.
-  explicit CandumpLogReader(std::string path);
+  // Opens `path` for reading; on failure the result's message is "<path>: cannot open file".
+  [[nodiscard]] static CandumpLogReaderOpenResult open(std::string path);
 
   [[nodiscard]] IoStatus receive(TimedFrame& out, int timeout_ms) override;
 
@@ -95,6 +109,8 @@ class CandumpLogReader final : public FrameSource {
   [[nodiscard]] const std::string& path() const { return path_; }
 
  private:
+  CandumpLogReader(std::string path, std::ifstream in);
+
   std::string path_;
   std::ifstream in_;
   std::string text_;
@@ -107,13 +123,15 @@ class CandumpLogReader final : public FrameSource {
 // the epoch: the caller decides what time a frame carries, e.g. its virtual send time).
 // send() returns kIoError, with error() set, for a frame that is not a classic standard frame
 // of 0..8 bytes, a negative timestamp or a failed write.
+struct CandumpLogWriterOpenResult;
 class CandumpLogWriter final : public FrameSink {
  public:
   using Clock = std::function<std::int64_t()>;
 
-  // Creates (truncates) `path`. Throws plinth::host::InputError when it cannot, or when the
-  // interface name is empty, longer than 15 characters or contains white space.
-  CandumpLogWriter(std::string path, std::string interface_name, Clock clock);
+  // Creates (truncates) `path`. On failure the result's message says why: the file cannot be
+  // created, or the interface name is empty, longer than 15 characters or contains white space.
+  [[nodiscard]] static CandumpLogWriterOpenResult open(std::string path, std::string interface_name,
+                                                       Clock clock);
 
   [[nodiscard]] IoStatus send(const can::CanFrame& frame) override;
   // Flushes to the file; false (error() set) when a write failed.
@@ -123,11 +141,27 @@ class CandumpLogWriter final : public FrameSink {
   [[nodiscard]] const std::string& path() const { return path_; }
 
  private:
+  CandumpLogWriter(std::string path, std::string interface_name, Clock clock, std::ofstream out);
+
   std::string path_;
   std::string interface_name_;
   Clock clock_;
   std::ofstream out_;
   std::string error_;
+};
+
+struct CandumpLogReaderOpenResult {
+  std::optional<CandumpLogReader> reader;  // set on success
+  std::string message;                     // names the file and the cause; empty on success
+
+  [[nodiscard]] bool ok() const { return reader.has_value(); }
+};
+
+struct CandumpLogWriterOpenResult {
+  std::optional<CandumpLogWriter> writer;  // set on success
+  std::string message;                     // names the file or the interface name and the cause
+
+  [[nodiscard]] bool ok() const { return writer.has_value(); }
 };
 
 }  // namespace plinth::hal

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 
+#include "plinth/core/name_table.h"
 #include "plinth/hal/can_codec.h"
 
 namespace plinth::hal {
@@ -27,17 +28,18 @@ enum class IoStatus : std::uint8_t {
   kIoError,      // the backend failed (socket closed, read error, interface gone)
 };
 
+inline constexpr NameTable<IoStatus, 7> kIoStatusNames{{{
+    {IoStatus::kOk, "ok"},
+    {IoStatus::kTimeout, "timeout"},
+    {IoStatus::kEndOfInput, "end of input"},
+    {IoStatus::kNotPlinth, "not a plinth frame"},
+    {IoStatus::kBusError, "bus error"},
+    {IoStatus::kOverflow, "frames dropped"},
+    {IoStatus::kIoError, "i/o error"},
+}}};
+
 [[nodiscard]] constexpr const char* io_status_name(IoStatus status) {
-  switch (status) {
-    case IoStatus::kOk: return "ok";
-    case IoStatus::kTimeout: return "timeout";
-    case IoStatus::kEndOfInput: return "end of input";
-    case IoStatus::kNotPlinth: return "not a plinth frame";
-    case IoStatus::kBusError: return "bus error";
-    case IoStatus::kOverflow: return "frames dropped";
-    case IoStatus::kIoError: return "i/o error";
-  }
-  return "invalid";
+  return kIoStatusNames.name(status);
 }
 
 // Both interfaces are used, never owned: their destructors are protected and not virtual (a

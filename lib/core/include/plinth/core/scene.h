@@ -4,6 +4,7 @@
 #pragma once
 
 #include "plinth/core/error.h"
+#include "plinth/core/name_table.h"
 
 namespace plinth {
 
@@ -60,6 +61,13 @@ struct SceneParams {
 // (theta < 0), as in the paper's Fig. 3.
 enum class Corner : unsigned char { kLeft = 1, kRight = 2 };
 
+// The names used in plinth-sim's outputs and the monitor's status lines.
+inline constexpr NameTable<Corner, 2> kCornerNames{{{
+    {Corner::kLeft, "left"},
+    {Corner::kRight, "right"},
+}}};
+[[nodiscard]] constexpr const char* corner_name(Corner corner) { return kCornerNames.name(corner); }
+
 // Geometry of rocking about one corner, in the body frame: the vector from the corner to C is
 // (offset, h); offset = b1 for corner 1 and -b2 for corner 2, which turns Eqs 8-9 for corner 1
 // into the equations of either corner.
@@ -92,6 +100,24 @@ struct Scene {
   }
   [[nodiscard]] bool has_base() const { return params.has_base; }
 };
+
+// What the model of a scene carries, fixed once when the scene is loaded: the simulator compiles
+// in the guards and resets of exactly these (internal/guards.h, active_guards), and they say
+// which events a scene can have.
+struct Features {
+  bool base = false;           // an isolated base (u is a degree of freedom)
+  bool base_stops = false;     // security stops on the base (Eqs 28-29)
+  bool sliding = false;        // friction is finite: sliding phases exist (Eqs 2-5, 10-15, 17-20)
+  bool support_edge = false;   // the block can overhang the support and fall (Eqs 13-14)
+  bool sliding_stops = false;  // sliding stops at |x| = x_hat (Eqs 30-32)
+};
+
+[[nodiscard]] constexpr Features features_of(const Scene& s) {
+  const SceneParams& p = s.params;
+  return {p.has_base, p.has_base_stops, p.has_friction,
+          p.has_friction && p.has_support && !p.has_sliding_stops,
+          p.has_friction && p.has_sliding_stops};
+}
 
 // Geometry of rocking about a pivot `distance` (b_i or b_hat_i, m) from C's vertical, on the
 // side `sign` (+1: corner 1, -1: corner 2).

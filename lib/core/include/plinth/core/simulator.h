@@ -1,6 +1,7 @@
-// The fixed-step hybrid solver: a one-step method (steppers.h; RK4 by default) on the current
+// The fixed-step hybrid solver: a one-step method (stepper.h; RK4 by default) on the current
 // phase's equations, every event located inside the step, the reset applied there, and the
-// step finished in the new phase so the time grid stays fixed.
+// step finished in the new phase so the time grid stays fixed. The flows, guards, resets and
+// steppers it is made of are internal (internal/*.h); the largest stable step: stability.h.
 #pragma once
 
 #include <array>
@@ -9,28 +10,34 @@
 #include "plinth/core/error.h"
 #include "plinth/core/events.h"
 #include "plinth/core/excitation.h"
-#include "plinth/core/flows.h"
-#include "plinth/core/full_contact_propagator.h"
-#include "plinth/core/guards.h"
+#include "plinth/core/internal/flows.h"
+#include "plinth/core/internal/full_contact_propagator.h"
+#include "plinth/core/internal/guards.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
-#include "plinth/core/steppers.h"
+#include "plinth/core/stepper.h"
 
 namespace plinth {
+namespace internal {
+template <Features F>
+struct EventLogic;
+template <class Method, class Kernel>
+struct StepInterval;
+}  // namespace internal
 
 struct SolverSettings {
   double step = 1e-4;  // s, the fixed time step
-  // The one-step method and how events are taken (steppers.h). docs/accuracy.md measures them.
+  // The one-step method and how events are taken (stepper.h). docs/accuracy.md measures them.
   Stepper stepper = Stepper::kRk4Located;
   // Full contact (Eq 1, linear) propagated exactly over each step with the ground acceleration
-  // linear within it (full_contact_propagator.h), whatever the stepper; its guards (Eqs 15, 16,
-  // 28) are evaluated, and located, on that exact solution.
+  // linear within it (internal/full_contact_propagator.h), whatever the stepper; its guards (Eqs
+  // 15, 16, 28) are evaluated, and located, on that exact solution.
   bool exact_full_contact = false;
   // Rest criterion: rocking ends at an impact that leaves less rocking energy than this
   // fraction of the energy needed to overturn, I theta'^2 / 2 < ratio m g (r_i - h).
   double rest_energy_ratio = 1e-6;
   // The base is held at a stop when it rebounds slower than this while the stop pushes, m/s.
-  // (rk4_step_end: or slower than a few steps of its acceleration; simulator.cpp, rest_speed.)
+  // (rk4_step_end: or slower than a few steps of its acceleration; event_logic.h, slowest_rebound.)
   double base_rest_speed = 1e-5;
   // The block sticks against a sliding stop instead of rebounding slower than this, m/s (the
   // same addition for rk4_step_end).
@@ -45,19 +52,6 @@ struct SolverSettings {
 
 // Checks the settings; the Error names the field at fault.
 [[nodiscard]] Error validate(const SolverSettings& settings);
-
-// The largest step RK4 integrates the scene's base stably, s: 2.5 / |lambda|max over the base's
-// linear dynamics m_eff u'' + c u' + k u = 0, with m_eff = m + m_b (full contact) and m_b alone
-// (the block sliding or rocking lets the base move without it, at most). RK4's stability region
-// reaches 2.78 on the real axis and 2.83 on the imaginary one. Infinity without a base.
-[[nodiscard]] double largest_stable_step(const Scene& scene);
-
-// The same for `stepper`: RK4 (either way of taking events) as above; Heun and semi-implicit
-// Euler, the largest step whose one-step map on those two linear systems grows no mode by more
-// than kStableGrowthPerStep per step (Heun's stability region misses the imaginary axis: an
-// undamped base grows by (h omega)^4 / 8 per step at any step).
-[[nodiscard]] double largest_stable_step(const Scene& scene, Stepper stepper);
-inline constexpr double kStableGrowthPerStep = 1e-8;
 
 class Simulator {
  public:
@@ -82,8 +76,9 @@ class Simulator {
   // Advances one step (no-op once a terminal phase is reached). A quiet step of exactly
   // propagated full contact is taken here, without a call to the step's intervals.
   void step() {
-    if (mode_.phase == Phase::kFullContact && full_contact_fn_ != nullptr &&
-        full_contact_fn_(*this, time(), static_cast<double>(step_count_ + 1) * settings_.step)) {
+    if (mode_.phase == Phase::kFullContact && quiet_full_contact_step_fn_ != nullptr &&
+        quiet_full_contact_step_fn_(*this, time(),
+                                    static_cast<double>(step_count_ + 1) * settings_.step)) {
       ++step_count_;
       return;
     }
@@ -108,12 +103,12 @@ class Simulator {
 
  private:
   template <Features F>
-  friend struct Hybrid;
+  friend struct internal::EventLogic;
   template <class Method, class Kernel>
-  friend struct Interval;
+  friend struct internal::StepInterval;
   friend struct SimulatorTestPeer;  // tests: turns the quiet full-contact step off to compare
 
-  void emit(const Event& event) {
+  void emit_event(const Event& event) {
     if (sink_ != nullptr) sink_->on_event(event);
   }
   // The guards of the current mode, after it changed.
@@ -121,8 +116,8 @@ class Simulator {
   void step_intervals();
   [[gnu::noinline]] void finish_step(double t0, double t_end);
 
-  // Advances in the current mode from t0 towards t_end (one interval of a step, Interval in
-  // simulator.cpp). On an event it applies the reset, sets t0 to the event's time and returns
+  // Advances in the current mode from t0 towards t_end (one interval of a step, StepInterval in
+  // step_interval.h). On an event it applies the reset, sets t0 to the event's time and returns
   // true.
   // `full_step`: the interval is the whole step (no event before it in this step).
   using IntervalFn = bool (*)(Simulator&, double& t0, double t_end, bool guards_live,
@@ -132,31 +127,31 @@ class Simulator {
   Excitation excitation_;
   SolverSettings settings_;
   EventSink* sink_ = nullptr;
-  // Bound once by create: the stepper's interval for each non-terminal Phase, and the hybrid
-  // logic (guards, resets) compiled for the scene's features.
+  // Bound once by create: the stepper's interval for each non-terminal Phase, and the event
+  // logic (guards, resets) compiled for the scene's features (EventLogic, event_logic.h).
   std::array<IntervalFn, 4> interval_fns_{};
-  void (*apply_fn_)(Simulator&, GuardId, double) = nullptr;
-  void (*settle_fn_)(Simulator&, double) = nullptr;
-  ActiveGuards (*guards_fn_)(const Mode&) = nullptr;
-  void (*enter_fn_)(Simulator&, double) = nullptr;  // starts phases whose onset already holds
-  Accelerations (*acc_fn_)(const Simulator&, double, const State&) = nullptr;
+  void (*apply_reset_fn_)(Simulator&, internal::GuardId, double t) = nullptr;
+  void (*settle_chatter_fn_)(Simulator&, double t) = nullptr;
+  internal::ActiveGuards (*guards_fn_)(const Mode&) = nullptr;
+  void (*start_phases_fn_)(Simulator&, double t) = nullptr;  // whose onset already holds
+  Accelerations (*accelerations_fn_)(const Simulator&, double t, const State&) = nullptr;
   // exact_full_contact: a quiet whole step of full contact (false: take the interval).
-  bool (*full_contact_fn_)(Simulator&, double t0, double t_end) = nullptr;
+  bool (*quiet_full_contact_step_fn_)(Simulator&, double t0, double t_end) = nullptr;
   // u_G'' at the end of the last quiet full-contact step, the start of step number
   // quiet_ground_step_, m/s2.
   double quiet_ground_horizontal_ = 0.0;
   std::int64_t quiet_ground_step_ = -1;
-  FullContactPropagator propagator_;  // for exact_full_contact, over one step
+  internal::FullContactPropagator propagator_;  // for exact_full_contact, over one step
   bool events_at_step_ends_ = false;  // the stepper takes events at step ends (rest speeds)
   Mode mode_;
   State y_ = State::Zero();
-  ActiveGuards active_guards_;
+  internal::ActiveGuards active_guards_;
   // The flow point and guard values at the start of the interval (points_[current_]) and at its
   // end (the other one, which becomes current when the step had no event: the next step starts
   // at the same time, state and mode, and this is its first stage). cache_valid_: the current
   // one holds the current time, state and mode.
-  std::array<FlowPoint, 2> points_{};
-  std::array<GuardValues, 2> guard_values_{};
+  std::array<internal::FlowPoint, 2> points_{};
+  std::array<internal::GuardValues, 2> guard_values_{};
   std::size_t current_ = 0;
   bool cache_valid_ = false;
   std::int64_t step_count_ = 0;

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 
+#include "plinth/core/name_table.h"
 #include "plinth/core/scene.h"
 
 namespace plinth {
@@ -31,6 +32,17 @@ enum class Phase : std::uint8_t {
   kFell,
 };
 
+// The names used in plinth-sim's CSV and in the monitor's status lines.
+inline constexpr NameTable<Phase, 6> kPhaseNames{{{
+    {Phase::kFullContact, "full_contact"},
+    {Phase::kSliding, "sliding"},
+    {Phase::kRocking, "rocking"},
+    {Phase::kSlideRocking, "slide_rocking"},
+    {Phase::kOverturned, "overturned"},
+    {Phase::kFell, "fell"},
+}}};
+[[nodiscard]] constexpr const char* phase_name(Phase phase) { return kPhaseNames.name(phase); }
+
 // The discrete part of the hybrid state.
 struct Mode {
   Phase phase = Phase::kFullContact;
@@ -55,9 +67,5 @@ struct Mode {
     return phase == Phase::kOverturned || phase == Phase::kFell;
   }
 };
-
-// The names used in plinth-sim's CSV and in the monitor's status lines.
-[[nodiscard]] const char* phase_name(Phase phase);
-[[nodiscard]] const char* corner_name(Corner corner);
 
 }  // namespace plinth

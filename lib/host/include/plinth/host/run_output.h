@@ -6,6 +6,7 @@
 #include <string>
 
 #include "plinth/core/events.h"
+#include "plinth/core/name_table.h"
 #include "plinth/core/state.h"
 
 namespace plinth::host {
@@ -24,7 +25,14 @@ class TimeHistoryCsv {
 
 enum class Outcome { kSurvived, kOverturned, kFell };
 
-[[nodiscard]] const char* outcome_name(Outcome outcome);
+inline constexpr NameTable<Outcome, 3> kOutcomeNames{{{
+    {Outcome::kSurvived, "survived"},
+    {Outcome::kOverturned, "overturned"},
+    {Outcome::kFell, "fell"},
+}}};
+[[nodiscard]] constexpr const char* outcome_name(Outcome outcome) {
+  return kOutcomeNames.name(outcome);
+}
 [[nodiscard]] Outcome outcome_of(Phase final_phase);
 
 // One JSON object per line: {"t": s, "event": name, ...details}.

@@ -12,8 +12,11 @@
 #include <optional>
 #include <string>
 
+#include "plinth/core/name_table.h"
 #include "plinth/core/scene.h"
-#include "plinth/host/sweep.h"
+#include "plinth/host/sweep_parameter.h"
+#include "plinth/host/sweep_plan.h"
+#include "plinth/host/sweep_search.h"
 
 namespace plinth::host {
 
@@ -25,8 +28,16 @@ enum class ImpulseStart : unsigned char {
   kSlideRocking,  // rocking first, then sliding within the first rocking phase
 };
 
-// "full_contact", "sliding", "rocking", "slide_rocking".
-[[nodiscard]] const char* impulse_start_name(ImpulseStart start);
+// The names in the impulse map's CSV.
+inline constexpr NameTable<ImpulseStart, 4> kImpulseStartNames{{{
+    {ImpulseStart::kFullContact, "full_contact"},
+    {ImpulseStart::kSliding, "sliding"},
+    {ImpulseStart::kRocking, "rocking"},
+    {ImpulseStart::kSlideRocking, "slide_rocking"},
+}}};
+[[nodiscard]] constexpr const char* impulse_start_name(ImpulseStart start) {
+  return kImpulseStartNames.name(start);
+}
 
 struct SimulatedStart {
   ImpulseStart start = ImpulseStart::kFullContact;
@@ -111,7 +122,7 @@ struct ImpulseThresholds {
 // thresholds and Eq 37 (on a base) or 0 and ground_overturning_impulse (on the ground).
 // With `compare_ground` (the scene must have a base), also the value's ground_counterpart's
 // "overturned_ground,overturned_closed_form_ground" (its rocking impulse is 0 for every
-// value, so it has no column); the same ground scene is searched once (OnceCache), and the
+// value, so it has no column); the same ground scene is searched once, and the
 // settings line says "compare=ground".
 [[nodiscard]] SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,
                                            const GridAxis& axis,

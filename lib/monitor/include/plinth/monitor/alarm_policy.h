@@ -1,6 +1,6 @@
 // Alarm policy: turns the estimator's risk and phase, the collapse detector and the fault
 // state into alarm levels and events for the building's alarm system (CAN AlarmEvent frames,
-// status lines). Levels and causes are the CAN protocol's (plinth::can::AlarmLevel, AlarmCause).
+// status lines). Levels and causes: alarm_level.h.
 //
 // Conditions, each with on/off thresholds on the risk (hysteresis: the condition starts at
 // risk >= on and ends at risk < off, off < on) and minimum durations (a condition must hold for
@@ -45,12 +45,10 @@
 #include <limits>
 
 #include "plinth/core/error.h"
-#include "plinth/hal/can_codec.h"
+#include "plinth/core/name_table.h"
+#include "plinth/monitor/alarm_level.h"
 
 namespace plinth::monitor {
-
-using AlarmLevel = can::AlarmLevel;
-using AlarmCause = can::AlarmCause;
 
 struct RiskThresholds {
   double on = 0.0;   // risk (dimensionless, 0..1) at or above which the condition starts
@@ -73,7 +71,7 @@ struct AlarmPolicySettings {
 // warning <= alarm, for on and for off).
 [[nodiscard]] Error validate(const AlarmPolicySettings& settings);
 
-// An operator's acknowledgement (the CAN Acknowledge frame without its source id).
+// An operator's acknowledgement (on the bus: the Acknowledge frame, without its source id).
 struct Acknowledgement {
   AlarmLevel level = AlarmLevel::kNormal;  // the latched level acknowledged
   std::uint8_t event_sequence = 0;         // the sequence of the latest event the operator saw
@@ -105,8 +103,27 @@ enum class InputProblem : std::uint8_t {
   kTimeWentBack,  // time earlier than the last update's: the update was refused
 };
 
-[[nodiscard]] const char* ack_outcome_name(AckOutcome outcome);
-[[nodiscard]] const char* input_problem_name(InputProblem problem);
+inline constexpr NameTable<AckOutcome, 6> kAckOutcomeNames{{{
+    {AckOutcome::kNone, "none"},
+    {AckOutcome::kReleased, "released"},
+    {AckOutcome::kReleasedConditionHolds, "released, condition holds"},
+    {AckOutcome::kStale, "stale sequence"},
+    {AckOutcome::kWrongLevel, "wrong level"},
+    {AckOutcome::kNothingLatched, "nothing latched"},
+}}};
+
+inline constexpr NameTable<InputProblem, 3> kInputProblemNames{{{
+    {InputProblem::kNone, "none"},
+    {InputProblem::kRiskInvalid, "risk not finite or outside [0, 1]"},
+    {InputProblem::kTimeWentBack, "time went back"},
+}}};
+
+[[nodiscard]] constexpr const char* ack_outcome_name(AckOutcome outcome) {
+  return kAckOutcomeNames.name(outcome);
+}
+[[nodiscard]] constexpr const char* input_problem_name(InputProblem problem) {
+  return kInputProblemNames.name(problem);
+}
 
 struct AlarmEventRecord {
   AlarmLevel level = AlarmLevel::kNormal;
@@ -116,9 +133,6 @@ struct AlarmEventRecord {
   std::int64_t time_ns = 0;  // the update's time
   std::uint8_t sequence = 0;
 };
-
-// The CAN AlarmEvent of a record: time in whole ms since start, wrapping after 2^32 ms.
-[[nodiscard]] can::AlarmEvent to_can_event(const AlarmEventRecord& record);
 
 inline constexpr std::size_t kMaxEventsPerUpdate = 2;
 

@@ -29,11 +29,18 @@
 #include <cstdint>
 
 #include "plinth/core/error.h"
+#include "plinth/core/name_table.h"
 
 namespace plinth::monitor {
 
 // The unit of the sensor's samples. g is standard gravity, 9.80665 m/s2.
 enum class AccelerationUnit : std::uint8_t { kStandardGravity = 0, kMetresPerSecondSquared = 1 };
+
+// The units' names in the configuration file.
+inline constexpr NameTable<AccelerationUnit, 2> kAccelerationUnitNames{{{
+    {AccelerationUnit::kStandardGravity, "g"},
+    {AccelerationUnit::kMetresPerSecondSquared, "m/s2"},
+}}};
 
 struct ConditioningSettings {
   AccelerationUnit unit = AccelerationUnit::kStandardGravity;
@@ -68,8 +75,26 @@ enum class OffsetTracking : std::uint8_t {
   kInvalidInput,  // non-finite input: refused
 };
 
-[[nodiscard]] const char* startup_rejection_name(StartupRejection rejection);
-[[nodiscard]] const char* offset_tracking_name(OffsetTracking tracking);
+inline constexpr NameTable<StartupRejection, 3> kStartupRejectionNames{{{
+    {StartupRejection::kNone, "none"},
+    {StartupRejection::kTooNoisy, "start-up window too noisy"},
+    {StartupRejection::kOffsetTooLarge, "offset too large (mounting or unit?)"},
+}}};
+
+inline constexpr NameTable<OffsetTracking, 5> kOffsetTrackingNames{{{
+    {OffsetTracking::kStartup, "start-up"},
+    {OffsetTracking::kNotQuiet, "not quiet"},
+    {OffsetTracking::kGated, "gated"},
+    {OffsetTracking::kTracked, "tracked"},
+    {OffsetTracking::kInvalidInput, "invalid input"},
+}}};
+
+[[nodiscard]] constexpr const char* startup_rejection_name(StartupRejection rejection) {
+  return kStartupRejectionNames.name(rejection);
+}
+[[nodiscard]] constexpr const char* offset_tracking_name(OffsetTracking tracking) {
+  return kOffsetTrackingNames.name(tracking);
+}
 
 struct ConditionedSample {
   bool ready = false;  // ground_m_s2 holds a conditioned sample (start-up done, input finite)

@@ -50,7 +50,8 @@
 #include <cstdint>
 
 #include "plinth/core/error.h"
-#include "plinth/hal/can_codec.h"
+#include "plinth/core/name_table.h"
+#include "plinth/monitor/alarm_level.h"
 
 namespace plinth::monitor {
 
@@ -95,11 +96,38 @@ enum class HealthCause : std::uint8_t {
   kCalibrationInvalid,  // the sensor's calibration-invalid flag
 };
 
-[[nodiscard]] const char* health_state_name(HealthState state);  // "ok", "degraded", "fault"
-[[nodiscard]] const char* health_cause_name(HealthCause cause);  // e.g. "sequence gap"
+inline constexpr NameTable<HealthState, 3> kHealthStateNames{{{
+    {HealthState::kOk, "ok"},
+    {HealthState::kDegraded, "degraded"},
+    {HealthState::kFault, "fault"},
+}}};
+
+inline constexpr NameTable<HealthCause, 14> kHealthCauseNames{{{
+    {HealthCause::kNone, "none"},
+    {HealthCause::kNoData, "no data yet"},
+    {HealthCause::kTimeout, "timeout"},
+    {HealthCause::kSequenceGap, "sequence gap"},
+    {HealthCause::kDuplicate, "duplicate sequence number"},
+    {HealthCause::kOutOfOrder, "sequence number out of order"},
+    {HealthCause::kNonFinite, "non-finite value"},
+    {HealthCause::kOutOfRange, "value out of range"},
+    {HealthCause::kUndefinedStatus, "undefined status bits"},
+    {HealthCause::kSaturated, "saturated"},
+    {HealthCause::kStuck, "stuck values"},
+    {HealthCause::kSelfTestFailed, "self-test failed"},
+    {HealthCause::kOverTemperature, "over temperature"},
+    {HealthCause::kCalibrationInvalid, "calibration invalid"},
+}}};
+
+[[nodiscard]] constexpr const char* health_state_name(HealthState state) {
+  return kHealthStateNames.name(state);
+}
+[[nodiscard]] constexpr const char* health_cause_name(HealthCause cause) {
+  return kHealthCauseNames.name(cause);
+}
 // The alarm cause to report for a fault: kSensorTimeout for no_data and timeout, kNone for
 // kNone, kSensorFault otherwise.
-[[nodiscard]] can::AlarmCause to_alarm_cause(HealthCause cause);
+[[nodiscard]] AlarmCause to_alarm_cause(HealthCause cause);
 
 // Event counts since the tracker was created (samples where a unit is not said).
 struct SensorCounters {
@@ -133,7 +161,7 @@ struct SensorHealth {
 struct SensorSample {
   std::int64_t receive_time_ns = 0;
   std::uint8_t sequence = 0;
-  std::uint8_t status = 0;  // can::sensor_status flags
+  std::uint8_t status = 0;                                   // sensor_flags (alarm_level.h)
   Eigen::Vector3d acceleration_g = Eigen::Vector3d::Zero();  // sensor frame, g
 };
 

@@ -1,0 +1,259 @@
+#include "inputs.h"
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <utility>
+#include <vector>
+
+#include "plinth/core/scene.h"
+#include "plinth/firmware/can_frames.h"
+#include "plinth/firmware/record_replay.h"
+#include "plinth/hal/candump_log.h"
+#include "plinth/hal/pacing.h"
+#include "plinth/hal/socketcan.h"
+#include "plinth/host/input_error.h"
+#include "record_input.h"
+
+namespace plinth::firmware {
+namespace {
+
+using host::InputError;
+
+constexpr std::int64_t kLogTickNs = 10'000'000;          // ticks inside a log's gaps: timeouts
+constexpr int kBusReceiveTimeoutMs = 10;                 // the live loop ticks at least this often
+constexpr std::int64_t kBusFaultHoldNs = 2'000'000'000;  // after the latest report
+
+// A record replayed sample by sample after the quiet lead-in (record_replay.h), so that the
+// estimator starts at the record's first sample and replay equals plinth-sim.
+class RecordInput final : public MonitorInput {
+ public:
+  RecordInput(std::string path, RecordSamples record, const MonitorConfig& config, double speed,
+              bool frames, const volatile std::sig_atomic_t& stop)
+      : path_(std::move(path)),
+        record_(std::move(record)),
+        config_(config),
+        lead_in_(static_cast<std::size_t>(record_replay_lead_in(config))),
+        frames_(frames),
+        pacer_(speed),
+        stop_(stop) {}
+
+  bool next(InputItem& item) override {
+    if (n_ == 0) pacer_.start();
+    if (n_ >= lead_in_ + record_.samples.size()) return false;
+    item.sample = record_replay_sample(
+        config_, static_cast<std::int64_t>(n_),
+        n_ < lead_in_ ? Eigen::Vector3d::Zero() : record_.samples[n_ - lead_in_], kStandardGravity);
+    if (!pacer_.wait_until(item.sample.receive_time_ns, stop_)) return false;
+    item.kind = InputItem::Kind::kSample;
+    item.has_frame = frames_ && encode_frame(item.sample, item.frame);
+    ++n_;
+    return true;
+  }
+
+  [[nodiscard]] const std::string& source() const override { return path_; }
+  [[nodiscard]] double t_origin() const override { return record_replay_origin_s(config_); }
+
+ private:
+  // The sample (m/s2) as its sensor's frame (g); false beyond the frame's +-8 g.
+  bool encode_frame(const monitor::SensorSample& sample, hal::TimedFrame& out) const {
+    monitor::SensorSample sample_g = sample;
+    sample_g.acceleration_g = sample.acceleration_g / kStandardGravity;
+    out.timestamp_ns = sample.receive_time_ns;
+    return can::encode(sensor_message(config_.ground_node, sample_g), out.frame).ok();
+  }
+
+  std::string path_;
+  RecordSamples record_;
+  MonitorConfig config_;
+  std::size_t lead_in_;
+  bool frames_;
+  hal::Pacer pacer_;
+  const volatile std::sig_atomic_t& stop_;
+  std::size_t n_ = 0;
+};
+
+// A candump log's frames at their logged times, with ticks inside its gaps (timeouts).
+class LogInput final : public MonitorInput {
+ public:
+  LogInput(hal::CandumpLogReader reader, double speed, const volatile std::sig_atomic_t& stop)
+      : reader_(std::move(reader)), pacer_(speed), stop_(stop) {}
+
+  bool next(InputItem& item) override {
+    if (!pending_ && !read_frame()) return false;
+    if (next_tick_ns_ < frame_.timestamp_ns) {
+      item.kind = InputItem::Kind::kTick;
+      item.time_ns = next_tick_ns_;
+      next_tick_ns_ += kLogTickNs;
+      return true;
+    }
+    item.kind = InputItem::Kind::kFrame;
+    item.frame = frame_;
+    pending_ = false;
+    return true;
+  }
+
+  [[nodiscard]] const std::string& source() const override { return reader_.path(); }
+
+ private:
+  // The next classic standard frame (others are not ours), paced to its logged time.
+  bool read_frame() {
+    for (;;) {
+      const hal::IoStatus status = reader_.receive(frame_, 0);
+      if (status == hal::IoStatus::kEndOfInput) return false;
+      if (status == hal::IoStatus::kIoError) throw InputError(reader_.error());  // file:line
+      if (status == hal::IoStatus::kOk) break;  // extended, RTR, FD, error frames: not ours
+    }
+    if (!first_ns_) {
+      first_ns_ = frame_.timestamp_ns;
+      next_tick_ns_ = frame_.timestamp_ns + kLogTickNs;
+      pacer_.start();
+    }
+    pending_ = true;
+    return pacer_.wait_until(frame_.timestamp_ns - *first_ns_, stop_);
+  }
+
+  hal::CandumpLogReader reader_;
+  hal::Pacer pacer_;
+  const volatile std::sig_atomic_t& stop_;
+  hal::TimedFrame frame_;
+  bool pending_ = false;  // frame_ is read, not yet given
+  std::optional<std::int64_t> first_ns_;
+  std::int64_t next_tick_ns_ = 0;
+};
+
+// A live SocketCAN bus. After each receive (at most kBusReceiveTimeoutMs): the frame, or the
+// bus trouble reported (held kBusFaultHoldNs after the latest report, then cleared), then a
+// tick at the newest frame's receive time: frames still queued in the socket are newer, and a
+// monitor that fell behind must not count its own delay as a sensor timeout. Only with nothing
+// to read is the wall clock the right time.
+class BusInput final : public MonitorInput {
+ public:
+  BusInput(hal::SocketCanPort port, std::string interface_name, double duration_s,
+           const volatile std::sig_atomic_t& stop)
+      : port_(std::move(port)),
+        interface_name_(std::move(interface_name)),
+        duration_ns_(duration_s > 0.0 ? std::llround(duration_s * 1e9) : 0),
+        stop_(stop) {}
+
+  bool next(InputItem& item) override {
+    switch (step_) {
+      case Step::kReceive:
+        if (!receive()) return false;
+        step_ = Step::kFaultCleared;
+        if (give_received(item)) return true;
+        [[fallthrough]];
+      case Step::kFaultCleared:
+        step_ = Step::kTick;
+        if (fault_until_ns_ != 0 && now_ns_ > fault_until_ns_) {
+          fault_until_ns_ = 0;
+          item.kind = InputItem::Kind::kBusFault;
+          item.bus_fault = false;
+          return true;
+        }
+        [[fallthrough]];
+      case Step::kTick:
+        step_ = Step::kReceive;
+        item.kind = InputItem::Kind::kTick;
+        item.time_ns = status_ == hal::IoStatus::kTimeout ? now_ns_ : last_frame_ns_;
+        return true;
+    }
+    return false;
+  }
+
+  [[nodiscard]] const std::string& source() const override { return interface_name_; }
+  [[nodiscard]] BusCounters bus_counters() const override {
+    BusCounters c = counters_;
+    c.dropped_frames = port_.total_dropped_frames();
+    return c;
+  }
+  [[nodiscard]] hal::FrameSink* sink() override { return &port_; }
+
+ private:
+  enum class Step : std::uint8_t { kReceive, kFaultCleared, kTick };
+
+  // Waits for the bus; false at the stop flag or after the duration.
+  bool receive() {
+    if (!started_) {
+      started_ = true;
+      end_ns_ = duration_ns_ > 0 ? hal::monotonic_now_ns() + duration_ns_ : INT64_MAX;
+    }
+    if (stop_ != 0 || hal::monotonic_now_ns() >= end_ns_) return false;
+    status_ = port_.receive(frame_, kBusReceiveTimeoutMs);
+    now_ns_ = hal::realtime_now_ns();
+    return true;
+  }
+
+  // What the receive brought: a frame, or bus trouble; false for nothing to give.
+  bool give_received(InputItem& item) {
+    switch (status_) {
+      case hal::IoStatus::kOk:
+        last_frame_ns_ = frame_.timestamp_ns;
+        item.kind = InputItem::Kind::kFrame;
+        item.frame = frame_;
+        return true;
+      case hal::IoStatus::kBusError:
+      case hal::IoStatus::kOverflow:
+        ++(status_ == hal::IoStatus::kBusError ? counters_.bus_errors : counters_.overflows);
+        fault_until_ns_ = now_ns_ + kBusFaultHoldNs;
+        item.kind = InputItem::Kind::kBusFault;
+        item.bus_fault = true;
+        return true;
+      case hal::IoStatus::kIoError:
+        throw InputError("CAN interface " + interface_name_ +
+                         ": receive failed: " + std::strerror(port_.last_error()));
+      default:
+        return false;
+    }
+  }
+
+  hal::SocketCanPort port_;
+  std::string interface_name_;
+  std::int64_t duration_ns_;
+  const volatile std::sig_atomic_t& stop_;
+  bool started_ = false;
+  std::int64_t end_ns_ = 0;
+  Step step_ = Step::kReceive;
+  hal::TimedFrame frame_;
+  hal::IoStatus status_ = hal::IoStatus::kTimeout;
+  std::int64_t now_ns_ = 0;
+  std::int64_t last_frame_ns_ = 0;   // receive time of the newest frame
+  std::int64_t fault_until_ns_ = 0;  // 0: no bus fault held
+  BusCounters counters_;
+};
+
+bool is_candump_log(const std::string& path) {
+  const std::string extension = std::filesystem::path(path).extension().string();
+  return extension == ".log" || extension == ".LOG";
+}
+
+}  // namespace
+
+std::unique_ptr<MonitorInput> open_input(const InputOptions& opt, MonitorConfig& config,
+                                         const volatile std::sig_atomic_t& stop) {
+  const bool log = !opt.replay_path.empty() && is_candump_log(opt.replay_path);
+  const bool record = !opt.replay_path.empty() && !log;
+  if (!record &&
+      (!opt.pga.empty() || opt.scale || !opt.replay_y_path.empty() || !opt.vertical_path.empty())) {
+    throw InputError("--pga, --scale, --replay-y and --vertical apply to an AT2 or CSV record");
+  }
+  if (record) {
+    RecordSamples samples = record_samples(
+        {opt.replay_path, opt.replay_y_path, opt.vertical_path, opt.pga, opt.scale, opt.rate_hz},
+        kStandardGravity);
+    configure_record_replay(config, samples.rate_hz);
+    return std::make_unique<RecordInput>(opt.replay_path, std::move(samples), config, opt.speed,
+                                         opt.recorder_frames, stop);
+  }
+  if (log) {
+    hal::CandumpLogReaderOpenResult opened = hal::CandumpLogReader::open(opt.replay_path);
+    if (!opened.ok()) throw InputError(opened.message);
+    return std::make_unique<LogInput>(std::move(*opened.reader), opt.speed, stop);
+  }
+  hal::SocketCanOpenResult opened = hal::SocketCanPort::open(opt.can_interface);
+  if (!opened.ok()) throw InputError(opened.message);
+  return std::make_unique<BusInput>(std::move(*opened.port), opt.can_interface, opt.duration_s,
+                                    stop);
+}
+
+}  // namespace plinth::firmware

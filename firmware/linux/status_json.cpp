@@ -1,0 +1,289 @@
+#include "status_json.h"
+
+#include <cstdio>
+
+#include "plinth/core/state.h"
+#include "plinth/hal/can_codec.h"
+#include "plinth/host/run_output.h"
+
+namespace plinth::firmware {
+namespace {
+
+constexpr const char* kAxisNames[] = {"x", "y"};
+
+double seconds(std::int64_t time_ns, double t_origin) {
+  return static_cast<double>(time_ns) * 1e-9 - t_origin;
+}
+
+std::string quoted(std::string_view text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') {
+      out += '\\';
+      out += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char escaped[8];
+      std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
+      out += escaped;
+    } else {
+      out += c;
+    }
+  }
+  return out + "\"";
+}
+
+// `digits` decimals ("%.*f"), or `digits` significant digits ("%.*g").
+std::string formatted(double value, int digits, bool fixed) {
+  char text[64];
+  if (fixed) {
+    std::snprintf(text, sizeof text, "%.*f", digits, value);
+  } else {
+    std::snprintf(text, sizeof text, "%.*g", digits, value);
+  }
+  return text;
+}
+
+// One axis's value, or {"x": .., "y": ..} with two axes.
+template <typename ValueOf>
+std::string per_axis(const MonitorStatus& s, ValueOf value_of) {
+  if (s.axis_count == 1) return value_of(s.axes[0]);
+  JsonObject axes;
+  for (int i = 0; i < s.axis_count; ++i) {
+    axes.raw(kAxisNames[i], value_of(s.axes[static_cast<std::size_t>(i)]));
+  }
+  return axes.close();
+}
+
+std::string axis_state(const AxisStatus& a) {
+  return JsonObject()
+      .general("u", a.state[kU], 6)
+      .general("x", a.state[kX], 6)
+      .general("theta", a.state[kTheta], 6)
+      .general("u_dot", a.state[kUDot], 6)
+      .general("x_dot", a.state[kXDot], 6)
+      .general("theta_dot", a.state[kThetaDot], 6)
+      .raw("overhang", std::to_string(a.mode.overhang))
+      .fixed("risk_overturning", a.risk.overturning, 4)
+      .fixed("risk_falling", a.risk.falling, 4)
+      .fixed("risk_base_stops", a.risk.base_stops, 4)
+      .close();
+}
+
+// A cross-check's RMS, m/s2, or null while its window is not full (or for the primary).
+std::string rms_value(const SensorStatus& sensor) {
+  if (sensor.primary || !sensor.window_full) return "null";
+  return formatted(sensor.rms_m_s2, 4, false);
+}
+
+// The sensors of a status line, each with its health and cross-check.
+std::string status_sensors(const MonitorStatus& s) {
+  std::vector<std::string> sensors;
+  for (int i = 0; i < s.sensor_count; ++i) {
+    const SensorStatus& sensor = s.sensors[static_cast<std::size_t>(i)];
+    sensors.push_back(JsonObject()
+                          .count("node", sensor.node)
+                          .text("role", sensor_role_name(sensor.role))
+                          .flag("primary", sensor.primary)
+                          .text("health", monitor::health_state_name(sensor.health.state))
+                          .text("cause", monitor::health_cause_name(sensor.health.cause))
+                          .flag("ready", sensor.ready)
+                          .raw("rms_m_s2", rms_value(sensor))
+                          .flag("disagreeing", sensor.disagreeing)
+                          .close());
+  }
+  return json_array(sensors);
+}
+
+std::uint64_t rejected(const monitor::SensorCounters& c) {
+  return c.non_finite + c.out_of_range + c.undefined_status;
+}
+
+// The samples a sensor's stream passed on, bridged, and lost.
+JsonObject& stream_counts(JsonObject& object, const monitor::SensorCounters& c) {
+  return object.count("fed", c.fed)
+      .count("bridged", c.bridged)
+      .count("missing", c.missing)
+      .count("long_gaps", c.long_gaps);
+}
+
+std::string frame_counters(const FrameCounters& f) {
+  return JsonObject()
+      .count("received", f.received)
+      .count("sensor_samples", f.sensor_samples)
+      .count("other_nodes", f.other_nodes)
+      .count("heartbeats", f.heartbeats)
+      .count("acknowledgements", f.acknowledgements)
+      .count("rejected", f.rejected)
+      .count("unknown_identifiers", f.unknown_identifiers)
+      .text("last_error", can::codec_error_text(f.last_error))
+      .close();
+}
+
+// The primary sensor's health counters.
+std::string sensor_counters(const monitor::SensorHealth& h) {
+  const monitor::SensorCounters& c = h.counters;
+  JsonObject object;
+  object.text("state", monitor::health_state_name(h.state));
+  return stream_counts(object, c)
+      .count("duplicates", c.duplicates)
+      .count("out_of_order", c.out_of_order)
+      .count("rejected", rejected(c))
+      .count("saturated", c.saturated)
+      .count("timeouts", c.timeouts)
+      .count("faults", c.faults)
+      .close();
+}
+
+// Every sensor's totals.
+std::string summary_sensors(const MonitorStatus& s) {
+  std::vector<std::string> sensors;
+  for (int i = 0; i < s.sensor_count; ++i) {
+    const SensorStatus& sensor = s.sensors[static_cast<std::size_t>(i)];
+    const monitor::SensorCounters& k = sensor.health.counters;
+    JsonObject object;
+    object.count("node", sensor.node)
+        .text("role", sensor_role_name(sensor.role))
+        .flag("primary", sensor.primary)
+        .text("state", monitor::health_state_name(sensor.health.state))
+        .count("received", k.received);
+    sensors.push_back(stream_counts(object, k)
+                          .count("rejected", rejected(k))
+                          .count("timeouts", k.timeouts)
+                          .count("faults", k.faults)
+                          .count("pairs", sensor.pairs)
+                          .count("unpaired", sensor.unpaired)
+                          .count("disagreements", sensor.disagreements)
+                          .general("max_rms_m_s2", sensor.max_rms_m_s2, 4)
+                          .close());
+  }
+  return json_array(sensors);
+}
+
+}  // namespace
+
+JsonObject& JsonObject::member(std::string_view key) {
+  if (!empty_) text_ += ", ";
+  empty_ = false;
+  text_ += quoted(key);
+  text_ += ": ";
+  return *this;
+}
+
+JsonObject& JsonObject::text(std::string_view key, std::string_view value) {
+  member(key).text_ += quoted(value);
+  return *this;
+}
+
+JsonObject& JsonObject::fixed(std::string_view key, double value, int decimals) {
+  member(key).text_ += formatted(value, decimals, true);
+  return *this;
+}
+
+JsonObject& JsonObject::general(std::string_view key, double value, int digits) {
+  member(key).text_ += formatted(value, digits, false);
+  return *this;
+}
+
+JsonObject& JsonObject::count(std::string_view key, std::uint64_t value) {
+  member(key).text_ += std::to_string(value);
+  return *this;
+}
+
+JsonObject& JsonObject::flag(std::string_view key, bool value) {
+  member(key).text_ += value ? "true" : "false";
+  return *this;
+}
+
+JsonObject& JsonObject::raw(std::string_view key, std::string_view json) {
+  member(key).text_ += json;
+  return *this;
+}
+
+std::string json_array(const std::vector<std::string>& values) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (i > 0) out += ", ";
+    out += values[i];
+  }
+  return out + "]";
+}
+
+std::string status_json(const MonitorStatus& s, double t_origin) {
+  JsonObject line;
+  line.text("type", "status").fixed("t", seconds(s.time_ns, t_origin), 6);
+  line.raw("phase",
+           per_axis(s, [](const AxisStatus& a) { return quoted(phase_name(a.mode.phase)); }));
+  line.raw("corner", per_axis(s, [](const AxisStatus& a) {
+             return quoted(a.mode.rocking() ? corner_name(a.mode.corner) : "none");
+           }));
+  line.fixed("risk", s.risk, 4)
+      .text("alarm", monitor::alarm_level_name(s.alarm))
+      .text("latched", monitor::alarm_level_name(s.latched))
+      .flag("estimating", s.estimating)
+      .text("sensor", monitor::health_state_name(s.sensor.state))
+      .text("sensor_cause", monitor::health_cause_name(s.sensor.cause))
+      .text("sensors_state", monitor::health_state_name(s.sensors_state))
+      .flag("disagreement", s.disagreement)
+      .count("failovers", s.failovers);
+  if (s.plate >= 0) {
+    line.raw("plate_residual_m_s2", rms_value(s.sensors[static_cast<std::size_t>(s.plate)]))
+        .flag("plate_mismatch", s.plate_mismatch);
+  }
+  line.raw("sensors", status_sensors(s));
+  line.raw("state", per_axis(s, axis_state));
+  return line.close();
+}
+
+std::string alarm_json(const monitor::AlarmEventRecord& e, double t_origin) {
+  return JsonObject()
+      .text("type", "alarm")
+      .fixed("t", seconds(e.time_ns, t_origin), 6)
+      .text("level", monitor::alarm_level_name(e.level))
+      .text("previous", monitor::alarm_level_name(e.previous_level))
+      .text("cause", monitor::alarm_cause_name(e.cause))
+      .flag("latched", e.latched)
+      .count("sequence", e.sequence)
+      .close();
+}
+
+std::string event_json(int axis, const Event& event) {
+  std::string line = host::event_json(event);  // {"t": .., "event": .., ...}
+  line.insert(1, std::string("\"type\": \"event\", \"axis\": \"") + kAxisNames[axis] + "\", ");
+  return line;
+}
+
+std::string summary_json(const Monitor& monitor, const RunTotals& totals, double t_origin) {
+  const MonitorStatus& s = monitor.status();
+  JsonObject line;
+  line.text("type", "summary")
+      .text("source", totals.source)
+      .fixed("t", seconds(s.time_ns, t_origin), 6)
+      .count("samples", totals.samples)
+      .text("final_phase", phase_name(s.axes[0].mode.phase))
+      .fixed("max_risk", totals.max_risk, 4)
+      .text("max_alarm", monitor::alarm_level_name(totals.max_level))
+      .text("alarm", monitor::alarm_level_name(s.alarm))
+      .count("alarm_events", totals.alarm_events)
+      .count("fault_events", totals.fault_events)
+      .count("phase_events", totals.phase_events)
+      .raw("frames", frame_counters(monitor.frames()))
+      .raw("sensor", sensor_counters(s.sensor))
+      .count("estimator_restarts", s.estimator_restarts)
+      .count("bus_send_errors", totals.bus_send_errors)
+      .count("bus_errors", totals.bus_errors)
+      .count("bus_dropped_frames", totals.bus_dropped_frames)
+      .text("sensors_state", monitor::health_state_name(s.sensors_state))
+      .count("failovers", s.failovers)
+      .count("failovers_continued", s.failovers_continued)
+      .raw("sensors", summary_sensors(s));
+  if (totals.recorder) {
+    line.raw("recorder", JsonObject()
+                             .count("captures_written", totals.captures_written)
+                             .count("captures_dropped", totals.captures_dropped)
+                             .count("write_errors", totals.recorder_write_errors)
+                             .close());
+  }
+  return line.close();
+}
+
+}  // namespace plinth::firmware

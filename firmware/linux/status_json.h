@@ -1,0 +1,70 @@
+// plinth-monitor's JSON Lines (docs/monitor.md): status, alarm, phase event and summary lines.
+// Host code: allocates.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "plinth/core/events.h"
+#include "plinth/firmware/monitor.h"
+#include "plinth/monitor/alarm_level.h"
+#include "plinth/monitor/alarm_policy.h"
+
+namespace plinth::firmware {
+
+// One JSON object, member by member, as plinth's JSON Lines write it: {"key": value, ...}.
+class JsonObject {
+ public:
+  JsonObject& text(std::string_view key, std::string_view value);       // a string, escaped
+  JsonObject& fixed(std::string_view key, double value, int decimals);  // printf's %.<decimals>f
+  JsonObject& general(std::string_view key, double value, int digits);  // printf's %.<digits>g
+  JsonObject& count(std::string_view key, std::uint64_t value);
+  JsonObject& flag(std::string_view key, bool value);
+  JsonObject& raw(std::string_view key, std::string_view json);  // a value written already
+  [[nodiscard]] std::string close() const { return text_ + "}"; }
+
+ private:
+  JsonObject& member(std::string_view key);
+  std::string text_ = "{";
+  bool empty_ = true;
+};
+
+// "[a, b, ...]" of values written already.
+[[nodiscard]] std::string json_array(const std::vector<std::string>& values);
+
+// {"type": "status", "t": .., "phase": .., "risk": .., "alarm": .., ...}: the monitor's status;
+// t in s of monitor time less `t_origin` (a record replay's lead-in).
+[[nodiscard]] std::string status_json(const MonitorStatus& status, double t_origin);
+
+// {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
+[[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);
+
+// {"type": "event", "axis": "x", "t": .., "event": .., ...}: a phase event of axis `axis`, its
+// time already in the output's time.
+[[nodiscard]] std::string event_json(int axis, const Event& event);
+
+// What a run did besides the monitor's own counters: the summary's other fields.
+struct RunTotals {
+  std::string source;  // the record, the log or the interface
+  std::uint64_t samples = 0;
+  double max_risk = 0.0;
+  monitor::AlarmLevel max_level = monitor::AlarmLevel::kNormal;  // the highest but fault
+  std::uint64_t alarm_events = 0;
+  std::uint64_t fault_events = 0;
+  std::uint64_t phase_events = 0;
+  std::uint64_t bus_send_errors = 0;     // frames not sent (the bus refused or not encodable)
+  std::uint64_t bus_errors = 0;          // error frames reported by the controller (live)
+  std::uint64_t bus_dropped_frames = 0;  // frames the kernel dropped before we read them (live)
+  bool recorder = false;                 // the event recorder ran: its counters follow
+  std::uint64_t captures_written = 0;
+  std::uint64_t captures_dropped = 0;
+  std::uint64_t recorder_write_errors = 0;
+};
+
+// {"type": "summary", "source": .., "samples": .., "final_phase": .., "max_risk": .., ...}.
+[[nodiscard]] std::string summary_json(const Monitor& monitor, const RunTotals& totals,
+                                       double t_origin);
+
+}  // namespace plinth::firmware

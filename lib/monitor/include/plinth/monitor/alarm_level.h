@@ -1,0 +1,72 @@
+// The monitor's alarm vocabulary: levels, their causes and the sensors' status flags. Domain
+// types of lib/monitor; the CAN protocol carries them with the same numbering (the mapping and
+// its static_asserts: firmware/monitor/src/can_frames.cpp). Freestanding.
+#pragma once
+
+#include <cstdint>
+
+#include "plinth/core/name_table.h"
+
+namespace plinth::monitor {
+
+// Ordered: a higher value is a more severe risk level; fault is trouble with the input.
+enum class AlarmLevel : std::uint8_t {
+  kNormal = 0,
+  kAdvisory = 1,
+  kWarning = 2,
+  kAlarm = 3,
+  kFault = 4,
+};
+
+enum class AlarmCause : std::uint8_t {
+  kNone = 0,                // level back to normal
+  kRiskThreshold = 1,       // overturning risk crossed the level's threshold
+  kPhaseChange = 2,         // the block left full contact (sliding or rocking began)
+  kOverturnDetected = 3,    // overturned or fell
+  kSensorTimeout = 4,       // a sensor's samples stopped arriving
+  kSensorFault = 5,         // a sensor reported saturation, self-test failure, ...
+  kSensorDisagreement = 6,  // redundant sensors disagree beyond tolerance
+  kAcknowledged = 7,        // an operator acknowledged the alarm (latched alarm released)
+  kBusError = 8,            // the bus reported errors or dropped frames
+  kInternalFault = 9,       // the monitor's own self-check failed
+};
+
+// The names in status and alarm lines (also the DBC's VAL_ names).
+inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
+    {AlarmLevel::kNormal, "normal"},
+    {AlarmLevel::kAdvisory, "advisory"},
+    {AlarmLevel::kWarning, "warning"},
+    {AlarmLevel::kAlarm, "alarm"},
+    {AlarmLevel::kFault, "fault"},
+}}};
+
+inline constexpr NameTable<AlarmCause, 10> kAlarmCauseNames{{{
+    {AlarmCause::kNone, "none"},
+    {AlarmCause::kRiskThreshold, "risk_threshold"},
+    {AlarmCause::kPhaseChange, "phase_change"},
+    {AlarmCause::kOverturnDetected, "overturn_detected"},
+    {AlarmCause::kSensorTimeout, "sensor_timeout"},
+    {AlarmCause::kSensorFault, "sensor_fault"},
+    {AlarmCause::kSensorDisagreement, "sensor_disagreement"},
+    {AlarmCause::kAcknowledged, "acknowledged"},
+    {AlarmCause::kBusError, "bus_error"},
+    {AlarmCause::kInternalFault, "internal_fault"},
+}}};
+
+[[nodiscard]] constexpr const char* alarm_level_name(AlarmLevel level) {
+  return kAlarmLevelNames.name(level);
+}
+[[nodiscard]] constexpr const char* alarm_cause_name(AlarmCause cause) {
+  return kAlarmCauseNames.name(cause);
+}
+
+// A sensor's status flags, as it reports them with each sample. Bits 4-7 are undefined.
+namespace sensor_flags {
+inline constexpr std::uint8_t kSaturated = 1U << 0;           // a sample hit full scale
+inline constexpr std::uint8_t kSelfTestFailed = 1U << 1;      // the accelerometer's self-test
+inline constexpr std::uint8_t kOverTemperature = 1U << 2;     // outside the rated temperature
+inline constexpr std::uint8_t kCalibrationInvalid = 1U << 3;  // no valid calibration stored
+inline constexpr std::uint8_t kDefinedMask = 0x0F;
+}  // namespace sensor_flags
+
+}  // namespace plinth::monitor

@@ -1,0 +1,7 @@
+// libFuzzer target: the PEER AT2 reader (every header layout), lib/host/src/record_io.cpp.
+#include "record_check.h"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  plinth::fuzz::fuzz_record(data, size, plinth::host::RecordFormat::kAt2);
+  return 0;
+}

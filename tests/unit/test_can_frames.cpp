@@ -1,0 +1,221 @@
+// The firmware's one map between domain types and CAN messages (firmware/monitor/can_frames.h),
+// against plinth.dbc's VAL_ tables, and the frames a Monitor hands over with each update.
+#include "plinth/firmware/can_frames.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "dbc_file.h"
+#include "plinth/firmware/monitor.h"
+#include "test_support.h"
+
+namespace plinth::firmware {
+namespace {
+
+using monitor::AlarmCause;
+using monitor::AlarmLevel;
+
+constexpr std::int64_t kMs = 1'000'000;
+constexpr std::array<Phase, 6> kPhases = {Phase::kFullContact,  Phase::kSliding,    Phase::kRocking,
+                                          Phase::kSlideRocking, Phase::kOverturned, Phase::kFell};
+
+Mode rocking_about(Corner corner) {
+  Mode m;
+  m.phase = Phase::kRocking;
+  m.corner = corner;
+  return m;
+}
+
+// The domain name that the wire value `raw` of DBC signal `signal` stands for ("?": none).
+std::string domain_name(const std::string& signal, unsigned raw) {
+  if (signal == "Phase") {
+    for (const Phase p : kPhases) {
+      if (static_cast<unsigned>(to_wire(p)) == raw) return phase_name(p);
+    }
+  } else if (signal == "Corner") {
+    if (static_cast<unsigned>(wire_corner(Mode{})) == raw) return "none";  // not rocking
+    for (const Corner c : {Corner::kLeft, Corner::kRight}) {
+      if (static_cast<unsigned>(wire_corner(rocking_about(c))) == raw) return corner_name(c);
+    }
+  } else if (signal == "AlarmLevel" || signal == "Level" || signal == "PreviousLevel") {
+    for (const auto& [level, name] : monitor::kAlarmLevelNames) {
+      if (static_cast<unsigned>(to_wire(level)) == raw) {
+        EXPECT_EQ(from_wire(to_wire(level)), level) << name;
+        return name;
+      }
+    }
+  } else if (signal == "Cause") {
+    for (const auto& [cause, name] : monitor::kAlarmCauseNames) {
+      if (static_cast<unsigned>(to_wire(cause)) == raw) return name;
+    }
+  } else if (signal == "Latched") {
+    return raw == 0 ? "not_latched" : "latched";  // a flag: the DBC names its two values
+  }
+  return "?";
+}
+
+// Every wire value the DBC names stands for the domain value of that name, and no domain
+// value is missing from the wire (the tables have as many entries as the domain has values).
+TEST(CanFrames, TheDbcsValueNamesAreTheDomainNames) {
+  const testing::Dbc& dbc = testing::plinth_dbc();
+  int tables = 0;
+  for (const auto& [key, table] : dbc.values) {
+    const std::string& signal = key.second;
+    SCOPED_TRACE(signal);
+    ++tables;
+    for (const auto& [raw, name] : table) EXPECT_EQ(name, domain_name(signal, raw)) << raw;
+    std::size_t values = 2;  // Latched
+    if (signal == "Phase") values = kPhases.size();
+    if (signal == "Corner") values = 3;  // none, left, right
+    if (signal == "Cause") values = monitor::kAlarmCauseNames.size();
+    if (signal == "AlarmLevel" || signal == "Level" || signal == "PreviousLevel") {
+      values = monitor::kAlarmLevelNames.size();
+    }
+    EXPECT_EQ(table.size(), values);
+  }
+  EXPECT_GT(tables, 5);  // MonitorStatus x2 (Phase, Corner, AlarmLevel), AlarmEvent, Acknowledge
+}
+
+TEST(CanFrames, AlarmEventsKeepTheirFieldsAndWrapTheirMilliseconds) {
+  monitor::AlarmEventRecord r;
+  r.level = AlarmLevel::kAlarm;
+  r.previous_level = AlarmLevel::kWarning;
+  r.cause = AlarmCause::kOverturnDetected;
+  r.latched = true;
+  r.time_ns = 5'000'123'456;
+  r.sequence = 200;
+  const can::AlarmEvent e = alarm_event_message(r);
+  EXPECT_EQ(e.time_since_start_ms, 5000U);
+  EXPECT_EQ(e.level, can::AlarmLevel::kAlarm);
+  EXPECT_EQ(e.previous_level, can::AlarmLevel::kWarning);
+  EXPECT_EQ(e.cause, can::AlarmCause::kOverturnDetected);
+  EXPECT_TRUE(e.latched);
+  EXPECT_EQ(e.sequence, 200);
+  can::CanFrame frame;
+  EXPECT_TRUE(can::encode(e, frame).ok());
+  r.time_ns = ((std::int64_t{1} << 32) + 7) * kMs;  // the frame's millisecond counter wraps
+  EXPECT_EQ(alarm_event_message(r).time_since_start_ms, 7U);
+}
+
+TEST(CanFrames, StatusCarriesPhaseCornerLevelRiskAndSampleAge) {
+  MonitorStatus s;
+  s.axis_count = 2;
+  s.axes[1].mode = rocking_about(Corner::kRight);
+  s.axes[1].risk.total = 0.4321;
+  s.alarm = AlarmLevel::kWarning;
+  s.estimating = true;
+  s.time_ns = 10'000 * kMs;
+  s.newest_sample_time_ns = 9'993 * kMs + 500'000;
+  const can::MonitorStatus m = status_message(s, 1, 17);
+  EXPECT_EQ(m.axis, 1);
+  EXPECT_EQ(m.phase, can::Phase::kRocking);
+  EXPECT_EQ(m.corner, can::Corner::kRight);
+  EXPECT_EQ(m.alarm_level, can::AlarmLevel::kWarning);
+  EXPECT_EQ(m.risk, 0.4321);
+  EXPECT_EQ(m.sequence, 17);
+  EXPECT_EQ(m.sample_age_ms, 6);  // whole ms
+  // Not rocking: no corner, whatever the mode's corner field holds.
+  s.axes[1].mode.phase = Phase::kSliding;
+  EXPECT_EQ(status_message(s, 1, 0).corner, can::Corner::kNone);
+  // Not estimating: the largest age the frame says; an age beyond it is clamped to it.
+  s.estimating = false;
+  EXPECT_EQ(status_message(s, 1, 0).sample_age_ms, 65535);
+  s.estimating = true;
+  s.newest_sample_time_ns = 0;
+  s.time_ns = 100'000 * kMs;
+  EXPECT_EQ(status_message(s, 0, 0).sample_age_ms, 65535);
+}
+
+TEST(CanFrames, SamplesAndAcknowledgementsFromTheWire) {
+  monitor::SensorSample in;
+  in.receive_time_ns = 123;
+  in.sequence = 9;
+  in.status = monitor::sensor_flags::kOverTemperature;
+  in.acceleration_g = Eigen::Vector3d(0.5, -0.25, 1.0);
+  can::CanFrame frame;
+  ASSERT_TRUE(can::encode(sensor_message(3, in), frame).ok());
+  EXPECT_EQ(frame.id, can::kSensorAccelerationBaseId + 3);
+  can::SensorAcceleration decoded;
+  ASSERT_TRUE(can::decode(frame, decoded).ok());
+  const monitor::SensorSample out = sample_of(decoded, 456);
+  EXPECT_EQ(out.receive_time_ns, 456);
+  EXPECT_EQ(out.sequence, 9);
+  EXPECT_EQ(out.status, monitor::sensor_flags::kOverTemperature);
+  EXPECT_EQ(out.acceleration_g, in.acceleration_g);  // multiples of the 0.25 mg step
+
+  const monitor::Acknowledgement ack = acknowledgement_of({can::AlarmLevel::kWarning, 4, 77});
+  EXPECT_EQ(ack.level, AlarmLevel::kWarning);
+  EXPECT_EQ(ack.event_sequence, 77);
+}
+
+// A monitor's updates carry the frames to send: an AlarmEvent per event, then a MonitorStatus
+// per axis when a status is due (at the interval, at an alarm change, at the heartbeat), each
+// decoding to what the status says, their sequence one up per status.
+TEST(CanFrames, UpdatesCarryTheFramesToSend) {
+  const Scene scene = plinth::testing::make(plinth::testing::paper_isolated(0.0));
+  MonitorConfig config;
+  config.axis_count = 2;
+  config.estimator.sample_rate_hz = 200.0;
+  config.conditioning.startup_window_s = 0.5;
+  config.status_interval_s = 0.25;
+  Monitor monitor;
+  ASSERT_TRUE(monitor.start(config, {&scene, &scene}).ok());
+  int statuses = 0;
+  int alarm_frames = 0;
+  std::uint8_t next_sequence = 0;
+  std::int64_t last_status_ns = -1;
+  for (int n = 0; n < 1200; ++n) {
+    monitor::SensorSample s;
+    s.receive_time_ns = n * 5 * kMs;
+    s.sequence = static_cast<std::uint8_t>(n);
+    s.acceleration_g = Eigen::Vector3d(1e-4 * std::sin(n), 0.0, 1.0);
+    const MonitorUpdate u = monitor.on_sample(s);
+    ASSERT_EQ(u.frame_count, u.event_count + (u.status_due ? 2U : 0U)) << n;
+    for (std::size_t i = 0; i < u.event_count; ++i, ++alarm_frames) {
+      can::AlarmEvent e;
+      ASSERT_TRUE(can::decode(u.frames[i], e).ok());
+      EXPECT_EQ(from_wire(e.level), u.events[i].level);
+      EXPECT_EQ(e.sequence, u.events[i].sequence);
+    }
+    if (!u.status_due) continue;
+    const std::int64_t t = monitor.status().time_ns;
+    EXPECT_TRUE(u.event_count > 0 || last_status_ns < 0 || t - last_status_ns >= 250 * kMs ||
+                t / (250 * kMs) > last_status_ns / (250 * kMs))
+        << "a status " << t - last_status_ns << " ns after the last without a reason";
+    last_status_ns = t;
+    ++statuses;
+    for (std::size_t axis = 0; axis < 2; ++axis) {
+      can::MonitorStatus m;
+      ASSERT_TRUE(can::decode(u.frames[u.event_count + axis], m).ok());
+      EXPECT_EQ(m.axis, axis);
+      EXPECT_EQ(m.sequence, next_sequence);
+      EXPECT_EQ(from_wire(m.alarm_level), monitor.status().alarm);
+      EXPECT_EQ(m.phase, to_wire(monitor.status().axes[axis].mode.phase));
+    }
+    ++next_sequence;
+  }
+  // 6 s of samples at a 0.25 s interval: 24 intervals, the first sample's status and the alarm
+  // changes (fault at the start, normal 2 s, lower_hold_s, after the sensor is ready).
+  EXPECT_GE(statuses, 25);
+  EXPECT_LE(statuses, 27);
+  EXPECT_EQ(alarm_frames, 2);
+  EXPECT_EQ(monitor.frames().not_encoded, 0U);
+}
+
+TEST(CanFrames, AStatusIsDueBeforeTheFirstSample) {
+  const Scene scene = plinth::testing::make(plinth::testing::paper_isolated(0.0));
+  Monitor monitor;
+  ASSERT_TRUE(monitor.start(MonitorConfig{}, {&scene, nullptr}).ok());
+  can::CanFrame heartbeat;
+  ASSERT_TRUE(can::encode(can::SensorHeartbeat{1, 1, 0, 1, 0, 0, 0}, heartbeat).ok());
+  const MonitorUpdate first = monitor.on_frame({heartbeat, 1000});
+  EXPECT_TRUE(first.status_due);
+  EXPECT_EQ(first.frame_count, 1U);
+  EXPECT_FALSE(monitor.on_frame({heartbeat, 2000}).status_due);  // the time did not move
+}
+
+}  // namespace
+}  // namespace plinth::firmware
