@@ -14,6 +14,8 @@ packages=(
   qemu-system-x86 linux-image-amd64 busybox-static xz-utils  # route qemu
   linux-headers-amd64 linux-source-6.1 gpiod  # gpio-sim in the qemu route
   python3 gnuplot-nox
+  gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib  # Cortex-M4F image
+  qemu-system-arm                                                            # runs it
   clang-14 libclang-rt-14-dev  # the sanitize preset: ASan + UBSan and libFuzzer (docs/fuzzing.md)
 )
 

@@ -8,95 +8,32 @@
 
 #include "plinth/core/scene.h"
 #include "plinth/firmware/can_frames.h"
+#include "plinth/firmware/record_replay.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/hal/pacing.h"
 #include "plinth/hal/socketcan.h"
 #include "plinth/host/input_error.h"
-#include "plinth/host/record_io.h"
-#include "plinth/host/record_sampling.h"
+#include "record_input.h"
 
 namespace plinth::firmware {
 namespace {
 
 using host::InputError;
 
-constexpr double kDefaultRecordRateHz = 200.0;  // for records outside the sensor rates
-constexpr double kMinSensorRateHz = 100.0;
-constexpr double kMaxSensorRateHz = 1000.0;
 constexpr std::int64_t kLogTickNs = 10'000'000;          // ticks inside a log's gaps: timeouts
 constexpr int kBusReceiveTimeoutMs = 10;                 // the live loop ticks at least this often
 constexpr std::int64_t kBusFaultHoldNs = 2'000'000'000;  // after the latest report
 
-// A record at the sensor rate, as the ground sensor reads it (m/s2; z reads g + v).
-struct RecordSamples {
-  double rate_hz = 0.0;
-  std::vector<Eigen::Vector3d> samples;
-};
-
-RecordSamples record_samples(const InputOptions& opt, double gravity) {
-  const host::Record h = host::read_record(opt.replay_path, gravity);
-  std::optional<host::Record> y;
-  if (!opt.replay_y_path.empty()) y = host::read_record(opt.replay_y_path, gravity);
-  std::optional<host::Record> v;
-  if (!opt.vertical_path.empty()) v = host::read_record(opt.vertical_path, gravity);
-  const double gamma = host::record_scale(h, opt.replay_path, opt.pga, opt.scale, gravity);
-  RecordSamples out;
-  const double native = 1.0 / h.dt;
-  out.rate_hz = opt.rate_hz                                                ? *opt.rate_hz
-                : native >= kMinSensorRateHz && native <= kMaxSensorRateHz ? native
-                                                                           : kDefaultRecordRateHz;
-  const std::size_t count = host::sample_count(h.duration(), out.rate_hz);
-  const auto read = [&](const SampledSignal& signal) {
-    return host::resample(signal, out.rate_hz, count);
-  };
-  const std::vector<double> ax = read(h.horizontal_signal());
-  const std::vector<double> ay = y ? read(y->horizontal_signal()) : std::vector<double>();
-  const std::vector<double> az = v                    ? read(v->horizontal_signal())
-                                 : h.vertical.empty() ? std::vector<double>()
-                                                      : read(h.vertical_signal());
-  out.samples.reserve(count);
-  for (std::size_t k = 0; k < count; ++k) {
-    out.samples.emplace_back(gamma * ax[k], ay.empty() ? 0.0 : gamma * ay[k],
-                             gravity + (az.empty() ? 0.0 : gamma * az[k]));
-  }
-  return out;
-}
-
-// The record is the ground's exact motion in m/s2, in the statue's frame: one ideal ground
-// sensor (a [[sensor]] list is reduced to its first ground sensor) with no bias to track, no
-// noise (the stuck-value check needs noise), and the quiet lead-in estimates the zero offset.
-// The file's sensor settings describe the real sensor, not this one.
-void fit_to_record(MonitorConfig& config, double rate_hz) {
-  config.estimator.sample_rate_hz = rate_hz;
-  for (int i = config.sensor_count - 1; i >= 0; --i) {
-    const SensorConfig& sensor = config.sensors[static_cast<std::size_t>(i)];
-    if (sensor.role != SensorRole::kGround) continue;
-    config.ground_node = sensor.node;
-    config.conditioning = sensor.conditioning;
-    config.sensor_health = sensor.sensor_health;
-  }
-  config.sensor_count = 0;
-  config.conditioning.unit = monitor::AccelerationUnit::kMetresPerSecondSquared;
-  config.conditioning.sensor_to_statue.setIdentity();
-  config.conditioning.tracking_time_constant_s = 1e6;
-  config.sensor_health.stuck_samples = 0;
-  config.sensor_health.full_scale_g = 1e6;
-  config.sensor_health.max_valid_g = 1e6;
-}
-
-// A record replayed sample by sample after a quiet lead-in: the health tracker's recovery (it
-// starts in fault, no data yet) and the conditioner's start-up window, so that the estimator
-// starts at the record's first sample and replay equals plinth-sim.
+// A record replayed sample by sample after the quiet lead-in (record_replay.h), so that the
+// estimator starts at the record's first sample and replay equals plinth-sim.
 class RecordInput final : public MonitorInput {
  public:
   RecordInput(std::string path, RecordSamples record, const MonitorConfig& config, double speed,
               bool frames, const volatile std::sig_atomic_t& stop)
       : path_(std::move(path)),
         record_(std::move(record)),
-        lead_in_(static_cast<std::size_t>(
-                     std::llround(config.conditioning.startup_window_s * record_.rate_hz)) +
-                 static_cast<std::size_t>(config.sensor_health.recovery_samples) - 1),
-        node_(config.ground_node),
+        config_(config),
+        lead_in_(static_cast<std::size_t>(record_replay_lead_in(config))),
         frames_(frames),
         pacer_(speed),
         stop_(stop) {}
@@ -104,24 +41,18 @@ class RecordInput final : public MonitorInput {
   bool next(InputItem& item) override {
     if (n_ == 0) pacer_.start();
     if (n_ >= lead_in_ + record_.samples.size()) return false;
-    monitor::SensorSample& sample = item.sample;
-    const double period_s = 1.0 / record_.rate_hz;
-    sample.receive_time_ns = std::llround(static_cast<double>(n_) * period_s * 1e9);
-    sample.sequence = static_cast<std::uint8_t>(n_ & 0xFF);
-    sample.status = 0;
-    sample.acceleration_g = n_ < lead_in_ ? Eigen::Vector3d(0.0, 0.0, kStandardGravity)
-                                          : record_.samples[n_ - lead_in_];
-    if (!pacer_.wait_until(sample.receive_time_ns, stop_)) return false;
+    item.sample = record_replay_sample(
+        config_, static_cast<std::int64_t>(n_),
+        n_ < lead_in_ ? Eigen::Vector3d::Zero() : record_.samples[n_ - lead_in_], kStandardGravity);
+    if (!pacer_.wait_until(item.sample.receive_time_ns, stop_)) return false;
     item.kind = InputItem::Kind::kSample;
-    item.has_frame = frames_ && encode_frame(sample, item.frame);
+    item.has_frame = frames_ && encode_frame(item.sample, item.frame);
     ++n_;
     return true;
   }
 
   [[nodiscard]] const std::string& source() const override { return path_; }
-  [[nodiscard]] double t_origin() const override {
-    return static_cast<double>(lead_in_) / record_.rate_hz;
-  }
+  [[nodiscard]] double t_origin() const override { return record_replay_origin_s(config_); }
 
  private:
   // The sample (m/s2) as its sensor's frame (g); false beyond the frame's +-8 g.
@@ -129,13 +60,13 @@ class RecordInput final : public MonitorInput {
     monitor::SensorSample sample_g = sample;
     sample_g.acceleration_g = sample.acceleration_g / kStandardGravity;
     out.timestamp_ns = sample.receive_time_ns;
-    return can::encode(sensor_message(node_, sample_g), out.frame).ok();
+    return can::encode(sensor_message(config_.ground_node, sample_g), out.frame).ok();
   }
 
   std::string path_;
   RecordSamples record_;
+  MonitorConfig config_;
   std::size_t lead_in_;
-  std::uint8_t node_;
   bool frames_;
   hal::Pacer pacer_;
   const volatile std::sig_atomic_t& stop_;
@@ -307,8 +238,10 @@ std::unique_ptr<MonitorInput> open_input(const InputOptions& opt, MonitorConfig&
     throw InputError("--pga, --scale, --replay-y and --vertical apply to an AT2 or CSV record");
   }
   if (record) {
-    RecordSamples samples = record_samples(opt, kStandardGravity);
-    fit_to_record(config, samples.rate_hz);
+    RecordSamples samples = record_samples(
+        {opt.replay_path, opt.replay_y_path, opt.vertical_path, opt.pga, opt.scale, opt.rate_hz},
+        kStandardGravity);
+    configure_record_replay(config, samples.rate_hz);
     return std::make_unique<RecordInput>(opt.replay_path, std::move(samples), config, opt.speed,
                                          opt.recorder_frames, stop);
   }

@@ -413,7 +413,7 @@ void apply_overrides(MonitorFile& file, const MonitorOverrides& o) {
 
 MonitorFile configure_monitor(const MonitorOverrides& overrides) {
   MonitorFile file;
-  file.config.conditioning.startup_window_s = kCommandLineStartupWindowS;
+  file.config = box_defaults();
   if (!overrides.config_path.empty()) file = load_monitor_file(overrides.config_path, file.config);
   apply_overrides(file, overrides);
   return file;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "plinth/firmware/monitor.h"
+#include "plinth/firmware/record_replay.h"
 
 namespace plinth::firmware {
 
@@ -24,9 +25,6 @@ struct MonitorFile {
 [[nodiscard]] MonitorFile load_monitor_text(const std::string& text, const std::string& origin,
                                             const MonitorConfig& defaults);
 
-// plinth-monitor's start-up window, s: shorter than MonitorConfig's (a replay's quiet lead-in).
-inline constexpr double kCommandLineStartupWindowS = 2.0;
-
 // What plinth-monitor's command line says about the configuration; unset: the file's value, or
 // the default.
 struct MonitorOverrides {
@@ -43,8 +41,8 @@ struct MonitorOverrides {
 // The command line over `file` (throws host::InputError for --node with [[sensor]] tables).
 void apply_overrides(MonitorFile& file, const MonitorOverrides& overrides);
 
-// plinth-monitor's configuration: the defaults with a kCommandLineStartupWindowS start-up
-// window, then the configuration file, then the command line.
+// plinth-monitor's configuration: the box's defaults (box_defaults(), record_replay.h), then
+// the configuration file, then the command line.
 [[nodiscard]] MonitorFile configure_monitor(const MonitorOverrides& overrides);
 
 }  // namespace plinth::firmware

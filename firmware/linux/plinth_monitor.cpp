@@ -3,7 +3,8 @@
 // estimates the block's phase and overturning risk, raises alarms and hands over the frames to
 // send. JSON Lines on stdout (status_json.h, docs/monitor.md): status lines when the monitor
 // reports a status, alarm lines, phase events, and a summary at the end. Live, the monitor's
-// status and alarm frames also go on the bus.
+// status and alarm frames also go on the bus; a replay writes them to a candump log with
+// --frames-out.
 #include <CLI/CLI.hpp>
 
 #include <cmath>
@@ -13,12 +14,14 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "event_recorder.h"
 #include "inputs.h"
 #include "monitor_config.h"
 #include "plinth/firmware/monitor.h"
+#include "plinth/hal/candump_log.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/scene_toml.h"
@@ -44,6 +47,7 @@ struct Options {
   std::string speed = "max";
   double duration = 0.0;
   std::string record_dir;
+  std::string frames_out;
   double pre_trigger = 30.0;
   double post_trigger = 60.0;
   bool quiet_events = false;
@@ -256,11 +260,25 @@ int run(const Options& opt) {
     monitor.set_event_sink(i, &sinks.back());
   }
   const std::unique_ptr<fw::EventRecorder> recorder = make_recorder(opt, config);
-  Outputs outputs(monitor, input->t_origin(), recorder.get(), input->sink());
+  // --frames-out: the frames a replay sends, stamped with the receive time of the input that
+  // caused them (what candump on the bus would show).
+  const Outputs* frames_clock = nullptr;
+  std::optional<plinth::hal::CandumpLogWriter> frames_log;
+  if (!opt.frames_out.empty()) {
+    plinth::hal::CandumpLogWriterOpenResult opened = plinth::hal::CandumpLogWriter::open(
+        opt.frames_out, "can0", [&frames_clock] { return frames_clock->last_frame_ns; });
+    if (!opened.ok()) throw InputError("--frames-out: " + opened.message);
+    frames_log.emplace(std::move(*opened.writer));
+  }
+  plinth::hal::FrameSink* const bus = frames_log ? &*frames_log : input->sink();
+  Outputs outputs(monitor, input->t_origin(), recorder.get(), bus);
+  frames_clock = &outputs;
   fw::InputItem item;
   while (g_stop == 0 && input->next(item)) take(item, monitor, outputs, recorder.get());
   if (recorder) recorder->close();  // every capture is on disk before the summary
-  const fw::RunTotals totals = run_totals(outputs, *input, monitor, recorder.get(), sinks);
+  if (frames_log && !frames_log->flush()) throw InputError("--frames-out: " + frames_log->error());
+  fw::RunTotals totals = run_totals(outputs, *input, monitor, recorder.get(), sinks);
+  if (frames_log) totals.bus_send_errors += monitor.frames().not_encoded;
   print_line(fw::summary_json(monitor, totals, input->t_origin()));
   std::fflush(stdout);
   return 0;
@@ -294,6 +312,9 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--duration", opt.duration, "live: stop after this many seconds")
       ->check(plinth::host::kFinitePositive);
   app.add_option("--record-dir", opt.record_dir, "event recorder: write captures here");
+  app.add_option("--frames-out", opt.frames_out,
+                 "replay: write the status and alarm frames sent to this candump log")
+      ->excludes("--can");
   app.add_option("--pre-trigger", opt.pre_trigger, "s kept before an alarm (default 30)")
       ->check(plinth::host::kFinite);
   app.add_option("--post-trigger", opt.post_trigger, "s kept after an alarm (default 60)")

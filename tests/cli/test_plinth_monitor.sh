@@ -76,6 +76,33 @@ assert {e["axis"] for e in events} <= {"x", "y"}
   else fail "two axes" "$problem"; fi
 fi
 
+# 2b. --frames-out: the status and alarm frames a replay sends, as a candump log, say what the
+#     JSON lines say (tests/cli/monitor_frames.py decodes them from the DBC's layout); one axis
+#     and two.
+FRAMES_CHECK=$(dirname "${BASH_SOURCE[0]}")/monitor_frames.py
+if expect_success "replay: --frames-out, one axis" --scene "$ECCENTRIC" --replay "$AT2" \
+    --scale 20 --status-interval 0.25 --frames-out "$TMP/frames1.log"; then
+  cp "$TMP/stdout" "$TMP/frames1.jsonl"
+  if problem=$(python3 "$FRAMES_CHECK" "$TMP/frames1.log" --json "$TMP/frames1.jsonl"); then
+    pass "--frames-out, one axis: frames agree with the JSON lines"
+  else fail "--frames-out, one axis" "$problem"; fi
+fi
+if expect_success "replay: --frames-out, two axes" --scene "$ISOLATED" --scene-y "$ECCENTRIC" \
+    --replay "$AT2" --replay-y "$AT2_270" --scale 10 --frames-out "$TMP/frames2.log"; then
+  if problem=$(python3 "$FRAMES_CHECK" "$TMP/frames2.log" --json "$TMP/stdout"); then
+    pass "--frames-out, two axes: frames agree with the JSON lines"
+  else fail "--frames-out, two axes" "$problem"; fi
+fi
+# The check can fail: the first alarm frame dropped.
+awk '/ 330#/ && !dropped { dropped = 1; next } 1' "$TMP/frames1.log" >"$TMP/frames-short.log"
+if python3 "$FRAMES_CHECK" "$TMP/frames-short.log" --json "$TMP/frames1.jsonl" >/dev/null; then
+  fail "--frames-out check" "a log without its first alarm frame passed"
+else pass "--frames-out check refuses a log missing an alarm frame"; fi
+expect_failure "--frames-out with --can" 'frames-out|can' -- --scene "$ISOLATED" --can vcan0 \
+  --frames-out "$TMP/x.log"
+expect_failure "--frames-out into a missing directory" 'nowhere' -- --scene "$ISOLATED" \
+  --replay "$AT2" --frames-out "$TMP/nowhere/frames.log"
+
 # 3. The event recorder: a capture around the warning, a candump log and a JSON summary; the
 #    log replayed through plinth-monitor as sensor frames.
 if expect_success "recorder: captures written" --scene "$ISOLATED" --replay "$AT2" --scale 20 \

@@ -188,7 +188,7 @@ TEST(MonitorOverrides, WithoutAFileTheCommandLinesDefaults) {
   o.status_interval_s = 0.02;
   o.node = 5;
   const MonitorFile f = configure_monitor(o);
-  EXPECT_EQ(f.config.conditioning.startup_window_s, kCommandLineStartupWindowS);
+  EXPECT_EQ(f.config.conditioning.startup_window_s, kBoxStartupWindowS);
   EXPECT_EQ(f.config.estimator.sample_rate_hz, 1000.0);
   EXPECT_EQ(f.config.status_interval_s, 0.02);
   EXPECT_EQ(f.config.ground_node, 5);

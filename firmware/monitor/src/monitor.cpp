@@ -8,6 +8,9 @@ namespace plinth::firmware {
 
 namespace {
 
+#define PLINTH_TEXT_OF(x) #x
+#define PLINTH_TEXT(x) PLINTH_TEXT_OF(x)
+
 // The settings of a cross-check window: window_s at the sample rate in [2, max] samples, and a
 // finite positive tolerance.
 Error validate_check(double window_s, double tolerance_m_s2, double rate_hz,
@@ -16,7 +19,8 @@ Error validate_check(double window_s, double tolerance_m_s2, double rate_hz,
   if (!std::isfinite(window_s) || samples < 2.0 ||
       samples > static_cast<double>(kMaxCheckWindowSamples)) {
     return {ErrorCode::kOutOfRange, window_field,
-            "must span 2 to 1000 sample periods at the sample rate"};
+            "must span 2 to " PLINTH_TEXT(PLINTH_MONITOR_MAX_CHECK_WINDOW_SAMPLES)
+            " sample periods at the sample rate"};
   }
   if (!std::isfinite(tolerance_m_s2) || tolerance_m_s2 <= 0.0) {
     return {ErrorCode::kOutOfRange, tolerance_field, "must be a positive acceleration, m/s2"};
@@ -54,7 +58,8 @@ Error validate_monitor_fields(const MonitorConfig& c) {
     return {ErrorCode::kOutOfRange, "monitor.axis_count", "must be 1 or 2"};
   }
   if (c.sensor_count < 0 || c.sensor_count > kMaxSensors) {
-    return {ErrorCode::kOutOfRange, "monitor.sensor_count", "must lie in [0, 4]"};
+    return {ErrorCode::kOutOfRange, "monitor.sensor_count",
+            "must lie in [0, " PLINTH_TEXT(PLINTH_MONITOR_MAX_SENSORS) "]"};
   }
   if (c.sensor_count == 0 &&
       (c.ground_node < can::kFirstSensorNode || c.ground_node > can::kLastSensorNode)) {

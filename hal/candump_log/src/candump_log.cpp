@@ -1,6 +1,5 @@
 #include "plinth/hal/candump_log.h"
 
-#include <cinttypes>
 #include <cstdio>
 #include <initializer_list>
 #include <limits>
@@ -250,20 +249,12 @@ std::string parse_candump_line(std::string_view line, CandumpLine& out) {
 
 std::string format_candump_line(std::int64_t timestamp_ns, std::string_view interface_name,
                                 const can::CanFrame& frame) {
-  const std::int64_t micros = timestamp_ns / kNsPerMicrosecond;
-  char text[64];
-  int n = std::snprintf(text, sizeof text, "(%010" PRId64 ".%06" PRId64 ") ", micros / 1'000'000,
-                        micros % 1'000'000);
-  std::string line(text, static_cast<std::size_t>(n));
-  line += interface_name;
-  n = std::snprintf(text, sizeof text, " %03" PRIX32 "#", frame.id);
-  line.append(text, static_cast<std::size_t>(n));
-  const std::size_t length = frame.length <= kMaxClassicLength ? frame.length : kMaxClassicLength;
-  for (std::size_t i = 0; i < length; ++i) {
-    n = std::snprintf(text, sizeof text, "%02X", static_cast<unsigned>(frame.data[i]));
-    line.append(text, static_cast<std::size_t>(n));
-  }
-  return line;
+  if (interface_name.size() > kCandumpMaxInterfaceLength) return {};
+  char name[kCandumpMaxInterfaceLength + 1] = {};
+  interface_name.copy(name, interface_name.size());
+  char line[kCandumpLineCapacity];
+  const std::size_t length = format_candump_line(line, sizeof line, timestamp_ns, name, frame);
+  return std::string(line, length);
 }
 
 CandumpLogReaderOpenResult CandumpLogReader::open(std::string path) {

@@ -217,10 +217,10 @@ RecordPlan plan_records(const Options& opt) {
 
 // Where frames go, with what to say when a send fails.
 struct Destination {
-  std::unique_ptr<plinth::hal::FrameSink> sink;
-  plinth::hal::CandumpLogWriter* log = nullptr;  // when the sink is a log
-  plinth::hal::SocketCanPort* port = nullptr;    // when the sink is a bus
-  std::string name;                              // "vcan0", "out.log"
+  std::unique_ptr<plinth::hal::CandumpLogWriter> log;  // when the sink is a log
+  std::unique_ptr<plinth::hal::SocketCanPort> port;    // when the sink is a bus
+  plinth::hal::FrameSink* sink = nullptr;              // the one of the two
+  std::string name;                                    // "vcan0", "out.log"
 
   // Sends; a full transmit queue (the bus is slower than the schedule, as at --speed max on a
   // real controller) is waited out for up to kQueueFullWaitNs rather than the frame dropped.
@@ -256,8 +256,8 @@ Destination open_bus(const std::string& interface_name) {
   if (!opened.ok()) throw InputError("--can: " + opened.message);
   auto port = std::make_unique<plinth::hal::SocketCanPort>(std::move(*opened.port));
   Destination destination;
-  destination.port = port.get();
-  destination.sink = std::move(port);
+  destination.sink = port.get();
+  destination.port = std::move(port);
   destination.name = interface_name;
   return destination;
 }
@@ -401,8 +401,8 @@ Destination open_destination(const Options& opt, plinth::hal::CandumpLogWriter::
   if (!opened.ok()) throw InputError(opened.message);
   auto writer = std::make_unique<plinth::hal::CandumpLogWriter>(std::move(*opened.writer));
   Destination destination;
-  destination.log = writer.get();
-  destination.sink = std::move(writer);
+  destination.sink = writer.get();
+  destination.log = std::move(writer);
   destination.name = opt.log_path;
   return destination;
 }

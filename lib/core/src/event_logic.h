@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "build_options.h"
 #include "phase_kernels.h"
 #include "plinth/core/events.h"
 #include "plinth/core/internal/flows.h"
@@ -451,6 +452,7 @@ struct EventLogic {
       case Stepper::kRk4Located:
         bind_intervals<methods::Rk4>(sim, settings.exact_full_contact);
         return;
+#if !PLINTH_CORE_RK4_ONLY
       case Stepper::kRk4StepEnd:
         bind_intervals<methods::Rk4StepEnd>(sim, settings.exact_full_contact);
         return;
@@ -460,6 +462,10 @@ struct EventLogic {
       case Stepper::kSemiImplicitEuler:
         bind_intervals<methods::SemiImplicitEuler>(sim, settings.exact_full_contact);
         return;
+#else
+      default:  // validate() refused the others: not compiled in
+        return;
+#endif
     }
   }
 

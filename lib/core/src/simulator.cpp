@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstddef>
 
+#include "build_options.h"
 #include "event_logic.h"
 #include "plinth/core/stability.h"
 
@@ -17,6 +18,10 @@ Error validate(const SolverSettings& st) {
   if (kStepperNames.name(st.stepper, nullptr) == nullptr) {
     static constexpr auto kOneOfSteppers = joined_names<kStepperNames>("must be one of ");
     return {ErrorCode::kOutOfRange, "solver.stepper", kOneOfSteppers.data()};
+  }
+  if (PLINTH_CORE_RK4_ONLY && st.stepper != Stepper::kRk4Located) {
+    return {ErrorCode::kOutOfRange, "solver.stepper",
+            "must be rk4_located: this build has no other (PLINTH_CORE_RK4_ONLY)"};
   }
   if (!std::isfinite(st.rest_energy_ratio) || st.rest_energy_ratio <= 0.0 ||
       st.rest_energy_ratio >= 1.0) {

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <limits>
 
+#include "build_options.h"
 #include "phase_kernels.h"
 #include "plinth/core/internal/flows.h"
 #include "plinth/core/internal/guards.h"
@@ -144,8 +145,8 @@ struct StepInterval {
     return first;
   }
 
-  [[gnu::flatten]] static bool advance_interval(Simulator& sim, double& t0, double t_end,
-                                                bool guards_live, bool full_step) {
+  PLINTH_FLATTEN static bool advance_interval(Simulator& sim, double& t0, double t_end,
+                                              bool guards_live, bool full_step) {
     const Scene& s = *sim.scene_;
     const Mode mode = sim.mode_;
     const State& y0 = sim.y_;  // replaced only once y1 (or the event's state) is complete

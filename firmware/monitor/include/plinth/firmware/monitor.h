@@ -75,14 +75,32 @@
 
 namespace plinth::firmware {
 
+// Capacities, fixed at build time: CMake cache variables of the same names (firmware/monitor);
+// the defaults are the host's. A microcontroller build with one ground sensor chooses 1 sensor,
+// a short history and 2-sample windows to fit its RAM (docs/microcontroller.md).
+#ifndef PLINTH_MONITOR_MAX_SENSORS
+#define PLINTH_MONITOR_MAX_SENSORS 4
+#endif
+#ifndef PLINTH_MONITOR_SENSOR_HISTORY
+#define PLINTH_MONITOR_SENSOR_HISTORY 128
+#endif
+#ifndef PLINTH_MONITOR_MAX_CHECK_WINDOW_SAMPLES
+#define PLINTH_MONITOR_MAX_CHECK_WINDOW_SAMPLES 1000
+#endif
+
 inline constexpr int kMaxAxes = 2;
-inline constexpr int kMaxSensors = 4;  // accelerometers, ground and plate together
+// Accelerometers, ground and plate together.
+inline constexpr int kMaxSensors = PLINTH_MONITOR_MAX_SENSORS;
 // Samples kept per sensor (conditioned, with receive times): the cross-checks' pairing and a
-// failover's catch-up. A timeout is below 128 sample periods, so a silent primary's failover
-// still finds the new primary's samples since the last one the estimators took.
-inline constexpr int kSensorHistory = 128;
+// failover's catch-up. A timeout is below 128 sample periods, so with 128 a silent primary's
+// failover still finds the new primary's samples since the last one the estimators took.
+inline constexpr int kSensorHistory = PLINTH_MONITOR_SENSOR_HISTORY;
 // Longest cross-check window, samples (window_s times the sample rate).
-inline constexpr int kMaxCheckWindowSamples = 1000;
+inline constexpr int kMaxCheckWindowSamples = PLINTH_MONITOR_MAX_CHECK_WINDOW_SAMPLES;
+static_assert(kMaxSensors >= 1, "at least the one ground sensor");
+static_assert(kSensorHistory >= static_cast<int>(monitor::kMaxFedPerSample),
+              "the history holds every sample one input can feed");
+static_assert(kMaxCheckWindowSamples >= 2, "a window spans at least 2 samples");
 
 enum class SensorRole : std::uint8_t {
   kGround = 0,  // on the ground (the foundation): may drive the estimators
@@ -106,13 +124,15 @@ struct SensorConfig {
 
 // Ground sensors against the primary.
 struct RedundancySettings {
-  double window_s = 0.5;         // s: sliding window of the RMS difference, 2..1000 samples
+  // s: sliding window of the RMS difference, 2 to kMaxCheckWindowSamples samples
+  double window_s = 0.5;
   double tolerance_m_s2 = 0.3;   // m/s2, > 0: an RMS difference beyond this is a disagreement
 };
 
 // The plate sensor against the model.
 struct PlateCheckSettings {
-  double window_s = 1.0;         // s: sliding window of the RMS residual, 2..1000 samples
+  // s: sliding window of the RMS residual, 2 to kMaxCheckWindowSamples samples
+  double window_s = 1.0;
   double threshold_m_s2 = 0.5;   // m/s2, > 0: an RMS residual beyond this is a mismatch
   bool raises_fault = false;     // a mismatch also raises the fault level (kSensorDisagreement)
 };

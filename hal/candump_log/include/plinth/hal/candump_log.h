@@ -28,6 +28,7 @@
 
 #include "plinth/core/name_table.h"
 #include "plinth/hal/can_codec.h"
+#include "plinth/hal/candump_format.h"
 #include "plinth/hal/frame_io.h"
 
 namespace plinth::hal {
@@ -54,8 +55,7 @@ inline constexpr NameTable<CandumpFrameKind, 6> kCandumpFrameKindNames{{{
   return kCandumpFrameKindNames.name(kind);
 }
 
-inline constexpr std::size_t kCandumpMaxFdLength = 64;         // bytes
-inline constexpr std::size_t kCandumpMaxInterfaceLength = 15;  // IFNAMSIZ - 1
+inline constexpr std::size_t kCandumpMaxFdLength = 64;  // bytes
 inline constexpr std::uint32_t kStandardIdMask = 0x7FF;
 inline constexpr std::uint32_t kExtendedIdMask = 0x1FFFFFFF;
 inline constexpr std::uint32_t kCanErrorFlag = 0x20000000;  // SocketCAN's CAN_ERR_FLAG
@@ -79,7 +79,8 @@ struct CandumpLine {
 
 // The log line of a classic frame with a standard identifier, as candump -l writes it
 // (uppercase hex, no newline): "(1700000000.123456) vcan0 301#0011223344556677".
-// The timestamp is truncated to whole microseconds; it must not be negative.
+// The timestamp is truncated to whole microseconds; it must not be negative, and the interface
+// name must be 1 to 15 characters (otherwise: ""). The freestanding form: candump_format.h.
 [[nodiscard]] std::string format_candump_line(std::int64_t timestamp_ns,
                                               std::string_view interface_name,
                                               const can::CanFrame& frame);

@@ -42,18 +42,32 @@ inline constexpr NameTable<IoStatus, 7> kIoStatusNames{{{
   return kIoStatusNames.name(status);
 }
 
+// Both interfaces are used, never owned: their destructors are protected and not virtual (a
+// backend is never deleted through them), so a microcontroller's driver class needs no deleting
+// destructor and pulls no operator delete into a heap-free image.
+
 // Where frames come from. receive() waits at most `timeout_ms` (0: poll, -1: forever).
 class FrameSource {
  public:
-  virtual ~FrameSource() = default;
   [[nodiscard]] virtual IoStatus receive(TimedFrame& out, int timeout_ms) = 0;
+
+ protected:
+  FrameSource() = default;
+  FrameSource(const FrameSource&) = default;
+  FrameSource& operator=(const FrameSource&) = default;
+  ~FrameSource() = default;
 };
 
 // Where frames go. send() never blocks for long: a full transmit queue is an error to report.
 class FrameSink {
  public:
-  virtual ~FrameSink() = default;
   [[nodiscard]] virtual IoStatus send(const can::CanFrame& frame) = 0;
+
+ protected:
+  FrameSink() = default;
+  FrameSink(const FrameSink&) = default;
+  FrameSink& operator=(const FrameSink&) = default;
+  ~FrameSink() = default;
 };
 
 }  // namespace plinth::hal

@@ -157,7 +157,7 @@ class SocketCanPort final : public FrameSource, public FrameSink {
   SocketCanPort& operator=(SocketCanPort&& other) noexcept;
   SocketCanPort(const SocketCanPort&) = delete;
   SocketCanPort& operator=(const SocketCanPort&) = delete;
-  ~SocketCanPort() override;
+  ~SocketCanPort();
 
   // kOk with a standard data frame in 0x300-0x37F (any length 0..8), or another status (see the
   // top of this file). `out` is written only on kOk.

@@ -1,0 +1,192 @@
+// plinth-embed-record: a record replay (scenes, records, scale, rate) as a C++ source for the
+// microcontroller image (firmware/cortex_m, docs/microcontroller.md). It takes plinth-monitor's
+// replay options and reads the files the same way (record_input.h), so that the image replays
+// exactly the samples plinth-monitor --replay feeds its loop: every double is written bit for
+// bit (hex floats), the scenes as the bytes of their SceneParams (the same layout on x86-64 and
+// the Arm EABI; the source checks the size).
+#include <CLI/CLI.hpp>
+#include <bit>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "plinth/firmware/monitor.h"
+#include "plinth/firmware/record_replay.h"
+#include "plinth/host/cli.h"
+#include "plinth/host/input_error.h"
+#include "plinth/host/scene_toml.h"
+#include "record_input.h"
+
+namespace {
+
+using plinth::host::InputError;
+namespace fw = plinth::firmware;
+
+static_assert(std::is_trivially_copyable_v<plinth::SceneParams>);
+
+struct Options {
+  std::string name;
+  std::string scene_path;
+  std::string scene_y_path;
+  fw::RecordReplayOptions input;
+  std::optional<int> steps;
+  std::string out_path;
+};
+
+std::string hex_double(double value) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%a", value);
+  return text;
+}
+
+// A C++ string literal of `text` (quotes and backslashes escaped).
+std::string literal(const std::string& text) {
+  std::string out = "\"";
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+// A SceneParams constant from the bytes of `params`.
+std::string scene_bytes(const plinth::SceneParams& params) {
+  const auto bytes = std::bit_cast<std::array<unsigned char, sizeof(plinth::SceneParams)>>(params);
+  std::ostringstream out;
+  out << "std::bit_cast<SceneParams>(std::array<unsigned char, " << bytes.size() << ">{";
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    out << (i % 16 == 0 ? "\n    " : " ") << static_cast<unsigned>(bytes[i]) << ",";
+  }
+  out << "})";
+  return out.str();
+}
+
+// `values` as an array in the RECORD region (the linker script), 4 to a line.
+void write_array(std::ostream& out, const char* name, const std::vector<double>& values) {
+  out << "__attribute__((section(\".record\"))) const double " << name << "[" << values.size()
+      << "] = {";
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    out << (i % 4 == 0 ? "\n    " : " ") << hex_double(values[i]) << ",";
+  }
+  out << "\n};\n";
+}
+
+// A number as plinth-monitor's options take it, exactly (17 significant digits).
+std::string exact(double value) {
+  char text[40];
+  std::snprintf(text, sizeof text, "%.17g", value);
+  return text;
+}
+
+// The options of plinth-monitor that replay the same case.
+std::string monitor_command(const Options& opt) {
+  std::ostringstream out;
+  out << "--scene " << opt.scene_path;
+  if (!opt.scene_y_path.empty()) out << " --scene-y " << opt.scene_y_path;
+  out << " --replay " << opt.input.path;
+  if (!opt.input.y_path.empty()) out << " --replay-y " << opt.input.y_path;
+  if (!opt.input.vertical_path.empty()) out << " --vertical " << opt.input.vertical_path;
+  if (!opt.input.pga.empty()) out << " --pga " << opt.input.pga;
+  if (opt.input.scale) out << " --scale " << exact(*opt.input.scale);
+  if (opt.input.rate_hz) out << " --rate " << exact(*opt.input.rate_hz);
+  if (opt.steps) out << " --steps " << *opt.steps;
+  return out.str();
+}
+
+int run(const Options& opt) {
+  const plinth::Scene scene_x = plinth::host::load_scene_file(opt.scene_path);
+  std::optional<plinth::Scene> scene_y;
+  if (!opt.scene_y_path.empty()) scene_y = plinth::host::load_scene_file(opt.scene_y_path);
+  if (!opt.input.y_path.empty() && !scene_y) {
+    throw InputError("--replay-y needs a second axis: --scene-y");
+  }
+  const double gravity = plinth::kStandardGravity;
+  const fw::RecordSamples record = fw::record_samples(opt.input, gravity);
+  // The image starts the box with these settings: refuse here what it would refuse there.
+  fw::MonitorConfig config = fw::box_defaults();
+  config.axis_count = scene_y ? 2 : 1;
+  if (opt.steps) config.estimator.steps_per_sample = *opt.steps;
+  fw::configure_record_replay(config, record.rate_hz);
+  const auto monitor = std::make_unique<fw::Monitor>();
+  if (const plinth::Error e = monitor->start(config, {&scene_x, scene_y ? &*scene_y : nullptr});
+      !e.ok()) {
+    throw InputError(std::string("monitor settings: ") + e.field + " " + e.reason);
+  }
+
+  std::vector<double> x, y, z;
+  bool any_y = false, any_vertical = false;
+  for (const Eigen::Vector3d& a : record.samples) {
+    x.push_back(a.x());
+    y.push_back(a.y());
+    z.push_back(a.z());
+    any_y = any_y || a.y() != 0.0;
+    any_vertical = any_vertical || a.z() != gravity;
+  }
+  std::ostringstream source;
+  source << "// Generated by plinth-embed-record: do not edit.\n"
+         << "// plinth-monitor " << monitor_command(opt) << "\n"
+         << "#include <array>\n#include <bit>\n\n#include \"plinth/firmware/replay_case.h\"\n\n"
+         << "namespace plinth::firmware {\nnamespace {\n\n"
+         << "static_assert(sizeof(SceneParams) == " << sizeof(plinth::SceneParams)
+         << ", \"SceneParams differs from the host's: regenerate with this build's tool\");\n\n";
+  write_array(source, "kX", x);
+  if (any_y) write_array(source, "kY", y);
+  if (any_vertical) write_array(source, "kZ", z);
+  source << "\n}  // namespace\n\n"
+         << "const ReplayCase kReplayCase{\n"
+         << "    .name = " << literal(opt.name) << ",\n"
+         << "    .command = " << literal(monitor_command(opt)) << ",\n"
+         << "    .scene_x = " << scene_bytes(scene_x.params) << ",\n"
+         << "    .has_scene_y = " << (scene_y ? "true" : "false") << ",\n"
+         << "    .scene_y = " << (scene_y ? scene_bytes(scene_y->params) : "SceneParams{}") << ",\n"
+         << "    .steps_per_sample = " << (opt.steps ? *opt.steps : 0) << ",\n"
+         << "    .record = {.description = " << literal(opt.input.path) << ",\n"
+         << "               .sample_rate_hz = " << hex_double(record.rate_hz) << ",\n"
+         << "               .count = " << record.samples.size() << ",\n"
+         << "               .x = kX,\n"
+         << "               .y = " << (any_y ? "kY" : "nullptr") << ",\n"
+         << "               .z = " << (any_vertical ? "kZ" : "nullptr") << "},\n"
+         << "};\n\n}  // namespace plinth::firmware\n";
+  std::ofstream out(opt.out_path);
+  out << source.str();
+  if (!out.flush()) throw InputError(opt.out_path + ": cannot write");
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "plinth-embed-record: a record replay as a C++ source for the microcontroller image"};
+  Options opt;
+  app.add_option("--name", opt.name, "the case's name, printed by the image")->required();
+  app.add_option("--scene", opt.scene_path, "scene file (TOML), the statue's first axis")
+      ->required();
+  app.add_option("--scene-y", opt.scene_y_path, "scene of the second axis");
+  app.add_option("--replay", opt.input.path, "record (.AT2, .csv) of axis x")->required();
+  app.add_option("--replay-y", opt.input.y_path, "second horizontal record (axis y)");
+  app.add_option("--vertical", opt.input.vertical_path, "vertical record");
+  app.add_option("--pga", opt.input.pga, "scale the record to this PGA, e.g. 0.3g");
+  app.add_option("--scale", opt.input.scale, "scale factor of the record")
+      ->check(plinth::host::kFinite)
+      ->excludes("--pga");
+  app.add_option("--rate", opt.input.rate_hz, "sensor rate, Hz (default: the record's, or 200)")
+      ->check(plinth::host::kFinitePositive);
+  app.add_option("--steps", opt.steps, "solver steps per sample (default 4)")
+      ->check(CLI::Range(1, 64));
+  app.add_option("--out", opt.out_path, "the C++ source to write")->required();
+  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+    return *exit_code;
+  }
+  try {
+    return run(opt);
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "plinth-embed-record: %s\n", error.what());
+    return 1;
+  }
+}

@@ -1,0 +1,13 @@
+// Private to plinth_core: build-time choices for small targets (lib/core/CMakeLists.txt,
+// docs/microcontroller.md). Every stepper and flattened intervals by default; a microcontroller
+// keeps the estimator's stepper alone and calls what the host inlines, to fit its flash.
+#pragma once
+
+#ifndef PLINTH_CORE_RK4_ONLY
+#define PLINTH_CORE_RK4_ONLY 0
+#endif
+#if !defined(PLINTH_CORE_FLATTEN) || PLINTH_CORE_FLATTEN
+#define PLINTH_FLATTEN [[gnu::flatten]]
+#else
+#define PLINTH_FLATTEN
+#endif
