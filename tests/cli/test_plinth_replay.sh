@@ -171,7 +171,12 @@ fi
 "$REPLAY" --record "$AT2" --speed 1 --log "$TMP/interrupted.log" --report-json \
   >"$TMP/stdout" 2>"$TMP/stderr" &
 replay_pid=$!
-sleep 0.7
+# Interrupted once some frames are logged (on a loaded machine the start-up alone can take a
+# while): poll the log for up to 20 s rather than sleeping a fixed time.
+for _ in $(seq 200); do
+  (($(wc -l <"$TMP/interrupted.log" 2>/dev/null || echo 0) > 100)) && break
+  sleep 0.1
+done
 kill -INT "$replay_pid"
 wait "$replay_pid"
 RC=$?
