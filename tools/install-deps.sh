@@ -14,6 +14,7 @@ packages=(
   qemu-system-x86 linux-image-amd64 busybox-static xz-utils  # route qemu
   linux-headers-amd64 linux-source-6.1 gpiod  # gpio-sim in the qemu route
   python3 gnuplot-nox
+  libgpiod-dev libsystemd-dev systemd  # relays (libgpiod), sd_notify; systemd-analyze tests the unit
   clang-14 libclang-rt-14-dev  # the sanitize preset: ASan + UBSan and libFuzzer (docs/fuzzing.md)
 )
 

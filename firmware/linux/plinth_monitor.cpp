@@ -5,7 +5,6 @@
 // reports a status, alarm lines, phase events, and a summary at the end. Live, the monitor's
 // status and alarm frames also go on the bus.
 #include <CLI/CLI.hpp>
-
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -18,10 +17,14 @@
 #include "inputs.h"
 #include "monitor_config.h"
 #include "plinth/firmware/monitor.h"
+#include "plinth/hal/pacing.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/scene_toml.h"
+#include "relay_gpiod.h"
+#include "relay_outputs.h"
 #include "status_json.h"
+#include "supervisor.h"
 
 namespace {
 
@@ -92,11 +95,12 @@ class AxisEvents final : public plinth::EventSink {
 class Outputs {
  public:
   Outputs(const fw::Monitor& monitor, double t_origin, fw::EventRecorder* recorder,
-          plinth::hal::FrameSink* bus)
-      : monitor_(monitor), t_origin_(t_origin), recorder_(recorder), bus_(bus) {}
+          plinth::hal::FrameSink* bus, fw::RelayOutputs* relays)
+      : monitor_(monitor), t_origin_(t_origin), recorder_(recorder), bus_(bus), relays_(relays) {}
 
   void handle(const fw::MonitorUpdate& u) {
     const fw::MonitorStatus& s = monitor_.status();
+    if (relays_ != nullptr) relays_->update(s.alarm, s.latched);  // first: the panel's contacts
     totals.max_risk = std::fmax(totals.max_risk, s.risk);
     for (std::size_t i = 0; i < u.frame_count; ++i) {
       if (bus_ != nullptr && bus_->send(u.frames[i]) != plinth::hal::IoStatus::kOk) {
@@ -139,6 +143,7 @@ class Outputs {
   double t_origin_;
   fw::EventRecorder* recorder_;
   plinth::hal::FrameSink* bus_;
+  fw::RelayOutputs* relays_;
 };
 
 // The monitor takes one input item.
@@ -184,6 +189,26 @@ std::unique_ptr<fw::EventRecorder> make_recorder(const Options& opt,
   rs.post_trigger_s = opt.post_trigger;
   rs.frame_rate_hz = 2.0 * config.estimator.sample_rate_hz + 100.0;
   return std::make_unique<fw::EventRecorder>(rs);
+}
+
+// The relays' lines, requested released (contacts open) until the monitor says otherwise.
+std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings) {
+  if (!settings.enabled()) return nullptr;
+  return std::make_unique<fw::RelayOutputs>(settings, fw::open_gpiod_relays(settings));
+}
+
+// Takes the input until it ends or a signal; systemd's watchdog hears of every item taken.
+void run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
+              fw::EventRecorder* recorder, fw::Supervisor& supervisor) {
+  supervisor.ready("monitoring " + input.source());
+  fw::InputItem item;
+  while (g_stop == 0 && input.next(item)) {
+    take(item, monitor, outputs, recorder);
+    const std::int64_t now_ns = plinth::hal::monotonic_now_ns();
+    if (supervisor.stall_due(now_ns)) fw::Supervisor::stall(g_stop);  // test only
+    supervisor.on_progress(now_ns);
+  }
+  supervisor.stopping();
 }
 
 fw::InputOptions input_options(const Options& opt) {
@@ -247,9 +272,10 @@ int run(const Options& opt) {
     monitor.set_event_sink(i, &sinks.back());
   }
   const std::unique_ptr<fw::EventRecorder> recorder = make_recorder(opt, config);
-  Outputs outputs(monitor, input->t_origin(), recorder.get(), input->sink());
-  fw::InputItem item;
-  while (g_stop == 0 && input->next(item)) take(item, monitor, outputs, recorder.get());
+  const std::unique_ptr<fw::RelayOutputs> relays = make_relays(file.relays);
+  Outputs outputs(monitor, input->t_origin(), recorder.get(), input->sink(), relays.get());
+  fw::Supervisor supervisor(file.watchdog);
+  run_loop(*input, monitor, outputs, recorder.get(), supervisor);
   if (recorder) recorder->close();  // every capture is on disk before the summary
   const fw::RunTotals totals = run_totals(outputs, *input, monitor, recorder.get(), sinks);
   print_line(fw::summary_json(monitor, totals, input->t_origin()));
@@ -290,6 +316,10 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--post-trigger", opt.post_trigger, "s kept after an alarm (default 60)")
       ->check(plinth::host::kFinite);
   app.add_flag("--no-events", opt.quiet_events, "leave out the phase event lines");
+  app.add_option("--relay-chip", c.relay_chip,
+                 "GPIO chip of the relays (relays.chip; the lines come from [relays])");
+  app.add_flag("--no-relays", c.no_relays, "drive no relays, whatever [relays] says")
+      ->excludes("--relay-chip");
   app.add_option("--stuck-samples", c.stuck_samples,
                  "identical samples that mean a stuck sensor (default 50; 0: off, for noise-free "
                  "synthetic logs)")
