@@ -100,7 +100,10 @@ class Outputs {
 
   void handle(const fw::MonitorUpdate& u) {
     const fw::MonitorStatus& s = monitor_.status();
-    if (relays_ != nullptr) relays_->update(s.alarm, s.latched);  // first: the panel's contacts
+    if (relays_ != nullptr) {  // first: the alarm panel's contacts
+      relays_->update(s.alarm, s.latched,
+                      s.sensors_state == mon::HealthState::kFault || s.disagreement);
+    }
     totals.max_risk = std::fmax(totals.max_risk, s.risk);
     for (std::size_t i = 0; i < u.frame_count; ++i) {
       if (bus_ != nullptr && bus_->send(u.frames[i]) != plinth::hal::IoStatus::kOk) {

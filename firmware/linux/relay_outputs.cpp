@@ -8,10 +8,11 @@
 
 namespace plinth::firmware {
 
-bool relay_energised(Relay relay, monitor::AlarmLevel shown, monitor::AlarmLevel latched) {
+bool relay_energised(Relay relay, monitor::AlarmLevel shown, monitor::AlarmLevel latched,
+                     bool fault) {
   using monitor::AlarmLevel;
   if (shown == AlarmLevel::kFault) return false;
-  if (relay == Relay::kFault) return true;
+  if (relay == Relay::kFault) return !fault;
   // Relay order = level order - 1: advisory opens at advisory, warning at warning, ...
   const int level = static_cast<int>(relay) + 1;
   const int reached = std::max(static_cast<int>(shown),
@@ -27,10 +28,10 @@ RelayOutputs::RelayOutputs(const RelaySettings& settings, std::unique_ptr<RelayB
   }
 }
 
-void RelayOutputs::update(monitor::AlarmLevel shown, monitor::AlarmLevel latched) {
+void RelayOutputs::update(monitor::AlarmLevel shown, monitor::AlarmLevel latched, bool fault) {
   for (std::size_t i = 0; i < kRelayCount; ++i) {
     if (wired_index_[i] < 0) continue;
-    const bool want = relay_energised(static_cast<Relay>(i), shown, latched);
+    const bool want = relay_energised(static_cast<Relay>(i), shown, latched, fault);
     if (want == energised_[i]) continue;
     ++writes_;
     if (backend_->set(static_cast<std::size_t>(wired_index_[i]), want)) {

@@ -36,10 +36,12 @@ struct RelaySettings {
 };
 
 // Whether `relay`'s coil is energised (its normally-open contact closed, "healthy") with the
-// alarm level shown and the level latched until acknowledged. The fault level opens every
-// relay; a level relay opens at its level or above, shown or latched.
+// alarm level shown, the level latched until acknowledged, and `fault`: a fault input present
+// (no usable ground sensor, sensors disagreeing) even where the level shown is an alarm, which
+// a fault never hides. The fault level opens every relay, a fault input the fault relay; a
+// level relay opens at its level or above, shown or latched.
 [[nodiscard]] bool relay_energised(Relay relay, monitor::AlarmLevel shown,
-                                   monitor::AlarmLevel latched);
+                                   monitor::AlarmLevel latched, bool fault);
 
 // The wired lines (RelaySettings::lines with offset >= 0), in that order.
 class RelayBackend {
@@ -55,9 +57,9 @@ class RelayOutputs {
   // `backend` holds the wired lines, every one released (de-energised) at first.
   RelayOutputs(const RelaySettings& settings, std::unique_ptr<RelayBackend> backend);
 
-  // The relays for the monitor's current levels; writes only the lines that change. A failed
-  // write is counted and tried again at the next update.
-  void update(monitor::AlarmLevel shown, monitor::AlarmLevel latched);
+  // The relays for the monitor's current levels and fault input (relay_energised); writes only
+  // the lines that change. A failed write is counted and tried again at the next update.
+  void update(monitor::AlarmLevel shown, monitor::AlarmLevel latched, bool fault);
 
   [[nodiscard]] bool energised(Relay relay) const {
     return energised_[static_cast<std::size_t>(relay)];

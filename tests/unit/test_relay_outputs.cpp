@@ -23,10 +23,10 @@ constexpr AlarmLevel kAlarm = AlarmLevel::kAlarm;
 constexpr AlarmLevel kFault = AlarmLevel::kFault;
 
 // Energised relays as a string in the order advisory, warning, alarm, fault: "1110".
-std::string pattern(AlarmLevel shown, AlarmLevel latched) {
+std::string pattern(AlarmLevel shown, AlarmLevel latched, bool fault = false) {
   std::string out;
   for (std::size_t i = 0; i < kRelayCount; ++i) {
-    out += relay_energised(static_cast<Relay>(i), shown, latched) ? '1' : '0';
+    out += relay_energised(static_cast<Relay>(i), shown, latched, fault) ? '1' : '0';
   }
   return out;
 }
@@ -51,6 +51,12 @@ TEST(RelayLogic, TheFaultLevelOpensEveryRelay) {
   EXPECT_EQ(pattern(kNormal, kFault), "1111");
 }
 
+TEST(RelayLogic, AFaultUnderAnAlarmStillOpensTheFaultRelay) {
+  EXPECT_EQ(pattern(kAlarm, kAlarm, true), "0000");  // the policy shows the alarm
+  EXPECT_EQ(pattern(kFault, kNormal, true), "0000");
+  EXPECT_EQ(pattern(kNormal, kNormal, true), "1110");
+}
+
 struct Bench {
   explicit Bench(const RelaySettings& settings, std::size_t wired) {
     auto fake = std::make_unique<FakeRelayBackend>(wired);
@@ -71,25 +77,25 @@ RelaySettings all_four() {
 TEST(RelayOutputs, ReleasedUntilTheMonitorIsHealthyThenWritesOnlyChanges) {
   Bench b(all_four(), 4);
   for (std::size_t i = 0; i < 4; ++i) EXPECT_FALSE(b.backend->level(i));
-  b.relays->update(kFault, kNormal);  // the box starts in fault: nothing to write
+  b.relays->update(kFault, kNormal, false);  // the box starts in fault: nothing to write
   EXPECT_TRUE(b.backend->writes().empty());
-  b.relays->update(kNormal, kNormal);
+  b.relays->update(kNormal, kNormal, false);
   ASSERT_EQ(b.backend->writes().size(), 4u);
   for (std::size_t i = 0; i < 4; ++i) EXPECT_TRUE(b.backend->level(i));
-  b.relays->update(kNormal, kNormal);
+  b.relays->update(kNormal, kNormal, false);
   EXPECT_EQ(b.backend->writes().size(), 4u);
-  b.relays->update(kWarning, kWarning);
+  b.relays->update(kWarning, kWarning, false);
   EXPECT_EQ(b.backend->writes().size(), 6u);
   EXPECT_FALSE(b.backend->level(0));
   EXPECT_FALSE(b.backend->level(1));
   EXPECT_TRUE(b.backend->level(2));
   EXPECT_TRUE(b.backend->level(3));
-  b.relays->update(kNormal, kWarning);  // the risk fell, the warning is latched: no change
+  b.relays->update(kNormal, kWarning, false);  // the risk fell, the warning is latched: no change
   EXPECT_EQ(b.backend->writes().size(), 6u);
-  b.relays->update(kNormal, kNormal);  // acknowledged
+  b.relays->update(kNormal, kNormal, false);  // acknowledged
   EXPECT_TRUE(b.backend->level(0));
   EXPECT_TRUE(b.backend->level(1));
-  b.relays->update(kFault, kNormal);
+  b.relays->update(kFault, kNormal, false);
   for (std::size_t i = 0; i < 4; ++i) EXPECT_FALSE(b.backend->level(i));
   EXPECT_EQ(b.relays->write_errors(), 0u);
 }
@@ -100,10 +106,10 @@ TEST(RelayOutputs, OnlyTheWiredRelaysInTheBackendsOrder) {
   s.lines[static_cast<std::size_t>(Relay::kAlarm)].offset = 3;
   s.lines[static_cast<std::size_t>(Relay::kFault)].offset = 1;
   Bench b(s, 2);
-  b.relays->update(kAdvisory, kNormal);
+  b.relays->update(kAdvisory, kNormal, false);
   EXPECT_TRUE(b.backend->level(0));  // alarm
   EXPECT_TRUE(b.backend->level(1));  // fault
-  b.relays->update(kAlarm, kAlarm);
+  b.relays->update(kAlarm, kAlarm, false);
   EXPECT_FALSE(b.backend->level(0));
   EXPECT_TRUE(b.backend->level(1));
   ASSERT_EQ(b.backend->writes().size(), 3u);
@@ -113,11 +119,11 @@ TEST(RelayOutputs, OnlyTheWiredRelaysInTheBackendsOrder) {
 TEST(RelayOutputs, AFailedWriteIsCountedAndTriedAgain) {
   Bench b(all_four(), 4);
   b.backend->fail_writes = true;
-  b.relays->update(kNormal, kNormal);
+  b.relays->update(kNormal, kNormal, false);
   EXPECT_EQ(b.relays->write_errors(), 4u);
   EXPECT_FALSE(b.relays->energised(Relay::kAlarm));
   b.backend->fail_writes = false;
-  b.relays->update(kNormal, kNormal);
+  b.relays->update(kNormal, kNormal, false);
   EXPECT_TRUE(b.relays->energised(Relay::kAlarm));
   EXPECT_TRUE(b.backend->level(2));
 }
