@@ -23,6 +23,7 @@
 #include "plinth/host/scene_toml.h"
 #include "relay_gpiod.h"
 #include "relay_outputs.h"
+#include "sample_trace.h"
 #include "status_json.h"
 #include "supervisor.h"
 
@@ -46,6 +47,7 @@ struct Options {
   std::string speed = "max";
   double duration = 0.0;
   std::string record_dir;
+  std::string trace_path;
   double pre_trigger = 30.0;
   double post_trigger = 60.0;
   bool quiet_events = false;
@@ -122,9 +124,11 @@ class Outputs {
       if (e.level == mon::AlarmLevel::kWarning || e.level == mon::AlarmLevel::kAlarm) trigger(e);
     }
     if (u.status_due) print_line(fw::status_json(s, t_origin_));
+    if (trace != nullptr) trace->after_update(monitor_);
   }
 
   fw::RunTotals totals;
+  fw::SampleTrace* trace = nullptr;  // --trace
   std::int64_t last_frame_ns = 0;  // receive time of the newest frame (the recorder's clock)
 
  private:
@@ -277,8 +281,13 @@ int run(const Options& opt) {
   const std::unique_ptr<fw::EventRecorder> recorder = make_recorder(opt, config);
   const std::unique_ptr<fw::RelayOutputs> relays = make_relays(file.relays);
   Outputs outputs(monitor, input->t_origin(), recorder.get(), input->sink(), relays.get());
+  std::optional<fw::SampleTrace> trace;
+  if (!opt.trace_path.empty()) {
+    outputs.trace = &trace.emplace(opt.trace_path, config.axis_count, input->t_origin());
+  }
   fw::Supervisor supervisor(file.watchdog);
   run_loop(*input, monitor, outputs, recorder.get(), supervisor);
+  if (trace) trace->close();
   if (recorder) recorder->close();  // every capture is on disk before the summary
   const fw::RunTotals totals = run_totals(outputs, *input, monitor, recorder.get(), sinks);
   print_line(fw::summary_json(monitor, totals, input->t_origin()));
@@ -319,6 +328,9 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--post-trigger", opt.post_trigger, "s kept after an alarm (default 60)")
       ->check(plinth::host::kFinite);
   app.add_flag("--no-events", opt.quiet_events, "leave out the phase event lines");
+  app.add_option("--trace", opt.trace_path,
+                 "write a line per sample to this file (TSV: risk, levels, ground, rotation, "
+                 "phase; for tools/plinth-event-plot)");
   app.add_option("--relay-chip", c.relay_chip,
                  "GPIO chip of the relays (relays.chip; the lines come from [relays])");
   app.add_flag("--no-relays", c.no_relays, "drive no relays, whatever [relays] says")
