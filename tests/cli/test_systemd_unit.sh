@@ -18,17 +18,8 @@ trap 'rm -rf "$tmp"' EXIT
 unit=$tmp/plinth-monitor.service
 sed "s#^ExecStart=/usr/local/bin/plinth-monitor #ExecStart=$monitor #" "$unit_src" >"$unit"
 
-passed=0
-failed=0
-check() {  # NAME STATUS [DETAIL]
-  if [ "$2" -eq 0 ]; then
-    echo "ok - $1"
-    passed=$((passed + 1))
-  else
-    echo "not ok - $1${3:+: $3}"
-    failed=$((failed + 1))
-  fi
-}
+# shellcheck source=tests/cli/checks.sh
+source "$src/tests/cli/checks.sh"
 
 grep -q "^ExecStart=$monitor " "$unit"
 check "ExecStart runs plinth-monitor (pointed at the build)" $?
@@ -56,5 +47,4 @@ score=$(printf '%s\n' "$report" | sed -n 's/.*Overall exposure level for .*: \([
 awk -v s="$score" 'BEGIN { exit !(s != "" && s <= 2.5) }'
 check "systemd-analyze security: exposure ${score:-?} <= 2.5" $? "$(printf '%s\n' "$report" | tail -3)"
 
-echo "$passed passed, $failed failed"
-[ "$failed" -eq 0 ]
+finish

@@ -3,12 +3,15 @@
 // kernel's gpio-sim (tests/integration/relays_guest.sh).
 #include <gtest/gtest.h>
 
+#include <fstream>
 #include <memory>
+#include <sstream>
 #include <string>
 
 #include "monitor_config.h"
 #include "plinth/host/input_error.h"
 #include "relay_fake.h"
+#include "relay_gpiod.h"
 #include "relay_outputs.h"
 
 namespace plinth::firmware {
@@ -182,6 +185,39 @@ TEST(RelayConfig, TheCommandLineReplacesTheChipOrTurnsTheRelaysOff) {
   EXPECT_FALSE(f.relays.enabled());
   MonitorFile none;
   EXPECT_THROW(apply_overrides(none, o), host::InputError);
+}
+
+TEST(RelayConfig, TheExamplesCommentedTableParsesOnceUncommented) {
+  std::ifstream in(std::string(PLINTH_SOURCE_DIR) + "/firmware/monitor.example.toml");
+  std::stringstream text;
+  bool inside = false;
+  for (std::string line; std::getline(in, line);) {
+    if (line == "#[relays]") inside = true;
+    if (inside && line.empty()) inside = false;
+    text << (inside ? line.substr(1) : line) << '\n';
+  }
+  const MonitorFile f = load_monitor_text(text.str(), "example.toml", MonitorConfig{});
+  EXPECT_EQ(f.relays.chip, "gpiochip0");
+  EXPECT_EQ(f.relays.lines[0].offset, 17);
+  EXPECT_TRUE(f.relays.lines[0].active_low);
+  EXPECT_EQ(f.relays.lines[3].offset, 23);
+  EXPECT_TRUE(load_monitor_file(std::string(PLINTH_SOURCE_DIR) + "/firmware/monitor.example.toml",
+                                MonitorConfig{})
+                  .watchdog.notify);
+}
+
+TEST(RelayGpiod, AChipThatDoesNotExistIsNamed) {
+  RelaySettings s;
+  s.chip = "/dev/plinth-no-such-gpiochip";
+  s.lines[0].offset = 0;
+  try {
+    (void)open_gpiod_relays(s);
+    FAIL() << "opened a chip that does not exist";
+  } catch (const host::InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "relays.chip: cannot open GPIO chip '/dev/plinth-no-such-gpiochip': No such file or "
+              "directory");
+  }
 }
 
 TEST(WatchdogConfig, NotifyAndTheTestOnlyStall) {
