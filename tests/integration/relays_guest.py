@@ -18,6 +18,7 @@ PLINTH_REPLAY; run from the repository's root.
 import json
 import os
 import random
+import select
 import signal
 import subprocess
 import sys
@@ -101,15 +102,49 @@ def start_monitor(folder, log):
     return subprocess.Popen(
         ["stdbuf", "-oL", MONITOR, "--scene", "sim/scenes/paper-isolated.toml", "--replay", log,
          "--speed", "1", "--config", config, "--status-interval", "0.25", "--no-events"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+
+
+def process_state(pid):
+    """The state letter of /proc/PID/stat (R, S, T stopped, Z exited), or None when gone."""
+    try:
+        with open("/proc/%d/stat" % pid) as f:
+            return f.read().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return None
 
 
 def statuses(proc):
-    """(status line, the lines' levels read right after it) as the monitor prints them."""
-    for line in proc.stdout:
-        record = json.loads(line)
-        if record["type"] == "status":
-            yield record, sim_levels()
+    """(newest status line, the lines' levels) each time the monitor prints a status: the monitor
+    is stopped (SIGSTOP) while its pipe is drained to its newest status and the levels are read,
+    so a loaded guest's slow reader compares like with like; then it goes on (SIGCONT). Its
+    pacing is by absolute deadlines, its sensor timeouts by the log's clock: the pauses change
+    neither. Nothing is read once it has exited (its lines are released then)."""
+    fd = proc.stdout.fileno()
+    pending = b""
+    while True:
+        chunk = os.read(fd, 65536)
+        if not chunk:
+            return
+        pending += chunk
+        if b'"type": "status"' not in pending:
+            continue
+        proc.send_signal(signal.SIGSTOP)
+        while process_state(proc.pid) not in ("T", "Z", None):
+            time.sleep(0.001)
+        while select.select([fd], [], [], 0)[0]:
+            more = os.read(fd, 65536)
+            if not more:
+                break
+            pending += more
+        complete, _, pending = pending.rpartition(b"\n")
+        newest = None
+        for line in complete.split(b"\n"):
+            if line.startswith(b"{") and b'"type": "status"' in line:
+                newest = json.loads(line)
+        if newest is not None and process_state(proc.pid) == "T":
+            yield newest, sim_levels()
+        proc.send_signal(signal.SIGCONT)
 
 
 def run_to_the_end(folder, log):
@@ -134,14 +169,15 @@ def run_to_the_end(folder, log):
             consumer_ok = (len(held) == 4 and all("output" in h for h in held) and
                            ["active-low" in h for h in held] == list(ACTIVE_LOW)) or info
     rc = proc.wait(timeout=60)
-    err = proc.stderr.read()
+    err = proc.stderr.read().decode()
     after = sim_levels()
     check(rc == 0, "the replay ran to its end (exit %s): %s" % (rc, err.strip()))
     check(not mismatches, "every status read back as its relays: mismatches %s" % mismatches)
     check(consumer_ok is True, "gpioinfo shows plinth-monitor holding 4 output lines, the last "
           "active-low: %s" % ("" if consumer_ok is True else consumer_ok))
-    check(seen.get(("fault", "normal", True), 0) >= 3,
-          "fault (start, the gap): every relay released, %d reads" % seen.get(("fault", "normal", True), 0))
+    in_fault = sum(n for state, n in seen.items() if state[0] == "fault")
+    check(in_fault >= 3, "fault (start, the gap, the new start-up window): every relay released, "
+          "%d reads" % in_fault)
     check(seen.get(("normal", "normal", False), 0) >= 10,
           "normal: every relay energised, %d reads" % seen.get(("normal", "normal", False), 0))
     check(seen.get(("alarm", "alarm", False), 0) >= 3,
