@@ -16,6 +16,7 @@ packages=(
   python3 gnuplot-nox
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib  # Cortex-M4F image
   qemu-system-arm                                                            # runs it
+  libgpiod-dev libsystemd-dev systemd  # relays (libgpiod), sd_notify; systemd-analyze tests the unit
   clang-14 libclang-rt-14-dev  # the sanitize preset: ASan + UBSan and libFuzzer (docs/fuzzing.md)
 )
 

@@ -3,6 +3,8 @@
 #include <toml++/toml.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -132,7 +134,23 @@ void sensor_bindings(std::vector<Binding>& b, const std::string& mounting,
   }
 }
 
-std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit) {
+// [relays]: the chip, every line's default polarity, and per relay its offset, either
+// `warning = 5` or `warning = { line = 5, active_low = true }`.
+void relay_bindings(std::vector<Binding>& b, RelaySettings& relays,
+                    std::array<bool, kRelayCount>& active_low) {
+  b.push_back({"relays.chip", string_into(relays.chip), "a string (a gpiochip name or path)"});
+  b.push_back({"relays.active_low", flag_into(active_low[0]), "true or false"});
+  for (std::size_t i = 0; i < kRelayCount; ++i) {
+    const std::string key = cat("relays.", kRelayNames[i]);
+    b.push_back({key, integer_into(relays.lines[i].offset), "an integer (a line offset)"});
+    b.push_back(
+        {cat(key, ".line"), integer_into(relays.lines[i].offset), "an integer (a line offset)"});
+    b.push_back({cat(key, ".active_low"), flag_into(relays.lines[i].active_low), "true or false"});
+  }
+}
+
+std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
+                              std::array<bool, kRelayCount>& relay_active_low) {
   MonitorConfig& c = f.config;
   monitor::AlarmPolicySettings& alarm = c.alarm;
   std::vector<Binding> b = {
@@ -170,6 +188,10 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit) {
       {"alarm_policy.heartbeat_period_s", number_into(alarm.heartbeat_period_s), "a number"},
   };
   sensor_bindings(b, "conditioning.", c.conditioning, c.sensor_health, unit);
+  relay_bindings(b, f.relays, relay_active_low);
+  b.push_back({"watchdog.notify", flag_into(f.watchdog.notify), "true or false"});
+  b.push_back({"watchdog.test_stall_after_s", number_into(f.watchdog.test_stall_after_s),
+               "a number (s; test only)"});
   for (auto [name, thresholds] : {std::pair<const char*, monitor::RiskThresholds*>{"advisory", &alarm.advisory},
                                   {"warning", &alarm.warning},
                                   {"alarm", &alarm.alarm},
@@ -321,6 +343,40 @@ std::string sensor_key(int index, const std::string& field) {
   return cat(head, field);
 }
 
+// The [relays] table as a whole: polarity defaults, offsets in range and distinct, a chip for
+// the lines and lines for the chip.
+void check_relays(RelaySettings& relays, bool default_active_low, const KeyLines& lines) {
+  constexpr int kMaxLineOffset = 1023;  // far beyond any chip's lines; the chip checks its own
+  bool any = false;
+  for (std::size_t i = 0; i < kRelayCount; ++i) {
+    RelayLine& line = relays.lines[i];
+    const std::string key = cat("relays.", kRelayNames[i]);
+    const std::string at = lines.has(key) ? key : cat(key, ".line");
+    if (!lines.has(cat(key, ".active_low"))) line.active_low = default_active_low;
+    if (!lines.has(key) && !lines.has(cat(key, ".line"))) {
+      if (lines.has(cat(key, ".active_low")))
+        lines.fail(cat(key, ".active_low"), cat(key, ": no line"));
+      line.offset = -1;
+      continue;
+    }
+    if (line.offset < 0 || line.offset > kMaxLineOffset) {
+      lines.fail(at,
+                 cat(key, ": line offset must lie in [0, ", std::to_string(kMaxLineOffset), "]"));
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (relays.lines[j].offset == line.offset) {
+        lines.fail(at, cat(key, ": line ", std::to_string(line.offset), " is already relays.",
+                           kRelayNames[j], "'s"));
+      }
+    }
+    any = true;
+  }
+  if (any && relays.chip.empty()) lines.fail("relays", "relays: lines without relays.chip");
+  if (!any && !relays.chip.empty()) {
+    lines.fail("relays.chip", "relays.chip: no relay lines (advisory, warning, alarm, fault)");
+  }
+}
+
 // validate(MonitorConfig), its field named as the file's key.
 void check(const MonitorConfig& config, const KeyLines& lines) {
   int sensor_index = -1;
@@ -343,7 +399,8 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   file.config = defaults;
   int node = defaults.ground_node;
   std::string unit;
-  std::vector<Binding> known = bindings(file, node, unit);
+  std::array<bool, kRelayCount> relay_active_low{};  // [0]: relays.active_low
+  std::vector<Binding> known = bindings(file, node, unit, relay_active_low);
   const toml::node* sensor_list = doc.get("sensor");
   const bool sensor_tables = sensor_list != nullptr && sensor_list->is_array();
   std::vector<std::pair<std::string, const toml::node*>> leaves;
@@ -367,6 +424,11 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     }
     file.config.axis_count = 2;
   }
+  check_relays(file.relays, relay_active_low[0], lines);
+  if (!std::isfinite(file.watchdog.test_stall_after_s) || file.watchdog.test_stall_after_s < 0.0) {
+    lines.fail("watchdog.test_stall_after_s",
+               "watchdog.test_stall_after_s: must be a finite number of seconds >= 0");
+  }
   check(file.config, lines);
   return file;
 }
@@ -384,6 +446,14 @@ void apply_overrides(MonitorFile& file, const MonitorOverrides& o) {
   if (o.steps) config.estimator.steps_per_sample = *o.steps;
   if (o.rate_hz) config.estimator.sample_rate_hz = *o.rate_hz;
   if (o.status_interval_s) config.status_interval_s = *o.status_interval_s;
+  if (o.no_relays) file.relays = RelaySettings{};
+  if (o.relay_chip && !o.no_relays) {
+    if (!file.relays.enabled()) {
+      throw InputError(cat("--relay-chip ", *o.relay_chip,
+                           ": no relay lines ([relays] in the configuration file names them)"));
+    }
+    file.relays.chip = *o.relay_chip;
+  }
   if (o.node) {
     if (config.sensor_count > 0) {
       throw InputError(cat("--node names the single ground sensor; ", o.config_path,

@@ -8,12 +8,16 @@
 
 #include "plinth/firmware/monitor.h"
 #include "plinth/firmware/record_replay.h"
+#include "relay_outputs.h"
+#include "supervisor.h"
 
 namespace plinth::firmware {
 
 struct MonitorFile {
   MonitorConfig config;
   std::string second_scene_path;  // monitor.second_scene, resolved against the file's folder
+  RelaySettings relays;           // [relays]
+  WatchdogSettings watchdog;      // [watchdog]
 };
 
 // Reads `path` over `defaults`. Throws host::InputError naming the file, the line and the key
@@ -36,6 +40,8 @@ struct MonitorOverrides {
   std::optional<double> status_interval_s;  // --status-interval: monitor.status_interval_s
   std::optional<double> startup_window_s;   // --startup-window: every sensor's
   std::optional<int> stuck_samples;         // --stuck-samples: every sensor's
+  std::optional<std::string> relay_chip;    // --relay-chip: relays.chip
+  bool no_relays = false;                   // --no-relays: the file's [relays] ignored
 };
 
 // The command line over `file` (throws host::InputError for --node with [[sensor]] tables).

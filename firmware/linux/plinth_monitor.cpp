@@ -6,7 +6,6 @@
 // status and alarm frames also go on the bus; a replay writes them to a candump log with
 // --frames-out.
 #include <CLI/CLI.hpp>
-
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -22,10 +21,15 @@
 #include "monitor_config.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/hal/candump_log.h"
+#include "plinth/hal/pacing.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/scene_toml.h"
+#include "relay_gpiod.h"
+#include "relay_outputs.h"
+#include "sample_trace.h"
 #include "status_json.h"
+#include "supervisor.h"
 
 namespace {
 
@@ -48,6 +52,7 @@ struct Options {
   double duration = 0.0;
   std::string record_dir;
   std::string frames_out;
+  std::string trace_path;
   double pre_trigger = 30.0;
   double post_trigger = 60.0;
   bool quiet_events = false;
@@ -97,11 +102,15 @@ class AxisEvents final : public plinth::EventSink {
 class Outputs {
  public:
   Outputs(const fw::Monitor& monitor, double t_origin, fw::EventRecorder* recorder,
-          plinth::hal::FrameSink* bus)
-      : monitor_(monitor), t_origin_(t_origin), recorder_(recorder), bus_(bus) {}
+          plinth::hal::FrameSink* bus, fw::RelayOutputs* relays)
+      : monitor_(monitor), t_origin_(t_origin), recorder_(recorder), bus_(bus), relays_(relays) {}
 
   void handle(const fw::MonitorUpdate& u) {
     const fw::MonitorStatus& s = monitor_.status();
+    if (relays_ != nullptr) {  // first: the alarm panel's contacts
+      relays_->update(s.alarm, s.latched,
+                      s.sensors_state == mon::HealthState::kFault || s.disagreement);
+    }
     totals.max_risk = std::fmax(totals.max_risk, s.risk);
     for (std::size_t i = 0; i < u.frame_count; ++i) {
       if (bus_ != nullptr && bus_->send(u.frames[i]) != plinth::hal::IoStatus::kOk) {
@@ -120,9 +129,11 @@ class Outputs {
       if (e.level == mon::AlarmLevel::kWarning || e.level == mon::AlarmLevel::kAlarm) trigger(e);
     }
     if (u.status_due) print_line(fw::status_json(s, t_origin_));
+    if (trace != nullptr) trace->after_update(monitor_);
   }
 
   fw::RunTotals totals;
+  fw::SampleTrace* trace = nullptr;  // --trace
   std::int64_t last_frame_ns = 0;  // receive time of the newest frame (the recorder's clock)
 
  private:
@@ -144,6 +155,7 @@ class Outputs {
   double t_origin_;
   fw::EventRecorder* recorder_;
   plinth::hal::FrameSink* bus_;
+  fw::RelayOutputs* relays_;
 };
 
 // The monitor takes one input item.
@@ -195,6 +207,26 @@ std::unique_ptr<fw::EventRecorder> make_recorder(const Options& opt,
   rs.post_trigger_s = opt.post_trigger;
   rs.frame_rate_hz = 2.0 * config.estimator.sample_rate_hz + 100.0;
   return std::make_unique<fw::EventRecorder>(rs);
+}
+
+// The relays' lines, requested released (contacts open) until the monitor says otherwise.
+std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings) {
+  if (!settings.enabled()) return nullptr;
+  return std::make_unique<fw::RelayOutputs>(settings, fw::open_gpiod_relays(settings));
+}
+
+// Takes the input until it ends or a signal; systemd's watchdog hears of every item taken.
+void run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
+              fw::EventRecorder* recorder, fw::Supervisor& supervisor) {
+  supervisor.ready("monitoring " + input.source());
+  fw::InputItem item;
+  while (g_stop == 0 && input.next(item)) {
+    take(item, monitor, outputs, recorder);
+    const std::int64_t now_ns = plinth::hal::monotonic_now_ns();
+    if (supervisor.stall_due(now_ns)) fw::Supervisor::stall(g_stop);  // test only
+    supervisor.on_progress(now_ns);
+  }
+  supervisor.stopping();
 }
 
 fw::InputOptions input_options(const Options& opt) {
@@ -271,10 +303,16 @@ int run(const Options& opt) {
     frames_log.emplace(std::move(*opened.writer));
   }
   plinth::hal::FrameSink* const bus = frames_log ? &*frames_log : input->sink();
-  Outputs outputs(monitor, input->t_origin(), recorder.get(), bus);
+  const std::unique_ptr<fw::RelayOutputs> relays = make_relays(file.relays);
+  Outputs outputs(monitor, input->t_origin(), recorder.get(), bus, relays.get());
   frames_clock = &outputs;
-  fw::InputItem item;
-  while (g_stop == 0 && input->next(item)) take(item, monitor, outputs, recorder.get());
+  std::optional<fw::SampleTrace> trace;
+  if (!opt.trace_path.empty()) {
+    outputs.trace = &trace.emplace(opt.trace_path, config.axis_count, input->t_origin());
+  }
+  fw::Supervisor supervisor(file.watchdog);
+  run_loop(*input, monitor, outputs, recorder.get(), supervisor);
+  if (trace) trace->close();
   if (recorder) recorder->close();  // every capture is on disk before the summary
   if (frames_log && !frames_log->flush()) throw InputError("--frames-out: " + frames_log->error());
   fw::RunTotals totals = run_totals(outputs, *input, monitor, recorder.get(), sinks);
@@ -320,6 +358,13 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--post-trigger", opt.post_trigger, "s kept after an alarm (default 60)")
       ->check(plinth::host::kFinite);
   app.add_flag("--no-events", opt.quiet_events, "leave out the phase event lines");
+  app.add_option("--trace", opt.trace_path,
+                 "write a line per sample to this file (TSV: risk, levels, ground, rotation, "
+                 "phase; for tools/plinth-event-plot)");
+  app.add_option("--relay-chip", c.relay_chip,
+                 "GPIO chip of the relays (relays.chip; the lines come from [relays])");
+  app.add_flag("--no-relays", c.no_relays, "drive no relays, whatever [relays] says")
+      ->excludes("--relay-chip");
   app.add_option("--stuck-samples", c.stuck_samples,
                  "identical samples that mean a stuck sensor (default 50; 0: off, for noise-free "
                  "synthetic logs)")
