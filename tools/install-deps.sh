@@ -14,6 +14,8 @@ packages=(
   qemu-system-x86 linux-image-amd64 busybox-static xz-utils  # route qemu
   linux-headers-amd64 linux-source-6.1 gpiod  # gpio-sim in the qemu route
   python3 gnuplot-nox
+  libmodbus-dev mbpoll  # plinth-monitor's Modbus TCP server, tested with mbpoll (docs/integration.md)
+  libmosquitto-dev mosquitto mosquitto-clients openssl  # its MQTT publisher, tested on a broker
   clang-14 libclang-rt-14-dev  # the sanitize preset: ASan + UBSan and libFuzzer (docs/fuzzing.md)
 )
 
