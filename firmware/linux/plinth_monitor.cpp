@@ -19,6 +19,7 @@
 #include "latency_log.h"
 #include "modbus_server.h"
 #include "monitor_config.h"
+#include "mqtt_publisher.h"
 #include "plinth/firmware/can_frames.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/cli.h"
@@ -314,8 +315,10 @@ constexpr std::size_t kLatencyCapacity = std::size_t{1} << 22;
 // The outputs off the loop that the configuration enables.
 std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFile& file) {
   std::vector<std::unique_ptr<fw::StatusOutput>> outputs;
-  if (!file.modbus.listen.empty())
+  if (!file.modbus.listen.empty()) {
     outputs.push_back(std::make_unique<fw::ModbusServer>(file.modbus));
+  }
+  if (!file.mqtt.broker.empty()) outputs.push_back(std::make_unique<fw::MqttPublisher>(file.mqtt));
   return outputs;
 }
 
@@ -414,6 +417,14 @@ void add_options(CLI::App& app, Options& opt) {
                  "Modbus TCP server at HOST:PORT (modbus.listen; docs/integration.md)");
   app.add_flag("--modbus-writes", c.modbus_writes,
                "the acknowledge and reset coils may be written (modbus.writes)");
+  app.add_option("--mqtt", c.mqtt_broker, "publish to the MQTT broker at HOST:PORT (mqtt.broker)");
+  app.add_option("--mqtt-box-id", c.mqtt_box_id, "the box's id in the topics (mqtt.box_id)");
+  app.add_option("--mqtt-username", c.mqtt_username, "MQTT user name (mqtt.username)");
+  app.add_option("--mqtt-password-file", c.mqtt_password_file,
+                 "a file whose first line is the MQTT password (mqtt.password_file)");
+  app.add_option("--mqtt-ca", c.mqtt_ca_file, "TLS: the CA that signed the broker's certificate");
+  app.add_option("--mqtt-cert", c.mqtt_cert_file, "TLS: the box's client certificate");
+  app.add_option("--mqtt-key", c.mqtt_key_file, "TLS: its private key");
   app.add_flag("--latency", opt.latency,
                "the summary gives each sample's latency, arrival to status ready (median, p99)");
   app.add_option("--stuck-samples", c.stuck_samples,

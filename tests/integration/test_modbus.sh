@@ -8,26 +8,10 @@
 # missing, unless CI=true.
 set -u
 
-# shellcheck source=tests/cli/harness.sh
-source "$(dirname "${BASH_SOURCE[0]}")/../cli/harness.sh"
-BIN=${PLINTH_MONITOR:-}
-if [[ ! -x "$BIN" ]]; then
-  echo "PLINTH_MONITOR=$BIN: not an executable" >&2
-  exit 2
-fi
-if ! command -v mbpoll >/dev/null; then
-  if [[ "${CI:-}" == "true" ]]; then
-    echo "mbpoll is missing (tools/install-deps.sh installs it)" >&2
-    exit 1
-  fi
-  echo "skipped: mbpoll is missing (tools/install-deps.sh installs it)"
-  exit 77
-fi
+# shellcheck source=tests/integration/outputs_harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/outputs_harness.sh"
+require_tools mbpoll
 ISOLATED=$SCENES/paper-isolated.toml
-
-free_port() {
-  python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
-}
 
 # registers PORT: the 32 input registers, one "address value" a line.
 registers() {
@@ -36,16 +20,6 @@ registers() {
 }
 # register PORT ADDRESS
 register() { registers "$1" | awk -v a="$2" '$1 == a { print $2 }'; }
-
-# wait_for FILE PATTERN SECONDS: until a line of FILE matches PATTERN (grep -E).
-wait_for() {
-  local i
-  for ((i = 0; i < $3 * 10; i++)); do
-    grep -qE "$2" "$1" 2>/dev/null && return 0
-    sleep 0.1
-  done
-  return 1
-}
 
 # wait_listening PORT: until the server answers.
 wait_listening() {

@@ -1,0 +1,211 @@
+#!/usr/bin/env bash
+# plinth-monitor's MQTT publisher against a real mosquitto broker that this test starts on
+# loopback with its own configuration (docs/integration.md): a password file, a plain and a TLS
+# listener (a CA and a server certificate made here with openssl), persistence. Checks: every
+# alarm line arrives on the events topic, in order, across a broker restart in the middle of a
+# replay; the retained state and availability; the Last Will when the box is killed (-9); a
+# wrong password refused with a clear message; bad settings refused naming the key or flag.
+#
+# Environment: PLINTH_MONITOR, PLINTH_SIM, PLINTH_SOURCE_DIR. Exit 77 (skip) when mosquitto,
+# its clients or openssl are missing, unless CI=true.
+set -u
+
+# shellcheck source=tests/integration/outputs_harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/outputs_harness.sh"
+require_tools mosquitto mosquitto_sub mosquitto_pub mosquitto_passwd openssl
+MOSQUITTO=$(command -v mosquitto || echo /usr/sbin/mosquitto)
+ISOLATED=$SCENES/paper-isolated.toml
+BROKER_PID=
+BOX=
+cleanup() {
+  [[ -n "$BOX" ]] && kill -9 "$BOX" 2>/dev/null
+  [[ -n "$BROKER_PID" ]] && kill "$BROKER_PID" 2>/dev/null
+  jobs -p | xargs -r kill 2>/dev/null
+  rm -rf "$TMP"
+}
+trap cleanup EXIT
+
+# The broker: users "box" and "watcher", a plain listener and a TLS one.
+PLAIN=$(free_port)
+TLS=$(free_port)
+mkdir -p "$TMP/db"
+openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 2 \
+  -subj "/CN=plinth test CA" -keyout "$TMP/ca.key" -out "$TMP/ca.crt" 2>/dev/null
+openssl req -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -subj "/CN=localhost" \
+  -keyout "$TMP/server.key" -out "$TMP/server.csr" 2>/dev/null
+printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\n' >"$TMP/server.ext"
+openssl x509 -req -in "$TMP/server.csr" -CA "$TMP/ca.crt" -CAkey "$TMP/ca.key" -CAcreateserial \
+  -days 2 -extfile "$TMP/server.ext" -out "$TMP/server.crt" 2>/dev/null
+mosquitto_passwd -c -b "$TMP/passwd" box box-secret 2>/dev/null
+mosquitto_passwd -b "$TMP/passwd" watcher watcher-secret 2>/dev/null
+echo box-secret >"$TMP/box.pw"
+echo wrong >"$TMP/wrong.pw"
+cat >"$TMP/broker.conf" <<EOF
+user root
+persistence true
+persistence_location $TMP/db/
+allow_anonymous false
+password_file $TMP/passwd
+listener $PLAIN 127.0.0.1
+listener $TLS 127.0.0.1
+cafile $TMP/ca.crt
+certfile $TMP/server.crt
+keyfile $TMP/server.key
+EOF
+start_broker() {
+  "$MOSQUITTO" -c "$TMP/broker.conf" >>"$TMP/broker.log" 2>&1 &
+  BROKER_PID=$!
+  local i
+  for ((i = 0; i < 100; i++)); do
+    mosquitto_pub -h 127.0.0.1 -p "$PLAIN" -u watcher -P watcher-secret -t ping -m x \
+      2>/dev/null && return 0
+    sleep 0.1
+  done
+  return 1
+}
+stop_broker() {
+  kill "$BROKER_PID" 2>/dev/null
+  wait "$BROKER_PID" 2>/dev/null
+  BROKER_PID=
+}
+WATCH=(-h 127.0.0.1 -p "$PLAIN" -u watcher -P watcher-secret)
+if ! start_broker; then
+  fail "mqtt: the broker starts" "$(tail -n 3 "$TMP/broker.log")"
+  echo "$PASSED passed, $FAILED failed"
+  exit 1
+fi
+
+# 1. TLS and a password; the broker stops in the middle of the replay and starts again while
+#    the alarm events happen: all of them arrive, in order, as the alarm lines say.
+cat >"$TMP/box.toml" <<EOF
+[mqtt]
+broker = "127.0.0.1:$TLS"
+box_id = "b1"
+username = "box"
+password_file = "box.pw"
+tls_ca_file = "ca.crt"
+reconnect_min_s = 0.1
+reconnect_max_s = 0.5
+state_interval_s = 0.2
+EOF
+mosquitto_sub "${WATCH[@]}" -c -i watcher -q 1 -v -t 'plinth/b1/events' \
+  >"$TMP/events.out" 2>"$TMP/events.err" &
+WATCHER=$!
+sleep 1
+"$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
+  --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
+BOX=$!
+if wait_for "$TMP/box.out" '"level": "normal"' 30; then
+  stop_broker
+  # The advisory, warning and alarm events happen while the broker is away.
+  wait_for "$TMP/box.out" '"level": "alarm", "previous"' 30
+  sleep 1
+  start_broker || fail "mqtt: the broker starts again" "$(tail -n 3 "$TMP/broker.log")"
+else
+  fail "mqtt: replay" "no normal level within 30 s"
+fi
+wait "$BOX"
+rc=$?
+BOX=
+sleep 2
+kill "$WATCHER" 2>/dev/null
+wait "$WATCHER" 2>/dev/null
+problem=$(python3 - "$TMP/box.out" "$TMP/events.out" <<'PY'
+import json, sys
+lines = open(sys.argv[1]).read().splitlines()
+alarms = [l for l in lines if l.startswith('{"type": "alarm"')]
+received = [l.split(" ", 1)[1] for l in open(sys.argv[2]).read().splitlines()]
+assert len(alarms) == 5, "the replay gave %d alarm lines" % len(alarms)
+assert received == alarms, "received %d events %s, the box wrote %s" % (
+    len(received), [json.loads(r)["sequence"] for r in received],
+    [json.loads(a)["sequence"] for a in alarms])
+mqtt = json.loads(lines[-1])["mqtt"]
+assert mqtt["connects"] >= 2 and mqtt["connections_lost"] >= 1, mqtt
+assert mqtt["events_published"] == 5 and mqtt["events_dropped"] == 0, mqtt
+assert mqtt["most_queued"] >= 3, mqtt
+PY
+)
+if ((rc == 0)) && [[ -z "$problem" ]]; then
+  pass "mqtt: TLS, password; every alarm line arrives in order across a broker restart"
+else
+  fail "mqtt: broker restart" "exit $rc; $problem; stderr: $(head -c 300 "$TMP/box.err")"
+fi
+if grep -q "lost" "$TMP/box.err" && grep -q "connected to 127.0.0.1:$TLS" "$TMP/box.err"; then
+  pass "mqtt: the lost connection and the reconnection are reported"
+else
+  fail "mqtt: reconnect messages" "$(head -c 300 "$TMP/box.err")"
+fi
+mosquitto_sub "${WATCH[@]}" -C 2 -W 5 -v -t plinth/b1/state -t plinth/b1/availability \
+  >"$TMP/retained.out" 2>&1
+problem=$(python3 - "$TMP/retained.out" "$TMP/box.out" <<'PY'
+import json, sys
+got = dict(l.split(" ", 1) for l in open(sys.argv[1]).read().splitlines())
+assert got.get("plinth/b1/availability") == "offline", got
+state = json.loads(got["plinth/b1/state"])
+status = [json.loads(l) for l in open(sys.argv[2]) if l.startswith('{"type": "status"')][-1]
+assert state["box"] == "b1" and state["level"] == status["alarm"] == "alarm", state
+assert state["latched"] == "alarm" and state["cause"] == "risk_threshold", state
+assert state["phase"] == {"x": status["phase"]} and state["risk"] == status["risk"], state
+assert state["time"].endswith("Z") and abs(state["t"] - status["t"]) < 0.2, state
+PY
+)
+if [[ -z "$problem" ]]; then pass "mqtt: the retained state is the last status; offline after a clean stop"
+else fail "mqtt: retained state" "$problem"; fi
+
+# 2. The Last Will: the box killed (-9) while connected on the plain listener.
+"$BIN" --scene "$ISOLATED" --replay "$AT2" --speed 1 --no-events --mqtt "127.0.0.1:$PLAIN" \
+  --mqtt-box-id b2 --mqtt-username box --mqtt-password-file "$TMP/box.pw" \
+  >"$TMP/box2.out" 2>"$TMP/box2.err" &
+BOX=$!
+online=""
+for ((i = 0; i < 100; i++)); do
+  online=$(mosquitto_sub "${WATCH[@]}" -C 1 -W 1 -t plinth/b2/availability 2>/dev/null)
+  [[ "$online" == online ]] && break
+  sleep 0.1
+done
+kill -9 "$BOX"
+wait "$BOX" 2>/dev/null
+BOX=
+sleep 0.5
+will=$(mosquitto_sub "${WATCH[@]}" -C 1 -W 5 -t plinth/b2/availability 2>/dev/null)
+if [[ "$online" == online && "$will" == offline ]]; then
+  pass "mqtt: availability online, then the Last Will says offline after kill -9"
+else
+  fail "mqtt: Last Will" "availability '$online' while running, '$will' after kill -9"
+fi
+
+# 3. A wrong password: refused with a clear message; the box goes on with its work.
+expect_success "mqtt: a wrong password does not stop the box" --scene "$ISOLATED" \
+  --replay "$AT2" --no-events --mqtt "127.0.0.1:$PLAIN" --mqtt-box-id b3 \
+  --mqtt-username box --mqtt-password-file "$TMP/wrong.pw" && true
+if grep -qE "refused the connection: (bad user name or password|not authorised)" "$TMP/stderr" &&
+  grep -q -- "--mqtt" "$TMP/stderr"; then
+  pass "mqtt: the wrong password is refused with a clear message"
+else
+  fail "mqtt: wrong password" "stderr: $(head -c 300 "$TMP/stderr")"
+fi
+stop_broker
+
+# 4. Bad settings.
+run_args=(--scene "$ISOLATED" --replay "$AT2")
+expect_failure "mqtt: broker without a port" "--mqtt" "HOST:PORT" -- \
+  "${run_args[@]}" --mqtt localhost
+expect_failure "mqtt: a CA file that does not exist" "mqtt.tls_ca_file" "--mqtt-ca" \
+  "no-such-ca.crt" -- "${run_args[@]}" --mqtt 127.0.0.1:1883 --mqtt-ca "$TMP/no-such-ca.crt"
+expect_failure "mqtt: a password file that does not exist" "mqtt.password_file" \
+  "--mqtt-password-file" -- "${run_args[@]}" --mqtt 127.0.0.1:1883 --mqtt-username box \
+  --mqtt-password-file "$TMP/no-such.pw"
+expect_failure "mqtt: a box id with a slash" "--mqtt-box-id" "topic level" -- \
+  "${run_args[@]}" --mqtt 127.0.0.1:1883 --mqtt-box-id a/b
+printf '[mqtt]\nbroker = "127.0.0.1:1883"\nevent_queue = 0\n' >"$TMP/bad.toml"
+expect_failure "mqtt: event_queue out of range" "bad.toml:3" "mqtt.event_queue" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+printf '[mqtt]\nbroker = "127.0.0.1"\n' >"$TMP/bad.toml"
+expect_failure "mqtt: broker without a port in the file" "bad.toml:2" "mqtt.broker" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+printf '[mqtt]\nbroker = "127.0.0.1:1883"\ntls_cert_file = "c.pem"\n' >"$TMP/bad.toml"
+expect_failure "mqtt: a certificate that does not exist" "mqtt.tls_cert_file" "c.pem" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+
+echo "$PASSED passed, $FAILED failed"
+((FAILED == 0))
