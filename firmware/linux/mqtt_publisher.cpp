@@ -52,6 +52,13 @@ std::string utc_text(std::int64_t wall_ns) {
   return text;
 }
 
+// libmosquitto's text of `rc` (errno's for MOSQ_ERR_ERRNO), without its final period.
+std::string error_text(int rc) {
+  std::string text = rc == MOSQ_ERR_ERRNO ? std::strerror(errno) : mosquitto_strerror(rc);
+  if (!text.empty() && text.back() == '.') text.pop_back();
+  return text;
+}
+
 std::string connack_text(int rc) {
   switch (rc) {
     case 1:
@@ -235,9 +242,7 @@ void MqttPublisher::try_connect(std::int64_t now_ns) {
     return;
   }
   ++connect_failures_;
-  lost(std::string("cannot reach the broker at ") + endpoint_text_ + ": " +
-           (rc == MOSQ_ERR_ERRNO ? std::strerror(errno) : mosquitto_strerror(rc)),
-       now_ns);
+  lost("cannot reach the broker at " + endpoint_text_ + ": " + error_text(rc), now_ns);
 }
 
 // The connection is gone: say why (once), and try again after the back-off.
@@ -246,7 +251,8 @@ void MqttPublisher::lost(const std::string& why, std::int64_t now_ns) {
   socket_open_ = false;
   if (why != last_problem_) {
     char retry[48];
-    std::snprintf(retry, sizeof retry, "; retrying every %g s at most", settings_.reconnect_max_s);
+    std::snprintf(retry, sizeof retry, "; retrying (back-off up to %g s)",
+                  settings_.reconnect_max_s);
     say(why + retry);
   }
   last_problem_ = why;
@@ -323,10 +329,8 @@ void MqttPublisher::run() {
     }
     const int rc = mosquitto_loop(client_, kLoopTimeoutMs, 1);
     if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED) {
-      if (connected_) ++connections_lost_;
-      lost(std::string("connection to ") + endpoint_text_ +
-               " lost: " + (rc == MOSQ_ERR_ERRNO ? std::strerror(errno) : mosquitto_strerror(rc)),
-           now);
+      // on_disconnect counted it.
+      lost("connection to " + endpoint_text_ + " lost: " + error_text(rc), now);
     } else if (rc == MOSQ_ERR_CONN_REFUSED) {
       lost(last_problem_, now);
     }
