@@ -85,6 +85,9 @@ extern "C" void disconnect_callback(mosquitto*, void* self, int rc) {
 extern "C" void publish_callback(mosquitto*, void* self, int mid) {
   static_cast<MqttPublisher*>(self)->on_publish(mid);
 }
+extern "C" void log_callback(mosquitto*, void* self, int level, const char* text) {
+  if ((level & MOSQ_LOG_ERR) != 0) static_cast<MqttPublisher*>(self)->on_error_log(text);
+}
 
 }  // namespace
 
@@ -148,6 +151,7 @@ MqttPublisher::MqttPublisher(const MqttSettings& settings) : settings_(settings)
   mosquitto_connect_callback_set(client_, connect_callback);
   mosquitto_disconnect_callback_set(client_, disconnect_callback);
   mosquitto_publish_callback_set(client_, publish_callback);
+  mosquitto_log_callback_set(client_, log_callback);
   backoff_s_ = settings_.reconnect_min_s;
   thread_ = std::thread([this] { run(); });
 }
@@ -183,8 +187,12 @@ void MqttPublisher::on_connect(int rc) {
 }
 
 void MqttPublisher::on_disconnect(int rc) {
+  if (connected_ && rc != 0 && !stopping_.load()) ++connections_lost_;
   connected_ = false;
-  if (rc != 0 && !stopping_.load()) ++connections_lost_;
+}
+
+void MqttPublisher::on_error_log(const char* text) {
+  if (text != nullptr) error_log_ = text;
 }
 
 void MqttPublisher::on_publish(int mid) {
@@ -246,9 +254,9 @@ void MqttPublisher::try_connect(std::int64_t now_ns) {
 }
 
 // The connection is gone: say why (once), and try again after the back-off.
-void MqttPublisher::lost(const std::string& why, std::int64_t now_ns) {
-  connected_ = false;
-  socket_open_ = false;
+void MqttPublisher::lost(const std::string& reason, std::int64_t now_ns) {
+  // libmosquitto's own error (a TLS certificate refused, ...) says more.
+  const std::string why = error_log_.empty() ? reason : reason + " (" + error_log_ + ")";
   if (why != last_problem_) {
     char retry[48];
     std::snprintf(retry, sizeof retry, "; retrying (back-off up to %g s)",
@@ -256,6 +264,13 @@ void MqttPublisher::lost(const std::string& why, std::int64_t now_ns) {
     say(why + retry);
   }
   last_problem_ = why;
+  back_off(now_ns);
+}
+
+void MqttPublisher::back_off(std::int64_t now_ns) {
+  connected_ = false;
+  socket_open_ = false;
+  error_log_.clear();
   next_attempt_ns_ = now_ns + ns_of(backoff_s_);
   backoff_s_ = std::min(2.0 * backoff_s_, settings_.reconnect_max_s);
 }
@@ -332,7 +347,7 @@ void MqttPublisher::run() {
       // on_disconnect counted it.
       lost("connection to " + endpoint_text_ + " lost: " + error_text(rc), now);
     } else if (rc == MOSQ_ERR_CONN_REFUSED) {
-      lost(last_problem_, now);
+      back_off(now);  // on_connect said why
     }
   }
   say_offline();

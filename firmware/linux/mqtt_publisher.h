@@ -45,6 +45,7 @@ class MqttPublisher final : public StatusOutput {
   void on_connect(int rc);
   void on_disconnect(int rc);
   void on_publish(int mid);
+  void on_error_log(const char* text);
 
  private:
   struct QueuedEvent {
@@ -57,7 +58,8 @@ class MqttPublisher final : public StatusOutput {
   void try_connect(std::int64_t now_ns);
   void publish_head(std::int64_t now_ns);
   void publish_state(std::int64_t now_ns);
-  void lost(const std::string& why, std::int64_t now_ns);
+  void lost(const std::string& reason, std::int64_t now_ns);
+  void back_off(std::int64_t now_ns);
   void say_offline();
   [[nodiscard]] bool publish(const std::string& topic, const std::string& payload, bool retain,
                              int* mid);
@@ -79,6 +81,7 @@ class MqttPublisher final : public StatusOutput {
   std::int64_t next_attempt_ns_ = 0;
   double backoff_s_ = 0.0;
   std::string last_problem_;  // the latest message printed (printed again only when it changes)
+  std::string error_log_;     // libmosquitto's latest error log line since the last message
   std::deque<QueuedEvent> queue_;
   std::int64_t head_sent_ns_ = 0;  // when the head event was last published
   StatusSnapshot state_;

@@ -75,56 +75,67 @@ if ! start_broker; then
   exit 1
 fi
 
-# 1. TLS and a password; the broker stops in the middle of the replay and starts again while
-#    the alarm events happen: all of them arrive, in order, as the alarm lines say.
-cat >"$TMP/box.toml" <<EOF
-[mqtt]
-broker = "127.0.0.1:$TLS"
-box_id = "b1"
-username = "box"
-password_file = "box.pw"
-tls_ca_file = "ca.crt"
-reconnect_min_s = 0.1
-reconnect_max_s = 0.5
-state_interval_s = 0.2
-EOF
-mosquitto_sub "${WATCH[@]}" -c -i watcher -q 1 -v -t 'plinth/b1/events' \
-  >"$TMP/events.out" 2>"$TMP/events.err" &
-WATCHER=$!
-sleep 1
-"$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
-  --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
-BOX=$!
-if wait_for "$TMP/box.out" '"level": "normal"' 30; then
-  stop_broker
-  # The advisory, warning and alarm events happen while the broker is away.
-  wait_for "$TMP/box.out" '"level": "alarm", "previous"' 30
+# restart_replay BOX_ID [KEY = VALUE lines]: Brienza x20 at --speed 2 through a box on the TLS
+# listener with a password; the broker stops once the level is back to normal and starts again
+# after the alarm, so the advisory, warning and alarm events happen while it is away. A
+# persistent subscriber takes the events topic. Sets rc; leaves $TMP/box.out, box.err and
+# events.out.
+restart_replay() {
+  local box=$1
+  shift
+  printf '[mqtt]\nbroker = "127.0.0.1:%s"\nbox_id = "%s"\nusername = "box"\n' "$TLS" "$box" \
+    >"$TMP/box.toml"
+  printf '%s\n' 'password_file = "box.pw"' 'tls_ca_file = "ca.crt"' 'reconnect_min_s = 0.1' \
+    'reconnect_max_s = 0.5' 'state_interval_s = 0.2' "$@" >>"$TMP/box.toml"
+  mosquitto_sub "${WATCH[@]}" -c -i "watcher-$box" -q 1 -v -t "plinth/$box/events" \
+    >"$TMP/events.out" 2>"$TMP/events.err" &
+  local watcher=$!
   sleep 1
-  start_broker || fail "mqtt: the broker starts again" "$(tail -n 3 "$TMP/broker.log")"
-else
-  fail "mqtt: replay" "no normal level within 30 s"
-fi
-wait "$BOX"
-rc=$?
-BOX=
-sleep 2
-kill "$WATCHER" 2>/dev/null
-wait "$WATCHER" 2>/dev/null
-problem=$(python3 - "$TMP/box.out" "$TMP/events.out" <<'PY'
+  "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
+    --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
+  BOX=$!
+  if wait_for "$TMP/box.out" '"level": "normal"' 30; then
+    stop_broker
+    wait_for "$TMP/box.out" '"level": "alarm", "previous"' 30
+    sleep 1
+    start_broker || fail "mqtt: the broker starts again" "$(tail -n 3 "$TMP/broker.log")"
+  else
+    fail "mqtt: replay" "no normal level within 30 s"
+  fi
+  wait "$BOX"
+  rc=$?
+  BOX=
+  sleep 2
+  kill "$watcher" 2>/dev/null
+  wait "$watcher" 2>/dev/null
+}
+
+# check_events PYTHON: the alarm lines of box.out (alarms), the payloads received (received)
+# and the summary's mqtt object (mqtt); prints the failed assertion.
+check_events() {
+  python3 - "$TMP/box.out" "$TMP/events.out" "$1" <<'PY'
 import json, sys
 lines = open(sys.argv[1]).read().splitlines()
 alarms = [l for l in lines if l.startswith('{"type": "alarm"')]
 received = [l.split(" ", 1)[1] for l in open(sys.argv[2]).read().splitlines()]
-assert len(alarms) == 5, "the replay gave %d alarm lines" % len(alarms)
-assert received == alarms, "received %d events %s, the box wrote %s" % (
-    len(received), [json.loads(r)["sequence"] for r in received],
-    [json.loads(a)["sequence"] for a in alarms])
 mqtt = json.loads(lines[-1])["mqtt"]
+seq = lambda ls: [json.loads(l)["sequence"] for l in ls]
+try:
+    assert len(alarms) == 5, "the replay gave %d alarm lines" % len(alarms)
+    exec(sys.argv[3])
+except AssertionError as e:
+    print(e)
+PY
+}
+
+# 1. Every alarm line arrives, in order, across the broker restart.
+restart_replay b1
+problem=$(check_events '
+assert received == alarms, "received events %s, the box wrote %s" % (seq(received), seq(alarms))
 assert mqtt["connects"] >= 2 and mqtt["connections_lost"] >= 1, mqtt
 assert mqtt["events_published"] == 5 and mqtt["events_dropped"] == 0, mqtt
 assert mqtt["most_queued"] >= 3, mqtt
-PY
-)
+')
 if ((rc == 0)) && [[ -z "$problem" ]]; then
   pass "mqtt: TLS, password; every alarm line arrives in order across a broker restart"
 else
@@ -151,6 +162,32 @@ PY
 )
 if [[ -z "$problem" ]]; then pass "mqtt: the retained state is the last status; offline after a clean stop"
 else fail "mqtt: retained state" "$problem"; fi
+
+# 1b. A queue of 2: of the three events held while the broker is away, the oldest is dropped
+#     and counted; the others arrive in order.
+restart_replay b4 'event_queue = 2'
+problem=$(check_events '
+assert received == alarms[:2] + alarms[3:], "received %s of %s" % (seq(received), seq(alarms))
+assert mqtt["events_dropped"] == 1 and mqtt["events_published"] == 4, mqtt
+assert mqtt["most_queued"] == 2, mqtt
+')
+if ((rc == 0)) && [[ -z "$problem" ]]; then
+  pass "mqtt: a full queue drops its oldest event and counts it"
+else
+  fail "mqtt: bounded queue" "exit $rc; $problem"
+fi
+
+# 1c. A broker certificate the box's CA did not sign: refused, with OpenSSL's reason.
+openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 2 \
+  -subj "/CN=another CA" -keyout "$TMP/other.key" -out "$TMP/other.crt" 2>/dev/null
+expect_success "mqtt: a broker certificate from another CA does not stop the box" \
+  --scene "$ISOLATED" --replay "$AT2" --no-events --mqtt "127.0.0.1:$TLS" --mqtt-box-id b5 \
+  --mqtt-username box --mqtt-password-file "$TMP/box.pw" --mqtt-ca "$TMP/other.crt" && true
+if grep -qi "certificate verify failed" "$TMP/stderr"; then
+  pass "mqtt: the certificate is refused with OpenSSL's reason"
+else
+  fail "mqtt: wrong CA" "stderr: $(head -c 300 "$TMP/stderr")"
+fi
 
 # 2. The Last Will: the box killed (-9) while connected on the plain listener.
 "$BIN" --scene "$ISOLATED" --replay "$AT2" --speed 1 --no-events --mqtt "127.0.0.1:$PLAIN" \
