@@ -17,6 +17,8 @@ packages=(
   gcc-arm-none-eabi libnewlib-arm-none-eabi libstdc++-arm-none-eabi-newlib  # Cortex-M4F image
   qemu-system-arm                                                            # runs it
   libgpiod-dev libsystemd-dev systemd  # relays (libgpiod), sd_notify; systemd-analyze tests the unit
+  libmodbus-dev mbpoll  # plinth-monitor's Modbus TCP server, tested with mbpoll (docs/integration.md)
+  libmosquitto-dev mosquitto mosquitto-clients openssl  # its MQTT publisher, tested on a broker
   clang-14 libclang-rt-14-dev  # the sanitize preset: ASan + UBSan and libFuzzer (docs/fuzzing.md)
 )
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -13,6 +14,7 @@
 
 #include "plinth/host/input_error.h"
 #include "plinth/host/text_file.h"
+#include "status_outputs.h"
 
 namespace plinth::firmware {
 
@@ -149,6 +151,31 @@ void relay_bindings(std::vector<Binding>& b, RelaySettings& relays,
   }
 }
 
+// The outputs' keys ([modbus], [mqtt]; docs/integration.md).
+void output_bindings(std::vector<Binding>& b, ModbusSettings& modbus, MqttSettings& mqtt) {
+  constexpr const char* kEndpoint = "a string, \"HOST:PORT\"";
+  b.push_back({"modbus.listen", string_into(modbus.listen), kEndpoint});
+  b.push_back({"modbus.writes", flag_into(modbus.writes), "true or false"});
+  b.push_back({"modbus.max_clients", integer_into(modbus.max_clients), "an integer"});
+  b.push_back({"mqtt.broker", string_into(mqtt.broker), kEndpoint});
+  const std::pair<const char*, std::string*> strings[] = {
+      {"mqtt.box_id", &mqtt.box_id},
+      {"mqtt.topic_prefix", &mqtt.topic_prefix},
+      {"mqtt.username", &mqtt.username},
+      {"mqtt.password", &mqtt.password},
+      {"mqtt.password_file", &mqtt.password_file},
+      {"mqtt.tls_ca_file", &mqtt.ca_file},
+      {"mqtt.tls_cert_file", &mqtt.cert_file},
+      {"mqtt.tls_key_file", &mqtt.key_file},
+  };
+  for (const auto& [key, target] : strings) b.push_back({key, string_into(*target), "a string"});
+  b.push_back({"mqtt.keepalive_s", integer_into(mqtt.keepalive_s), "an integer"});
+  b.push_back({"mqtt.event_queue", integer_into(mqtt.event_queue), "an integer"});
+  b.push_back({"mqtt.state_interval_s", number_into(mqtt.state_interval_s), "a number"});
+  b.push_back({"mqtt.reconnect_min_s", number_into(mqtt.reconnect_min_s), "a number"});
+  b.push_back({"mqtt.reconnect_max_s", number_into(mqtt.reconnect_max_s), "a number"});
+}
+
 std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
                               std::array<bool, kRelayCount>& relay_active_low) {
   MonitorConfig& c = f.config;
@@ -192,6 +219,7 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
   b.push_back({"watchdog.notify", flag_into(f.watchdog.notify), "true or false"});
   b.push_back({"watchdog.test_stall_after_s", number_into(f.watchdog.test_stall_after_s),
                "a number (s; test only)"});
+  output_bindings(b, f.modbus, f.mqtt);
   for (auto [name, thresholds] : {std::pair<const char*, monitor::RiskThresholds*>{"advisory", &alarm.advisory},
                                   {"warning", &alarm.warning},
                                   {"alarm", &alarm.alarm},
@@ -390,6 +418,69 @@ void check(const MonitorConfig& config, const KeyLines& lines) {
   lines.fail(at, cat(key, ": ", e.reason));
 }
 
+std::string number_text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
+// A file key's path, relative to the file's folder.
+void resolve_path(std::string& path, const std::string& origin) {
+  const std::filesystem::path p(path);
+  if (!path.empty() && p.is_relative()) {
+    path = (std::filesystem::path(origin).parent_path() / p).string();
+  }
+}
+
+// A topic level: not empty, no wildcard; `slashes`: may hold several levels.
+bool topic_part(const std::string& text, bool slashes) {
+  if (text.empty() || text.front() == '/' || text.back() == '/') return false;
+  return text.find_first_of(slashes ? "+#" : "+#/") == std::string::npos &&
+         text.find("//") == std::string::npos;
+}
+
+// The [modbus] and [mqtt] keys: addresses, ranges, topic parts; paths resolved.
+void check_outputs(MonitorFile& file, const KeyLines& lines, const std::string& origin) {
+  ModbusSettings& modbus = file.modbus;
+  MqttSettings& mqtt = file.mqtt;
+  if (lines.has("modbus.listen")) {
+    modbus.listen_where = cat(lines.where("modbus.listen"), ": modbus.listen");
+    (void)parse_endpoint(modbus.listen, modbus.listen_where);
+  }
+  if (modbus.max_clients < 1 || modbus.max_clients > 64) {
+    lines.fail("modbus.max_clients", "modbus.max_clients: must lie in [1, 64]");
+  }
+  if (lines.has("mqtt.broker")) {
+    mqtt.broker_where = cat(lines.where("mqtt.broker"), ": mqtt.broker");
+    (void)parse_endpoint(mqtt.broker, mqtt.broker_where);
+  }
+  if (lines.has("mqtt.box_id") && !topic_part(mqtt.box_id, false)) {
+    lines.fail("mqtt.box_id", "mqtt.box_id: expected one topic level (no '/', '+' or '#')");
+  }
+  if (!topic_part(mqtt.topic_prefix, true)) {
+    lines.fail("mqtt.topic_prefix",
+               "mqtt.topic_prefix: expected topic levels (no '+' or '#', no empty level)");
+  }
+  const auto range = [&](const char* key, double value, double low, double high) {
+    if (!(value >= low && value <= high)) {
+      lines.fail(key, cat(key, ": must lie in [", number_text(low), ", ", number_text(high), "]"));
+    }
+  };
+  range("mqtt.keepalive_s", mqtt.keepalive_s, 5, 3600);
+  range("mqtt.event_queue", mqtt.event_queue, 1, 100000);
+  range("mqtt.state_interval_s", mqtt.state_interval_s, 0.001, 3600);
+  range("mqtt.reconnect_min_s", mqtt.reconnect_min_s, 0.01, 3600);
+  range("mqtt.reconnect_max_s", mqtt.reconnect_max_s, mqtt.reconnect_min_s, 3600);
+  if (!mqtt.password.empty() && !mqtt.password_file.empty()) {
+    lines.fail("mqtt.password",
+               "mqtt.password: give mqtt.password or mqtt.password_file, not both");
+  }
+  for (std::string* path : {&mqtt.password_file, &mqtt.ca_file, &mqtt.cert_file, &mqtt.key_file}) {
+    resolve_path(*path, origin);
+  }
+  mqtt.files_where = origin;
+}
+
 }  // namespace
 
 MonitorFile load_monitor_text(const std::string& text, const std::string& origin,
@@ -430,6 +521,7 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
                "watchdog.test_stall_after_s: must be a finite number of seconds >= 0");
   }
   check(file.config, lines);
+  check_outputs(file, lines, origin);
   return file;
 }
 
@@ -439,6 +531,41 @@ MonitorFile load_monitor_file(const std::string& path, const MonitorConfig& defa
   return load_monitor_text(host::read_text_file(path, kMaxConfigBytes, "configuration file"), path,
                            defaults);
 }
+
+namespace {
+
+// The [modbus] and [mqtt] flags over the file's keys.
+void apply_output_overrides(MonitorFile& file, const MonitorOverrides& o) {
+  if (!o.modbus_listen.empty()) {
+    file.modbus.listen = o.modbus_listen;
+    file.modbus.listen_where = "--modbus";
+    (void)parse_endpoint(o.modbus_listen, "--modbus");
+  }
+  if (o.modbus_writes) file.modbus.writes = true;
+  MqttSettings& mqtt = file.mqtt;
+  if (!o.mqtt_broker.empty()) {
+    mqtt.broker = o.mqtt_broker;
+    mqtt.broker_where = "--mqtt";
+    (void)parse_endpoint(o.mqtt_broker, "--mqtt");
+  }
+  if (!o.mqtt_box_id.empty()) {
+    if (!topic_part(o.mqtt_box_id, false)) {
+      throw InputError("--mqtt-box-id: expected one topic level (no '/', '+' or '#'), got \"" +
+                       o.mqtt_box_id + "\"");
+    }
+    mqtt.box_id = o.mqtt_box_id;
+  }
+  if (!o.mqtt_username.empty()) mqtt.username = o.mqtt_username;
+  if (!o.mqtt_password_file.empty()) {
+    mqtt.password_file = o.mqtt_password_file;
+    mqtt.password.clear();
+  }
+  if (!o.mqtt_ca_file.empty()) mqtt.ca_file = o.mqtt_ca_file;
+  if (!o.mqtt_cert_file.empty()) mqtt.cert_file = o.mqtt_cert_file;
+  if (!o.mqtt_key_file.empty()) mqtt.key_file = o.mqtt_key_file;
+}
+
+}  // namespace
 
 void apply_overrides(MonitorFile& file, const MonitorOverrides& o) {
   MonitorConfig& config = file.config;
@@ -479,6 +606,7 @@ void apply_overrides(MonitorFile& file, const MonitorOverrides& o) {
       h.stuck_samples = *o.stuck_samples;
     });
   }
+  apply_output_overrides(file, o);
 }
 
 MonitorFile configure_monitor(const MonitorOverrides& overrides) {

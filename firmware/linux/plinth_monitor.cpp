@@ -6,6 +6,7 @@
 // status and alarm frames also go on the bus; a replay writes them to a candump log with
 // --frames-out.
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -18,7 +19,11 @@
 
 #include "event_recorder.h"
 #include "inputs.h"
+#include "latency_log.h"
+#include "modbus_server.h"
 #include "monitor_config.h"
+#include "mqtt_publisher.h"
+#include "plinth/firmware/can_frames.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/hal/pacing.h"
@@ -56,6 +61,7 @@ struct Options {
   double pre_trigger = 30.0;
   double post_trigger = 60.0;
   bool quiet_events = false;
+  bool latency = false;
   fw::MonitorOverrides config;  // --config and the options that override it
 };
 
@@ -98,12 +104,22 @@ class AxisEvents final : public plinth::EventSink {
 };
 
 // What follows each update: its frames on the bus (live), alarm lines, recorder triggers,
-// the status line when the monitor reports a status; and the run's totals.
+// the status line when the monitor reports a status, a snapshot and the alarm events for the
+// outputs off the loop (status_outputs.h); and the run's totals.
 class Outputs {
  public:
   Outputs(const fw::Monitor& monitor, double t_origin, fw::EventRecorder* recorder,
-          plinth::hal::FrameSink* bus, fw::RelayOutputs* relays)
-      : monitor_(monitor), t_origin_(t_origin), recorder_(recorder), bus_(bus), relays_(relays) {}
+          plinth::hal::FrameSink* bus, fw::RelayOutputs* relays,
+          std::vector<fw::StatusOutput*> outputs)
+      : monitor_(monitor),
+        t_origin_(t_origin),
+        recorder_(recorder),
+        bus_(bus),
+        relays_(relays),
+        outputs_(std::move(outputs)),
+        start_ns_(fw::monotonic_ns()) {
+    post_snapshot();
+  }
 
   void handle(const fw::MonitorUpdate& u) {
     const fw::MonitorStatus& s = monitor_.status();
@@ -127,9 +143,50 @@ class Outputs {
         totals.max_level = e.level;
       }
       if (e.level == mon::AlarmLevel::kWarning || e.level == mon::AlarmLevel::kAlarm) trigger(e);
+      post_alarm(e);
     }
-    if (u.status_due) print_line(fw::status_json(s, t_origin_));
+    if (u.status_due) {
+      print_line(fw::status_json(s, t_origin_));
+      ++snapshot_.statuses;
+    }
     if (trace != nullptr) trace->after_update(monitor_);
+    post_snapshot();
+  }
+
+  // The outputs' operator commands, carried out on the loop: an acknowledgement as the bus's
+  // Acknowledge frame would bring it; a reset starts the monitor again (`restart`).
+  template <typename Restart>
+  void carry_out_commands(fw::Monitor& monitor, Restart restart) {
+    for (fw::StatusOutput* output : outputs_) {
+      fw::CommandRequest c;
+      while (output->mailbox().take_command(c)) {
+        ++snapshot_.commands;
+        if (c.command == fw::OperatorCommand::kReset) {
+          restart();
+          ++snapshot_.resets;
+          snapshot_.any_event = false;
+          snapshot_.cause = mon::AlarmCause::kNone;
+          print_line(fw::JsonObject()
+                         .text("type", "command")
+                         .text("command", "reset")
+                         .text("source", output->name())
+                         .close());
+          post_snapshot();
+          continue;
+        }
+        const fw::MonitorUpdate u = monitor.on_frame(acknowledge_frame(c));
+        snapshot_.last_ack = u.acknowledgement;
+        print_line(fw::JsonObject()
+                       .text("type", "command")
+                       .text("command", "acknowledge")
+                       .text("source", output->name())
+                       .text("level", mon::alarm_level_name(c.level))
+                       .count("sequence", c.event_sequence)
+                       .text("outcome", mon::ack_outcome_name(u.acknowledgement))
+                       .close());
+        handle(u);
+      }
+    }
   }
 
   fw::RunTotals totals;
@@ -151,11 +208,44 @@ class Outputs {
     recorder_->trigger(info, last_frame_ns);
   }
 
+  void post_alarm(const mon::AlarmEventRecord& e) {
+    snapshot_.cause = e.cause;
+    snapshot_.event_sequence = e.sequence;
+    snapshot_.any_event = true;
+    for (fw::StatusOutput* output : outputs_) output->mailbox().post_alarm({e, t_origin_});
+  }
+
+  void post_snapshot() {
+    if (outputs_.empty()) return;
+    fw::copy_status(monitor_, t_origin_, snapshot_);
+    ++snapshot_.updates;
+    snapshot_.wall_time_ns = fw::wall_clock_ns();
+    snapshot_.uptime_ns = fw::monotonic_ns() - start_ns_;
+    for (fw::StatusOutput* output : outputs_) output->mailbox().post_status(snapshot_);
+  }
+
+  // The Acknowledge frame of a command (source id kCommandSourceId), at the newest frame's time.
+  plinth::hal::TimedFrame acknowledge_frame(const fw::CommandRequest& c) const {
+    plinth::can::Acknowledge message;
+    message.level = fw::to_wire(c.level);
+    message.source_id = kCommandSourceId;
+    message.event_sequence = c.event_sequence;
+    plinth::hal::TimedFrame frame;
+    frame.timestamp_ns = last_frame_ns;
+    (void)plinth::can::encode(message, frame.frame);  // every level and sequence encodes
+    return frame;
+  }
+
+  static constexpr std::uint8_t kCommandSourceId = 0xF0;  // the box's own outputs
+
   const fw::Monitor& monitor_;
   double t_origin_;
   fw::EventRecorder* recorder_;
   plinth::hal::FrameSink* bus_;
   fw::RelayOutputs* relays_;
+  std::vector<fw::StatusOutput*> outputs_;
+  std::int64_t start_ns_;
+  fw::StatusSnapshot snapshot_;
 };
 
 // The monitor takes one input item.
@@ -216,12 +306,22 @@ std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings)
 }
 
 // Takes the input until it ends or a signal; systemd's watchdog hears of every item taken.
+// The loop: each input item taken, its latency noted (--latency), the network outputs' operator
+// commands carried out, the watchdog told of the progress.
+template <typename Restart>
 void run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
-              fw::EventRecorder* recorder, fw::Supervisor& supervisor) {
+              fw::EventRecorder* recorder, fw::Supervisor& supervisor, fw::LatencyLog* latency,
+              Restart restart) {
   supervisor.ready("monitoring " + input.source());
   fw::InputItem item;
   while (g_stop == 0 && input.next(item)) {
+    const std::int64_t arrival_ns = latency != nullptr ? fw::monotonic_ns() : 0;
     take(item, monitor, outputs, recorder);
+    if (latency != nullptr && item.kind != fw::InputItem::Kind::kTick &&
+        item.kind != fw::InputItem::Kind::kBusFault) {
+      latency->add(fw::monotonic_ns() - arrival_ns);
+    }
+    outputs.carry_out_commands(monitor, restart);
     const std::int64_t now_ns = plinth::hal::monotonic_now_ns();
     if (supervisor.stall_due(now_ns)) fw::Supervisor::stall(g_stop);  // test only
     supervisor.on_progress(now_ns);
@@ -265,6 +365,19 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
   return t;
 }
 
+// Samples whose latency --latency keeps (4 bytes each); later ones are counted only.
+constexpr std::size_t kLatencyCapacity = std::size_t{1} << 22;
+
+// The outputs off the loop that the configuration enables.
+std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFile& file) {
+  std::vector<std::unique_ptr<fw::StatusOutput>> outputs;
+  if (!file.modbus.listen.empty()) {
+    outputs.push_back(std::make_unique<fw::ModbusServer>(file.modbus));
+  }
+  if (!file.mqtt.broker.empty()) outputs.push_back(std::make_unique<fw::MqttPublisher>(file.mqtt));
+  return outputs;
+}
+
 int run(const Options& opt) {
   const int sources = (opt.replay_path.empty() ? 0 : 1) + (opt.can_interface.empty() ? 0 : 1);
   if (sources != 1) throw InputError("give exactly one input: --replay FILE or --can INTERFACE");
@@ -303,20 +416,36 @@ int run(const Options& opt) {
     frames_log.emplace(std::move(*opened.writer));
   }
   plinth::hal::FrameSink* const bus = frames_log ? &*frames_log : input->sink();
+  // Paced input: each line goes out as it is written, for whoever reads them live.
+  if (input_settings.speed > 0.0 || !opt.can_interface.empty()) {
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  }
   const std::unique_ptr<fw::RelayOutputs> relays = make_relays(file.relays);
-  Outputs outputs(monitor, input->t_origin(), recorder.get(), bus, relays.get());
+  const std::vector<std::unique_ptr<fw::StatusOutput>> network = start_outputs(file);
+  std::vector<fw::StatusOutput*> output_list;
+  for (const auto& o : network) output_list.push_back(o.get());
+  Outputs outputs(monitor, input->t_origin(), recorder.get(), bus, relays.get(), output_list);
   frames_clock = &outputs;
   std::optional<fw::SampleTrace> trace;
   if (!opt.trace_path.empty()) {
     outputs.trace = &trace.emplace(opt.trace_path, config.axis_count, input->t_origin());
   }
+  std::optional<fw::LatencyLog> latency;
+  if (opt.latency) latency.emplace(kLatencyCapacity);
   fw::Supervisor supervisor(file.watchdog);
-  run_loop(*input, monitor, outputs, recorder.get(), supervisor);
+  const auto restart = [&] { start_monitor(monitor, config, scene_x, scene_y); };
+  run_loop(*input, monitor, outputs, recorder.get(), supervisor, latency ? &*latency : nullptr,
+           restart);
   if (trace) trace->close();
   if (recorder) recorder->close();  // every capture is on disk before the summary
   if (frames_log && !frames_log->flush()) throw InputError("--frames-out: " + frames_log->error());
   fw::RunTotals totals = run_totals(outputs, *input, monitor, recorder.get(), sinks);
   if (frames_log) totals.bus_send_errors += monitor.frames().not_encoded;
+  for (const auto& o : network) {
+    o->stop();  // the MQTT publisher delivers its queue first (bounded)
+    totals.outputs.emplace_back(o->name(), o->summary_json());
+  }
+  if (latency) totals.outputs.emplace_back("latency", latency->summary_json());
   print_line(fw::summary_json(monitor, totals, input->t_origin()));
   std::fflush(stdout);
   return 0;
@@ -365,6 +494,20 @@ void add_options(CLI::App& app, Options& opt) {
                  "GPIO chip of the relays (relays.chip; the lines come from [relays])");
   app.add_flag("--no-relays", c.no_relays, "drive no relays, whatever [relays] says")
       ->excludes("--relay-chip");
+  app.add_option("--modbus", c.modbus_listen,
+                 "Modbus TCP server at HOST:PORT (modbus.listen; docs/integration.md)");
+  app.add_flag("--modbus-writes", c.modbus_writes,
+               "the acknowledge and reset coils may be written (modbus.writes)");
+  app.add_option("--mqtt", c.mqtt_broker, "publish to the MQTT broker at HOST:PORT (mqtt.broker)");
+  app.add_option("--mqtt-box-id", c.mqtt_box_id, "the box's id in the topics (mqtt.box_id)");
+  app.add_option("--mqtt-username", c.mqtt_username, "MQTT user name (mqtt.username)");
+  app.add_option("--mqtt-password-file", c.mqtt_password_file,
+                 "a file whose first line is the MQTT password (mqtt.password_file)");
+  app.add_option("--mqtt-ca", c.mqtt_ca_file, "TLS: the CA that signed the broker's certificate");
+  app.add_option("--mqtt-cert", c.mqtt_cert_file, "TLS: the box's client certificate");
+  app.add_option("--mqtt-key", c.mqtt_key_file, "TLS: its private key");
+  app.add_flag("--latency", opt.latency,
+               "the summary gives each sample's latency, arrival to status ready (median, p99)");
   app.add_option("--stuck-samples", c.stuck_samples,
                  "identical samples that mean a stuck sensor (default 50; 0: off, for noise-free "
                  "synthetic logs)")

@@ -291,6 +291,7 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
                              .count("write_errors", totals.recorder_write_errors)
                              .close());
   }
+  for (const auto& [key, json] : totals.outputs) line.raw(key, json);
   return line.close();
 }
 

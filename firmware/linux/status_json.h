@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "plinth/core/events.h"
@@ -61,6 +62,8 @@ struct RunTotals {
   std::uint64_t captures_written = 0;
   std::uint64_t captures_dropped = 0;
   std::uint64_t recorder_write_errors = 0;
+  // Members written already, after the others: the outputs' counters ("modbus": {...}, ...).
+  std::vector<std::pair<std::string, std::string>> outputs;
 };
 
 // {"type": "summary", "source": .., "samples": .., "final_phase": .., "max_risk": .., ...}.

@@ -1,0 +1,386 @@
+#include "mqtt_publisher.h"
+
+#include <mosquitto.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <mutex>
+
+#include "plinth/host/input_error.h"
+#include "plinth/host/text_file.h"
+#include "status_json.h"
+
+namespace plinth::firmware {
+
+namespace {
+
+constexpr int kQos = 1;
+constexpr int kLoopTimeoutMs = 10;        // how soon the thread sees new events, states and stop()
+constexpr double kRepublishAfterS = 5.0;  // an event not acknowledged this long goes out again
+constexpr std::int64_t kNsPerS = 1'000'000'000;
+
+std::int64_t ns_of(double seconds) { return static_cast<std::int64_t>(seconds * 1e9); }
+
+void say(const std::string& message) {
+  std::fprintf(stderr, "plinth-monitor: mqtt: %s\n", message.c_str());
+}
+
+// A file the settings name: it must be a readable regular file.
+void check_file(const std::string& path, const char* key, const char* flag) {
+  if (path.empty()) return;
+  (void)host::read_text_file(path, std::size_t{1} << 20, std::string(key) + " / " + flag + " file");
+}
+
+std::string first_line(const std::string& text) {
+  const std::size_t end = text.find_first_of("\r\n");
+  return end == std::string::npos ? text : text.substr(0, end);
+}
+
+// ISO 8601 UTC with ms: "2026-11-25T19:50:47.123Z".
+std::string utc_text(std::int64_t wall_ns) {
+  const std::time_t seconds = static_cast<std::time_t>(wall_ns / kNsPerS);
+  std::tm utc{};
+  gmtime_r(&seconds, &utc);
+  char text[40];
+  const std::size_t n = std::strftime(text, sizeof text, "%Y-%m-%dT%H:%M:%S", &utc);
+  std::snprintf(text + n, sizeof text - n, ".%03dZ",
+                static_cast<int>((wall_ns % kNsPerS) / 1'000'000));
+  return text;
+}
+
+// libmosquitto's text of `rc` (errno's for MOSQ_ERR_ERRNO), without its final period.
+std::string error_text(int rc) {
+  std::string text = rc == MOSQ_ERR_ERRNO ? std::strerror(errno) : mosquitto_strerror(rc);
+  if (!text.empty() && text.back() == '.') text.pop_back();
+  return text;
+}
+
+std::string connack_text(int rc) {
+  switch (rc) {
+    case 1:
+      return "unacceptable protocol version";
+    case 2:
+      return "client identifier rejected";
+    case 3:
+      return "broker unavailable";
+    case 4:
+      return "bad user name or password (mqtt.username, mqtt.password or password_file)";
+    case 5:
+      return "not authorised (mqtt.username, mqtt.password or password_file)";
+    default:
+      return std::string("code ") + std::to_string(rc) + ": " + mosquitto_connack_string(rc);
+  }
+}
+
+extern "C" void connect_callback(mosquitto*, void* self, int rc) {
+  static_cast<MqttPublisher*>(self)->on_connect(rc);
+}
+extern "C" void disconnect_callback(mosquitto*, void* self, int rc) {
+  static_cast<MqttPublisher*>(self)->on_disconnect(rc);
+}
+extern "C" void publish_callback(mosquitto*, void* self, int mid) {
+  static_cast<MqttPublisher*>(self)->on_publish(mid);
+}
+extern "C" void log_callback(mosquitto*, void* self, int level, const char* text) {
+  if ((level & MOSQ_LOG_ERR) != 0) static_cast<MqttPublisher*>(self)->on_error_log(text);
+}
+
+}  // namespace
+
+MqttPublisher::MqttPublisher(const MqttSettings& settings) : settings_(settings) {
+  static std::once_flag library;
+  std::call_once(library, [] { mosquitto_lib_init(); });
+  const Endpoint endpoint = parse_endpoint(settings.broker, settings.broker_where);
+  host_ = endpoint.host;
+  port_ = endpoint.port;
+  endpoint_text_ = endpoint.text() + " (" + settings.broker_where + ")";
+  if (settings_.box_id.empty()) {
+    char name[256] = {};
+    gethostname(name, sizeof name - 1);
+    settings_.box_id = name[0] != '\0' ? name : "box";
+  }
+  const std::string base = settings_.topic_prefix + "/" + settings_.box_id + "/";
+  state_topic_ = base + "state";
+  events_topic_ = base + "events";
+  availability_topic_ = base + "availability";
+
+  std::string password = settings_.password;
+  if (!settings_.password_file.empty()) {
+    password = first_line(host::read_text_file(settings_.password_file, 4096,
+                                               "mqtt.password_file / --mqtt-password-file"));
+  }
+  check_file(settings_.ca_file, "mqtt.tls_ca_file", "--mqtt-ca");
+  check_file(settings_.cert_file, "mqtt.tls_cert_file", "--mqtt-cert");
+  check_file(settings_.key_file, "mqtt.tls_key_file", "--mqtt-key");
+  if (settings_.cert_file.empty() != settings_.key_file.empty()) {
+    throw host::InputError(
+        "mqtt.tls_cert_file and mqtt.tls_key_file (--mqtt-cert, --mqtt-key): give both or neither");
+  }
+  if (!settings_.cert_file.empty() && settings_.ca_file.empty()) {
+    throw host::InputError("mqtt.tls_cert_file (--mqtt-cert): needs mqtt.tls_ca_file (--mqtt-ca)");
+  }
+
+  const std::string client_id = "plinth-" + settings_.box_id;
+  client_ = mosquitto_new(client_id.c_str(), true, this);
+  if (client_ == nullptr) throw host::InputError("mqtt: cannot create the client (no memory)");
+  const auto fail = [&](const std::string& what, int rc) {
+    mosquitto_destroy(client_);
+    client_ = nullptr;
+    throw host::InputError(what + ": " + mosquitto_strerror(rc));
+  };
+  int rc = mosquitto_will_set(client_, availability_topic_.c_str(), 7, "offline", kQos, true);
+  if (rc != MOSQ_ERR_SUCCESS) fail("mqtt: the Last Will on " + availability_topic_, rc);
+  if (!settings_.username.empty()) {
+    rc = mosquitto_username_pw_set(client_, settings_.username.c_str(),
+                                   password.empty() ? nullptr : password.c_str());
+    if (rc != MOSQ_ERR_SUCCESS) fail("mqtt.username", rc);
+  } else if (!password.empty()) {
+    fail("mqtt.password without mqtt.username (--mqtt-username)", MOSQ_ERR_INVAL);
+  }
+  if (!settings_.ca_file.empty()) {
+    rc = mosquitto_tls_set(client_, settings_.ca_file.c_str(), nullptr,
+                           settings_.cert_file.empty() ? nullptr : settings_.cert_file.c_str(),
+                           settings_.key_file.empty() ? nullptr : settings_.key_file.c_str(),
+                           nullptr);
+    if (rc != MOSQ_ERR_SUCCESS) fail("mqtt.tls_ca_file " + settings_.ca_file + " (--mqtt-ca)", rc);
+  }
+  mosquitto_connect_callback_set(client_, connect_callback);
+  mosquitto_disconnect_callback_set(client_, disconnect_callback);
+  mosquitto_publish_callback_set(client_, publish_callback);
+  mosquitto_log_callback_set(client_, log_callback);
+  backoff_s_ = settings_.reconnect_min_s;
+  thread_ = std::thread([this] { run(); });
+}
+
+MqttPublisher::~MqttPublisher() {
+  stop();
+  if (client_ != nullptr) mosquitto_destroy(client_);
+}
+
+void MqttPublisher::stop() {
+  stopping_.store(true);
+  if (thread_.joinable()) thread_.join();
+}
+
+void MqttPublisher::on_connect(int rc) {
+  if (rc != 0) {
+    ++refusals_;
+    const std::string problem =
+        "the broker at " + endpoint_text_ + " refused the connection: " + connack_text(rc);
+    if (problem != last_problem_) say(problem);
+    last_problem_ = problem;
+    return;
+  }
+  connected_ = true;
+  ++connects_;
+  backoff_s_ = settings_.reconnect_min_s;
+  const std::string problem = "connected to " + endpoint_text_;
+  if (problem != last_problem_ && !last_problem_.empty()) say(problem);
+  last_problem_ = problem;
+  (void)publish(availability_topic_, "online", true, nullptr);
+  state_due_ = have_state_;
+  head_sent_ns_ = 0;  // the head event goes out again if the broker never acknowledged it
+}
+
+void MqttPublisher::on_disconnect(int rc) {
+  if (connected_ && rc != 0 && !stopping_.load()) ++connections_lost_;
+  connected_ = false;
+}
+
+void MqttPublisher::on_error_log(const char* text) {
+  if (text != nullptr) error_log_ = text;
+}
+
+void MqttPublisher::on_publish(int mid) {
+  if (mid == offline_mid_) offline_acknowledged_ = true;
+  if (queue_.empty()) return;
+  const std::vector<int>& mids = queue_.front().mids;
+  if (std::find(mids.begin(), mids.end(), mid) == mids.end()) return;
+  queue_.pop_front();
+  ++events_published_;
+  head_sent_ns_ = 0;
+}
+
+bool MqttPublisher::publish(const std::string& topic, const std::string& payload, bool retain,
+                            int* mid) {
+  return mosquitto_publish(client_, mid, topic.c_str(), static_cast<int>(payload.size()),
+                           payload.data(), kQos, retain) == MOSQ_ERR_SUCCESS;
+}
+
+// The loop's alarm events into the queue (bounded), its newest snapshot into the state.
+void MqttPublisher::take_mailbox(std::int64_t now_ns) {
+  AlarmNotice notice;
+  while (mailbox_.take_alarm(notice)) {
+    // The oldest waiting event makes room; never the one the broker may be acknowledging.
+    if (static_cast<int>(queue_.size()) >= settings_.event_queue) {
+      const bool head_in_flight = !queue_.front().mids.empty();
+      if (head_in_flight && queue_.size() > 1) {
+        queue_.erase(queue_.begin() + 1);
+      } else {
+        queue_.pop_front();
+      }
+      ++events_dropped_;
+    }
+    queue_.push_back({alarm_json(notice.event, notice.t_origin), {}});
+    most_queued_ = std::max(most_queued_, queue_.size());
+  }
+  StatusSnapshot s;
+  if (!mailbox_.take_status(s)) return;
+  const bool changed = !have_state_ || s.level != state_sent_.level ||
+                       s.latched != state_sent_.latched || s.cause != state_sent_.cause ||
+                       s.phase != state_sent_.phase || s.resets != state_sent_.resets;
+  state_ = s;
+  have_state_ = true;
+  if (changed || now_ns - state_sent_ns_ >= ns_of(settings_.state_interval_s)) state_due_ = true;
+}
+
+void MqttPublisher::try_connect(std::int64_t now_ns) {
+  if (now_ns < next_attempt_ns_) return;
+  // A new session each time: libmosquitto keeps the unacknowledged publishes and sends them
+  // again once the broker accepted it.
+  const int rc = mosquitto_connect(client_, host_.c_str(), port_, settings_.keepalive_s);
+  if (rc == MOSQ_ERR_SUCCESS) {
+    socket_open_ = true;
+    next_attempt_ns_ = now_ns + ns_of(backoff_s_);  // if the session never starts
+    backoff_s_ = std::min(2.0 * backoff_s_, settings_.reconnect_max_s);
+    return;
+  }
+  ++connect_failures_;
+  lost("cannot reach the broker at " + endpoint_text_ + ": " + error_text(rc), now_ns);
+}
+
+// The connection is gone: say why (once), and try again after the back-off.
+void MqttPublisher::lost(const std::string& reason, std::int64_t now_ns) {
+  // libmosquitto's own error (a TLS certificate refused, ...) says more.
+  const std::string why = error_log_.empty() ? reason : reason + " (" + error_log_ + ")";
+  if (why != last_problem_) {
+    char retry[48];
+    std::snprintf(retry, sizeof retry, "; retrying (back-off up to %g s)",
+                  settings_.reconnect_max_s);
+    say(why + retry);
+  }
+  last_problem_ = why;
+  back_off(now_ns);
+}
+
+void MqttPublisher::back_off(std::int64_t now_ns) {
+  connected_ = false;
+  socket_open_ = false;
+  error_log_.clear();
+  next_attempt_ns_ = now_ns + ns_of(backoff_s_);
+  backoff_s_ = std::min(2.0 * backoff_s_, settings_.reconnect_max_s);
+}
+
+// The head event goes out when the one before was acknowledged (or again after a silence).
+void MqttPublisher::publish_head(std::int64_t now_ns) {
+  if (queue_.empty()) return;
+  QueuedEvent& head = queue_.front();
+  if (!head.mids.empty() && head_sent_ns_ != 0 &&
+      now_ns - head_sent_ns_ < ns_of(kRepublishAfterS)) {
+    return;
+  }
+  int mid = 0;
+  if (!publish(events_topic_, head.payload, false, &mid)) return;
+  if (!head.mids.empty()) ++events_republished_;
+  head.mids.push_back(mid);
+  head_sent_ns_ = now_ns;
+}
+
+std::string MqttPublisher::state_json() const {
+  const StatusSnapshot& s = state_;
+  JsonObject phase;
+  const char* axes[] = {"x", "y"};
+  for (int i = 0; i < s.axis_count && i < kMaxAxes; ++i) {
+    phase.text(axes[i], phase_name(s.phase[static_cast<std::size_t>(i)]));
+  }
+  return JsonObject()
+      .text("box", settings_.box_id)
+      .fixed("t", s.t, 6)
+      .text("time", utc_text(s.wall_time_ns))
+      .text("level", monitor::alarm_level_name(s.level))
+      .text("latched", monitor::alarm_level_name(s.latched))
+      .text("cause", monitor::alarm_cause_name(s.cause))
+      .fixed("risk", s.risk, 4)
+      .raw("phase", phase.close())
+      .flag("estimating", s.estimating)
+      .text("sensor", monitor::health_state_name(s.sensor))
+      .count("heartbeat", s.statuses)
+      .close();
+}
+
+void MqttPublisher::publish_state(std::int64_t now_ns) {
+  if (!state_due_) return;
+  if (!publish(state_topic_, state_json(), true, nullptr)) return;
+  state_due_ = false;
+  state_sent_ = state_;
+  state_sent_ns_ = now_ns;
+  ++states_published_;
+}
+
+void MqttPublisher::run() {
+  std::int64_t flush_deadline_ns = 0;
+  while (true) {
+    const std::int64_t now = monotonic_ns();
+    take_mailbox(now);
+    if (stopping_.load()) {
+      if (flush_deadline_ns == 0) {
+        flush_deadline_ns = now + ns_of(kFlushTimeoutS);
+        state_due_ = have_state_ && state_.updates != state_sent_.updates;  // the final state
+      }
+      if ((queue_.empty() && (!state_due_ || !connected_)) || now > flush_deadline_ns) break;
+    }
+    if (!connected_) try_connect(now);
+    if (connected_) {
+      publish_state(now);
+      publish_head(now);
+    }
+    if (!socket_open_) {
+      usleep(kLoopTimeoutMs * 1000);
+      continue;
+    }
+    const int rc = mosquitto_loop(client_, kLoopTimeoutMs, 1);
+    if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED) {
+      // on_disconnect counted it.
+      lost("connection to " + endpoint_text_ + " lost: " + error_text(rc), now);
+    } else if (rc == MOSQ_ERR_CONN_REFUSED) {
+      back_off(now);  // on_connect said why
+    }
+  }
+  say_offline();
+}
+
+// A clean stop: "offline" on the availability topic (the Will goes only on a lost connection).
+void MqttPublisher::say_offline() {
+  if (!connected_) return;
+  if (publish(availability_topic_, "offline", true, &offline_mid_)) {
+    const std::int64_t deadline = monotonic_ns() + kNsPerS;
+    while (!offline_acknowledged_ && monotonic_ns() < deadline &&
+           mosquitto_loop(client_, kLoopTimeoutMs, 1) == MOSQ_ERR_SUCCESS) {
+    }
+  }
+  mosquitto_disconnect(client_);
+  (void)mosquitto_loop(client_, kLoopTimeoutMs, 1);
+}
+
+std::string MqttPublisher::summary_json() const {
+  return JsonObject()
+      .text("broker", endpoint_text_.substr(0, endpoint_text_.find(' ')))
+      .text("box", settings_.box_id)
+      .count("connects", connects_)
+      .count("connect_failures", connect_failures_)
+      .count("refusals", refusals_)
+      .count("connections_lost", connections_lost_)
+      .count("events_published", events_published_)
+      .count("events_republished", events_republished_)
+      .count("events_dropped", events_dropped_ + mailbox_.events_dropped())
+      .count("events_undelivered", queue_.size())
+      .count("most_queued", most_queued_)
+      .count("states_published", states_published_)
+      .close();
+}
+
+}  // namespace plinth::firmware

@@ -1,0 +1,80 @@
+#include "status_outputs.h"
+
+#include <time.h>
+
+#include <cerrno>
+#include <cstdlib>
+
+#include "plinth/host/input_error.h"
+
+namespace plinth::firmware {
+
+namespace {
+
+std::int64_t clock_ns(clockid_t clock) {
+  timespec ts{};
+  clock_gettime(clock, &ts);
+  return static_cast<std::int64_t>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
+}
+
+}  // namespace
+
+std::int64_t monotonic_ns() { return clock_ns(CLOCK_MONOTONIC); }
+std::int64_t wall_clock_ns() { return clock_ns(CLOCK_REALTIME); }
+
+void copy_status(const Monitor& monitor, double t_origin, StatusSnapshot& snapshot) {
+  const MonitorStatus& s = monitor.status();
+  snapshot.time_ns = s.time_ns;
+  snapshot.t = static_cast<double>(s.time_ns) * 1e-9 - t_origin;
+  snapshot.level = s.alarm;
+  snapshot.latched = s.latched;
+  snapshot.risk = s.risk;
+  snapshot.axis_count = s.axis_count;
+  for (std::size_t i = 0; i < snapshot.phase.size(); ++i) snapshot.phase[i] = s.axes[i].mode.phase;
+  snapshot.estimating = s.estimating;
+  snapshot.sensor = s.sensor.state;
+  snapshot.sensors_state = s.sensors_state;
+  snapshot.sensor_counters = s.sensor.counters;
+  snapshot.estimator_restarts = s.estimator_restarts;
+}
+
+std::string Endpoint::text() const {
+  const bool v6 = host.find(':') != std::string::npos;
+  return (v6 ? "[" + host + "]" : host) + ":" + std::to_string(port);
+}
+
+Endpoint parse_endpoint(const std::string& text, const std::string& what) {
+  const auto bad = [&](const std::string& why) {
+    return host::InputError(what +
+                            ": expected HOST:PORT (e.g. 127.0.0.1:1502 or [::1]:1502), got \"" +
+                            text + "\": " + why);
+  };
+  Endpoint e;
+  std::string port;
+  if (!text.empty() && text.front() == '[') {
+    const std::size_t close = text.find(']');
+    if (close == std::string::npos) throw bad("no closing ']'");
+    e.host = text.substr(1, close - 1);
+    if (close + 1 >= text.size() || text[close + 1] != ':') throw bad("no ':PORT' after ']'");
+    port = text.substr(close + 2);
+  } else {
+    const std::size_t colon = text.rfind(':');
+    if (colon == std::string::npos) throw bad("no ':PORT'");
+    e.host = text.substr(0, colon);
+    if (e.host.find(':') != std::string::npos) throw bad("an IPv6 address goes in brackets");
+    port = text.substr(colon + 1);
+  }
+  if (e.host.empty()) throw bad("no host");
+  for (const char c : e.host) {
+    if (c == ' ' || c == '\t' || c == '/' || c == '[' || c == ']') throw bad("not a host name");
+  }
+  if (port.empty() || port.size() > 5 ||
+      port.find_first_not_of("0123456789") != std::string::npos) {
+    throw bad("the port is not a number");
+  }
+  e.port = std::atoi(port.c_str());
+  if (e.port < 1 || e.port > 65535) throw bad("the port must lie in [1, 65535]");
+  return e;
+}
+
+}  // namespace plinth::firmware

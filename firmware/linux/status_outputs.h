@@ -1,0 +1,179 @@
+// The seam between plinth-monitor's real-time loop and its outputs off that loop (Modbus TCP,
+// MQTT, ...; docs/integration.md). The loop copies a StatusSnapshot after each update and each
+// alarm event into every output's mailbox: lock-free, no allocation, never a wait on an output's
+// thread (a full event ring drops the event and counts it). Operator commands (acknowledge,
+// reset) come back the same way, one ring per output, polled by the loop.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+#include "plinth/core/state.h"
+#include "plinth/firmware/monitor.h"
+#include "plinth/monitor/alarm_level.h"
+#include "plinth/monitor/alarm_policy.h"
+#include "plinth/monitor/sensor_health.h"
+
+namespace plinth::firmware {
+
+// What the box shows after one update of the loop.
+struct StatusSnapshot {
+  std::uint64_t updates = 0;   // updates of the loop so far
+  std::uint64_t statuses = 0;  // status reports so far (the heartbeat counter)
+  std::int64_t time_ns = 0;    // monitor time
+  double t = 0.0;              // s: the JSON lines' time (monitor time less the record's lead-in)
+  std::int64_t wall_time_ns = 0;  // CLOCK_REALTIME when the loop took it
+  std::int64_t uptime_ns = 0;     // since plinth-monitor started (CLOCK_MONOTONIC)
+  monitor::AlarmLevel level = monitor::AlarmLevel::kNormal;    // shown
+  monitor::AlarmLevel latched = monitor::AlarmLevel::kNormal;  // kNormal: nothing latched
+  monitor::AlarmCause cause = monitor::AlarmCause::kNone;      // of the latest alarm event
+  std::uint8_t event_sequence = 0;  // of the latest alarm event (an acknowledgement quotes it)
+  bool any_event = false;
+  double risk = 0.0;
+  int axis_count = 1;
+  std::array<Phase, kMaxAxes> phase{};
+  bool estimating = false;
+  monitor::HealthState sensor = monitor::HealthState::kFault;  // the primary's
+  monitor::HealthState sensors_state = monitor::HealthState::kFault;
+  monitor::SensorCounters sensor_counters;  // the primary's
+  std::uint64_t estimator_restarts = 0;
+  monitor::AckOutcome last_ack = monitor::AckOutcome::kNone;  // of the latest command
+  std::uint64_t commands = 0;  // operator commands the loop carried out
+  std::uint64_t resets = 0;
+};
+
+// One alarm event as the JSON alarm line writes it.
+struct AlarmNotice {
+  monitor::AlarmEventRecord event;
+  double t_origin = 0.0;  // s: alarm_json(event, t_origin)
+};
+
+enum class OperatorCommand : std::uint8_t {
+  kAcknowledge,  // the latched level, quoting the latest event's sequence
+  kReset,        // the monitor starts again as at power-up
+};
+
+struct CommandRequest {
+  OperatorCommand command = OperatorCommand::kAcknowledge;
+  monitor::AlarmLevel level = monitor::AlarmLevel::kNormal;  // kAcknowledge: the latched level
+  std::uint8_t event_sequence = 0;  // kAcknowledge: the latest event the operator saw
+};
+
+// The newest of a stream of values, one writer and one reader, without locks (a triple buffer):
+// publish() never waits, take() gives the newest value not taken yet.
+template <typename T>
+class LatestValue {
+ public:
+  void publish(const T& value) noexcept {
+    slots_[back_] = value;
+    back_ = middle_.exchange(back_ | kFresh, std::memory_order_acq_rel) & kIndex;
+  }
+  // False when nothing new was published since the last take.
+  [[nodiscard]] bool take(T& out) noexcept {
+    if ((middle_.load(std::memory_order_acquire) & kFresh) == 0) return false;
+    front_ = middle_.exchange(front_, std::memory_order_acq_rel) & kIndex;
+    out = slots_[front_];
+    return true;
+  }
+
+ private:
+  static constexpr unsigned kIndex = 3U;
+  static constexpr unsigned kFresh = 4U;
+  std::array<T, 3> slots_{};
+  std::atomic<unsigned> middle_{1U};
+  unsigned back_ = 0U;   // the writer's slot
+  unsigned front_ = 2U;  // the reader's slot
+};
+
+// A bounded FIFO, one writer and one reader, without locks.
+template <typename T, std::size_t N>
+class SpscRing {
+  static_assert(N > 0 && (N & (N - 1)) == 0, "a power of two");
+
+ public:
+  [[nodiscard]] bool push(const T& value) noexcept {
+    const std::uint64_t head = head_.load(std::memory_order_relaxed);
+    if (head - tail_.load(std::memory_order_acquire) >= N) return false;
+    slots_[head % N] = value;
+    head_.store(head + 1, std::memory_order_release);
+    return true;
+  }
+  [[nodiscard]] bool pop(T& out) noexcept {
+    const std::uint64_t tail = tail_.load(std::memory_order_relaxed);
+    if (tail == head_.load(std::memory_order_acquire)) return false;
+    out = slots_[tail % N];
+    tail_.store(tail + 1, std::memory_order_release);
+    return true;
+  }
+
+ private:
+  std::array<T, N> slots_{};
+  alignas(64) std::atomic<std::uint64_t> head_{0};
+  alignas(64) std::atomic<std::uint64_t> tail_{0};
+};
+
+// What the loop hands one output: the newest snapshot, the alarm events in order, and the
+// output's commands back.
+class OutputMailbox {
+ public:
+  static constexpr std::size_t kEventSlots = 256;
+  static constexpr std::size_t kCommandSlots = 16;
+
+  // Loop side.
+  void post_status(const StatusSnapshot& snapshot) noexcept { status_.publish(snapshot); }
+  void post_alarm(const AlarmNotice& notice) noexcept {
+    if (!events_.push(notice)) events_dropped_.fetch_add(1, std::memory_order_relaxed);
+  }
+  [[nodiscard]] bool take_command(CommandRequest& out) noexcept { return commands_.pop(out); }
+
+  // Output side.
+  [[nodiscard]] bool take_status(StatusSnapshot& out) noexcept { return status_.take(out); }
+  [[nodiscard]] bool take_alarm(AlarmNotice& out) noexcept { return events_.pop(out); }
+  // False when the ring is full (the loop has not polled): the command is refused.
+  [[nodiscard]] bool post_command(const CommandRequest& c) noexcept { return commands_.push(c); }
+  // Alarm events the loop could not hand over (the ring was full).
+  [[nodiscard]] std::uint64_t events_dropped() const noexcept {
+    return events_dropped_.load(std::memory_order_relaxed);
+  }
+
+ private:
+  LatestValue<StatusSnapshot> status_;
+  SpscRing<AlarmNotice, kEventSlots> events_;
+  SpscRing<CommandRequest, kCommandSlots> commands_;
+  std::atomic<std::uint64_t> events_dropped_{0};
+};
+
+// An output with its own thread. The loop only touches mailbox(); summary_json() and stop()
+// run on the main thread at the end.
+class StatusOutput {
+ public:
+  virtual ~StatusOutput() = default;
+  [[nodiscard]] virtual OutputMailbox& mailbox() = 0;
+  // Delivers what is queued (bounded by the output's own limit) and ends the thread.
+  virtual void stop() = 0;
+  // The output's counters for the summary line: a JSON object.
+  [[nodiscard]] virtual std::string summary_json() const = 0;
+  [[nodiscard]] virtual const char* name() const = 0;  // the summary's key: "modbus", "mqtt"
+};
+
+// Copies `monitor`'s status into `snapshot` (time, level, risk, phases, sensors); the fields the
+// loop keeps itself (updates, statuses, the latest event, commands) are left as they are.
+void copy_status(const Monitor& monitor, double t_origin, StatusSnapshot& snapshot);
+
+// CLOCK_MONOTONIC and CLOCK_REALTIME, ns.
+[[nodiscard]] std::int64_t monotonic_ns();
+[[nodiscard]] std::int64_t wall_clock_ns();
+
+// "HOST:PORT" or "[IPv6]:PORT" split; `what` names the key or flag in the message
+// (host::InputError: "--modbus: expected HOST:PORT, got ...").
+struct Endpoint {
+  std::string host;
+  int port = 0;
+  [[nodiscard]] std::string text() const;
+};
+[[nodiscard]] Endpoint parse_endpoint(const std::string& text, const std::string& what);
+
+}  // namespace plinth::firmware

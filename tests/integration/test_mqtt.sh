@@ -1,0 +1,251 @@
+#!/usr/bin/env bash
+# plinth-monitor's MQTT publisher against a real mosquitto broker that this test starts on
+# loopback with its own configuration (docs/integration.md): a password file, a plain and a TLS
+# listener (a CA and a server certificate made here with openssl), persistence. Checks: every
+# alarm line arrives on the events topic, in order, across a broker restart in the middle of a
+# replay; the retained state and availability; the Last Will when the box is killed (-9); a
+# wrong password refused with a clear message; bad settings refused naming the key or flag.
+#
+# Environment: PLINTH_MONITOR, PLINTH_SIM, PLINTH_SOURCE_DIR. Exit 77 (skip) when mosquitto,
+# its clients or openssl are missing, unless CI=true.
+set -u
+
+# shellcheck source=tests/integration/outputs_harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/outputs_harness.sh"
+require_tools mosquitto mosquitto_sub mosquitto_pub mosquitto_passwd openssl
+MOSQUITTO=$(command -v mosquitto || echo /usr/sbin/mosquitto)
+ISOLATED=$SCENES/paper-isolated.toml
+BROKER_PID=
+BOX=
+cleanup() {
+  [[ -n "$BOX" ]] && kill -9 "$BOX" 2>/dev/null
+  [[ -n "$BROKER_PID" ]] && kill "$BROKER_PID" 2>/dev/null
+  jobs -p | xargs -r kill 2>/dev/null
+  rm -rf "$TMP"
+}
+trap cleanup EXIT
+
+# The broker: users "box" and "watcher", a plain listener and a TLS one.
+PLAIN=$(free_port)
+TLS=$(free_port)
+mkdir -p "$TMP/db"
+openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 2 \
+  -subj "/CN=plinth test CA" -keyout "$TMP/ca.key" -out "$TMP/ca.crt" 2>/dev/null
+openssl req -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -subj "/CN=localhost" \
+  -keyout "$TMP/server.key" -out "$TMP/server.csr" 2>/dev/null
+printf 'subjectAltName=IP:127.0.0.1,DNS:localhost\n' >"$TMP/server.ext"
+openssl x509 -req -in "$TMP/server.csr" -CA "$TMP/ca.crt" -CAkey "$TMP/ca.key" -CAcreateserial \
+  -days 2 -extfile "$TMP/server.ext" -out "$TMP/server.crt" 2>/dev/null
+mosquitto_passwd -c -b "$TMP/passwd" box box-secret 2>/dev/null
+mosquitto_passwd -b "$TMP/passwd" watcher watcher-secret 2>/dev/null
+echo box-secret >"$TMP/box.pw"
+echo wrong >"$TMP/wrong.pw"
+cat >"$TMP/broker.conf" <<EOF
+user root
+persistence true
+persistence_location $TMP/db/
+allow_anonymous false
+password_file $TMP/passwd
+listener $PLAIN 127.0.0.1
+listener $TLS 127.0.0.1
+cafile $TMP/ca.crt
+certfile $TMP/server.crt
+keyfile $TMP/server.key
+EOF
+start_broker() {
+  "$MOSQUITTO" -c "$TMP/broker.conf" >>"$TMP/broker.log" 2>&1 &
+  BROKER_PID=$!
+  local i
+  for ((i = 0; i < 100; i++)); do
+    mosquitto_pub -h 127.0.0.1 -p "$PLAIN" -u watcher -P watcher-secret -t ping -m x \
+      2>/dev/null && return 0
+    sleep 0.1
+  done
+  return 1
+}
+stop_broker() {
+  kill "$BROKER_PID" 2>/dev/null
+  wait "$BROKER_PID" 2>/dev/null
+  BROKER_PID=
+}
+WATCH=(-h 127.0.0.1 -p "$PLAIN" -u watcher -P watcher-secret)
+if ! start_broker; then
+  fail "mqtt: the broker starts" "$(tail -n 3 "$TMP/broker.log")"
+  echo "$PASSED passed, $FAILED failed"
+  exit 1
+fi
+
+# restart_replay BOX_ID [KEY = VALUE lines]: Brienza x20 at --speed 2 through a box on the TLS
+# listener with a password; the broker stops once the level is back to normal and starts again
+# after the alarm, so the advisory, warning and alarm events happen while it is away. A
+# persistent subscriber takes the events topic. Sets rc; leaves $TMP/box.out, box.err and
+# events.out.
+restart_replay() {
+  local box=$1
+  shift
+  printf '[mqtt]\nbroker = "127.0.0.1:%s"\nbox_id = "%s"\nusername = "box"\n' "$TLS" "$box" \
+    >"$TMP/box.toml"
+  printf '%s\n' 'password_file = "box.pw"' 'tls_ca_file = "ca.crt"' 'reconnect_min_s = 0.1' \
+    'reconnect_max_s = 0.5' 'state_interval_s = 0.2' "$@" >>"$TMP/box.toml"
+  mosquitto_sub "${WATCH[@]}" -c -i "watcher-$box" -q 1 -v -t "plinth/$box/events" \
+    >"$TMP/events.out" 2>"$TMP/events.err" &
+  local watcher=$!
+  sleep 1
+  "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
+    --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
+  BOX=$!
+  if wait_for "$TMP/box.out" '"level": "normal"' 30; then
+    stop_broker
+    wait_for "$TMP/box.out" '"level": "alarm", "previous"' 30
+    sleep 1
+    start_broker || fail "mqtt: the broker starts again" "$(tail -n 3 "$TMP/broker.log")"
+  else
+    fail "mqtt: replay" "no normal level within 30 s"
+  fi
+  wait "$BOX"
+  rc=$?
+  BOX=
+  sleep 2
+  kill "$watcher" 2>/dev/null
+  wait "$watcher" 2>/dev/null
+}
+
+# check_events PYTHON: the alarm lines of box.out (alarms), the payloads received (received,
+# an event repeated at once counted once: QoS 1 delivers at least once, and an event whose
+# acknowledgement the broker's stop cut off is sent again) and the summary's mqtt object
+# (mqtt); prints the failed assertion.
+check_events() {
+  python3 - "$TMP/box.out" "$TMP/events.out" "$1" <<'PY'
+import json, sys
+lines = open(sys.argv[1]).read().splitlines()
+alarms = [l for l in lines if l.startswith('{"type": "alarm"')]
+payloads = [l.split(" ", 1)[1] for l in open(sys.argv[2]).read().splitlines()]
+received = [p for i, p in enumerate(payloads) if i == 0 or p != payloads[i - 1]]
+mqtt = json.loads(lines[-1])["mqtt"]
+seq = lambda ls: [json.loads(l)["sequence"] for l in ls]
+try:
+    assert len(alarms) == 5, "the replay gave %d alarm lines" % len(alarms)
+    exec(sys.argv[3])
+except AssertionError as e:
+    print(e)
+PY
+}
+
+# 1. Every alarm line arrives, in order, across the broker restart.
+restart_replay b1
+problem=$(check_events '
+assert received == alarms, "received events %s, the box wrote %s" % (seq(received), seq(alarms))
+assert mqtt["connects"] >= 2 and mqtt["connections_lost"] >= 1, mqtt
+assert mqtt["events_published"] == 5 and mqtt["events_dropped"] == 0, mqtt
+assert mqtt["most_queued"] >= 3, mqtt
+')
+if ((rc == 0)) && [[ -z "$problem" ]]; then
+  pass "mqtt: TLS, password; every alarm line arrives in order across a broker restart"
+else
+  fail "mqtt: broker restart" "exit $rc; $problem; stderr: $(head -c 300 "$TMP/box.err")"
+fi
+if grep -q "lost" "$TMP/box.err" && grep -q "connected to 127.0.0.1:$TLS" "$TMP/box.err"; then
+  pass "mqtt: the lost connection and the reconnection are reported"
+else
+  fail "mqtt: reconnect messages" "$(head -c 300 "$TMP/box.err")"
+fi
+mosquitto_sub "${WATCH[@]}" -C 2 -W 5 -v -t plinth/b1/state -t plinth/b1/availability \
+  >"$TMP/retained.out" 2>&1
+problem=$(python3 - "$TMP/retained.out" "$TMP/box.out" <<'PY'
+import json, sys
+got = dict(l.split(" ", 1) for l in open(sys.argv[1]).read().splitlines())
+assert got.get("plinth/b1/availability") == "offline", got
+state = json.loads(got["plinth/b1/state"])
+status = [json.loads(l) for l in open(sys.argv[2]) if l.startswith('{"type": "status"')][-1]
+assert state["box"] == "b1" and state["level"] == status["alarm"] == "alarm", state
+assert state["latched"] == "alarm" and state["cause"] == "risk_threshold", state
+assert state["phase"] == {"x": status["phase"]} and state["risk"] == status["risk"], state
+assert state["time"].endswith("Z") and abs(state["t"] - status["t"]) < 0.2, state
+PY
+)
+if [[ -z "$problem" ]]; then pass "mqtt: the retained state is the last status; offline after a clean stop"
+else fail "mqtt: retained state" "$problem"; fi
+
+# 1b. A queue of 2: of the three events held while the broker is away, the oldest is dropped
+#     and counted; the others arrive in order.
+restart_replay b4 'event_queue = 2'
+problem=$(check_events '
+assert received == alarms[:2] + alarms[3:], "received %s of %s" % (seq(received), seq(alarms))
+assert mqtt["events_dropped"] == 1 and mqtt["events_published"] == 4, mqtt
+assert mqtt["most_queued"] == 2, mqtt
+')
+if ((rc == 0)) && [[ -z "$problem" ]]; then
+  pass "mqtt: a full queue drops its oldest event and counts it"
+else
+  fail "mqtt: bounded queue" "exit $rc; $problem"
+fi
+
+# 1c. A broker certificate the box's CA did not sign: refused, with OpenSSL's reason.
+openssl req -x509 -newkey ec -pkeyopt ec_paramgen_curve:prime256v1 -nodes -days 2 \
+  -subj "/CN=another CA" -keyout "$TMP/other.key" -out "$TMP/other.crt" 2>/dev/null
+expect_success "mqtt: a broker certificate from another CA does not stop the box" \
+  --scene "$ISOLATED" --replay "$AT2" --no-events --mqtt "127.0.0.1:$TLS" --mqtt-box-id b5 \
+  --mqtt-username box --mqtt-password-file "$TMP/box.pw" --mqtt-ca "$TMP/other.crt" && true
+if grep -qi "certificate verify failed" "$TMP/stderr"; then
+  pass "mqtt: the certificate is refused with OpenSSL's reason"
+else
+  fail "mqtt: wrong CA" "stderr: $(head -c 300 "$TMP/stderr")"
+fi
+
+# 2. The Last Will: the box killed (-9) while connected on the plain listener.
+"$BIN" --scene "$ISOLATED" --replay "$AT2" --speed 1 --no-events --mqtt "127.0.0.1:$PLAIN" \
+  --mqtt-box-id b2 --mqtt-username box --mqtt-password-file "$TMP/box.pw" \
+  >"$TMP/box2.out" 2>"$TMP/box2.err" &
+BOX=$!
+online=""
+for ((i = 0; i < 100; i++)); do
+  online=$(mosquitto_sub "${WATCH[@]}" -C 1 -W 1 -t plinth/b2/availability 2>/dev/null)
+  [[ "$online" == online ]] && break
+  sleep 0.1
+done
+kill -9 "$BOX"
+wait "$BOX" 2>/dev/null
+BOX=
+sleep 0.5
+will=$(mosquitto_sub "${WATCH[@]}" -C 1 -W 5 -t plinth/b2/availability 2>/dev/null)
+if [[ "$online" == online && "$will" == offline ]]; then
+  pass "mqtt: availability online, then the Last Will says offline after kill -9"
+else
+  fail "mqtt: Last Will" "availability '$online' while running, '$will' after kill -9"
+fi
+
+# 3. A wrong password: refused with a clear message; the box goes on with its work.
+expect_success "mqtt: a wrong password does not stop the box" --scene "$ISOLATED" \
+  --replay "$AT2" --no-events --mqtt "127.0.0.1:$PLAIN" --mqtt-box-id b3 \
+  --mqtt-username box --mqtt-password-file "$TMP/wrong.pw" && true
+if grep -qE "refused the connection: (bad user name or password|not authorised)" "$TMP/stderr" &&
+  grep -q -- "--mqtt" "$TMP/stderr"; then
+  pass "mqtt: the wrong password is refused with a clear message"
+else
+  fail "mqtt: wrong password" "stderr: $(head -c 300 "$TMP/stderr")"
+fi
+stop_broker
+
+# 4. Bad settings.
+run_args=(--scene "$ISOLATED" --replay "$AT2")
+expect_failure "mqtt: broker without a port" "--mqtt" "HOST:PORT" -- \
+  "${run_args[@]}" --mqtt localhost
+expect_failure "mqtt: a CA file that does not exist" "mqtt.tls_ca_file" "--mqtt-ca" \
+  "no-such-ca.crt" -- "${run_args[@]}" --mqtt 127.0.0.1:1883 --mqtt-ca "$TMP/no-such-ca.crt"
+expect_failure "mqtt: a password file that does not exist" "mqtt.password_file" \
+  "--mqtt-password-file" -- "${run_args[@]}" --mqtt 127.0.0.1:1883 --mqtt-username box \
+  --mqtt-password-file "$TMP/no-such.pw"
+expect_failure "mqtt: a box id with a slash" "--mqtt-box-id" "topic level" -- \
+  "${run_args[@]}" --mqtt 127.0.0.1:1883 --mqtt-box-id a/b
+printf '[mqtt]\nbroker = "127.0.0.1:1883"\nevent_queue = 0\n' >"$TMP/bad.toml"
+expect_failure "mqtt: event_queue out of range" "bad.toml:3" "mqtt.event_queue" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+printf '[mqtt]\nbroker = "127.0.0.1"\n' >"$TMP/bad.toml"
+expect_failure "mqtt: broker without a port in the file" "bad.toml:2" "mqtt.broker" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+printf '[mqtt]\nbroker = "127.0.0.1:1883"\ntls_cert_file = "c.pem"\n' >"$TMP/bad.toml"
+expect_failure "mqtt: a certificate that does not exist" "mqtt.tls_cert_file" "c.pem" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+
+echo "$PASSED passed, $FAILED failed"
+((FAILED == 0))
