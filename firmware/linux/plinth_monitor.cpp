@@ -5,13 +5,13 @@
 // reports a status, alarm lines, phase events, and a summary at the end. Live, the monitor's
 // status and alarm frames also go on the bus.
 #include <CLI/CLI.hpp>
-
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "event_recorder.h"
@@ -20,6 +20,7 @@
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 #include "plinth/host/scene_toml.h"
 #include "status_json.h"
 
@@ -54,9 +55,12 @@ double parse_speed(const std::string& text) {
   if (text == "max") return 0.0;
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v <= 0.0) {
-    throw InputError("--speed: expected a positive factor of real time or 'max', got '" + text +
-                     "'");
+  if (end == text.c_str() || *end != '\0' || !(v >= plinth::host::kMinReplaySpeed) ||
+      !(v <= plinth::host::kMaxReplaySpeed)) {
+    throw InputError("--speed: expected a factor of real time from " +
+                     plinth::host::number_text(plinth::host::kMinReplaySpeed) + " to " +
+                     plinth::host::number_text(plinth::host::kMaxReplaySpeed) +
+                     ", or 'max', got '" + text + "'");
   }
   return v;
 }
@@ -165,12 +169,40 @@ void take(const fw::InputItem& item, fw::Monitor& monitor, Outputs& outputs,
   }
 }
 
+// The command-line option that sets a monitor setting, "" for settings only a file sets.
+std::string option_of(const std::string& field) {
+  static const std::pair<const char*, const char*> kOptions[] = {
+      {"status_interval", "--status-interval"},
+      {"startup_window", "--startup-window"},
+      {"sample_rate", "--rate"},
+      {"steps_per_sample", "--steps"},
+      {"stuck_samples", "--stuck-samples"},
+      {"node", "--node"}};
+  for (const auto& [key, option] : kOptions) {
+    if (field.find(key) != std::string::npos) return option;
+  }
+  return "";
+}
+
+// Monitor::start's error, naming the option or the file that gave the setting.
 void start_monitor(fw::Monitor& monitor, const fw::MonitorConfig& config,
-                   const plinth::Scene& scene_x, const std::optional<plinth::Scene>& scene_y) {
+                   const plinth::Scene& scene_x, const std::optional<plinth::Scene>& scene_y,
+                   const CLI::App& app, const std::string& config_path) {
   const plinth::Error e = monitor.start(config, {&scene_x, scene_y ? &*scene_y : nullptr});
   if (e.ok()) return;
-  std::string message = std::string("monitor settings: ") + e.field + " " + e.reason;
-  if (std::isfinite(e.limit)) message += " (limit " + std::to_string(e.limit) + ")";
+  const std::string option = option_of(e.field);
+  std::string where;
+  if (!option.empty() && app.count(option) > 0) {
+    where = option + " " + app[option]->as<std::string>() + " (" + e.field + ")";
+  } else if (!config_path.empty()) {
+    where = config_path + ": " + e.field;
+  } else {
+    where = std::string("monitor setting ") + e.field;
+  }
+  std::string message = where + ": " + e.reason;
+  if (e.limit != 0.0 && std::isfinite(e.limit) && message.find('[') == std::string::npos) {
+    message += " (limit " + plinth::host::number_text(e.limit) + ")";
+  }
   throw InputError(message);
 }
 
@@ -222,7 +254,7 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
   return t;
 }
 
-int run(const Options& opt) {
+int run(const Options& opt, const CLI::App& app) {
   const int sources = (opt.replay_path.empty() ? 0 : 1) + (opt.can_interface.empty() ? 0 : 1);
   if (sources != 1) throw InputError("give exactly one input: --replay FILE or --can INTERFACE");
   const fw::InputOptions input_settings = input_options(opt);
@@ -239,7 +271,7 @@ int run(const Options& opt) {
   const std::unique_ptr<fw::MonitorInput> input = fw::open_input(input_settings, config, g_stop);
 
   fw::Monitor monitor;
-  start_monitor(monitor, config, scene_x, scene_y);
+  start_monitor(monitor, config, scene_x, scene_y, app, opt.config.config_path);
   std::vector<AxisEvents> sinks;
   sinks.reserve(static_cast<std::size_t>(config.axis_count));
   for (int i = 0; i < config.axis_count; ++i) {
@@ -307,5 +339,5 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  return plinth::host::run_tool("plinth-monitor", [&] { return run(opt); });
+  return plinth::host::run_tool("plinth-monitor", [&] { return run(opt, app); });
 }

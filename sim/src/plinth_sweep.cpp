@@ -4,6 +4,7 @@
 // shards and their merge; plots with gnuplot.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
@@ -13,6 +14,7 @@
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/job_runner.h"
+#include "plinth/host/limits.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
 #include "plinth/host/sweep_impulse.h"
@@ -109,6 +111,33 @@ plinth::host::GridAxis axis_of(const std::string& name, const std::optional<doub
   return axis;
 }
 
+// Simulations of an impulse last at most this long (sweep_impulse.cpp: 60 s on the ground,
+// five base periods on a base), s.
+constexpr double kImpulseSimulationBound = 60.0;
+
+// The steps of one simulation and of one bisection, within the limits (limits.h).
+void check_work(const Options& opt, double simulated_s, const char* what) {
+  using plinth::host::given;
+  (void)plinth::host::bounded_count(
+      std::ceil(simulated_s / opt.dt), plinth::host::kMaxSweepSimulationSteps,
+      given("--dt", opt.dt) + " (" + what + " of " + plinth::host::number_text(simulated_s) + " s)",
+      "each simulation would take", "solver steps");
+  if (opt.impulse_curve) {
+    (void)plinth::host::bounded_count(std::ceil(std::log2(opt.impulse_max / opt.impulse_tol)),
+                                      plinth::host::kMaxBisectionSteps,
+                                      given("--impulse-tol", opt.impulse_tol) + " with " +
+                                          given("--impulse-max", opt.impulse_max),
+                                      "each search would take", "bisection steps");
+  }
+}
+
+void check_bisection(double pga_max_g, double tol_g, const std::string& pga_max,
+                     const std::string& tol) {
+  (void)plinth::host::bounded_count(
+      std::ceil(std::log2(pga_max_g / tol_g)), plinth::host::kMaxBisectionSteps,
+      "--tol " + tol + " with --pga-max " + pga_max, "each search would take", "bisection steps");
+}
+
 int run_sweep_mode(const Options& opt) {
   // Cheap checks first, so a usage slip does not wait for files to load.
   const char* mode = opt.impulse_map     ? "with --impulse-map"
@@ -138,6 +167,9 @@ int run_sweep_mode(const Options& opt) {
 
   const plinth::Scene scene = plinth::host::load_scene_file(opt.scene_path);
   const double g = scene.g;
+  if (opt.impulse_map || opt.impulse_curve) {
+    check_work(opt, kImpulseSimulationBound, "an impulse simulation");
+  }
   plinth::host::SweepPlan plan;
   if (opt.impulse_map) {
     const auto mu_axis = axis_of("mu_s", opt.mu_from, opt.mu_to, opt.mu_steps, "mu-", "", mode);
@@ -159,6 +191,8 @@ int run_sweep_mode(const Options& opt) {
     settings.tolerance_g = plinth::host::parse_acceleration(opt.tol, g, "--tol") / g;
     settings.dt = opt.dt;
     plinth::host::validate(settings);
+    check_bisection(settings.pga_max_g, settings.tolerance_g, opt.pga_max, opt.tol);
+    check_work(opt, record.duration() + 2.0, "a record");
     if (opt.param2.empty()) {
       plan = plinth::host::plan_thresholds(scene.params, record, *parameter, *axis, settings,
                                            opt.compare_ground);

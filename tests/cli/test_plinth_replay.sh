@@ -104,17 +104,17 @@ if expect_success "--loop 3 --t-end 1: exit 0" --record "$AT2" --t-end 1 --loop 
     --rate 200 --t-end 1 --loops 3 --axis "1:x:$AT2"
 fi
 
-# A CSV with a vertical column drives z of the same node; --scale 1000 saturates.
+# A CSV with a vertical column drives z of the same node; --scale 100 (30 g) saturates.
 printf 't,a [g],v [g]\n0,0,0\n0.01,0.1,-0.2\n0.02,-0.05,0.3\n0.03,0,0\n' >"$TMP/vertical.csv"
 if expect_success "CSV with a vertical column: exit 0" --record "$TMP/vertical.csv" --rate 100 \
   --speed max --log "$TMP/vertical.log"; then
   check_log "CSV with a vertical column: az = 1 g + v" "$TMP/vertical.log" --rate 100 \
     --axis "1:x:$TMP/vertical.csv" --axis "1:z:$TMP/vertical.csv:v"
 fi
-if expect_success "--scale 1000 (beyond full scale): exit 0" --record "$TMP/vertical.csv" \
-  --rate 100 --scale 1000 --speed max --log "$TMP/saturated.log"; then
-  check_log "--scale 1000: clamped to full scale with the saturated flag" "$TMP/saturated.log" \
-    --rate 100 --scale 1000 --axis "1:x:$TMP/vertical.csv" --axis "1:z:$TMP/vertical.csv:v"
+if expect_success "--scale 100 (beyond full scale): exit 0" --record "$TMP/vertical.csv" \
+  --rate 100 --scale 100 --speed max --log "$TMP/saturated.log"; then
+  check_log "--scale 100: clamped to full scale with the saturated flag" "$TMP/saturated.log" \
+    --rate 100 --scale 100 --axis "1:x:$TMP/vertical.csv" --axis "1:z:$TMP/vertical.csv:v"
 fi
 
 # A candump log as input: its sensor frames go out again at their logged times.
@@ -238,7 +238,7 @@ expect_failure "--pga nan" '--pga' -- --record "$AT2" --pga nang "${LOG[@]}"
 expect_failure "--pga with --scale" '--pga|--scale' -- \
   --record "$AT2" --pga 0.3g --scale 2 "${LOG[@]}"
 expect_failure "--scale nan" '--scale' -- --record "$AT2" --scale nan "${LOG[@]}"
-expect_failure "--speed 0" '--speed' "greater than zero or 'max'" -- --record "$AT2" --speed 0 \
+expect_failure "--speed 0" '--speed' "from 0.001 to 1e\+06, or 'max'" -- --record "$AT2" --speed 0 \
   --log "$TMP/bad.log"
 expect_failure "--speed fast" '--speed' "'fast'" -- \
   --record "$AT2" --speed fast --log "$TMP/bad.log"

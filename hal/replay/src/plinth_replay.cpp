@@ -22,6 +22,7 @@
 #include "plinth/hal/socketcan.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/record_sampling.h"
 
@@ -331,8 +332,12 @@ const CLI::Validator kSpeed(
     [](const std::string& text) -> std::string {
       double speed = 0.0;
       if (text != "max" &&
-          (!CLI::detail::lexical_cast(text, speed) || !std::isfinite(speed) || speed <= 0.0)) {
-        return "must be a number greater than zero or 'max', got '" + text + "'";
+          (!CLI::detail::lexical_cast(text, speed) || !(speed >= plinth::host::kMinReplaySpeed) ||
+           !(speed <= plinth::host::kMaxReplaySpeed))) {
+        return "must be a factor of real time from " +
+               plinth::host::number_text(plinth::host::kMinReplaySpeed) + " to " +
+               plinth::host::number_text(plinth::host::kMaxReplaySpeed) + ", or 'max', got '" +
+               text + "'";
       }
       return {};
     },

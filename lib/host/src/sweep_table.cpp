@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 
 namespace plinth::host {
 namespace {
@@ -83,6 +84,9 @@ std::vector<double> sweep_values(double from, double to, int steps, const std::s
     throw InputError(from_option + " " + format_value(from) + " is greater than " + to_option +
                      " " + format_value(to));
   }
+  (void)bounded_count(steps, kMaxSweepAxisValues,
+                      prefix + "steps" + suffix + " " + std::to_string(steps),
+                      "the axis would have", "values");
   std::vector<double> values;
   values.reserve(static_cast<std::size_t>(steps));
   for (int i = 0; i < steps; ++i) {

@@ -1,0 +1,95 @@
+#!/usr/bin/env bash
+# Issue 17's classes of hostile input, one section per class, each program that the class
+# reaches: numbers that imply unbounded work, endless inputs, time that jumps in logs, text
+# that reaches gnuplot, outputs that collide or are left partial, and messages that name what
+# is wrong. Every case must end in time, refused with a message naming the option, key or
+# file, or handled correctly. The limits: docs/limits.md.
+#
+# Environment: PLINTH_SIM, PLINTH_SWEEP, PLINTH_REPLAY, PLINTH_MONITOR (the binaries);
+# PLINTH_SOURCE_DIR, the repository root.
+set -u
+
+# shellcheck source=tests/cli/harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
+TIMEOUT=(timeout -k 5 60)
+SWEEP=${PLINTH_SWEEP:-}
+REPLAY=${PLINTH_REPLAY:-}
+MONITOR=${PLINTH_MONITOR:-}
+for binary in "$SWEEP" "$REPLAY" "$MONITOR"; do
+  if [[ ! -x "$binary" ]]; then
+    echo "PLINTH_SWEEP, PLINTH_REPLAY, PLINTH_MONITOR: '$binary' is not an executable" >&2
+    exit 2
+  fi
+done
+ISOLATED=$SCENES/paper-isolated.toml
+GROUND=$SCENES/non-isolated.toml
+SWEEP_ARGS=(--scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 2 --steps 2)
+
+# expect_absent NAME FILE...: none of the files may exist (nothing partial left behind).
+expect_absent() {
+  local name=$1
+  shift
+  local file
+  for file in "$@"; do
+    if [[ -e "$file" ]]; then
+      fail "$name" "$file was left behind"
+      return
+    fi
+  done
+  pass "$name"
+}
+
+echo "# 1. numbers that imply unbounded work, memory or output"
+BIN=$SIM
+expect_failure "sim --dt 1e-20: steps" '--dt 1e-20' 'solver steps' 'limit 1e\+09' -- \
+  --scene "$ISOLATED" --record "$AT2" --dt 1e-20
+expect_failure "sim --t-end 1e18: steps" '--t-end 1e\+18' 'solver steps' -- \
+  --scene "$ISOLATED" --record "$AT2" --t-end 1e18
+expect_failure "sim --scale 1e308: scaled peak" '--scale 1e\+308' 'limit 100 g' -- \
+  --scene "$ISOLATED" --record "$AT2" --scale 1e308 --out scaled.csv
+expect_absent "sim --scale 1e308: no CSV" scaled.csv
+expect_failure "sim --pga 500g: scaled peak" '--pga 500g' 'limit 100 g' -- \
+  --scene "$ISOLATED" --record "$AT2" --pga 500g
+expect_failure "sim --pga 0g" '--pga 0g' 'greater than zero' -- \
+  --scene "$ISOLATED" --record "$AT2" --pga 0g
+expect_failure "sim --pga -1g" '--pga -1g' 'greater than zero' -- \
+  --scene "$ISOLATED" --record "$AT2" --pga -1g
+expect_failure "sim --amplitude 1e300g" '--amplitude' 'limit 100 g' -- \
+  --scene "$ISOLATED" --pulse sine --amplitude 1e300g --period 0.5
+expect_failure "sim --out-interval rows" '--out-interval 1e-09' 'rows' 'limit 1e\+07' -- \
+  --scene "$ISOLATED" --record "$AT2" --dt 1e-6 --out-interval 1e-9 --out rows.csv
+BIN=$SWEEP
+expect_failure "sweep --tol 1e-300g: bisection" '--tol 1e-300g' 'bisection steps' 'limit 40' -- \
+  "${SWEEP_ARGS[@]}" --tol 1e-300g --out tol.csv
+expect_failure "sweep --dt 1e-300: steps" '--dt 1e-300' 'solver steps' -- \
+  "${SWEEP_ARGS[@]}" --dt 1e-300 --out dt.csv
+expect_failure "sweep --steps 2e9: values" '--steps 2000000000' 'limit 1e\+05' -- \
+  --scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 2 --steps 2000000000 --out v.csv
+expect_failure "sweep map rows" '--steps2 2000' 'rows' -- \
+  --scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 2 --steps 2000 \
+  --param2 xi --from2 0 --to2 0.1 --steps2 2000 --out map.csv
+expect_failure "sweep --impulse-tol 1e-300" '--impulse-tol' 'bisection steps' -- \
+  --scene "$ISOLATED" --param T --from 1 --to 2 --steps 2 --impulse-curve --impulse-tol 1e-300 \
+  --out ic.csv
+expect_failure "sweep --jobs 100000" '--jobs' '256' -- "${SWEEP_ARGS[@]}" --jobs 100000 --out j.csv
+expect_failure "sweep --pga-max 1e300g" '--pga-max 1e300g' 'bisection steps' -- \
+  "${SWEEP_ARGS[@]}" --pga-max 1e300g --out p.csv
+BIN=$REPLAY
+expect_failure "replay --speed 1e-300" '--speed' '0.001' -- --record "$AT2" --log s.log --speed 1e-300
+expect_failure "replay --scale 1e308" '--scale 1e\+308' 'limit 100 g' -- \
+  --record "$AT2" --log s.log --scale 1e308
+expect_failure "replay --pga 0g" '--pga 0g' -- --record "$AT2" --log s.log --pga 0g
+BIN=$MONITOR
+expect_failure "monitor --status-interval 1e300" '--status-interval' 'status_interval' -- \
+  --scene "$ISOLATED" --replay "$AT2" --status-interval 1e300
+if grep -q 'limit 0.000000' "$TMP/stderr"; then
+  fail "monitor: no '(limit 0.000000)'" "$(first_stderr_line)"
+fi
+expect_failure "monitor --speed 1e-300" '--speed' -- --scene "$ISOLATED" --replay "$AT2" --speed 1e-300
+expect_failure "monitor --scale 1e308" '--scale 1e\+308' 'limit 100 g' -- \
+  --scene "$ISOLATED" --replay "$AT2" --scale 1e308
+expect_failure "monitor --pga -1g" '--pga -1g' 'greater than zero' -- \
+  --scene "$ISOLATED" --replay "$AT2" --pga -1g
+
+echo "$PASSED passed, $FAILED failed"
+((FAILED == 0))
