@@ -91,5 +91,61 @@ expect_failure "monitor --scale 1e308" '--scale 1e\+308' 'limit 100 g' -- \
 expect_failure "monitor --pga -1g" '--pga -1g' 'greater than zero' -- \
   --scene "$ISOLATED" --replay "$AT2" --pga -1g
 
+echo "# 2. endless and oversized inputs; signals"
+ln -s /dev/zero zero.log
+ln -s /dev/zero zero.AT2
+mkfifo fifo.AT2
+head -c 2000000 /dev/zero | tr '\0' 'a' >long-line.log
+mkdir folder.log
+BIN=$SIM
+expect_failure "sim --scene /dev/zero" '/dev/zero' 'scene' 'not a regular file' -- \
+  --scene /dev/zero --record "$AT2"
+expect_failure "sim --record /dev/zero" '/dev/zero' 'not a regular file' -- \
+  --scene "$ISOLATED" --record /dev/zero
+expect_failure "sim --vertical FIFO" 'fifo.AT2' 'not a regular file' -- \
+  --scene "$ISOLATED" --record "$AT2" --vertical fifo.AT2
+BIN=$SWEEP
+expect_failure "sweep --record /dev/zero" '/dev/zero' 'not a regular file' -- \
+  --scene "$ISOLATED" --record /dev/zero --param T --from 1 --to 2 --steps 2 --out z.csv
+expect_failure "sweep plot /dev/zero" '/dev/zero' 'not a regular file' -- plot /dev/zero --out z.png
+expect_failure "sweep merge /dev/zero" '/dev/zero' 'not a regular file' -- \
+  merge --out m.csv /dev/zero
+BIN=$REPLAY
+expect_failure "replay --record /dev/zero as a log" 'zero.log' 'not a regular file' -- \
+  --record zero.log --log z.log --speed max
+expect_failure "replay --record /dev/zero as AT2" 'zero.AT2' 'not a regular file' -- \
+  --record zero.AT2 --log z.log --speed max
+expect_failure "replay: a log with an endless line" 'long-line.log:1' 'longer than 512 bytes' -- \
+  --record long-line.log --log z.log --speed max
+expect_failure "replay: a folder as the log" 'folder.log' 'directory' -- \
+  --record folder.log --log z.log --speed max
+BIN=$MONITOR
+expect_failure "monitor --replay /dev/zero as a log" 'zero.log' 'not a regular file' -- \
+  --scene "$ISOLATED" --replay zero.log
+expect_failure "monitor: a log with an endless line" 'long-line.log:1' 'longer than 512' -- \
+  --scene "$ISOLATED" --replay long-line.log
+expect_failure "monitor --config /dev/zero" '/dev/zero' 'configuration' -- \
+  --scene "$ISOLATED" --config /dev/zero --replay "$AT2"
+expect_failure "monitor --config a folder" "$SCENES" 'directory' -- \
+  --scene "$ISOLATED" --config "$SCENES" --replay "$AT2"
+expect_failure "monitor --scene FIFO" 'fifo.AT2' 'not a regular file' -- \
+  --scene fifo.AT2 --replay "$AT2"
+
+# SIGTERM ends a long run at once, with exit 130 and no output left behind.
+"${TIMEOUT[@]}" "$SIM" --scene "$ISOLATED" --record "$AT2" --t-end 50000 --out-interval 0.01 --out long.csv \
+  --events long.jsonl >/dev/null 2>"$TMP/stderr" &
+sim_pid=$!
+sleep 1
+kill -TERM "$sim_pid"
+wait "$sim_pid"
+RC=$?
+if ((RC == 130)) && grep -q 'interrupted' "$TMP/stderr"; then
+  pass "sim: SIGTERM ends the run (exit 130)"
+else
+  fail "sim: SIGTERM ends the run (exit 130)" "exit $RC; $(first_stderr_line)"
+fi
+expect_absent "sim: SIGTERM leaves no output" long.csv long.jsonl long.csv.partial-* \
+  long.jsonl.partial-*
+
 echo "$PASSED passed, $FAILED failed"
 ((FAILED == 0))

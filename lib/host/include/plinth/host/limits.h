@@ -26,6 +26,10 @@ inline constexpr int kMaxJobs = 256;
 // Peak ground acceleration after --pga or --scale, g: no earthquake comes near it, and it keeps
 // every product of the solver finite.
 inline constexpr double kMaxScaledPeakG = 100.0;
+// plinth-replay with a candump log as input holds its sensor frames in memory: at most this
+// many (3 h of one node at 1000 Hz), and at most this many lines read in all.
+inline constexpr double kMaxReplayLogFrames = 1e7;
+inline constexpr double kMaxReplayLogLines = 1e8;
 // plinth-replay --speed: slowest and fastest factor of real time ("max" means no pacing).
 inline constexpr double kMinReplaySpeed = 1e-3;
 inline constexpr double kMaxReplaySpeed = 1e6;
