@@ -31,6 +31,8 @@ namespace fw = plinth::firmware;
 namespace mon = plinth::monitor;
 
 volatile std::sig_atomic_t g_stop = 0;
+// Exit code of a replay that ends in an input fault (input_fault below).
+constexpr int kInputFaultExit = 3;
 extern "C" void on_signal(int) { g_stop = 1; }
 
 struct Options {
@@ -241,6 +243,10 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
   t.source = input.source();
   t.samples += monitor.frames().sensor_samples;
   for (const AxisEvents& sink : sinks) t.phase_events += sink.count;
+  const fw::InputTimeCounters time = input.time_counters();
+  t.log_time_back = time.went_back;
+  t.log_time_still = time.stood_still;
+  t.log_time_gaps = time.gaps;
   const fw::BusCounters bus = input.bus_counters();
   t.bus_errors = bus.bus_errors;
   t.bus_dropped_frames = bus.dropped_frames;
@@ -252,6 +258,29 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
     t.recorder_write_errors = recorder->write_errors();
   }
   return t;
+}
+
+// A file replay that ends without the box vouching for it: no estimator ever ran (an empty
+// log, no usable sensor frame), or the log's time could not be monitor time. Says why on
+// stderr; "" when the run is sound (a live bus is judged by its own fault levels).
+std::string input_fault(fw::MonitorInput& input, bool estimated) {
+  const fw::InputTimeCounters time = input.time_counters();
+  if (time.total() > 0) {
+    std::fprintf(stderr,
+                 "plinth-monitor: fault: %s (%llu timestamps back, %llu standing still, %llu "
+                 "gaps beyond %g s in all)\n",
+                 time.first.c_str(), static_cast<unsigned long long>(time.went_back),
+                 static_cast<unsigned long long>(time.stood_still),
+                 static_cast<unsigned long long>(time.gaps), fw::kMaxLogGapS);
+    return "log_time";
+  }
+  if (!estimated && input.sink() == nullptr) {
+    std::fprintf(stderr,
+                 "plinth-monitor: fault: %s: no usable sensor data, the estimator never ran\n",
+                 input.source().c_str());
+    return "no_sensor_data";
+  }
+  return "";
 }
 
 int run(const Options& opt, const CLI::App& app) {
@@ -281,12 +310,17 @@ int run(const Options& opt, const CLI::App& app) {
   const std::unique_ptr<fw::EventRecorder> recorder = make_recorder(opt, config);
   Outputs outputs(monitor, input->t_origin(), recorder.get(), input->sink());
   fw::InputItem item;
-  while (g_stop == 0 && input->next(item)) take(item, monitor, outputs, recorder.get());
+  bool estimated = false;  // the estimators ran at some point
+  while (g_stop == 0 && input->next(item)) {
+    take(item, monitor, outputs, recorder.get());
+    estimated = estimated || monitor.status().estimating;
+  }
   if (recorder) recorder->close();  // every capture is on disk before the summary
-  const fw::RunTotals totals = run_totals(outputs, *input, monitor, recorder.get(), sinks);
+  fw::RunTotals totals = run_totals(outputs, *input, monitor, recorder.get(), sinks);
+  totals.input_fault = input_fault(*input, estimated);
   print_line(fw::summary_json(monitor, totals, input->t_origin()));
   std::fflush(stdout);
-  return 0;
+  return totals.input_fault.empty() || g_stop != 0 ? 0 : kInputFaultExit;
 }
 
 void add_options(CLI::App& app, Options& opt) {

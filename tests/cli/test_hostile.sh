@@ -147,5 +147,54 @@ fi
 expect_absent "sim: SIGTERM leaves no output" long.csv long.jsonl long.csv.partial-* \
   long.jsonl.partial-*
 
+echo "# 3. time in candump logs; no 'normal' while no estimator runs"
+BIN=$MONITOR
+# expect_input_fault NAME CAUSE PATTERN LOG: plinth-monitor on LOG ends in time with exit 3, the
+# summary "alarm": "fault" with "input_fault": CAUSE, and stderr matching PATTERN.
+expect_input_fault() {
+  run --scene "$ISOLATED" --replay "$4"
+  if ((RC != 3)); then
+    fail "$1" "exit $RC, expected 3; stderr: $(first_stderr_line)"
+  elif ! tail -n 1 "$TMP/stdout" | grep -q "\"alarm\": \"fault\", \"input_fault\": \"$2\""; then
+    fail "$1" "summary: $(tail -n 1 "$TMP/stdout" | cut -c 1-200)"
+  elif ! grep -qE -- "$3" "$TMP/stderr"; then
+    fail "$1" "stderr does not match /$3/: $(first_stderr_line)"
+  else
+    pass "$1"
+  fi
+}
+"$REPLAY" --record "$AT2" --pga 0.3g --speed max --log quake.log 2>/dev/null
+: >empty.log
+echo "(1700000000.000000) vcan0 123#00" >no-sensor.log
+# Shifts the timestamps of lines FROM.. by SECONDS (awk keeps six decimals).
+shift_log() {
+  awk -v from="$2" -v by="$3" '{ if (NR >= from) { t = substr($1, 2, length($1) - 2) + by;
+    $1 = sprintf("(%.6f)", t) } print }' "$1"
+}
+shift_log quake.log 3001 -5 >back.log
+shift_log quake.log 3001 3e9 >jump.log
+awk '{ $1 = "(1700000000.000000)"; print }' quake.log >still.log
+expect_success "monitor: a sound log ends exit 0" --scene "$ISOLATED" --replay quake.log
+expect_input_fault "monitor: an empty log ends fault" no_sensor_data 'empty.log.*never ran' empty.log
+expect_input_fault "monitor: a log without sensor frames ends fault" no_sensor_data \
+  'no-sensor.log.*never ran' no-sensor.log
+expect_input_fault "monitor: time going back is a fault" log_time 'back.log:3001: timestamp goes back' \
+  back.log
+if grep -q '"cause": "bus_error"' "$TMP/stdout"; then
+  pass "monitor: time going back raises the fault level"
+else
+  fail "monitor: time going back raises the fault level" "no fault alarm line"
+fi
+expect_input_fault "monitor: time standing still is a fault" log_time 'still.log:3: .*stands still' \
+  still.log
+expect_input_fault "monitor: a jump of centuries is a fault" log_time 'jump.log:3001: .*10 s gap' \
+  jump.log
+lines=$(grep -c '"type": "status"' "$TMP/stdout")
+if ((lines < 1000)); then
+  pass "monitor: no status-line flood across a gap ($lines status lines)"
+else
+  fail "monitor: no status-line flood across a gap" "$lines status lines"
+fi
+
 echo "$PASSED passed, $FAILED failed"
 ((FAILED == 0))
