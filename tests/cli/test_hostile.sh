@@ -196,5 +196,33 @@ else
   fail "monitor: no status-line flood across a gap" "$lines status lines"
 fi
 
+echo "# 4. text that reaches gnuplot is data"
+if command -v gnuplot >/dev/null 2>&1; then
+  hostile=$'x\'\nsystem "touch pwned"\n\'' # a quote, newlines and a gnuplot command
+  BIN=$SWEEP
+  small=(--scene "$SCENES/paper-eccentric.toml" --record "$AT2" --param T --from 1 --to 2
+    --steps 2 --pga-max 2g --tol 0.05g --jobs 1)
+  if expect_success "sweep with a hostile --plot name" "${small[@]}" --out small.csv \
+    --plot "$hostile.png"; then
+    expect_absent "sweep --plot: no command ran" pwned
+    if [[ -s "$hostile.png" && -s "$hostile.svg" ]]; then
+      pass "sweep --plot: the images carry the hostile name"
+    else
+      fail "sweep --plot: the images carry the hostile name" "not written"
+    fi
+  fi
+  expect_success "sweep plot --out with a hostile name" plot small.csv --out "p$hostile.svg" &&
+    expect_absent "sweep plot --out: no command ran" pwned
+  expect_success "sweep merge --plot with a hostile name" merge --out merged.csv \
+    --plot "m$hostile.png" small.csv && expect_absent "sweep merge --plot: no command ran" pwned
+  if [[ -x "${PLINTH_ACCURACY:-}" ]]; then
+    BIN=$PLINTH_ACCURACY
+    expect_success "accuracy --plot into a hostile folder" --quick --plot --out-dir "a$hostile" &&
+      expect_absent "accuracy --plot: no command ran" pwned
+  fi
+else
+  echo "# gnuplot not installed: section 4 skipped (tools/install-deps.sh installs it)"
+fi
+
 echo "$PASSED passed, $FAILED failed"
 ((FAILED == 0))
