@@ -9,12 +9,14 @@
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/job_runner.h"
 #include "plinth/host/limits.h"
+#include "plinth/host/output_file.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
 #include "plinth/host/sweep_impulse.h"
@@ -145,6 +147,9 @@ int run_sweep_mode(const Options& opt) {
                                          : "for a PGA sweep";
   require_text(opt.scene_path, "--scene", mode);
   require_text(opt.out_path, "--out", mode);
+  plinth::host::check_output_path("--out", opt.out_path);
+  plinth::host::check_distinct_files({{"--out", opt.out_path}},
+                                     {{"--scene", opt.scene_path}, {"--record", opt.record_path}});
   plinth::host::JobRun run;
   parse_shard(opt.shard, run.shard_index, run.shard_count);
   run.jobs =
@@ -232,6 +237,10 @@ int run_sweep_mode(const Options& opt) {
 }
 
 int run_merge(const MergeOptions& opt) {
+  plinth::host::check_output_path("--out", opt.out_path);
+  std::vector<std::pair<std::string, std::string>> inputs;
+  for (const std::string& path : opt.inputs) inputs.emplace_back("input", path);
+  plinth::host::check_distinct_files({{"--out", opt.out_path}}, inputs);
   if (!opt.plot_path.empty()) {
     (void)plinth::cli::plot_stem(opt.plot_path);
     (void)plinth::cli::find_gnuplot();

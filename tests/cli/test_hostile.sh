@@ -24,6 +24,9 @@ done
 ISOLATED=$SCENES/paper-isolated.toml
 GROUND=$SCENES/non-isolated.toml
 SWEEP_ARGS=(--scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 2 --steps 2)
+# A sweep that runs in about a second.
+small=(--scene "$SCENES/paper-eccentric.toml" --record "$AT2" --param T --from 1 --to 2 --steps 2
+  --pga-max 2g --tol 0.05g --jobs 1)
 
 # expect_absent NAME FILE...: none of the files may exist (nothing partial left behind).
 expect_absent() {
@@ -200,8 +203,6 @@ echo "# 4. text that reaches gnuplot is data"
 if command -v gnuplot >/dev/null 2>&1; then
   hostile=$'x\'\nsystem "touch pwned"\n\'' # a quote, newlines and a gnuplot command
   BIN=$SWEEP
-  small=(--scene "$SCENES/paper-eccentric.toml" --record "$AT2" --param T --from 1 --to 2
-    --steps 2 --pga-max 2g --tol 0.05g --jobs 1)
   if expect_success "sweep with a hostile --plot name" "${small[@]}" --out small.csv \
     --plot "$hostile.png"; then
     expect_absent "sweep --plot: no command ran" pwned
@@ -223,6 +224,72 @@ if command -v gnuplot >/dev/null 2>&1; then
 else
   echo "# gnuplot not installed: section 4 skipped (tools/install-deps.sh installs it)"
 fi
+
+echo "# 5. outputs that collide, are left partial, or lie"
+BIN=$SIM
+: >taken.csv
+ln taken.csv hard.csv
+ln -s taken.csv soft.jsonl
+expect_failure "sim --out and --events the same file" '--out x.csv and --events x.csv' \
+  'same file' -- --scene "$ISOLATED" --record "$AT2" --out x.csv --events x.csv
+expect_failure "sim --out and --events via a hard link" 'same file' -- \
+  --scene "$ISOLATED" --record "$AT2" --out taken.csv --events hard.csv
+expect_failure "sim --out and --events via a symbolic link" 'same file' -- \
+  --scene "$ISOLATED" --record "$AT2" --out taken.csv --events soft.jsonl
+expect_failure "sim --out over the record" 'overwrite the input' -- \
+  --scene "$ISOLATED" --record "$AT2" --out "$AT2"
+expect_failure "sim --out in a missing folder" '--out nowhere/x.csv' 'does not exist' -- \
+  --scene "$ISOLATED" --record "$AT2" --out nowhere/x.csv
+expect_failure "sim --out-interval longer than the run" '--out-interval 1e\+300' \
+  'longer than the run' -- --scene "$ISOLATED" --record "$AT2" --out-interval 1e300 --out oi.csv
+expect_absent "sim: a refused run leaves no file" x.csv oi.csv nowhere
+printf 't,a [g],v [g]\n0,0,0\n0.01,0.1,-0.2\n0.02,-0.05,0.3\n0.03,0,0\n' >three.csv
+if expect_success "sim: a 3-column CSV" --scene "$ISOLATED" --record three.csv --t-end 0.1; then
+  if grep -q 'vertical: its own column' "$TMP/stdout"; then
+    pass "sim uses a 3-column CSV's vertical column (as plinth-replay does)"
+  else
+    fail "sim uses a 3-column CSV's vertical column" "$(grep excitation "$TMP/stdout")"
+  fi
+fi
+BIN=$REPLAY
+if expect_success "replay: clipping above full scale" --record three.csv --rate 100 --scale 100 \
+  --speed max --log clipped.log --report-json; then
+  if grep -q 'samples beyond the frames. full scale' "$TMP/stderr" &&
+    grep -q '"clipped_samples": [1-9]' "$TMP/stdout"; then
+    pass "replay: clipped samples counted and reported"
+  else
+    fail "replay: clipped samples counted and reported" "$(first_stderr_line)"
+  fi
+fi
+expect_failure "replay --log over the record" '--log' 'same file' -- \
+  --record "$AT2" --log "$AT2" --speed max
+expect_failure "replay --log in a missing folder" '--log nowhere/r.log' 'does not exist' -- \
+  --record "$AT2" --log nowhere/r.log --speed max
+"${TIMEOUT[@]}" "$REPLAY" --record "$AT2" --log slow.log >/dev/null 2>"$TMP/stderr" &
+replay_pid=$!
+sleep 1
+kill -INT "$replay_pid"
+wait "$replay_pid"
+RC=$?
+if ((RC == 130)); then pass "replay: SIGINT exit 130"; else fail "replay: SIGINT exit 130" "exit $RC"; fi
+expect_absent "replay: an interrupted --log is not left as complete" slow.log slow.log.partial-*
+if [[ -s slow.log.partial ]]; then pass "replay: the frames sent kept in slow.log.partial"; else
+  fail "replay: the frames sent kept in slow.log.partial" "missing"
+fi
+BIN=$SWEEP
+"$SWEEP" "${small[@]}" --out resume.csv >/dev/null 2>&1
+sed -i '3s/^1,[^,]*,/1,nan,/; 4s/^2,[^,]*,/2,-1,/' resume.csv
+if expect_success "sweep: resuming a file with nan and negative thresholds" "${small[@]}" \
+  --out resume.csv; then
+  if grep -q 'resume.csv:3: column sliding' "$TMP/stderr" && ! grep -qE 'nan|,-1,' resume.csv; then
+    pass "sweep: NaN and negative thresholds are not resumed"
+  else
+    fail "sweep: NaN and negative thresholds are not resumed" "$(first_stderr_line)"
+  fi
+fi
+expect_failure "sweep merge --out over an input" 'same file' -- merge --out resume.csv resume.csv
+expect_failure "sweep --out in a missing folder" '--out nowhere/s.csv' 'does not exist' -- \
+  "${SWEEP_ARGS[@]}" --out nowhere/s.csv
 
 echo "$PASSED passed, $FAILED failed"
 ((FAILED == 0))

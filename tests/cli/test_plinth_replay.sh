@@ -167,7 +167,8 @@ if expect_success "--speed 2: exit 0" --record "$AT2" --t-end 0.5 --rate 1000 --
   check_log "--speed 2: the log keeps the record's times" "$TMP/fast.log" --same-as "$TMP/paced.log"
 fi
 
-# Ctrl-C: stops at once, with the report, exit 130, and a log that is whole up to there.
+# Ctrl-C: stops at once, with the report, exit 130, and a log that is whole up to there, kept
+# as interrupted.log.partial (never under the name of a complete log).
 "$REPLAY" --record "$AT2" --speed 1 --log "$TMP/interrupted.log" --report-json \
   >"$TMP/stdout" 2>"$TMP/stderr" &
 replay_pid=$!
@@ -181,12 +182,17 @@ if ((RC == 130)) && [[ "$(json_field interrupted)" == true ]] &&
 else
   fail "Ctrl-C: exit 130 with the report" "exit $RC; stdout: $(head -c 200 "$TMP/stdout")"
 fi
-if ((HAVE_PYTHON)) &&
-  python3 "$CHECK" "$TMP/interrupted.log" --same-as "$TMP/interrupted.log" >/dev/null &&
-  (($(wc -l <"$TMP/interrupted.log") > 100)); then
-  pass "Ctrl-C: the log is whole up to the stop ($(wc -l <"$TMP/interrupted.log") lines)"
+PARTIAL=$TMP/interrupted.log.partial
+if [[ -e "$TMP/interrupted.log" ]]; then
+  fail "Ctrl-C: no log under the complete log's name" "interrupted.log exists"
+else
+  pass "Ctrl-C: no log under the complete log's name"
+fi
+if ((HAVE_PYTHON)) && [[ -f "$PARTIAL" ]] &&
+  python3 "$CHECK" "$PARTIAL" --same-as "$PARTIAL" >/dev/null && (($(wc -l <"$PARTIAL") > 100)); then
+  pass "Ctrl-C: the log is whole up to the stop ($(wc -l <"$PARTIAL") lines, in .partial)"
 elif ((HAVE_PYTHON)); then
-  fail "Ctrl-C: the log is whole up to the stop" "$(wc -l <"$TMP/interrupted.log") lines"
+  fail "Ctrl-C: the log is whole up to the stop" "$(wc -l <"$PARTIAL" 2>&1) lines"
 fi
 
 # ---------------------------------------------------------------------------------------------
@@ -254,7 +260,7 @@ expect_failure "--loop 0" '--loop' -- --record "$AT2" --loop 0 "${LOG[@]}"
 expect_failure "--t-end 0" '--t-end' -- --record "$AT2" --t-end 0 "${LOG[@]}"
 expect_failure "neither --can nor --log" '--can' '--log' -- --record "$AT2"
 expect_failure "both --can and --log" '--can|--log' -- --record "$AT2" --can vcan0 "${LOG[@]}"
-expect_failure "unwritable --log" '/nonexistent/dir/x\.log' 'cannot open' -- --record "$AT2" \
+expect_failure "unwritable --log" '/nonexistent/dir/x\.log' 'cannot open|does not exist' -- --record "$AT2" \
   --speed max --log /nonexistent/dir/x.log
 expect_failure "--log-interface too long" 'interface' '15' -- --record "$AT2" \
   --log-interface a_very_long_interface "${LOG[@]}"

@@ -70,6 +70,7 @@ SensorNodeSamples resample(const SensorNodeInput& input, double scale, double ra
     }
     out.acceleration_g.push_back(clamped_g);
     out.status.push_back(status);
+    if (status != 0) ++out.clipped;
   }
   return out;
 }
