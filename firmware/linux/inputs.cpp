@@ -1,5 +1,7 @@
 #include "inputs.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -73,14 +75,24 @@ class RecordInput final : public MonitorInput {
   std::size_t n_ = 0;
 };
 
-// A candump log's frames at their logged times, with ticks inside its gaps (timeouts).
+// A candump log's frames at their logged times, with ticks inside its gaps (timeouts), and the
+// time policy of inputs.h: frames stamped back or still are counted and dropped, gaps beyond
+// kMaxLogGapS counted and not ticked through; each raises the input fault.
 class LogInput final : public MonitorInput {
  public:
   LogInput(hal::CandumpLogReader reader, double speed, const volatile std::sig_atomic_t& stop)
-      : reader_(std::move(reader)), pacer_(speed), stop_(stop) {}
+      : reader_(std::move(reader)), pacer_(speed), stop_(stop) {
+    last_ns_by_id_.fill(-1);
+  }
 
   bool next(InputItem& item) override {
     if (!pending_ && !read_frame()) return false;
+    if (fault_change_) {
+      fault_change_ = false;
+      item.kind = InputItem::Kind::kBusFault;
+      item.bus_fault = fault_until_ns_ != 0;
+      return true;
+    }
     if (next_tick_ns_ < frame_.timestamp_ns) {
       item.kind = InputItem::Kind::kTick;
       item.time_ns = next_tick_ns_;
@@ -94,23 +106,59 @@ class LogInput final : public MonitorInput {
   }
 
   [[nodiscard]] const std::string& source() const override { return reader_.path(); }
+  [[nodiscard]] InputTimeCounters time_counters() const override { return time_; }
 
  private:
-  // The next classic standard frame (others are not ours), paced to its logged time.
+  // The next classic standard frame (others are not ours) with a usable time, paced to it.
   bool read_frame() {
     for (;;) {
       const hal::IoStatus status = reader_.receive(frame_, 0);
       if (status == hal::IoStatus::kEndOfInput) return false;
       if (status == hal::IoStatus::kIoError) throw InputError(reader_.error());  // file:line
-      if (status == hal::IoStatus::kOk) break;  // extended, RTR, FD, error frames: not ours
+      if (status != hal::IoStatus::kOk) continue;  // extended, RTR, FD, error frames: not ours
+      if (usable_time()) break;
     }
     if (!first_ns_) {
       first_ns_ = frame_.timestamp_ns;
       next_tick_ns_ = frame_.timestamp_ns + kLogTickNs;
       pacer_.start();
     }
+    if (fault_until_ns_ != 0 && frame_.timestamp_ns > fault_until_ns_) {
+      fault_until_ns_ = 0;
+      fault_change_ = true;
+    }
+    previous_ns_ = frame_.timestamp_ns;
+    last_ns_by_id_[frame_.frame.id & hal::kStandardIdMask] = frame_.timestamp_ns;
     pending_ = true;
     return pacer_.wait_until(frame_.timestamp_ns - *first_ns_, stop_);
+  }
+
+  // Whether frame_'s time can be monitor time; counts and raises the fault when it cannot, or
+  // when it jumps beyond kMaxLogGapS (then the ticks skip the rest of the gap).
+  bool usable_time() {
+    if (!first_ns_) return true;
+    const std::int64_t t = frame_.timestamp_ns;
+    const std::int64_t max_gap_ns = std::llround(kMaxLogGapS * 1e9);
+    const char* what = nullptr;
+    const std::uint64_t gaps_before = time_.gaps;
+    if (t < previous_ns_) {
+      ++time_.went_back;
+      what = "timestamp goes back";
+    } else if (t == last_ns_by_id_[frame_.frame.id & hal::kStandardIdMask]) {
+      ++time_.stood_still;
+      what = "timestamp stands still (the previous frame's of this identifier)";
+    } else if (t - previous_ns_ > max_gap_ns) {
+      ++time_.gaps;
+      what = "timestamp jumps forward beyond the 10 s gap limit";
+      next_tick_ns_ = std::max(next_tick_ns_, t - max_gap_ns);
+    }
+    if (what == nullptr) return true;
+    if (time_.first.empty()) {
+      time_.first = reader_.path() + ":" + std::to_string(reader_.line_number()) + ": " + what;
+    }
+    if (fault_until_ns_ == 0) fault_change_ = true;
+    fault_until_ns_ = std::max(t, previous_ns_) + std::llround(kInputFaultHoldS * 1e9);
+    return time_.gaps > gaps_before;  // a gap's frame is given, one back or still is not
   }
 
   hal::CandumpLogReader reader_;
@@ -120,6 +168,11 @@ class LogInput final : public MonitorInput {
   bool pending_ = false;  // frame_ is read, not yet given
   std::optional<std::int64_t> first_ns_;
   std::int64_t next_tick_ns_ = 0;
+  std::int64_t previous_ns_ = 0;  // the latest usable frame's time
+  std::array<std::int64_t, hal::kStandardIdMask + 1> last_ns_by_id_{};  // -1: none yet
+  std::int64_t fault_until_ns_ = 0;                                     // 0: no input fault held
+  bool fault_change_ = false;  // the fault is to be raised or cleared before the frame
+  InputTimeCounters time_;
 };
 
 // A live SocketCAN bus. After each receive (at most kBusReceiveTimeoutMs): the frame, or the

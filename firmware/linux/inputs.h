@@ -40,6 +40,20 @@ struct BusCounters {
   std::uint64_t dropped_frames = 0;  // frames the kernel dropped before we read them
 };
 
+// A log's timestamps that cannot be monitor time (docs/monitor.md, "Time in logs"): a frame
+// stamped before the previous one, or at the same microsecond, is not given to the monitor; a
+// jump forward beyond kMaxLogGapS is given, but not ticked through beyond that gap. Each raises
+// the input fault (as a bus fault) until kInputFaultHoldS of well-stamped frames have passed.
+inline constexpr double kMaxLogGapS = 10.0;
+inline constexpr double kInputFaultHoldS = 2.0;
+struct InputTimeCounters {
+  std::uint64_t went_back = 0;
+  std::uint64_t stood_still = 0;
+  std::uint64_t gaps = 0;  // jumps forward beyond kMaxLogGapS
+  std::string first;       // "file:line: what" of the first
+  [[nodiscard]] std::uint64_t total() const { return went_back + stood_still + gaps; }
+};
+
 class MonitorInput {
  public:
   virtual ~MonitorInput() = default;
@@ -50,6 +64,7 @@ class MonitorInput {
   // Monitor time of the record's t = 0, s (a record replay's quiet lead-in); 0 otherwise.
   [[nodiscard]] virtual double t_origin() const { return 0.0; }
   [[nodiscard]] virtual BusCounters bus_counters() const { return {}; }
+  [[nodiscard]] virtual InputTimeCounters time_counters() const { return {}; }
   // Where the monitor's status and alarm frames go; nullptr: nowhere (a replay).
   [[nodiscard]] virtual hal::FrameSink* sink() { return nullptr; }
 };

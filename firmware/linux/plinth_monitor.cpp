@@ -29,6 +29,7 @@
 #include "plinth/hal/pacing.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 #include "plinth/host/scene_toml.h"
 #include "relay_gpiod.h"
 #include "relay_outputs.h"
@@ -43,6 +44,8 @@ namespace fw = plinth::firmware;
 namespace mon = plinth::monitor;
 
 volatile std::sig_atomic_t g_stop = 0;
+// Exit code of a replay that ends in an input fault (input_fault below).
+constexpr int kInputFaultExit = 3;
 extern "C" void on_signal(int) { g_stop = 1; }
 
 struct Options {
@@ -70,9 +73,12 @@ double parse_speed(const std::string& text) {
   if (text == "max") return 0.0;
   char* end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
-  if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v <= 0.0) {
-    throw InputError("--speed: expected a positive factor of real time or 'max', got '" + text +
-                     "'");
+  if (end == text.c_str() || *end != '\0' || !(v >= plinth::host::kMinReplaySpeed) ||
+      !(v <= plinth::host::kMaxReplaySpeed)) {
+    throw InputError("--speed: expected a factor of real time from " +
+                     plinth::host::number_text(plinth::host::kMinReplaySpeed) + " to " +
+                     plinth::host::number_text(plinth::host::kMaxReplaySpeed) +
+                     ", or 'max', got '" + text + "'");
   }
   return v;
 }
@@ -272,18 +278,46 @@ void take(const fw::InputItem& item, fw::Monitor& monitor, Outputs& outputs,
   }
 }
 
+// The command-line option that sets a monitor setting, "" for settings only a file sets.
+std::string option_of(const std::string& field) {
+  static const std::pair<const char*, const char*> kOptions[] = {
+      {"status_interval", "--status-interval"},
+      {"startup_window", "--startup-window"},
+      {"sample_rate", "--rate"},
+      {"steps_per_sample", "--steps"},
+      {"stuck_samples", "--stuck-samples"},
+      {"node", "--node"}};
+  for (const auto& [key, option] : kOptions) {
+    if (field.find(key) != std::string::npos) return option;
+  }
+  return "";
+}
+
 // Each axis's ensemble: the scene file's statue first, then the corners of its [uncertainty]
-// (one member when it declares none).
+// (one member when it declares none). Monitor::start's error names the option or the file that
+// gave the setting.
 void start_monitor(fw::Monitor& monitor, const fw::MonitorConfig& config,
                    const plinth::host::UncertainScene& scene_x,
-                   const std::optional<plinth::host::UncertainScene>& scene_y) {
+                   const std::optional<plinth::host::UncertainScene>& scene_y,
+                   const CLI::App& app, const std::string& config_path) {
   const plinth::Error e = monitor.start(
       config, {std::span<const plinth::Scene>(scene_x.members),
                scene_y ? std::span<const plinth::Scene>(scene_y->members)
                        : std::span<const plinth::Scene>()});
   if (e.ok()) return;
-  std::string message = std::string("monitor settings: ") + e.field + " " + e.reason;
-  if (std::isfinite(e.limit)) message += " (limit " + std::to_string(e.limit) + ")";
+  const std::string option = option_of(e.field);
+  std::string where;
+  if (!option.empty() && app.count(option) > 0) {
+    where = option + " " + app[option]->as<std::string>() + " (" + e.field + ")";
+  } else if (!config_path.empty()) {
+    where = config_path + ": " + e.field;
+  } else {
+    where = std::string("monitor setting ") + e.field;
+  }
+  std::string message = where + ": " + e.reason;
+  if (e.limit != 0.0 && std::isfinite(e.limit) && message.find('[') == std::string::npos) {
+    message += " (limit " + plinth::host::number_text(e.limit) + ")";
+  }
   throw InputError(message);
 }
 
@@ -307,16 +341,19 @@ std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings)
 
 // Takes the input until it ends or a signal; systemd's watchdog hears of every item taken.
 // The loop: each input item taken, its latency noted (--latency), the network outputs' operator
-// commands carried out, the watchdog told of the progress.
+// commands carried out, the watchdog told of the progress. True when the estimators ran at some
+// point.
 template <typename Restart>
-void run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
+bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
               fw::EventRecorder* recorder, fw::Supervisor& supervisor, fw::LatencyLog* latency,
               Restart restart) {
   supervisor.ready("monitoring " + input.source());
   fw::InputItem item;
+  bool estimated = false;
   while (g_stop == 0 && input.next(item)) {
     const std::int64_t arrival_ns = latency != nullptr ? fw::monotonic_ns() : 0;
     take(item, monitor, outputs, recorder);
+    estimated = estimated || monitor.status().estimating;
     if (latency != nullptr && item.kind != fw::InputItem::Kind::kTick &&
         item.kind != fw::InputItem::Kind::kBusFault) {
       latency->add(fw::monotonic_ns() - arrival_ns);
@@ -327,6 +364,7 @@ void run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
     supervisor.on_progress(now_ns);
   }
   supervisor.stopping();
+  return estimated;
 }
 
 fw::InputOptions input_options(const Options& opt) {
@@ -352,6 +390,10 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
   t.source = input.source();
   t.samples += monitor.frames().sensor_samples;
   for (const AxisEvents& sink : sinks) t.phase_events += sink.count;
+  const fw::InputTimeCounters time = input.time_counters();
+  t.log_time_back = time.went_back;
+  t.log_time_still = time.stood_still;
+  t.log_time_gaps = time.gaps;
   const fw::BusCounters bus = input.bus_counters();
   t.bus_errors = bus.bus_errors;
   t.bus_dropped_frames = bus.dropped_frames;
@@ -378,7 +420,30 @@ std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFi
   return outputs;
 }
 
-int run(const Options& opt) {
+// A file replay that ends without the box vouching for it: no estimator ever ran (an empty
+// log, no usable sensor frame), or the log's time could not be monitor time. Says why on
+// stderr; "" when the run is sound (a live bus is judged by its own fault levels).
+std::string input_fault(fw::MonitorInput& input, bool estimated) {
+  const fw::InputTimeCounters time = input.time_counters();
+  if (time.total() > 0) {
+    std::fprintf(stderr,
+                 "plinth-monitor: fault: %s (%llu timestamps back, %llu standing still, %llu "
+                 "gaps beyond %g s in all)\n",
+                 time.first.c_str(), static_cast<unsigned long long>(time.went_back),
+                 static_cast<unsigned long long>(time.stood_still),
+                 static_cast<unsigned long long>(time.gaps), fw::kMaxLogGapS);
+    return "log_time";
+  }
+  if (!estimated && input.sink() == nullptr) {
+    std::fprintf(stderr,
+                 "plinth-monitor: fault: %s: no usable sensor data, the estimator never ran\n",
+                 input.source().c_str());
+    return "no_sensor_data";
+  }
+  return "";
+}
+
+int run(const Options& opt, const CLI::App& app) {
   const int sources = (opt.replay_path.empty() ? 0 : 1) + (opt.can_interface.empty() ? 0 : 1);
   if (sources != 1) throw InputError("give exactly one input: --replay FILE or --can INTERFACE");
   const fw::InputOptions input_settings = input_options(opt);
@@ -397,7 +462,7 @@ int run(const Options& opt) {
   const std::unique_ptr<fw::MonitorInput> input = fw::open_input(input_settings, config, g_stop);
 
   fw::Monitor monitor;
-  start_monitor(monitor, config, scene_x, scene_y);
+  start_monitor(monitor, config, scene_x, scene_y, app, opt.config.config_path);
   std::vector<AxisEvents> sinks;
   sinks.reserve(static_cast<std::size_t>(config.axis_count));
   for (int i = 0; i < config.axis_count; ++i) {
@@ -433,9 +498,11 @@ int run(const Options& opt) {
   std::optional<fw::LatencyLog> latency;
   if (opt.latency) latency.emplace(kLatencyCapacity);
   fw::Supervisor supervisor(file.watchdog);
-  const auto restart = [&] { start_monitor(monitor, config, scene_x, scene_y); };
-  run_loop(*input, monitor, outputs, recorder.get(), supervisor, latency ? &*latency : nullptr,
-           restart);
+  const auto restart = [&] {
+    start_monitor(monitor, config, scene_x, scene_y, app, opt.config.config_path);
+  };
+  const bool estimated = run_loop(*input, monitor, outputs, recorder.get(), supervisor,
+                                  latency ? &*latency : nullptr, restart);
   if (trace) trace->close();
   if (recorder) recorder->close();  // every capture is on disk before the summary
   if (frames_log && !frames_log->flush()) throw InputError("--frames-out: " + frames_log->error());
@@ -446,9 +513,10 @@ int run(const Options& opt) {
     totals.outputs.emplace_back(o->name(), o->summary_json());
   }
   if (latency) totals.outputs.emplace_back("latency", latency->summary_json());
+  totals.input_fault = input_fault(*input, estimated);
   print_line(fw::summary_json(monitor, totals, input->t_origin()));
   std::fflush(stdout);
-  return 0;
+  return totals.input_fault.empty() || g_stop != 0 ? 0 : kInputFaultExit;
 }
 
 void add_options(CLI::App& app, Options& opt) {
@@ -525,5 +593,5 @@ int main(int argc, char** argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  return plinth::host::run_tool("plinth-monitor", [&] { return run(opt); });
+  return plinth::host::run_tool("plinth-monitor", [&] { return run(opt, app); });
 }

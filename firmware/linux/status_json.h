@@ -58,6 +58,12 @@ struct RunTotals {
   std::uint64_t bus_send_errors = 0;     // frames not sent (the bus refused or not encodable)
   std::uint64_t bus_errors = 0;          // error frames reported by the controller (live)
   std::uint64_t bus_dropped_frames = 0;  // frames the kernel dropped before we read them (live)
+  std::uint64_t log_time_back = 0;       // log frames stamped before the previous (dropped)
+  std::uint64_t log_time_still = 0;      // log frames stamped at the previous time (dropped)
+  std::uint64_t log_time_gaps = 0;       // log jumps forward beyond kMaxLogGapS
+  // Why the run cannot be vouched for ("no_sensor_data", "log_time"), "" when it can: the
+  // summary then says "alarm": "fault" with this "input_fault".
+  std::string input_fault;
   bool recorder = false;                 // the event recorder ran: its counters follow
   std::uint64_t captures_written = 0;
   std::uint64_t captures_dropped = 0;

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "gnuplot.h"
 #include "plinth/core/simulator.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
@@ -430,7 +431,8 @@ void plot(const Options& opt, const std::vector<Summary>& summary) {
     if (!out.flush()) throw InputError(data + ": write failed");
   }
   std::string script =
-      "# Drawn by plinth-accuracy (docs/accuracy.md) from accuracy-summary.dat.\n"
+      "# Drawn by plinth-accuracy (docs/accuracy.md); file names are arguments: gnuplot -c "
+      "accuracy.gp accuracy-summary.dat accuracy.png accuracy.svg\n"
       "set logscale xy\nset format y '10^{%L}'\nset grid\nset key bottom left font ',9'\n"
       "set xlabel 'cost: wall time per simulated second (ms/s)'\n";
   const char* panels[][3] = {
@@ -443,26 +445,22 @@ void plot(const Options& opt, const std::vector<Summary>& summary) {
   for (const auto& p : panels) {
     body += std::string("set title '") + p[2] + "'\nset ylabel '" + p[1] + "'\nplot ";
     for (std::size_t i = 0; i < kVariants.size(); ++i) {
-      body += "'" + data + "' index " + std::to_string(i) + " using 2:" + p[0] +
-              " with linespoints pt " + std::to_string(i + 4) + " title '" + kVariants[i].name() +
-              "' noenhanced" + (i + 1 < kVariants.size() ? ", " : "\n");
+      body += "ARG1 index " + std::to_string(i) + " using 2:" + p[0] + " with linespoints pt " +
+              std::to_string(i + 4) + " title '" + kVariants[i].name() + "' noenhanced" +
+              (i + 1 < kVariants.size() ? ", " : "\n");
     }
   }
   body += "unset multiplot\n";
-  script += "set terminal pngcairo size 1400,1000 font ',10'\nset output '" + stem + ".png'\n" +
-            body + "set terminal svg size 1400,1000 dynamic font ',10'\nset output '" + stem +
-            ".svg'\n" + body + "set output\n";
+  script += "set terminal pngcairo size 1400,1000 font ',10'\nset output ARG2\n" + body +
+            "set terminal svg size 1400,1000 dynamic font ',10'\nset output ARG3\n" + body +
+            "set output\n";
   const std::string gp = stem + ".gp";
   {
     std::ofstream out(gp);
     out << script;
     if (!out.flush()) throw InputError(gp + ": write failed");
   }
-  const std::string command = "gnuplot '" + gp + "'";
-  if (std::system(command.c_str()) != 0) {
-    throw InputError("gnuplot failed on " + gp +
-                     " (is the Debian package gnuplot-nox installed? apt-get install gnuplot-nox)");
-  }
+  plinth::cli::run_gnuplot(gp, {data, stem + ".png", stem + ".svg"});  // names as data
 }
 
 std::string markdown(const std::vector<Summary>& summary) {

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,8 @@
 #include "plinth/core/simulator.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
+#include "plinth/host/output_file.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/record_sampling.h"
 #include "plinth/host/run_output.h"
@@ -116,12 +119,12 @@ class RunSink final : public plinth::EventSink {
   std::string last_text_ = "full_contact";
 };
 
-std::unique_ptr<std::ofstream> open_output(const std::string& path, const char* what) {
-  if (path.empty()) return nullptr;
-  auto out = std::make_unique<std::ofstream>(path);
-  if (!*out) throw InputError(path + ": cannot open " + what + " for writing");
-  return out;
-}
+// Set by SIGINT and SIGTERM: the run stops at the next step and leaves no output behind.
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void request_stop(int /*signal*/) { g_stop = 1; }
+
+// Exit code of a run stopped by SIGINT or SIGTERM (128 + SIGINT, as shells report it).
+constexpr int kInterruptedExit = 130;
 
 std::string describe_scene(const plinth::Scene& s) {
   char text[320];
@@ -159,7 +162,85 @@ std::string describe_scene(const plinth::Scene& s) {
   return out;
 }
 
+// The record (and its vertical motion: --vertical, else the record's own vertical column) as
+// the excitation, scaled as asked; `text` describes it.
+plinth::Excitation record_excitation(const Options& opt, double g, plinth::host::Record& record,
+                                     plinth::host::Record& vertical, std::string& text) {
+  record = plinth::host::read_record(opt.record_path, g);
+  std::string vertical_text = record.vertical.empty() ? "" : "; vertical: its own column";
+  plinth::SampledSignal vertical_signal = record.vertical_signal();
+  if (!opt.vertical_path.empty()) {
+    vertical = plinth::host::read_record(opt.vertical_path, g);
+    if (std::fabs(vertical.dt - record.dt) > 1e-9 * record.dt) {
+      throw InputError("--vertical " + opt.vertical_path + ": sampling interval " +
+                       plinth::host::number_text(vertical.dt) +
+                       " s differs from the horizontal record's " +
+                       plinth::host::number_text(record.dt) + " s");
+    }
+    vertical_signal = vertical.horizontal_signal();
+    vertical_text = "; vertical: " + opt.vertical_path +
+                    (record.vertical.empty() ? "" : " (in place of the record's own column)");
+  }
+  const double gamma = plinth::host::record_scale(record, opt.record_path, opt.pga, opt.scale, g);
+  if (!opt.vertical_path.empty()) {
+    plinth::host::check_scaled_peak(
+        gamma, vertical.peak_horizontal(), g,
+        opt.pga.empty() ? plinth::host::given("--scale", gamma) : "--pga " + opt.pga);
+  }
+  char line[256];
+  std::snprintf(line, sizeof line, "%s, PGA %.4g g (scale %.4g), dt %g s, %.2f s",
+                record.name.c_str(), gamma * record.peak_horizontal() / g, gamma, record.dt,
+                record.duration());
+  text = line + vertical_text;
+  return plinth::Excitation::record(record.horizontal_signal(), vertical_signal, gamma);
+}
+
+// The steps of the run and between CSV rows, within the limits (limits.h).
+struct StepPlan {
+  std::int64_t steps = 0;
+  std::int64_t out_every = 1;
+};
+
+StepPlan plan_steps(const Options& opt, double t_end) {
+  using plinth::host::given;
+  const std::string subject =
+      given("--dt", opt.dt) + (opt.t_end
+                                   ? " and " + given("--t-end", t_end)
+                                   : " (a run of " + plinth::host::number_text(t_end) + " s)");
+  StepPlan plan;
+  plan.steps = plinth::host::bounded_count(std::round(t_end / opt.dt), plinth::host::kMaxRunSteps,
+                                           subject, "the run would take", "solver steps");
+  if (opt.out_path.empty()) return plan;
+  if (opt.out_interval > t_end) {
+    throw InputError(given("--out-interval", opt.out_interval) + ": longer than the run (" +
+                     plinth::host::number_text(t_end) + " s); the CSV would hold one row");
+  }
+  plan.out_every = std::max<std::int64_t>(1, std::llround(opt.out_interval / opt.dt));
+  (void)plinth::host::bounded_count(
+      static_cast<double>(plan.steps / plan.out_every), plinth::host::kMaxTimeHistoryRows,
+      given("--out-interval", opt.out_interval) + " with " + given("--dt", opt.dt),
+      "the time history would have", "rows");
+  return plan;
+}
+
+void install_stop_handlers() {
+  struct sigaction action {};
+  action.sa_handler = request_stop;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+}
+
+bool finite_state(const plinth::State& y) { return y.allFinite(); }
+
 int run(const Options& opt) {
+  // Outputs first: a slip in a file name is reported before any work.
+  plinth::host::check_distinct_files({{"--out", opt.out_path}, {"--events", opt.events_path}},
+                                     {{"--scene", opt.scene_path},
+                                      {"--record", opt.record_path},
+                                      {"--vertical", opt.vertical_path}});
+  if (!opt.out_path.empty()) plinth::host::check_output_path("--out", opt.out_path);
+  if (!opt.events_path.empty()) plinth::host::check_output_path("--events", opt.events_path);
   const plinth::Scene scene = plinth::host::load_scene_file(opt.scene_path);
   const double g = scene.g;
 
@@ -168,26 +249,13 @@ int run(const Options& opt) {
   plinth::Excitation excitation;
   std::string excitation_text = "none";
   if (!opt.record_path.empty()) {
-    record = plinth::host::read_record(opt.record_path, g);
-    if (!opt.vertical_path.empty()) {
-      vertical = plinth::host::read_record(opt.vertical_path, g);
-      if (std::fabs(vertical.dt - record.dt) > 1e-9 * record.dt) {
-        throw InputError(opt.vertical_path + ": sampling interval " +
-                         std::to_string(vertical.dt) + " s differs from the horizontal record's " +
-                         std::to_string(record.dt) + " s");
-      }
-    }
-    const double peak = record.peak_horizontal();
-    const double gamma = plinth::host::record_scale(record, opt.record_path, opt.pga, opt.scale, g);
-    excitation = plinth::Excitation::record(
-        record.horizontal_signal(),
-        opt.vertical_path.empty() ? plinth::SampledSignal{} : vertical.horizontal_signal(), gamma);
-    char text[256];
-    std::snprintf(text, sizeof text, "%s, PGA %.4g g (scale %.4g), dt %g s, %.2f s",
-                  record.name.c_str(), gamma * peak / g, gamma, record.dt, record.duration());
-    excitation_text = text;
+    excitation = record_excitation(opt, g, record, vertical, excitation_text);
   } else if (!opt.pulse.empty()) {
     const double amplitude = plinth::host::parse_acceleration(opt.amplitude, g, "--amplitude");
+    if (!(std::fabs(amplitude) / g <= plinth::host::kMaxScaledPeakG)) {
+      throw InputError("--amplitude " + opt.amplitude + ": limit " +
+                       plinth::host::number_text(plinth::host::kMaxScaledPeakG) + " g");
+    }
     excitation = opt.pulse == "sine" ? plinth::Excitation::sine_pulse(amplitude, *opt.period)
                                      : plinth::Excitation::cosine_pulse(amplitude, *opt.period);
     char text[160];
@@ -207,18 +275,14 @@ int run(const Options& opt) {
       plinth::Simulator::create(scene, excitation, settings, sim));
 
   const double t_end = opt.t_end ? *opt.t_end : std::max(10.0, excitation.duration() + 5.0);
-  auto csv_file = open_output(opt.out_path, "the time history");
-  std::unique_ptr<std::ofstream> events_file;
-  try {
-    events_file = open_output(opt.events_path, "the event log");
-  } catch (const InputError&) {
-    csv_file.reset();
-    std::filesystem::remove(opt.out_path);  // leave no half-made outputs behind
-    throw;
-  }
+  const StepPlan plan = plan_steps(opt, t_end);
+  std::optional<plinth::host::OutputFile> csv_file;
+  std::optional<plinth::host::OutputFile> events_file;
+  if (!opt.out_path.empty()) csv_file.emplace("--out", opt.out_path);
+  if (!opt.events_path.empty()) events_file.emplace("--events", opt.events_path);
   std::optional<plinth::host::TimeHistoryCsv> csv;
-  if (csv_file) csv.emplace(*csv_file);
-  RunSink sink(events_file.get());
+  if (csv_file) csv.emplace(csv_file->stream());
+  RunSink sink(events_file ? &events_file->stream() : nullptr);
   sim.set_event_sink(&sink);
 
   if (opt.impulse) {
@@ -226,19 +290,31 @@ int run(const Options& opt) {
   } else {
     sim.start_at_rest();
   }
-  const auto steps = static_cast<std::int64_t>(std::llround(t_end / opt.dt));
-  const std::int64_t out_every = std::max<std::int64_t>(1, std::llround(opt.out_interval / opt.dt));
+  install_stop_handlers();
   double peak_theta = 0.0;
   double peak_u = 0.0;
   double peak_x = 0.0;
   const auto wall_start = std::chrono::steady_clock::now();
-  for (std::int64_t i = 0; i <= steps; ++i) {
+  for (std::int64_t i = 0; i <= plan.steps; ++i) {
     const plinth::State& y = sim.state();
+    if (!finite_state(y)) {
+      char text[160];
+      std::snprintf(text, sizeof text,
+                    "the solver's state is not finite at t = %.6g s (an overflow): no result "
+                    "(try a smaller --dt, or check the excitation)",
+                    sim.time());
+      throw InputError(text);
+    }
+    if (g_stop != 0) {
+      std::fprintf(stderr, "plinth-sim: interrupted at t = %.4f s: no output written\n",
+                   sim.time());
+      return kInterruptedExit;
+    }
     peak_theta = std::max(peak_theta, std::fabs(y[plinth::kTheta]));
     peak_u = std::max(peak_u, std::fabs(y[plinth::kU]));
     peak_x = std::max(peak_x, std::fabs(y[plinth::kX]));
-    const bool last = sim.mode().terminal() || i == steps;
-    if (csv && (i % out_every == 0 || last)) {
+    const bool last = sim.mode().terminal() || i == plan.steps;
+    if (csv && (i % plan.out_every == 0 || last)) {
       csv->write_row(sim.time(), excitation.at(sim.time()).horizontal, y, sim.mode().phase);
     }
     if (last) break;
@@ -246,9 +322,9 @@ int run(const Options& opt) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   const plinth::host::Outcome outcome = plinth::host::outcome_of(sim.mode().phase);
-  if (events_file) *events_file << plinth::host::end_json(sim.time(), outcome) << '\n';
-  if (csv_file && !csv_file->flush()) throw InputError(opt.out_path + ": write failed");
-  if (events_file && !events_file->flush()) throw InputError(opt.events_path + ": write failed");
+  if (events_file) events_file->stream() << plinth::host::end_json(sim.time(), outcome) << '\n';
+  if (csv_file) csv_file->commit();
+  if (events_file) events_file->commit();
 
   std::printf("scene:      %s (%s)\n", opt.scene_path.c_str(), describe_scene(scene).c_str());
   std::printf("excitation: %s\n", excitation_text.c_str());

@@ -4,15 +4,19 @@
 // shards and their merge; plots with gnuplot.
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <optional>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/job_runner.h"
+#include "plinth/host/limits.h"
+#include "plinth/host/output_file.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/run_progress.h"
 #include "plinth/host/scene_toml.h"
@@ -93,6 +97,33 @@ plinth::host::GridAxis axis_of(const std::string& name, const std::optional<doub
   return axis;
 }
 
+// Simulations of an impulse last at most this long (sweep_impulse.cpp: 60 s on the ground,
+// five base periods on a base), s.
+constexpr double kImpulseSimulationBound = 60.0;
+
+// The steps of one simulation and of one bisection, within the limits (limits.h).
+void check_work(const Options& opt, double simulated_s, const char* what) {
+  using plinth::host::given;
+  (void)plinth::host::bounded_count(
+      std::ceil(simulated_s / opt.dt), plinth::host::kMaxSweepSimulationSteps,
+      given("--dt", opt.dt) + " (" + what + " of " + plinth::host::number_text(simulated_s) + " s)",
+      "each simulation would take", "solver steps");
+  if (opt.impulse_curve) {
+    (void)plinth::host::bounded_count(std::ceil(std::log2(opt.impulse_max / opt.impulse_tol)),
+                                      plinth::host::kMaxBisectionSteps,
+                                      given("--impulse-tol", opt.impulse_tol) + " with " +
+                                          given("--impulse-max", opt.impulse_max),
+                                      "each search would take", "bisection steps");
+  }
+}
+
+void check_bisection(double pga_max_g, double tol_g, const std::string& pga_max,
+                     const std::string& tol) {
+  (void)plinth::host::bounded_count(
+      std::ceil(std::log2(pga_max_g / tol_g)), plinth::host::kMaxBisectionSteps,
+      "--tol " + tol + " with --pga-max " + pga_max, "each search would take", "bisection steps");
+}
+
 int run_sweep_mode(const Options& opt) {
   // Cheap checks first, so a usage slip does not wait for files to load.
   const char* mode = opt.impulse_map     ? "with --impulse-map"
@@ -100,6 +131,9 @@ int run_sweep_mode(const Options& opt) {
                                          : "for a PGA sweep";
   require_text(opt.scene_path, "--scene", mode);
   require_text(opt.out_path, "--out", mode);
+  plinth::host::check_output_path("--out", opt.out_path);
+  plinth::host::check_distinct_files({{"--out", opt.out_path}},
+                                     {{"--scene", opt.scene_path}, {"--record", opt.record_path}});
   plinth::host::JobRun run;
   plinth::host::parse_shard(opt.shard, run.shard_index, run.shard_count);
   run.jobs =
@@ -122,6 +156,9 @@ int run_sweep_mode(const Options& opt) {
 
   const plinth::Scene scene = plinth::host::load_scene_file(opt.scene_path);
   const double g = scene.g;
+  if (opt.impulse_map || opt.impulse_curve) {
+    check_work(opt, kImpulseSimulationBound, "an impulse simulation");
+  }
   plinth::host::SweepPlan plan;
   if (opt.impulse_map) {
     const auto mu_axis = axis_of("mu_s", opt.mu_from, opt.mu_to, opt.mu_steps, "mu-", "", mode);
@@ -143,6 +180,8 @@ int run_sweep_mode(const Options& opt) {
     settings.tolerance_g = plinth::host::parse_acceleration(opt.tol, g, "--tol") / g;
     settings.dt = opt.dt;
     plinth::host::validate(settings);
+    check_bisection(settings.pga_max_g, settings.tolerance_g, opt.pga_max, opt.tol);
+    check_work(opt, record.duration() + 2.0, "a record");
     if (opt.param2.empty()) {
       plan = plinth::host::plan_thresholds(scene.params, record, *parameter, *axis, settings,
                                            opt.compare_ground);
@@ -182,6 +221,10 @@ int run_sweep_mode(const Options& opt) {
 }
 
 int run_merge(const MergeOptions& opt) {
+  plinth::host::check_output_path("--out", opt.out_path);
+  std::vector<std::pair<std::string, std::string>> inputs;
+  for (const std::string& path : opt.inputs) inputs.emplace_back("input", path);
+  plinth::host::check_distinct_files({{"--out", opt.out_path}}, inputs);
   if (!opt.plot_path.empty()) {
     (void)plinth::cli::plot_stem(opt.plot_path);
     (void)plinth::cli::find_gnuplot();

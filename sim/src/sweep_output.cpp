@@ -12,6 +12,7 @@
 
 #include "plinth/host/input_error.h"
 #include "plinth/host/run_progress.h"
+#include "plinth/host/output_file.h"
 
 namespace plinth::cli {
 namespace {
@@ -64,17 +65,9 @@ std::vector<std::string> resumable_rows(const std::string& path,
 
 
 void write_table_file(const SweepTable& table, const std::string& path) {
-  const std::string temporary = path + ".tmp";
-  {
-    std::ofstream out(temporary);
-    if (!out) throw InputError(path + ": cannot open for writing");
-    plinth::host::write_sweep_table(out, table);
-    out.close();
-    if (!out) throw InputError(path + ": cannot write");
-  }
-  std::error_code error;
-  std::filesystem::rename(temporary, path, error);
-  if (error) throw InputError(path + ": cannot write (" + error.message() + ")");
+  plinth::host::OutputFile out("--out", path);  // a temporary renamed once complete
+  plinth::host::write_sweep_table(out.stream(), table);
+  out.commit();
 }
 
 SweepOutcome run_to_file(const plinth::host::SweepPlan& plan, plinth::host::JobRun run,

@@ -1,13 +1,7 @@
 #include "sweep_plot.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <array>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -18,12 +12,11 @@
 #include <utility>
 #include <vector>
 
+#include "gnuplot.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/sweep_impulse.h"
 #include "plinth/host/sweep_parameter.h"
 #include "plinth/host/sweep_search.h"
-
-extern char** environ;
 
 namespace plinth::cli {
 namespace {
@@ -31,10 +24,6 @@ namespace {
 using plinth::host::InputError;
 using plinth::host::SweepTable;
 using Field = std::optional<double>;
-
-constexpr const char* kInstallHint =
-    "gnuplot is needed for --plot and was not found on PATH: install the Debian package "
-    "gnuplot-nox (apt-get install gnuplot-nox, or tools/install-deps.sh)";
 
 // Axis labels in gnuplot's enhanced text.
 std::string axis_label(const std::string& name) {
@@ -134,13 +123,15 @@ class Script {
 
   [[nodiscard]] std::string text(const std::string& stem, const std::string& source) const {
     std::ostringstream out;
-    out << "# Drawn by plinth-sweep from " << source << " (docs/sweep.md); run: gnuplot "
-        << std::filesystem::path(stem).filename().string() << ".gp\n"
+    const std::string name = comment_text(std::filesystem::path(stem).filename().string());
+    out << "# Drawn by plinth-sweep from " << comment_text(source)
+        << " (docs/sweep.md); file names are arguments: gnuplot -c " << name << ".gp " << name
+        << ".png " << name << ".svg\n"
         << "set encoding utf8\n"
         << head_.str() << "set terminal pngcairo size " << size_ << " enhanced font 'sans,11'\n"
-        << "set output " << quoted(stem + ".png") << '\n'
+        << "set output ARG1\n"
         << body_.str() << "set terminal svg size " << size_ << " dynamic enhanced font 'sans,11'\n"
-        << "set output " << quoted(stem + ".svg") << '\n'
+        << "set output ARG2\n"
         << (multiplot_ ? body_.str() : std::string("replot\n")) << "unset output\n";
     return out.str();
   }
@@ -390,9 +381,12 @@ void impulse_map_plot(Script& s, const Columns& c) {
     const std::string name = plinth::host::impulse_start_name(starts[k]);
     std::string lines;
     for (std::size_t r = 0; r < c.text.size(); ++r) {
-      if (c.text[r][simulated] != name) continue;
-      lines += c.text[r][impulse] + ' ' + c.text[r][mu] + '\n';
-      if (c.text[r][predicted] != name) differ += c.text[r][impulse] + ' ' + c.text[r][mu] + '\n';
+      const Field i = c.at(r, impulse);
+      const Field m = c.at(r, mu);
+      if (c.text[r][simulated] != name || !i || !m) continue;  // numbers only reach the script
+      const std::string point = number(*i) + ' ' + number(*m) + '\n';
+      lines += point;
+      if (c.text[r][predicted] != name) differ += point;
     }
     s.raw_block(name, lines.empty() ? "NaN NaN\n" : lines);
     plot += "$" + name + " using 1:2 with points pt " + std::to_string(points[k]) +
@@ -472,19 +466,6 @@ void impulse_curve_plot(Script& s, const Columns& c) {
 
 }  // namespace
 
-std::string find_gnuplot() {
-  const char* path = std::getenv("PATH");
-  std::string dirs = path != nullptr ? path : "";
-  std::istringstream in(dirs);
-  std::string dir;
-  while (std::getline(in, dir, ':')) {
-    if (dir.empty()) continue;
-    const std::string candidate = dir + "/gnuplot";
-    if (::access(candidate.c_str(), X_OK) == 0) return candidate;
-  }
-  throw InputError(kInstallHint);
-}
-
 std::string plot_stem(const std::string& plot_path) {
   const std::filesystem::path p(plot_path);
   const std::string ext = p.extension().string();
@@ -525,44 +506,18 @@ std::string gnuplot_script(const SweepTable& table, const std::string& stem) {
 }
 
 std::string plot_sweep(const SweepTable& table, const std::string& plot_path) {
-  const std::string gnuplot = find_gnuplot();
+  (void)find_gnuplot();
   const std::string stem = plot_stem(plot_path);
   const std::string script_path = stem + ".gp";
   {
     std::ofstream out(script_path);
     out << gnuplot_script(table, stem);
-    if (!out) throw InputError(script_path + ": cannot write the gnuplot script");
+    if (!out.flush()) throw InputError(script_path + ": cannot write the gnuplot script");
   }
-  const std::string error_path = (std::filesystem::temp_directory_path() /
-                                  ("plinth-sweep-gnuplot-" + std::to_string(::getpid()) + ".txt"))
-                                     .string();
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 2, error_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0644);
-  std::vector<char*> argv = {const_cast<char*>(gnuplot.c_str()),  // posix_spawn's signature
-                             const_cast<char*>(script_path.c_str()), nullptr};
-  pid_t pid = 0;
-  const int spawned = posix_spawn(&pid, gnuplot.c_str(), &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0) throw InputError(kInstallHint);
-  int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-  }
-  std::string errors;
-  {
-    std::ifstream in(error_path);
-    std::ostringstream text;
-    text << in.rdbuf();
-    errors = text.str();
-  }
-  std::filesystem::remove(error_path);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    throw InputError("gnuplot failed on " + script_path + ":\n" + errors);
-  }
+  run_gnuplot(script_path, {stem + ".png", stem + ".svg"});
   for (const char* ext : {".png", ".svg"}) {
     if (!std::filesystem::exists(stem + ext)) {
-      throw InputError("gnuplot did not write " + stem + ext + ":\n" + errors);
+      throw InputError("gnuplot did not write " + stem + ext);
     }
   }
   return stem + ".png and " + stem + ".svg";

@@ -5,13 +5,10 @@
 
 #include <string>
 
+#include "gnuplot.h"
 #include "plinth/host/sweep_table.h"
 
 namespace plinth::cli {
-
-// Where gnuplot lies on PATH; throws InputError naming the Debian package when it is not
-// there.
-[[nodiscard]] std::string find_gnuplot();
 
 // The stem of a --plot argument ("map.png" -> "map"); throws InputError unless it ends with
 // .png or .svg.
@@ -22,8 +19,9 @@ namespace plinth::cli {
 [[nodiscard]] std::string gnuplot_script(const plinth::host::SweepTable& table,
                                          const std::string& stem);
 
-// Writes <stem>.gp and runs gnuplot on it; throws InputError when gnuplot is missing or fails.
-// Returns the two images' names ("map.png and map.svg").
+// Writes <stem>.gp and runs gnuplot on it (the image names as ARG1, ARG2: gnuplot.h); throws
+// InputError when gnuplot is missing or fails. Returns the two images' names ("map.png and
+// map.svg").
 std::string plot_sweep(const plinth::host::SweepTable& table, const std::string& plot_path);
 
 }  // namespace plinth::cli

@@ -258,10 +258,10 @@ expect_failure "--dt 0" '--dt' -- --scene "$ISOLATED" --record "$AT2" --pga 0.3g
 expect_failure "--dt negative" '--dt' -- --scene "$ISOLATED" --record "$AT2" --pga 0.3g --dt -1e-4
 expect_failure "--pulse without --amplitude" '--amplitude' -- \
   --scene "$ISOLATED" --pulse sine --period 0.5
-expect_failure "unwritable --out" '/nonexistent/dir/x\.csv' 'cannot open|cannot write|no such' -- \
+expect_failure "unwritable --out" '/nonexistent/dir/x\.csv' 'cannot open|cannot write|no such|does not exist' -- \
   --scene "$ISOLATED" --record "$AT2" --pga 0.3g --out /nonexistent/dir/x.csv
 expect_failure "unwritable --events" '/nonexistent/dir/x\.jsonl' \
-  'cannot open|cannot write|no such' -- \
+  'cannot open|cannot write|no such|does not exist' -- \
   --scene "$ISOLATED" --record "$AT2" --pga 0.3g --events /nonexistent/dir/x.jsonl
 expect_failure "--scale together with --pga" '--scale' '--pga' -- \
   --scene "$ISOLATED" --record "$AT2" --pga 0.3g --scale 2

@@ -39,9 +39,12 @@ TEST(RecordScale, PgaOverThePeakElseTheScaleElseOne) {
 TEST(RecordScale, OneMessagePerProblem) {
   const Record r = record_of({0.0, 1.0}, 0.01);
   EXPECT_EQ(scale_error(r, "-0.3g"),
-            "--pga: must be greater than zero (use --scale with a negative factor to mirror the "
-            "record)");
-  EXPECT_EQ(scale_error(r, "0g").rfind("--pga: must be greater than zero", 0), 0U);
+            "--pga -0.3g: must be greater than zero (use --scale with a negative factor to mirror "
+            "the record)");
+  EXPECT_EQ(scale_error(r, "0g").rfind("--pga 0g: must be greater than zero", 0), 0U);
+  EXPECT_EQ(scale_error(r, "500g"),
+            "--pga 500g: the scaled record's peak would be 500 g, limit 100 g");
+  EXPECT_THROW((void)record_scale(r, "quake.AT2", "", 1e308, kGravity), InputError);
   EXPECT_NE(scale_error(r, "0.3").find("--pga"), std::string::npos);  // no unit
   EXPECT_EQ(scale_error(record_of({0.0, 0.0}, 0.01), "0.3g"),
             "quake.AT2: record is all zeros, cannot scale to --pga");

@@ -277,7 +277,7 @@ TEST(Sweep, BadInputsSayWhatIsWrong) {
   JobRun no_jobs;
   no_jobs.jobs = 0;
   EXPECT_EQ(input_error_text([&] { (void)run_plan(plan, {0}, no_jobs, rows); }),
-            "--jobs: must be at least 1, got 0");
+            "--jobs: must be 1 to 256, got 0");
   // A simulation's error names the value it ran for.
   SweepSettings big_step = coarse();
   big_step.dt = 0.01;

@@ -1,8 +1,10 @@
 #include "plinth/hal/candump_log.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <initializer_list>
 #include <limits>
+#include <system_error>
 #include <utility>
 
 namespace plinth::hal {
@@ -259,9 +261,17 @@ std::string format_candump_line(std::int64_t timestamp_ns, std::string_view inte
 
 CandumpLogReaderOpenResult CandumpLogReader::open(std::string path) {
   CandumpLogReaderOpenResult result;
-  std::ifstream in(path);
-  if (!in) {
-    result.message = path + ": cannot open file";
+  std::error_code error;
+  const std::filesystem::file_status status = std::filesystem::status(path, error);
+  const char* why = !std::filesystem::exists(status)        ? " (no such file)"
+                    : std::filesystem::is_directory(status) ? " (it is a directory)"
+                    : !std::filesystem::is_regular_file(status)
+                        ? " (not a regular file: a FIFO, socket or device)"
+                        : "";
+  std::ifstream in;
+  if (*why == '\0') in.open(path);
+  if (*why != '\0' || !in) {
+    result.message = path + ": cannot open file" + why;
     return result;
   }
   result.reader.emplace(CandumpLogReader(std::move(path), std::move(in)));
@@ -271,10 +281,36 @@ CandumpLogReaderOpenResult CandumpLogReader::open(std::string path) {
 CandumpLogReader::CandumpLogReader(std::string path, std::ifstream in)
     : path_(std::move(path)), in_(std::move(in)) {}
 
+// The next line into text_, at most kCandumpMaxLineBytes + 1 of it (more means too long).
+bool CandumpLogReader::read_line() {
+  text_.clear();
+  std::streambuf* buffer = in_.rdbuf();
+  for (;;) {
+    const int c = buffer->sbumpc();
+    if (c == std::char_traits<char>::eof()) {
+      if (text_.empty()) {
+        in_.setstate(std::ios::eofbit);
+        return false;
+      }
+      return true;
+    }
+    if (c == '\n') return true;
+    text_.push_back(static_cast<char>(c));
+    if (text_.size() > kCandumpMaxLineBytes) return true;
+  }
+}
+
 IoStatus CandumpLogReader::receive(TimedFrame& out, int /*timeout_ms*/) {
   error_.clear();
-  while (std::getline(in_, text_)) {
+  if (ended_) return IoStatus::kEndOfInput;
+  while (read_line()) {
     ++line_number_;
+    if (text_.size() > kCandumpMaxLineBytes) {
+      ended_ = true;
+      error_ = join({path_, ":", std::to_string(line_number_), ": line longer than ",
+                     std::to_string(kCandumpMaxLineBytes), " bytes: not a candump log"});
+      return IoStatus::kIoError;
+    }
     const std::string problem = parse_candump_line(text_, line_);
     if (!problem.empty()) {
       error_ = join({path_, ":", std::to_string(line_number_), ": ", problem});
@@ -295,6 +331,7 @@ IoStatus CandumpLogReader::receive(TimedFrame& out, int /*timeout_ms*/) {
     }
   }
   if (in_.bad()) {
+    ended_ = true;
     error_ = join({path_, ":", std::to_string(line_number_ + 1), ": read error"});
     return IoStatus::kIoError;
   }
@@ -307,8 +344,9 @@ CandumpLogWriterOpenResult CandumpLogWriter::open(std::string path, std::string 
   bool has_blank = false;
   for (const char c : interface_name) has_blank = has_blank || is_blank(c) || c == '\n';
   if (interface_name.empty() || interface_name.size() > kCandumpMaxInterfaceLength || has_blank) {
-    result.message = join({"log interface name ", quoted(interface_name),
-                           ": must be 1 to 15 characters without spaces"});
+    result.message =
+        join({"log interface name ", (quoted)(interface_name),  // not std::quoted (ADL)
+              ": must be 1 to 15 characters without spaces"});
     return result;
   }
   std::ofstream out(path, std::ios::out | std::ios::trunc);

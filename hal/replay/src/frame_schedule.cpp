@@ -8,6 +8,7 @@
 #include "plinth/core/scene.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 #include "plinth/host/record_sampling.h"
 
 namespace plinth::replay {
@@ -69,6 +70,7 @@ SensorNodeSamples resample(const SensorNodeInput& input, double scale, double ra
     }
     out.acceleration_g.push_back(clamped_g);
     out.status.push_back(status);
+    if (status != 0) ++out.clipped;
   }
   return out;
 }
@@ -143,6 +145,14 @@ LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s) 
     const hal::IoStatus status = reader.receive(timed, 0);
     if (status == hal::IoStatus::kEndOfInput) break;
     if (status == hal::IoStatus::kIoError) throw host::InputError(reader.error());
+    if (static_cast<double>(reader.line_number()) > host::kMaxReplayLogLines ||
+        static_cast<double>(out.frames.size()) >= host::kMaxReplayLogFrames) {
+      throw host::InputError(path + ":" + std::to_string(reader.line_number()) +
+                             ": the log is longer than plinth-replay holds (" +
+                             host::number_text(host::kMaxReplayLogFrames, 3) +
+                             " sensor frames or " + host::number_text(host::kMaxReplayLogLines, 3) +
+                             " lines); use --t-end, or split it");
+    }
     const can::MessageKind kind =
         status == hal::IoStatus::kOk ? can::classify(timed.frame.id) : can::MessageKind::kUnknown;
     if (kind != can::MessageKind::kSensorAcceleration &&

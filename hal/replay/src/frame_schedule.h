@@ -43,6 +43,7 @@ struct SensorNodeSamples {
   std::uint8_t node = can::kFirstSensorNode;
   std::vector<std::array<double, 3>> acceleration_g;  // per sample: ax, ay, az
   std::vector<std::uint8_t> status;                   // per sample
+  std::size_t clipped = 0;  // samples with an axis clamped to the full scale
 };
 
 // Samples at t = k / rate_hz, k = 0 .. floor(duration_s * rate_hz) (host::resample: the

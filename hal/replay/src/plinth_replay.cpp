@@ -1,5 +1,7 @@
 // plinth-replay: recorded earthquakes sent as plinth sensor frames, on a CAN bus (SocketCAN) or
 // into a candump log, paced on absolute deadlines. See hal/README.md.
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <array>
@@ -9,10 +11,13 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <system_error>
+#include <utility>
 #include <vector>
 
 #include "frame_schedule.h"
@@ -22,6 +27,8 @@
 #include "plinth/hal/socketcan.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
+#include "plinth/host/output_file.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/record_sampling.h"
 
@@ -123,6 +130,7 @@ double peak_of(const plinth::SampledSignal& signal) {
 struct RecordPlan {
   std::vector<plinth::replay::SensorNodeSamples> nodes;
   std::string description;
+  std::size_t clipped = 0;  // samples clipped to the full scale, all nodes
 };
 
 std::vector<Component> components_of(const Options& opt) {
@@ -204,14 +212,24 @@ RecordPlan plan_records(const Options& opt) {
   for (const auto& [node, input] : inputs) {
     plan.nodes.push_back(plinth::replay::resample(input, scale, opt.rate_hz, duration_s));
   }
-  char text[320];
-  std::snprintf(text, sizeof text,
-                "%s: %zu node%s, %.4g s at %g Hz (%zu samples per node), scale %.4g, peak "
-                "horizontal %.4g g%s",
-                main_record.name.c_str(), plan.nodes.size(), plan.nodes.size() == 1 ? "" : "s",
-                duration_s, opt.rate_hz, plan.nodes.front().status.size(), scale, peak_g,
-                opt.pga.empty() ? "" : " (--pga)");
+  std::size_t clipped = 0;
+  for (const plinth::replay::SensorNodeSamples& node : plan.nodes) clipped += node.clipped;
+  char text[480];
+  const int n =
+      std::snprintf(text, sizeof text,
+                    "%s: %zu node%s, %.4g s at %g Hz (%zu samples per node), scale %.4g, peak "
+                    "horizontal %.4g g%s",
+                    main_record.name.c_str(), plan.nodes.size(), plan.nodes.size() == 1 ? "" : "s",
+                    duration_s, opt.rate_hz, plan.nodes.front().status.size(), scale, peak_g,
+                    opt.pga.empty() ? "" : " (--pga)");
+  if (clipped > 0 && n > 0) {
+    std::snprintf(text + n, sizeof text - static_cast<std::size_t>(n),
+                  "; %zu samples beyond the frames' full scale (-8.192 to +8.192 g) clipped to "
+                  "it and flagged saturated: the frames do not carry that peak",
+                  clipped);
+  }
   plan.description = text;
+  plan.clipped = clipped;
   return plan;
 }
 
@@ -221,6 +239,7 @@ struct Destination {
   std::unique_ptr<plinth::hal::SocketCanPort> port;    // when the sink is a bus
   plinth::hal::FrameSink* sink = nullptr;              // the one of the two
   std::string name;                                    // "vcan0", "out.log"
+  std::string temporary;                               // a log: the file written until complete
 
   // Sends; a full transmit queue (the bus is slower than the schedule, as at --speed max on a
   // real controller) is waited out for up to kQueueFullWaitNs rather than the frame dropped.
@@ -268,6 +287,7 @@ struct Report {
   std::int64_t heartbeat_frames = 0;
   std::int64_t send_errors = 0;
   std::int64_t skipped_log_lines = 0;
+  std::size_t clipped_samples = 0;
   std::string first_send_error;
   double virtual_time_s = 0.0;
   double wall_time_s = 0.0;
@@ -310,13 +330,14 @@ void print_report(const Options& opt, const Report& r, const plinth::hal::Pacer&
   }
   std::printf(
       "{\"frames_sent\": %lld, \"acceleration_frames\": %lld, \"heartbeat_frames\": %lld, "
-      "\"send_errors\": %lld, \"skipped_log_lines\": %lld, \"virtual_time_s\": %.6f, "
+      "\"send_errors\": %lld, \"skipped_log_lines\": %lld, \"clipped_samples\": %zu, "
+      "\"virtual_time_s\": %.6f, "
       "\"wall_time_s\": %.6f, \"speed\": %s, \"loops\": %lld, \"interrupted\": %s, %s}\n",
       static_cast<long long>(r.frames_sent), static_cast<long long>(r.acceleration_frames),
       static_cast<long long>(r.heartbeat_frames), static_cast<long long>(r.send_errors),
-      static_cast<long long>(r.skipped_log_lines), r.virtual_time_s, r.wall_time_s,
-      opt.speed == "max" ? "\"max\"" : opt.speed.c_str(), static_cast<long long>(opt.loops),
-      r.interrupted ? "true" : "false", jitter);
+      static_cast<long long>(r.skipped_log_lines), r.clipped_samples, r.virtual_time_s,
+      r.wall_time_s, opt.speed == "max" ? "\"max\"" : opt.speed.c_str(),
+      static_cast<long long>(opt.loops), r.interrupted ? "true" : "false", jitter);
   std::fflush(stdout);
 }
 
@@ -331,8 +352,12 @@ const CLI::Validator kSpeed(
     [](const std::string& text) -> std::string {
       double speed = 0.0;
       if (text != "max" &&
-          (!CLI::detail::lexical_cast(text, speed) || !std::isfinite(speed) || speed <= 0.0)) {
-        return "must be a number greater than zero or 'max', got '" + text + "'";
+          (!CLI::detail::lexical_cast(text, speed) || !(speed >= plinth::host::kMinReplaySpeed) ||
+           !(speed <= plinth::host::kMaxReplaySpeed))) {
+        return "must be a factor of real time from " +
+               plinth::host::number_text(plinth::host::kMinReplaySpeed) + " to " +
+               plinth::host::number_text(plinth::host::kMaxReplaySpeed) + ", or 'max', got '" +
+               text + "'";
       }
       return {};
     },
@@ -362,6 +387,7 @@ void install_stop_handlers() {
 struct Input {
   std::unique_ptr<plinth::replay::FrameSchedule> schedule;
   std::string description;
+  std::size_t clipped_samples = 0;
   std::int64_t skipped_log_lines = 0;
 };
 
@@ -370,6 +396,7 @@ Input open_input(const Options& opt, const CLI::App& app) {
   if (!is_candump_log(opt.record_path)) {
     RecordPlan plan = plan_records(opt);
     input.description = plan.description;
+    input.clipped_samples = plan.clipped;
     input.schedule = std::make_unique<plinth::replay::RecordSchedule>(std::move(plan.nodes),
                                                                       opt.rate_hz, opt.loops);
     return input;
@@ -396,15 +423,42 @@ Input open_input(const Options& opt, const CLI::App& app) {
 // The log (stamped by `clock`) or the bus.
 Destination open_destination(const Options& opt, plinth::hal::CandumpLogWriter::Clock clock) {
   if (opt.log_path.empty()) return open_bus(opt.can_interface);
+  // Written beside the target and renamed once complete (finish_log).
+  const std::string temporary = opt.log_path + ".partial-" + std::to_string(::getpid());
   plinth::hal::CandumpLogWriterOpenResult opened =
-      plinth::hal::CandumpLogWriter::open(opt.log_path, opt.log_interface, std::move(clock));
-  if (!opened.ok()) throw InputError(opened.message);
+      plinth::hal::CandumpLogWriter::open(temporary, opt.log_interface, std::move(clock));
+  if (!opened.ok()) throw InputError("--log " + opt.log_path + ": " + opened.message);
   auto writer = std::make_unique<plinth::hal::CandumpLogWriter>(std::move(*opened.writer));
   Destination destination;
   destination.sink = writer.get();
   destination.log = std::move(writer);
   destination.name = opt.log_path;
+  destination.temporary = temporary;
   return destination;
+}
+
+// The log renamed into place when every frame went into it. An interrupted run keeps what it
+// sent as "<log>.partial"; a failed one keeps nothing: no log that looks complete is left.
+void finish_log(const Destination& destination, const Report& report) {
+  if (destination.log == nullptr) return;
+  std::error_code error;
+  if (report.send_errors == 0) {
+    const std::string target =
+        report.interrupted ? destination.name + ".partial" : destination.name;
+    std::filesystem::rename(destination.temporary, target, error);
+    if (!error) {
+      if (report.interrupted) {
+        std::fprintf(stderr, "plinth-replay: interrupted: the frames sent are in %s\n",
+                     target.c_str());
+      }
+      return;
+    }
+    std::fprintf(stderr, "plinth-replay: --log %s: cannot replace it: %s\n", target.c_str(),
+                 error.message().c_str());
+  }
+  std::filesystem::remove(destination.temporary, error);
+  std::fprintf(stderr, "plinth-replay: --log %s not written (the run failed)\n",
+               destination.name.c_str());
 }
 
 // Every frame of the schedule at its deadline; `current_virtual_ns` follows the frame being sent
@@ -434,6 +488,14 @@ void send_all(plinth::replay::FrameSchedule& schedule, const Destination& destin
 
 int run(const Options& opt, const CLI::App& app) {
   const double speed = parse_speed(opt.speed);
+  if (!opt.log_path.empty()) {
+    plinth::host::check_output_path("--log", opt.log_path);
+    std::vector<std::pair<std::string, std::string>> inputs = {{"--record", opt.record_path},
+                                                               {"--record-y", opt.record_y_path},
+                                                               {"--record-z", opt.record_z_path}};
+    for (const std::string& text : opt.node_records) inputs.emplace_back("--node-record", text);
+    plinth::host::check_distinct_files({{"--log", opt.log_path}}, inputs);
+  }
   const Input input = open_input(opt, app);
   // The log's timestamps are the frames' virtual send times (at speed 1) from now, so that
   // canplayer -I replays the log in real time whatever --speed wrote it.
@@ -448,6 +510,7 @@ int run(const Options& opt, const CLI::App& app) {
   install_stop_handlers();
   Report report;
   report.skipped_log_lines = input.skipped_log_lines;
+  report.clipped_samples = input.clipped_samples;
   plinth::hal::Pacer pacer(speed);
   pacer.start();
   send_all(*input.schedule, destination, pacer, current_virtual_ns, report);
@@ -457,6 +520,7 @@ int run(const Options& opt, const CLI::App& app) {
     if (report.first_send_error.empty()) report.first_send_error = destination.log->error();
   }
   print_report(opt, report, pacer, destination.name);
+  finish_log(destination, report);
   if (report.interrupted) return kExitInterrupted;
   return report.send_errors == 0 ? 0 : 1;
 }

@@ -4,6 +4,7 @@
 #include <thread>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 
 namespace plinth::host {
 
@@ -25,8 +26,9 @@ void parse_shard(const std::string& text, int& index, int& count) {
 }
 
 void validate(const JobRun& run) {
-  if (run.jobs < 1) {
-    throw InputError("--jobs: must be at least 1, got " + std::to_string(run.jobs));
+  if (run.jobs < 1 || run.jobs > kMaxJobs) {
+    throw InputError("--jobs: must be 1 to " + std::to_string(kMaxJobs) + ", got " +
+                     std::to_string(run.jobs));
   }
   if (run.shard_count < 1 || run.shard_index < 1 || run.shard_index > run.shard_count) {
     throw InputError("--shard: must be i/N with 1 <= i <= N, got " +

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 #include "plinth/host/units.h"
 
 namespace plinth::host {
@@ -33,16 +34,26 @@ double interpolated_at(const SampledSignal& signal, double t) {
 
 double record_scale(const Record& record, const std::string& record_path, const std::string& pga,
                     std::optional<double> scale, double gravity) {
-  if (pga.empty()) return scale.value_or(1.0);
+  double vertical_peak = 0.0;
+  for (const double a : record.vertical) vertical_peak = std::max(vertical_peak, std::fabs(a));
+  const double peak = std::max(record.peak_horizontal(), vertical_peak);
+  if (pga.empty()) {
+    const double gamma = scale.value_or(1.0);
+    if (scale) check_scaled_peak(gamma, peak, gravity, given("--scale", gamma));
+    return gamma;
+  }
   const double target = parse_acceleration(pga, gravity, "--pga");
   if (target <= 0.0) {
-    throw InputError(
-        "--pga: must be greater than zero (use --scale with a negative factor to mirror the "
-        "record)");
+    throw InputError("--pga " + pga +
+                     ": must be greater than zero (use --scale with a negative factor to mirror "
+                     "the record)");
   }
-  const double peak = record.peak_horizontal();
-  if (peak <= 0.0) throw InputError(record_path + ": record is all zeros, cannot scale to --pga");
-  return target / peak;
+  if (record.peak_horizontal() <= 0.0) {
+    throw InputError(record_path + ": record is all zeros, cannot scale to --pga");
+  }
+  const double gamma = target / record.peak_horizontal();
+  check_scaled_peak(gamma, peak, gravity, "--pga " + pga);
+  return gamma;
 }
 
 std::size_t sample_count(double duration_s, double rate_hz) {

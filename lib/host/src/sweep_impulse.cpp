@@ -10,6 +10,7 @@
 #include "plinth/core/events.h"
 #include "plinth/core/simulator.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 
 namespace plinth::host {
 namespace {
@@ -168,6 +169,11 @@ SweepPlan plan_impulse_map(const SceneParams& base, const GridAxis& mu_axis,
   const std::vector<double> mus = sweep_values(mu_axis.from, mu_axis.to, mu_axis.steps, "--mu-");
   const std::vector<double> impulses =
       sweep_values(impulse_axis.from, impulse_axis.to, impulse_axis.steps, "--impulse-");
+  (void)bounded_count(static_cast<double>(mus.size()) * static_cast<double>(impulses.size()),
+                      kMaxSweepRows,
+                      "--mu-steps " + std::to_string(mus.size()) + " and --impulse-steps " +
+                          std::to_string(impulses.size()),
+                      "the map would have", "rows");
   if (impulses.front() <= 0.0) {
     throw InputError("--impulse-from: |I| must be greater than zero, got " +
                      format_value(impulses.front()) + " m/s");

@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 
 namespace plinth::host {
 namespace {
@@ -167,6 +168,11 @@ SweepPlan plan_threshold_map(const SceneParams& base, const Record& record,
   }
   const std::vector<double> values1 = sweep_values(axis1.from, axis1.to, axis1.steps);
   const std::vector<double> values2 = sweep_values(axis2.from, axis2.to, axis2.steps, "--", "2");
+  (void)bounded_count(static_cast<double>(values1.size()) * static_cast<double>(values2.size()),
+                      kMaxSweepRows,
+                      "--steps " + std::to_string(values1.size()) + " and --steps2 " +
+                          std::to_string(values2.size()),
+                      "the map would have", "rows");
   auto scenes = std::make_shared<std::vector<Scene>>();
   scenes->reserve(values1.size() * values2.size());
   for (const double v1 : values1) {

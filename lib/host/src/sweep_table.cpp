@@ -11,6 +11,8 @@
 #include <utility>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
+#include "plinth/host/text_file.h"
 
 namespace plinth::host {
 namespace {
@@ -83,6 +85,9 @@ std::vector<double> sweep_values(double from, double to, int steps, const std::s
     throw InputError(from_option + " " + format_value(from) + " is greater than " + to_option +
                      " " + format_value(to));
   }
+  (void)bounded_count(steps, kMaxSweepAxisValues,
+                      prefix + "steps" + suffix + " " + std::to_string(steps),
+                      "the axis would have", "values");
   std::vector<double> values;
   values.reserve(static_cast<std::size_t>(steps));
   for (int i = 0; i < steps; ++i) {
@@ -250,15 +255,39 @@ std::string row_key(const std::string& row, std::size_t key_columns) {
   return row.substr(0, end);
 }
 
+namespace {
+
+// Problems of a row's result fields (after the key columns): a number there is a threshold, so
+// it must be finite and not negative; names (an impulse map's "sliding") and empty fields are
+// results too. Empty when the row is sound.
+std::string result_field_problem(const std::vector<std::string>& header,
+                                 const std::vector<std::string>& fields, std::size_t key_columns) {
+  for (std::size_t i = 0; i < fields.size(); ++i) {
+    const std::string& field = fields[i];
+    if (field.empty()) continue;
+    char* end = nullptr;
+    const double value = std::strtod(field.c_str(), &end);
+    if (end == field.c_str() || *end != '\0') continue;  // a name
+    const std::string column = i < header.size() ? header[i] : std::to_string(i + 1);
+    if (!std::isfinite(value)) return "column " + column + ": '" + field + "' is not finite";
+    if (i >= key_columns && value < 0.0) {
+      return "column " + column + ": '" + field + "' is negative";
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
 SweepTable read_sweep_table(const std::string& path, std::size_t* dropped) {
-  std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the sweep CSV");
+  std::istringstream in(read_text_file(path, kMaxSweepTableBytes, "sweep CSV"));
   SweepTable table;
   if (!std::getline(in, table.settings)) throw InputError(path + ": empty file, not a sweep CSV");
-  (void)parse_settings(table.settings, path + ":1");
+  const std::size_t key_columns = parse_grid(table.settings, path + ":1").size();
   if (!std::getline(in, table.header) || table.header.empty()) {
     throw InputError(path + ":2: missing the CSV header");
   }
+  const std::vector<std::string> header = csv_fields(table.header);
   const std::size_t fields = count_fields(table.header);
   std::string line;
   for (int number = 3; std::getline(in, line); ++number) {
@@ -271,6 +300,11 @@ SweepTable read_sweep_table(const std::string& path, std::size_t* dropped) {
       throw InputError(path + ":" + std::to_string(number) + ": " +
                        std::to_string(count_fields(line)) + " fields, the header has " +
                        std::to_string(fields) + " (a truncated row?)");
+    }
+    const std::string problem = result_field_problem(header, csv_fields(line), key_columns);
+    if (!problem.empty()) {
+      throw InputError(path + ":" + std::to_string(number) + ": " + problem +
+                       " (not a value plinth-sweep writes)");
     }
     table.rows.push_back(line);
   }

@@ -55,7 +55,11 @@ inline constexpr NameTable<CandumpFrameKind, 6> kCandumpFrameKindNames{{{
   return kCandumpFrameKindNames.name(kind);
 }
 
-inline constexpr std::size_t kCandumpMaxFdLength = 64;  // bytes
+inline constexpr std::size_t kCandumpMaxFdLength = 64;         // bytes
+inline constexpr std::size_t kCandumpMaxInterfaceLength = 15;  // IFNAMSIZ - 1
+// A line of a CAN FD frame with 64 bytes separated by dots is about 260 bytes; a longer line is
+// not a candump line, and reading it whole could take any amount of memory.
+inline constexpr std::size_t kCandumpMaxLineBytes = 512;
 inline constexpr std::uint32_t kStandardIdMask = 0x7FF;
 inline constexpr std::uint32_t kExtendedIdMask = 0x1FFFFFFF;
 inline constexpr std::uint32_t kCanErrorFlag = 0x20000000;  // SocketCAN's CAN_ERR_FLAG
@@ -92,12 +96,15 @@ struct CandumpLine {
 //   kNotPlinth   an extended, remote, CAN FD or raw-DLC frame (only the timestamp is set);
 //   kBusError    a logged error frame (only the timestamp is set);
 //   kIoError     a malformed line or a read error: error() says "file:line: what"; the next
-//                call goes on with the following line;
+//                call goes on with the following line (after a line longer than
+//                kCandumpMaxLineBytes, or a read error, the input ends there);
 //   kEndOfInput  at the end of the file (and on every later call).
 struct CandumpLogReaderOpenResult;
 class CandumpLogReader final : public FrameSource {
  public:
-  // Opens `path` for reading; on failure the result's message is "<path>: cannot open file".
+  // Opens `path` for reading; on failure the result's message is "<path>: cannot open file"
+  // with the reason: missing, a directory, or not a regular file (a FIFO or device such as
+  // /dev/zero, which would never end).
   [[nodiscard]] static CandumpLogReaderOpenResult open(std::string path);
 
   [[nodiscard]] IoStatus receive(TimedFrame& out, int timeout_ms) override;
@@ -110,6 +117,7 @@ class CandumpLogReader final : public FrameSource {
 
  private:
   CandumpLogReader(std::string path, std::ifstream in);
+  bool read_line();
 
   std::string path_;
   std::ifstream in_;
@@ -117,6 +125,7 @@ class CandumpLogReader final : public FrameSource {
   CandumpLine line_;
   std::size_t line_number_ = 0;
   std::string error_;
+  bool ended_ = false;  // after a line too long or a read error
 };
 
 // Writes a candump log file. Each sent frame becomes one line stamped with `clock()` (ns since

@@ -14,7 +14,8 @@ namespace plinth::host {
 
 // The factor gamma the command line asks for: `pga` (an acceleration with its unit, "0.3g")
 // over the record's peak horizontal acceleration, or `scale`, or 1 when neither is given.
-// Throws InputError for a --pga that is not a positive acceleration, and for a record that is
+// Throws InputError for a --pga that is not a positive acceleration, a scaled peak (horizontal
+// or vertical) above kMaxScaledPeakG (limits.h), and for a record that is
 // all zeros (named by `record_path`).
 [[nodiscard]] double record_scale(const Record& record, const std::string& record_path,
                                   const std::string& pga, std::optional<double> scale,

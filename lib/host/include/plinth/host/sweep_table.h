@@ -85,8 +85,13 @@ struct SweepTable {
 // The key of a row: its first `key_columns` comma-separated fields.
 [[nodiscard]] std::string row_key(const std::string& row, std::size_t key_columns);
 
-// Reads a table. Throws InputError naming the file (and line) when it cannot be read, lacks
-// the settings line or header, or a row has another number of fields than the header; when
+// A sweep CSV is read whole; longer than this it is refused (text_file.h).
+inline constexpr std::size_t kMaxSweepTableBytes = std::size_t{256} << 20;  // 256 MiB
+
+// Reads a table. Throws InputError naming the file (and line) when it cannot be read (also a
+// directory, a FIFO, a device, or longer than kMaxSweepTableBytes), lacks the settings line
+// or header, holds a number that is not finite, or a negative number in a result column
+// (after the grid's key columns), or a row has another number of fields than the header; when
 // `dropped` is given, such rows (cut short by a kill) are skipped and counted instead.
 [[nodiscard]] SweepTable read_sweep_table(const std::string& path, std::size_t* dropped = nullptr);
 

@@ -1,0 +1,22 @@
+// Running gnuplot on a script the tools write, with file names passed as data: the script reads
+// them as ARG1, ARG2, ... (gnuplot -c SCRIPT ARGS), never as text inside its commands, so no
+// name (a newline, a quote) can add a command. Shared by plinth-sweep and plinth-accuracy.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace plinth::cli {
+
+// The gnuplot executable on PATH. Throws InputError with the Debian package to install.
+[[nodiscard]] std::string find_gnuplot();
+
+// Runs `gnuplot -c script args...` without a shell and waits for it. Throws InputError with
+// gnuplot's own messages when it fails.
+void run_gnuplot(const std::string& script_path, const std::vector<std::string>& args);
+
+// `text` for a '#' comment line of a script: control characters (a newline would end the
+// comment) become '?'.
+[[nodiscard]] std::string comment_text(std::string text);
+
+}  // namespace plinth::cli

@@ -1,0 +1,295 @@
+#!/usr/bin/env bash
+# Issue 17's classes of hostile input, one section per class, each program that the class
+# reaches: numbers that imply unbounded work, endless inputs, time that jumps in logs, text
+# that reaches gnuplot, outputs that collide or are left partial, and messages that name what
+# is wrong. Every case must end in time, refused with a message naming the option, key or
+# file, or handled correctly. The limits: docs/limits.md.
+#
+# Environment: PLINTH_SIM, PLINTH_SWEEP, PLINTH_REPLAY, PLINTH_MONITOR (the binaries);
+# PLINTH_SOURCE_DIR, the repository root.
+set -u
+
+# shellcheck source=tests/cli/harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
+TIMEOUT=(timeout -k 5 60)
+SWEEP=${PLINTH_SWEEP:-}
+REPLAY=${PLINTH_REPLAY:-}
+MONITOR=${PLINTH_MONITOR:-}
+for binary in "$SWEEP" "$REPLAY" "$MONITOR"; do
+  if [[ ! -x "$binary" ]]; then
+    echo "PLINTH_SWEEP, PLINTH_REPLAY, PLINTH_MONITOR: '$binary' is not an executable" >&2
+    exit 2
+  fi
+done
+ISOLATED=$SCENES/paper-isolated.toml
+GROUND=$SCENES/non-isolated.toml
+SWEEP_ARGS=(--scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 2 --steps 2)
+# A sweep that runs in about a second.
+small=(--scene "$SCENES/paper-eccentric.toml" --record "$AT2" --param T --from 1 --to 2 --steps 2
+  --pga-max 2g --tol 0.05g --jobs 1)
+
+# expect_absent NAME FILE...: none of the files may exist (nothing partial left behind).
+expect_absent() {
+  local name=$1
+  shift
+  local file
+  for file in "$@"; do
+    if [[ -e "$file" ]]; then
+      fail "$name" "$file was left behind"
+      return
+    fi
+  done
+  pass "$name"
+}
+
+echo "# 1. numbers that imply unbounded work, memory or output"
+BIN=$SIM
+expect_failure "sim --dt 1e-20: steps" '--dt 1e-20' 'solver steps' 'limit 1e\+09' -- \
+  --scene "$ISOLATED" --record "$AT2" --dt 1e-20
+expect_failure "sim --t-end 1e18: steps" '--t-end 1e\+18' 'solver steps' -- \
+  --scene "$ISOLATED" --record "$AT2" --t-end 1e18
+expect_failure "sim --scale 1e308: scaled peak" '--scale 1e\+308' 'limit 100 g' -- \
+  --scene "$ISOLATED" --record "$AT2" --scale 1e308 --out scaled.csv
+expect_absent "sim --scale 1e308: no CSV" scaled.csv
+expect_failure "sim --pga 500g: scaled peak" '--pga 500g' 'limit 100 g' -- \
+  --scene "$ISOLATED" --record "$AT2" --pga 500g
+expect_failure "sim --pga 0g" '--pga 0g' 'greater than zero' -- \
+  --scene "$ISOLATED" --record "$AT2" --pga 0g
+expect_failure "sim --pga -1g" '--pga -1g' 'greater than zero' -- \
+  --scene "$ISOLATED" --record "$AT2" --pga -1g
+expect_failure "sim --amplitude 1e300g" '--amplitude' 'limit 100 g' -- \
+  --scene "$ISOLATED" --pulse sine --amplitude 1e300g --period 0.5
+expect_failure "sim --out-interval rows" '--out-interval 1e-09' 'rows' 'limit 1e\+07' -- \
+  --scene "$ISOLATED" --record "$AT2" --dt 1e-6 --out-interval 1e-9 --out rows.csv
+BIN=$SWEEP
+expect_failure "sweep --tol 1e-300g: bisection" '--tol 1e-300g' 'bisection steps' 'limit 40' -- \
+  "${SWEEP_ARGS[@]}" --tol 1e-300g --out tol.csv
+expect_failure "sweep --dt 1e-300: steps" '--dt 1e-300' 'solver steps' -- \
+  "${SWEEP_ARGS[@]}" --dt 1e-300 --out dt.csv
+expect_failure "sweep --steps 2e9: values" '--steps 2000000000' 'limit 1e\+05' -- \
+  --scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 2 --steps 2000000000 --out v.csv
+expect_failure "sweep map rows" '--steps2 2000' 'rows' -- \
+  --scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 2 --steps 2000 \
+  --param2 xi --from2 0 --to2 0.1 --steps2 2000 --out map.csv
+expect_failure "sweep --impulse-tol 1e-300" '--impulse-tol' 'bisection steps' -- \
+  --scene "$ISOLATED" --param T --from 1 --to 2 --steps 2 --impulse-curve --impulse-tol 1e-300 \
+  --out ic.csv
+expect_failure "sweep --jobs 100000" '--jobs' '256' -- "${SWEEP_ARGS[@]}" --jobs 100000 --out j.csv
+expect_failure "sweep --pga-max 1e300g" '--pga-max 1e300g' 'bisection steps' -- \
+  "${SWEEP_ARGS[@]}" --pga-max 1e300g --out p.csv
+BIN=$REPLAY
+expect_failure "replay --speed 1e-300" '--speed' '0.001' -- --record "$AT2" --log s.log --speed 1e-300
+expect_failure "replay --scale 1e308" '--scale 1e\+308' 'limit 100 g' -- \
+  --record "$AT2" --log s.log --scale 1e308
+expect_failure "replay --pga 0g" '--pga 0g' -- --record "$AT2" --log s.log --pga 0g
+BIN=$MONITOR
+expect_failure "monitor --status-interval 1e300" '--status-interval' 'status_interval' -- \
+  --scene "$ISOLATED" --replay "$AT2" --status-interval 1e300
+if grep -q 'limit 0.000000' "$TMP/stderr"; then
+  fail "monitor: no '(limit 0.000000)'" "$(first_stderr_line)"
+fi
+expect_failure "monitor --speed 1e-300" '--speed' -- --scene "$ISOLATED" --replay "$AT2" --speed 1e-300
+expect_failure "monitor --scale 1e308" '--scale 1e\+308' 'limit 100 g' -- \
+  --scene "$ISOLATED" --replay "$AT2" --scale 1e308
+expect_failure "monitor --pga -1g" '--pga -1g' 'greater than zero' -- \
+  --scene "$ISOLATED" --replay "$AT2" --pga -1g
+
+echo "# 2. endless and oversized inputs; signals"
+ln -s /dev/zero zero.log
+ln -s /dev/zero zero.AT2
+mkfifo fifo.AT2
+head -c 2000000 /dev/zero | tr '\0' 'a' >long-line.log
+mkdir folder.log
+BIN=$SIM
+expect_failure "sim --scene /dev/zero" '/dev/zero' 'scene' 'not a regular file' -- \
+  --scene /dev/zero --record "$AT2"
+expect_failure "sim --record /dev/zero" '/dev/zero' 'not a regular file' -- \
+  --scene "$ISOLATED" --record /dev/zero
+expect_failure "sim --vertical FIFO" 'fifo.AT2' 'not a regular file' -- \
+  --scene "$ISOLATED" --record "$AT2" --vertical fifo.AT2
+BIN=$SWEEP
+expect_failure "sweep --record /dev/zero" '/dev/zero' 'not a regular file' -- \
+  --scene "$ISOLATED" --record /dev/zero --param T --from 1 --to 2 --steps 2 --out z.csv
+expect_failure "sweep plot /dev/zero" '/dev/zero' 'not a regular file' -- plot /dev/zero --out z.png
+expect_failure "sweep merge /dev/zero" '/dev/zero' 'not a regular file' -- \
+  merge --out m.csv /dev/zero
+BIN=$REPLAY
+expect_failure "replay --record /dev/zero as a log" 'zero.log' 'not a regular file' -- \
+  --record zero.log --log z.log --speed max
+expect_failure "replay --record /dev/zero as AT2" 'zero.AT2' 'not a regular file' -- \
+  --record zero.AT2 --log z.log --speed max
+expect_failure "replay: a log with an endless line" 'long-line.log:1' 'longer than 512 bytes' -- \
+  --record long-line.log --log z.log --speed max
+expect_failure "replay: a folder as the log" 'folder.log' 'directory' -- \
+  --record folder.log --log z.log --speed max
+BIN=$MONITOR
+expect_failure "monitor --replay /dev/zero as a log" 'zero.log' 'not a regular file' -- \
+  --scene "$ISOLATED" --replay zero.log
+expect_failure "monitor: a log with an endless line" 'long-line.log:1' 'longer than 512' -- \
+  --scene "$ISOLATED" --replay long-line.log
+expect_failure "monitor --config /dev/zero" '/dev/zero' 'configuration' -- \
+  --scene "$ISOLATED" --config /dev/zero --replay "$AT2"
+expect_failure "monitor --config a folder" "$SCENES" 'directory' -- \
+  --scene "$ISOLATED" --config "$SCENES" --replay "$AT2"
+expect_failure "monitor --scene FIFO" 'fifo.AT2' 'not a regular file' -- \
+  --scene fifo.AT2 --replay "$AT2"
+
+# SIGTERM ends a long run at once, with exit 130 and no output left behind.
+"${TIMEOUT[@]}" "$SIM" --scene "$ISOLATED" --record "$AT2" --t-end 50000 --out-interval 0.01 --out long.csv \
+  --events long.jsonl >/dev/null 2>"$TMP/stderr" &
+sim_pid=$!
+sleep 1
+kill -TERM "$sim_pid"
+wait "$sim_pid"
+RC=$?
+if ((RC == 130)) && grep -q 'interrupted' "$TMP/stderr"; then
+  pass "sim: SIGTERM ends the run (exit 130)"
+else
+  fail "sim: SIGTERM ends the run (exit 130)" "exit $RC; $(first_stderr_line)"
+fi
+expect_absent "sim: SIGTERM leaves no output" long.csv long.jsonl long.csv.partial-* \
+  long.jsonl.partial-*
+
+echo "# 3. time in candump logs; no 'normal' while no estimator runs"
+BIN=$MONITOR
+# expect_input_fault NAME CAUSE PATTERN LOG: plinth-monitor on LOG ends in time with exit 3, the
+# summary "alarm": "fault" with "input_fault": CAUSE, and stderr matching PATTERN.
+expect_input_fault() {
+  run --scene "$ISOLATED" --replay "$4"
+  if ((RC != 3)); then
+    fail "$1" "exit $RC, expected 3; stderr: $(first_stderr_line)"
+  elif ! tail -n 1 "$TMP/stdout" | grep -q "\"alarm\": \"fault\", \"input_fault\": \"$2\""; then
+    fail "$1" "summary: $(tail -n 1 "$TMP/stdout" | cut -c 1-200)"
+  elif ! grep -qE -- "$3" "$TMP/stderr"; then
+    fail "$1" "stderr does not match /$3/: $(first_stderr_line)"
+  else
+    pass "$1"
+  fi
+}
+"$REPLAY" --record "$AT2" --pga 0.3g --speed max --log quake.log 2>/dev/null
+: >empty.log
+echo "(1700000000.000000) vcan0 123#00" >no-sensor.log
+# Shifts the timestamps of lines FROM.. by SECONDS (awk keeps six decimals).
+shift_log() {
+  awk -v from="$2" -v by="$3" '{ if (NR >= from) { t = substr($1, 2, length($1) - 2) + by;
+    $1 = sprintf("(%.6f)", t) } print }' "$1"
+}
+shift_log quake.log 3001 -5 >back.log
+shift_log quake.log 3001 3e9 >jump.log
+awk '{ $1 = "(1700000000.000000)"; print }' quake.log >still.log
+expect_success "monitor: a sound log ends exit 0" --scene "$ISOLATED" --replay quake.log
+expect_input_fault "monitor: an empty log ends fault" no_sensor_data 'empty.log.*never ran' empty.log
+expect_input_fault "monitor: a log without sensor frames ends fault" no_sensor_data \
+  'no-sensor.log.*never ran' no-sensor.log
+expect_input_fault "monitor: time going back is a fault" log_time 'back.log:3001: timestamp goes back' \
+  back.log
+if grep -q '"cause": "bus_error"' "$TMP/stdout"; then
+  pass "monitor: time going back raises the fault level"
+else
+  fail "monitor: time going back raises the fault level" "no fault alarm line"
+fi
+expect_input_fault "monitor: time standing still is a fault" log_time 'still.log:3: .*stands still' \
+  still.log
+expect_input_fault "monitor: a jump of centuries is a fault" log_time 'jump.log:3001: .*10 s gap' \
+  jump.log
+lines=$(grep -c '"type": "status"' "$TMP/stdout")
+if ((lines < 1000)); then
+  pass "monitor: no status-line flood across a gap ($lines status lines)"
+else
+  fail "monitor: no status-line flood across a gap" "$lines status lines"
+fi
+
+echo "# 4. text that reaches gnuplot is data"
+if command -v gnuplot >/dev/null 2>&1; then
+  hostile=$'x\'\nsystem "touch pwned"\n\'' # a quote, newlines and a gnuplot command
+  BIN=$SWEEP
+  if expect_success "sweep with a hostile --plot name" "${small[@]}" --out small.csv \
+    --plot "$hostile.png"; then
+    expect_absent "sweep --plot: no command ran" pwned
+    if [[ -s "$hostile.png" && -s "$hostile.svg" ]]; then
+      pass "sweep --plot: the images carry the hostile name"
+    else
+      fail "sweep --plot: the images carry the hostile name" "not written"
+    fi
+  fi
+  expect_success "sweep plot --out with a hostile name" plot small.csv --out "p$hostile.svg" &&
+    expect_absent "sweep plot --out: no command ran" pwned
+  expect_success "sweep merge --plot with a hostile name" merge --out merged.csv \
+    --plot "m$hostile.png" small.csv && expect_absent "sweep merge --plot: no command ran" pwned
+  if [[ -x "${PLINTH_ACCURACY:-}" ]]; then
+    BIN=$PLINTH_ACCURACY
+    expect_success "accuracy --plot into a hostile folder" --quick --plot --out-dir "a$hostile" &&
+      expect_absent "accuracy --plot: no command ran" pwned
+  fi
+else
+  echo "# gnuplot not installed: section 4 skipped (tools/install-deps.sh installs it)"
+fi
+
+echo "# 5. outputs that collide, are left partial, or lie"
+BIN=$SIM
+: >taken.csv
+ln taken.csv hard.csv
+ln -s taken.csv soft.jsonl
+expect_failure "sim --out and --events the same file" '--out x.csv and --events x.csv' \
+  'same file' -- --scene "$ISOLATED" --record "$AT2" --out x.csv --events x.csv
+expect_failure "sim --out and --events via a hard link" 'same file' -- \
+  --scene "$ISOLATED" --record "$AT2" --out taken.csv --events hard.csv
+expect_failure "sim --out and --events via a symbolic link" 'same file' -- \
+  --scene "$ISOLATED" --record "$AT2" --out taken.csv --events soft.jsonl
+expect_failure "sim --out over the record" 'overwrite the input' -- \
+  --scene "$ISOLATED" --record "$AT2" --out "$AT2"
+expect_failure "sim --out in a missing folder" '--out nowhere/x.csv' 'does not exist' -- \
+  --scene "$ISOLATED" --record "$AT2" --out nowhere/x.csv
+expect_failure "sim --out-interval longer than the run" '--out-interval 1e\+300' \
+  'longer than the run' -- --scene "$ISOLATED" --record "$AT2" --out-interval 1e300 --out oi.csv
+expect_absent "sim: a refused run leaves no file" x.csv oi.csv nowhere
+printf 't,a [g],v [g]\n0,0,0\n0.01,0.1,-0.2\n0.02,-0.05,0.3\n0.03,0,0\n' >three.csv
+if expect_success "sim: a 3-column CSV" --scene "$ISOLATED" --record three.csv --t-end 0.1; then
+  if grep -q 'vertical: its own column' "$TMP/stdout"; then
+    pass "sim uses a 3-column CSV's vertical column (as plinth-replay does)"
+  else
+    fail "sim uses a 3-column CSV's vertical column" "$(grep excitation "$TMP/stdout")"
+  fi
+fi
+BIN=$REPLAY
+if expect_success "replay: clipping above full scale" --record three.csv --rate 100 --scale 100 \
+  --speed max --log clipped.log --report-json; then
+  if grep -q 'samples beyond the frames. full scale' "$TMP/stderr" &&
+    grep -q '"clipped_samples": [1-9]' "$TMP/stdout"; then
+    pass "replay: clipped samples counted and reported"
+  else
+    fail "replay: clipped samples counted and reported" "$(first_stderr_line)"
+  fi
+fi
+expect_failure "replay --log over the record" '--log' 'same file' -- \
+  --record "$AT2" --log "$AT2" --speed max
+expect_failure "replay --log in a missing folder" '--log nowhere/r.log' 'does not exist' -- \
+  --record "$AT2" --log nowhere/r.log --speed max
+"${TIMEOUT[@]}" "$REPLAY" --record "$AT2" --log slow.log >/dev/null 2>"$TMP/stderr" &
+replay_pid=$!
+sleep 1
+kill -INT "$replay_pid"
+wait "$replay_pid"
+RC=$?
+if ((RC == 130)); then pass "replay: SIGINT exit 130"; else fail "replay: SIGINT exit 130" "exit $RC"; fi
+expect_absent "replay: an interrupted --log is not left as complete" slow.log slow.log.partial-*
+if [[ -s slow.log.partial ]]; then pass "replay: the frames sent kept in slow.log.partial"; else
+  fail "replay: the frames sent kept in slow.log.partial" "missing"
+fi
+BIN=$SWEEP
+"$SWEEP" "${small[@]}" --out resume.csv >/dev/null 2>&1
+sed -i '3s/^1,[^,]*,/1,nan,/; 4s/^2,[^,]*,/2,-1,/' resume.csv
+if expect_success "sweep: resuming a file with nan and negative thresholds" "${small[@]}" \
+  --out resume.csv; then
+  if grep -q 'resume.csv:3: column sliding' "$TMP/stderr" && ! grep -qE 'nan|,-1,' resume.csv; then
+    pass "sweep: NaN and negative thresholds are not resumed"
+  else
+    fail "sweep: NaN and negative thresholds are not resumed" "$(first_stderr_line)"
+  fi
+fi
+expect_failure "sweep merge --out over an input" 'same file' -- merge --out resume.csv resume.csv
+expect_failure "sweep --out in a missing folder" '--out nowhere/s.csv' 'does not exist' -- \
+  "${SWEEP_ARGS[@]}" --out nowhere/s.csv
+
+echo "$PASSED passed, $FAILED failed"
+((FAILED == 0))
