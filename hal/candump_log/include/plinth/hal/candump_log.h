@@ -56,7 +56,6 @@ inline constexpr NameTable<CandumpFrameKind, 6> kCandumpFrameKindNames{{{
 }
 
 inline constexpr std::size_t kCandumpMaxFdLength = 64;         // bytes
-inline constexpr std::size_t kCandumpMaxInterfaceLength = 15;  // IFNAMSIZ - 1
 // A line of a CAN FD frame with 64 bytes separated by dots is about 260 bytes; a longer line is
 // not a candump line, and reading it whole could take any amount of memory.
 inline constexpr std::size_t kCandumpMaxLineBytes = 512;
