@@ -86,7 +86,10 @@ def main():
         check(bool(messages) and messages[0][1].startswith("READY=1\nSTATUS=monitoring "),
               "READY=1 with a STATUS comes first: %r" % messages[:1])
         pings = ping_times(messages)
-        check(len(pings) >= 6, "WATCHDOG=1 about every 0.5 s over 4 s: %d pings" % len(pings))
+        # From READY=1 (late under a sanitizer or load) to SIGTERM at 4 s: a ping per 0.5 s.
+        span = 4.0 - (messages[0][0] if messages else 4.0)
+        check(len(pings) >= 3 and len(pings) >= int(span / 0.5),
+              "WATCHDOG=1 every 0.5 s from READY=1 to SIGTERM (%.2f s): %d pings" % (span, len(pings)))
         gaps = [b - a for a, b in zip(pings, pings[1:])]
         check(all(g >= 0.45 for g in gaps), "no ping sooner than half WATCHDOG_USEC: %s" % gaps)
         check(all(g < WATCHDOG_USEC / 1e6 for g in gaps),
