@@ -263,6 +263,10 @@ int run(const Options& opt) {
                   opt.pulse.c_str(), amplitude / g, *opt.period);
     excitation_text = text;
   } else if (opt.impulse) {
+    if (!(std::fabs(*opt.impulse) <= plinth::host::kMaxImpulse)) {
+      throw InputError(plinth::host::given("--impulse", *opt.impulse) + ": limit " +
+                       plinth::host::number_text(plinth::host::kMaxImpulse) + " m/s");
+    }
     char text[96];
     std::snprintf(text, sizeof text, "impulse I = %g m/s (Eq 34)", *opt.impulse);
     excitation_text = text;

@@ -158,6 +158,15 @@ int run_sweep_mode(const Options& opt) {
   const double g = scene.g;
   if (opt.impulse_map || opt.impulse_curve) {
     check_work(opt, kImpulseSimulationBound, "an impulse simulation");
+    for (const auto& [option, value] :
+         {std::pair<const char*, std::optional<double>>{"--impulse-to", opt.impulse_to},
+          {"--impulse-from", opt.impulse_from},
+          {"--impulse-max", opt.impulse_max}}) {
+      if (value && !(std::fabs(*value) <= plinth::host::kMaxImpulse)) {
+        throw InputError(plinth::host::given(option, *value) + ": limit " +
+                         plinth::host::number_text(plinth::host::kMaxImpulse) + " m/s");
+      }
+    }
   }
   plinth::host::SweepPlan plan;
   if (opt.impulse_map) {

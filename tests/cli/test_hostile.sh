@@ -100,6 +100,7 @@ ln -s /dev/zero zero.AT2
 mkfifo fifo.AT2
 head -c 2000000 /dev/zero | tr '\0' 'a' >long-line.log
 mkdir folder.log
+printf '[block]\nhalf_width = -1\nslenderness = 3\ndensity = 2000\n' >negative.toml
 BIN=$SIM
 expect_failure "sim --scene /dev/zero" '/dev/zero' 'scene' 'not a regular file' -- \
   --scene /dev/zero --record "$AT2"
@@ -290,6 +291,30 @@ fi
 expect_failure "sweep merge --out over an input" 'same file' -- merge --out resume.csv resume.csv
 expect_failure "sweep --out in a missing folder" '--out nowhere/s.csv' 'does not exist' -- \
   "${SWEEP_ARGS[@]}" --out nowhere/s.csv
+
+echo "# 6. messages name the option, file and key"
+BIN=$SIM
+expect_failure "sim: an unknown flag" '--no-such-flag' -- --scene "$ISOLATED" --no-such-flag
+BIN=$SWEEP
+expect_failure "sweep: an unknown flag" '--no-such-flag' -- "${SWEEP_ARGS[@]}" --no-such-flag
+BIN=$REPLAY
+expect_failure "replay: an unknown flag" '--no-such-flag' -- --record "$AT2" --no-such-flag
+BIN=$MONITOR
+expect_failure "monitor: an unknown flag" '--no-such-flag' -- --scene "$ISOLATED" --no-such-flag
+BIN=$SIM
+expect_failure "sim: a repeated option" '--dt' -- --scene "$ISOLATED" --record "$AT2" --dt 1e-4 \
+  --dt 2e-4
+expect_failure "sim --impulse 1e308" '--impulse 1e\+308' 'limit 100 m/s' -- \
+  --scene "$ISOLATED" --impulse 1e308
+expect_failure "sim: a scene key out of range names file and key" 'negative.toml' 'half_width' -- \
+  --scene negative.toml --record "$AT2"
+BIN=$MONITOR
+expect_failure "monitor: a repeated option" '--scene' -- --scene "$ISOLATED" --scene "$ISOLATED" \
+  --replay "$AT2"
+BIN=$SWEEP
+expect_failure "sweep: no 'vector::reserve'" '--steps' -- --scene "$ISOLATED" --record "$AT2" \
+  --param T --from 1 --to 2 --steps 2147483647 --out r.csv
+if grep -q 'vector::' "$TMP/stderr"; then fail "sweep: no library message" "$(first_stderr_line)"; fi
 
 echo "$PASSED passed, $FAILED failed"
 ((FAILED == 0))

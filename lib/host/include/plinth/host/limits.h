@@ -18,6 +18,9 @@ inline constexpr double kMaxSweepSimulationSteps = 1e8;
 inline constexpr double kMaxTimeHistoryRows = 1e7;
 // Halvings of the PGA bracket a sweep's bisection may take: --pga-max / --tol <= 2^40.
 inline constexpr double kMaxBisectionSteps = 40.0;
+// An impulse |I| (Eq 34's initial velocity), m/s: 100 m/s throws any statue far beyond
+// overturning.
+inline constexpr double kMaxImpulse = 100.0;
 // Values along one axis of a sweep grid (--steps), and rows of a whole grid.
 inline constexpr double kMaxSweepAxisValues = 1e5;
 inline constexpr double kMaxSweepRows = 1e6;
