@@ -254,7 +254,7 @@ std::int64_t Monitor::monitor_time(std::int64_t receive_time_ns) {
 // Quiet: every member of every axis in full contact, and the worst risk low (the offset is
 // tracked only then; the same for every member, whatever their order).
 bool Monitor::quiet() const {
-  bool quiet = status_.estimating && status_.risk < config_.quiet_risk;
+  bool quiet = status_.estimating && status_.calibrated && status_.risk < config_.quiet_risk;
   for (int i = 0; i < status_.axis_count && quiet; ++i) {
     const auto k = static_cast<std::size_t>(i);
     for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
@@ -302,6 +302,10 @@ void Monitor::process(int sensor, const monitor::FedSample& sample) {
   Sensor& s = sensors_[static_cast<std::size_t>(sensor)];
   const monitor::ConditionedSample c = s.conditioner.condition(sample.acceleration_g, quiet());
   if (!c.ready) return;  // start-up window, or refused input (counted by the conditioner)
+  // A verification window passed on the primary: the running estimators are trusted again.
+  if (c.window_passed && sensor == status_.primary && status_.estimating) {
+    status_.calibrated = true;
+  }
   if (sample.restart) {  // a seam: nothing before it connects, nor compares, to what follows
     s.history.clear();
     s.window.reset();
@@ -388,6 +392,11 @@ void Monitor::drive(const HistoryEntry& entry) {
     }
     ++status_.estimator_restarts;
     status_.estimator_start_ns = entry.time_ns - epoch_ns_;
+    // Calibrated only on the sample right after a passing window; else verify a new one.
+    monitor::Conditioner& conditioner =
+        sensors_[static_cast<std::size_t>(status_.primary)].conditioner;
+    status_.calibrated = conditioner.status().samples_since_window <= 1;
+    if (!status_.calibrated) conditioner.begin_verification();
     restart_pending_ = false;
     align_pending_ = false;
     estimate_.clear();
@@ -610,6 +619,8 @@ void Monitor::evaluate(MonitorUpdate& update) {
   input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status_.sensor.cause)
                       : (disagreement || mismatch_fault) ? monitor::AlarmCause::kSensorDisagreement
                                                          : monitor::AlarmCause::kBusError;
+  // Never normal while no estimator runs, or runs on an untrusted start (the start-up rule).
+  input.not_calibrated = !status_.estimating || !status_.calibrated;
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
   pending_ack_ = false;

@@ -50,6 +50,14 @@
 // (at rest, full contact) with the first sample that conditioning marks ready, and starts again
 // at rest on a sample the health tracker marks `restart` (after a fault nothing is known of
 // what happened meanwhile; the fault level shows it).
+//
+// Start-up rule (docs/monitor.md): the estimators' offset and initial state (at rest) are
+// trusted only when a window that passed conditioning's quietness test ends at the sample they
+// start on (`calibrated`). Any other start (after a sensor fault, a failover without
+// continuity) leaves them uncalibrated: they run, but the primary's conditioner verifies a new
+// window and they are calibrated when one passes. The level is never normal while the
+// estimators do not run or are not calibrated: the alarm policy's fault, cause kNotCalibrated
+// (an alarm still shows above it).
 #pragma once
 
 #include <Eigen/Core>
@@ -195,6 +203,9 @@ struct SensorStatus {
 struct MonitorStatus {
   std::int64_t time_ns = 0;  // monitor time of the newest sample (or tick)
   bool estimating = false;   // conditioning ready and the estimators running
+  // Their offset and initial state are trusted (the start-up rule, above); else the level is
+  // fault, cause kNotCalibrated.
+  bool calibrated = false;
   int axis_count = 1;
   std::array<AxisStatus, kMaxAxes> axes{};
   double risk = 0.0;  // the worst axis's total
