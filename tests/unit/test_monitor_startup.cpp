@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -51,10 +52,11 @@ struct Case {
   double collapse_s = -1.0;  // the solver's first terminal phase, s (-1: none)
 };
 
-Case make_case(const Scene& scene, const host::Record& r, double gamma) {
+// `quiet_tail_s` of rest follow the record (the quake ends; the sensor's noise goes on).
+Case make_case(const Scene& scene, const host::Record& r, double gamma, double quiet_tail_s = 0.0) {
   Case c;
   const SampledSignal h = r.horizontal_signal();
-  const auto count = static_cast<std::size_t>(std::floor(r.duration() * kRateHz)) + 1;
+  const auto count = static_cast<std::size_t>(std::floor((r.duration() + quiet_tail_s) * kRateHz)) + 1;
   for (std::size_t n = 0; n < count; ++n) {
     c.ground_m_s2.push_back(gamma * h.at(static_cast<double>(n) / kRateHz));
   }
@@ -101,6 +103,7 @@ struct BoxRun {
   bool normal_while_moving = false;  // normal with risk 0 while the truth moves
   double first_bad_s = -1.0;         // the first time of either of the two above
   AlarmCause first_fault_cause = AlarmCause::kNone;
+  double normal_from_s = -1.0;  // the first time the box showed normal (-1: never)
 };
 
 void check_update(const Case& c, std::size_t n, const fw::Monitor& box, BoxRun& run) {
@@ -113,6 +116,7 @@ void check_update(const Case& c, std::size_t n, const fw::Monitor& box, BoxRun& 
   const bool untrusted = normal && !(st.estimating && st.calibrated);
   const bool blind = normal && st.risk == 0.0 && moving(c.truth[n]);
   if ((untrusted || blind) && run.first_bad_s < 0.0) run.first_bad_s = t;
+  if (normal && run.normal_from_s < 0.0) run.normal_from_s = t;
   run.normal_untrusted = run.normal_untrusted || untrusted;
   run.normal_while_moving = run.normal_while_moving || blind;
 }
@@ -228,6 +232,64 @@ TEST(MonitorStartup, RestartDuringShakingIsNotCalibrated) {
   EXPECT_FALSE(box->status().estimating);  // the coda never gave a quiet window at 0.8 g
   EXPECT_EQ(box->status().alarm, AlarmLevel::kFault);
 }
+
+// Issue 13's test: the box started at every whole second of each bundled record, at the
+// smallest PGA of a 0.1 g grid at which the solver, fed the whole record, brings the block down
+// (and at 1.5 times that), the record followed by kQuietTailS of rest (so that boxes started
+// during the quake can vouch again once it is over, and are checked then too). For every start before the collapse: an alarm before it, or fault
+// throughout; for every start: never normal unless estimating and calibrated, and never normal
+// with risk 0 while the solver says the block moves.
+constexpr double kQuietTailS = 8.0;
+
+class EverySecondStart : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(EverySecondStart, AlarmBeforeTheCollapseOrFaultAndNeverBlindNormal) {
+  const Scene scene = ground_block();
+  const host::Record r = record(GetParam());
+  double pga_g = 0.2;
+  Case c;
+  for (; pga_g <= 3.0 + 1e-9 && c.collapse_s < 0.0; pga_g += 0.1) {
+    c = make_case(scene, r, pga_g * kStandardGravity / r.peak_horizontal(), kQuietTailS);
+  }
+  ASSERT_GE(c.collapse_s, 0.0) << "no collapse up to 3 g";
+  pga_g -= 0.1;
+  auto box = std::make_unique<fw::Monitor>();
+  int alarmed = 0;
+  int faulted = 0;
+  int earned_normal = 0;  // starts where a quiet window let the box vouch (normal shown)
+  for (const double factor : {1.0, 1.5}) {
+    if (factor != 1.0) {
+      c = make_case(scene, r, factor * pga_g * kStandardGravity / r.peak_horizontal(),
+                    kQuietTailS);
+    }
+    const auto seconds = static_cast<std::size_t>(std::floor(r.duration()));
+    for (std::size_t k = 0; k <= seconds; ++k) {
+      const BoxRun run = run_from(c, scene, k * static_cast<std::size_t>(kRateHz), *box);
+      const double start_s = static_cast<double>(k);
+      SCOPED_TRACE(::testing::Message() << pga_g * factor << " g, started at " << start_s
+                                        << " s, collapse at " << c.collapse_s << " s");
+      EXPECT_FALSE(run.normal_untrusted) << "at " << run.first_bad_s << " s";
+      EXPECT_FALSE(run.normal_while_moving) << "at " << run.first_bad_s << " s";
+      earned_normal += run.normal_from_s >= 0.0 ? 1 : 0;
+      if (c.collapse_s >= 0.0 && start_s < c.collapse_s) {
+        EXPECT_TRUE(run.alarm_before_collapse || run.fault_until_collapse);
+        alarmed += run.alarm_before_collapse ? 1 : 0;
+        faulted += run.fault_until_collapse ? 1 : 0;
+      }
+    }
+  }
+  std::printf("%s: %.1f g, collapse at %.3f s (x1.5: %.3f s): starts before the collapse with "
+              "an alarm before it %d, fault throughout %d; starts that earned normal %d\n",
+              GetParam(), pga_g, make_case(scene, r, pga_g * kStandardGravity / r.peak_horizontal()).collapse_s,
+              c.collapse_s, alarmed, faulted, earned_normal);
+}
+
+INSTANTIATE_TEST_SUITE_P(BundledRecords, EverySecondStart,
+                         ::testing::Values("elcentro1940_180", "friuli1976-09-11_buia_NS",
+                                           "friuli1976-09-15_buia_000", "friuli1976-09-15_buia_270",
+                                           "irpinia1980_bagnoli_000", "irpinia1980_bagnoli_270",
+                                           "irpinia1980_brienza_000", "irpinia1980_brienza_270",
+                                           "irpinia1980_calitri_000", "irpinia1980_calitri_270"));
 
 }  // namespace
 }  // namespace plinth
