@@ -21,6 +21,7 @@ namespace {
 namespace fw = firmware;
 using monitor::AlarmCause;
 using monitor::AlarmLevel;
+namespace can = plinth::can;
 
 const std::string kSource = PLINTH_SOURCE_DIR;
 constexpr double kRateHz = 200.0;  // the sensor rate of the candump log
@@ -201,6 +202,22 @@ TEST(MonitorStartup, NeverNormalWhileNoEstimatorRuns) {
   EXPECT_TRUE(box->status().calibrated);
   EXPECT_EQ(box->status().alarm, AlarmLevel::kNormal);
   EXPECT_TRUE(event_normal);
+}
+
+// Found by fuzz_monitor (tests/fuzz/regressions/monitor/heartbeat_before_any_sample.bin): a
+// frame that is not a sample, before any sample, made a status that said the alarm policy's
+// initial `normal`. The first status says fault (the sensor has sent no data).
+TEST(MonitorStartup, AFrameBeforeAnySampleReportsFault) {
+  const Scene scene = ground_block();
+  auto box = std::make_unique<fw::Monitor>();
+  ASSERT_TRUE(box->start(box_config(), {&scene, nullptr}).ok());
+  can::CanFrame heartbeat;
+  ASSERT_TRUE(can::encode(can::SensorHeartbeat{1, 16, 0, 0, 0, 0, 0}, heartbeat).ok());
+  const fw::MonitorUpdate u = box->on_frame({heartbeat, 0});
+  ASSERT_TRUE(u.status_due);
+  EXPECT_EQ(box->status().alarm, AlarmLevel::kFault);
+  ASSERT_EQ(u.event_count, 1U);
+  EXPECT_EQ(u.events[0].cause, AlarmCause::kSensorTimeout);  // the sensor's "no data yet"
 }
 
 // A restart (Monitor::start again, as after a watchdog reset) in the middle of the shaking

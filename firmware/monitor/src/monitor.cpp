@@ -229,6 +229,7 @@ Error Monitor::start(const MonitorConfig& config,
   have_epoch_ = false;
   bus_fault_ = false;
   pending_ack_ = false;
+  evaluated_ = false;
   status_interval_ns_ = std::llround(config.status_interval_s * 1e9);
   next_status_ns_ = 0;
   status_sequence_ = 0;
@@ -279,7 +280,7 @@ MonitorUpdate Monitor::on_sensor_sample(int sensor, const monitor::SensorSample&
 
 void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update) {
   if (sensor < 0 || sensor >= sensor_count_) {
-    report(update);
+    report_state(update);
     return;
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
@@ -633,7 +634,18 @@ void Monitor::evaluate(MonitorUpdate& update) {
   }
   status_.alarm = out.level;
   status_.latched = out.latched_level;
+  evaluated_ = true;
   report(update);
+}
+
+// A status without new input: evaluated once first, so that no status says the alarm policy's
+// initial `normal` (found by fuzz_monitor: a heartbeat frame before any sample).
+void Monitor::report_state(MonitorUpdate& update) {
+  if (evaluated_) {
+    report(update);
+  } else {
+    evaluate(update);
+  }
 }
 
 template <typename Message>
@@ -701,7 +713,7 @@ int Monitor::sensor_of_node(std::uint8_t node) const {
 MonitorUpdate Monitor::on_frame(const hal::TimedFrame& timed) {
   ++frames_.received;
   MonitorUpdate update;
-  if (!take_frame(timed, update)) report(update);  // nothing evaluated: a status may be due
+  if (!take_frame(timed, update)) report_state(update);  // nothing evaluated: a status may be due
   return update;
 }
 

@@ -381,6 +381,7 @@ class Monitor {
   void update_axes_status(monitor::AlarmInput& input);
   void evaluate(MonitorUpdate& update);
   void report(MonitorUpdate& update);
+  void report_state(MonitorUpdate& update);
   template <typename Message>
   void add_frame(MonitorUpdate& update, const Message& message);
   [[nodiscard]] std::int64_t monitor_time(std::int64_t receive_time_ns);
@@ -406,6 +407,7 @@ class Monitor {
   bool have_epoch_ = false;
   std::int64_t epoch_ns_ = 0;  // receive time of the first sample
   bool bus_fault_ = false;
+  bool evaluated_ = false;  // the alarm policy has evaluated an input since start()
   bool pending_ack_ = false;
   monitor::Acknowledgement ack_;
   std::int64_t status_interval_ns_ = 100'000'000;
