@@ -12,10 +12,11 @@
 //   5 ack       level, sequence: an Acknowledge frame
 //   6 late      dt (0.25 ms units): the receive clock steps back (a late frame's timestamp)
 //   7 restart   Monitor::start again (a watchdog reset)
-// After every call the check function below: the estimator's invariants (finite state, phase
-// and mode consistent, risk and probability in [0, 1]), never normal while not estimating or
-// not calibrated, the heartbeat (a status at least every heartbeat period of monitor time), and
-// that a fault reports what was rejected (its cause is the one the monitor's inputs give).
+// At most kMaxFramesPerInput frames are sent. After every call the check function below: the
+// estimator's invariants (finite state, phase and mode consistent, risk and probability in [0, 1]),
+// never normal while not estimating or not calibrated, the heartbeat (a status at least every
+// heartbeat period of monitor time), and that a fault reports what was rejected (its cause is the
+// one the monitor's inputs give).
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -36,6 +37,9 @@ using plinth::fuzz::check;
 
 constexpr double kRateHz = 200.0;
 constexpr std::int64_t kPeriodNs = 5'000'000;
+// Frames per input at most (10 s at 200 Hz: start-up and verification windows, timeouts and
+// heartbeats all fit); keeps an execution short so the suite's short run stays short.
+constexpr int kMaxFramesPerInput = 2000;
 
 // The paper's isolated block with base stops (every kind of phase is reachable).
 const plinth::Scene& scene() {
@@ -103,6 +107,8 @@ class Harness {
     rejected_ = 0;
   }
 
+  [[nodiscard]] bool spent() const { return frames_sent_ >= kMaxFramesPerInput; }
+
   void step(Reader& in) {
     switch (in.byte() % 8) {
       case 0:
@@ -134,7 +140,11 @@ class Harness {
   }
 
  private:
-  void send(const can::CanFrame& frame) { after(box_->on_frame({frame, clock_ns_})); }
+  void send(const can::CanFrame& frame) {
+    if (frames_sent_ >= kMaxFramesPerInput) return;
+    ++frames_sent_;
+    after(box_->on_frame({frame, clock_ns_}));
+  }
 
   void sensor_frame(std::uint8_t node, double ax, double ay, double az, std::uint8_t flags) {
     can::SensorAcceleration m;
@@ -269,6 +279,7 @@ class Harness {
   bool have_status_ = false;
   std::int64_t last_time_ns_ = 0;
   std::uint64_t rejected_ = 0;
+  int frames_sent_ = 0;
 };
 
 }  // namespace
@@ -276,6 +287,6 @@ class Harness {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   Reader in(data, size);
   Harness box(in.byte());
-  for (int ops = 0; !in.done() && ops < 4096; ++ops) box.step(in);
+  for (int ops = 0; !in.done() && !box.spent() && ops < 4096; ++ops) box.step(in);
   return 0;
 }
