@@ -228,6 +228,7 @@ std::string status_json(const MonitorStatus& s, double t_origin) {
       .text("alarm", monitor::alarm_level_name(s.alarm))
       .text("latched", monitor::alarm_level_name(s.latched))
       .flag("estimating", s.estimating)
+      .flag("calibrated", s.calibrated)
       .text("sensor", monitor::health_state_name(s.sensor.state))
       .text("sensor_cause", monitor::health_cause_name(s.sensor.cause))
       .text("sensors_state", monitor::health_state_name(s.sensors_state))

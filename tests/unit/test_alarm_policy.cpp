@@ -313,6 +313,36 @@ TEST(AlarmPolicy, FaultIsShownAtOnceAndClearsAfterTheLowerHold) {
   expect_change(cleared, AlarmLevel::kNormal, AlarmLevel::kFault, AlarmCause::kNone, false);
 }
 
+// Not calibrated: the fault level at once and for exactly as long as it lasts (no lower hold);
+// an active fault beneath it reports its own cause; an alarm shows above it.
+TEST(AlarmPolicy, NotCalibratedIsAFaultWithoutHold) {
+  AlarmPolicySettings s = latching(false, true);
+  Policy p(s);
+  p.base.not_calibrated = true;
+  expect_change(p.at(0, 0.0), AlarmLevel::kFault, AlarmLevel::kNormal, AlarmCause::kNotCalibrated,
+                false);
+  EXPECT_EQ(p.at(100, 0.95).level, AlarmLevel::kAlarm);  // event 1: alarm, latched
+  EXPECT_EQ(p.at(150, 0.0).level, AlarmLevel::kAlarm);   // held by its latch
+  const AlarmOutput acked = p.ack(200, 0.0, AlarmLevel::kAlarm, 1);
+  expect_change(acked, AlarmLevel::kFault, AlarmLevel::kAlarm, AlarmCause::kAcknowledged, false);
+  p.base.not_calibrated = false;
+  expect_change(p.at(201, 0.0), AlarmLevel::kNormal, AlarmLevel::kFault, AlarmCause::kNone, false);
+
+  // A sensor fault and not calibrated: the fault's cause; the fault's hold outlasts it.
+  s.lower_hold_s = 0.5;
+  Policy q(s);
+  q.base.not_calibrated = true;
+  q.base.fault_active = true;
+  q.base.fault_cause = AlarmCause::kSensorTimeout;
+  expect_change(q.at(0, 0.0), AlarmLevel::kFault, AlarmLevel::kNormal, AlarmCause::kSensorTimeout,
+                false);
+  q.base.fault_active = false;
+  q.base.not_calibrated = false;
+  EXPECT_EQ(q.at(10, 0.0).level, AlarmLevel::kFault);
+  EXPECT_EQ(q.at(509, 0.0).level, AlarmLevel::kFault);
+  EXPECT_EQ(q.at(510, 0.0).level, AlarmLevel::kNormal);
+}
+
 TEST(AlarmPolicy, AFaultNeverHidesAnAlarm) {
   Policy p(latching(false, true));
   (void)p.at(0, 0.9);  // event 0: alarm

@@ -271,7 +271,12 @@ TEST(CanFrames, AStatusIsDueBeforeTheFirstSample) {
   ASSERT_TRUE(can::encode(can::SensorHeartbeat{1, 1, 0, 1, 0, 0, 0}, heartbeat).ok());
   const MonitorUpdate first = monitor.on_frame({heartbeat, 1000});
   EXPECT_TRUE(first.status_due);
-  EXPECT_EQ(first.frame_count, 1U);
+  // The first evaluation's AlarmEvent (fault: no data yet), then the status: never the alarm
+  // policy's initial normal (found by fuzz_monitor).
+  ASSERT_EQ(first.event_count, 1U);
+  EXPECT_EQ(first.events[0].level, monitor::AlarmLevel::kFault);
+  EXPECT_EQ(first.frame_count, 2U);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kFault);
   EXPECT_FALSE(monitor.on_frame({heartbeat, 2000}).status_due);  // the time did not move
 }
 

@@ -72,6 +72,12 @@ TEST(ConditioningSettings, DefaultsAreValidAndEveryFieldIsChecked) {
   s.startup_max_offset_m_s2 = std::numeric_limits<double>::infinity();
   expect_refused(s, "conditioning.startup_max_offset_m_s2", ErrorCode::kNotFinite);
   s = {};
+  s.startup_max_drift_m_s2 = -0.1;
+  expect_refused(s, "conditioning.startup_max_drift_m_s2", ErrorCode::kOutOfRange);
+  s = {};
+  s.startup_gravity_tolerance_m_s2 = std::numeric_limits<double>::quiet_NaN();
+  expect_refused(s, "conditioning.startup_gravity_tolerance_m_s2", ErrorCode::kNotFinite);
+  s = {};
   s.tracking_time_constant_s = 0.0;
   expect_refused(s, "conditioning.tracking_time_constant_s", ErrorCode::kOutOfRange);
   s = {};
@@ -197,14 +203,25 @@ TEST(Conditioning, WindowStandardDeviationBoundary) {
 }
 
 TEST(Conditioning, WindowWithGravityInTheWrongPlaceIsRejected) {
-  // Declared m/s2, sent in g: gravity reads 1 instead of 9.8.
+  // Declared m/s2, sent in g: gravity reads 1 instead of 9.8 (the mean's norm is not g0).
   ConditioningSettings s = ten_sample_window();
   s.unit = AccelerationUnit::kMetresPerSecondSquared;
   Conditioner wrong_unit = make(s);
   for (int i = 0; i < 10; ++i) (void)wrong_unit.condition({0.0, 0.0, 1.0}, true);
   EXPECT_FALSE(wrong_unit.status().ready);
-  EXPECT_EQ(wrong_unit.status().last_rejection, StartupRejection::kOffsetTooLarge);
-  EXPECT_EQ(wrong_unit.status().rejected_offset, 1U);
+  EXPECT_EQ(wrong_unit.status().last_rejection, StartupRejection::kNotGravity);
+  EXPECT_EQ(wrong_unit.status().rejected_gravity, 1U);
+
+  // A gain 6 % high: every offset component within its limit (z: 0.59 m/s2 < 1), the norm not.
+  s = ten_sample_window();
+  Conditioner wrong_gain = make(s);
+  for (int i = 0; i < 10; ++i) (void)wrong_gain.condition({0.0, 0.0, 1.06}, true);
+  EXPECT_FALSE(wrong_gain.status().ready);
+  EXPECT_EQ(wrong_gain.status().last_rejection, StartupRejection::kNotGravity);
+  s.startup_gravity_tolerance_m_s2 = 0.6;  // named threshold: 0.59 m/s2 is then within it
+  Conditioner tolerant = make(s);
+  for (int i = 0; i < 10; ++i) (void)tolerant.condition({0.0, 0.0, 1.06}, true);
+  EXPECT_TRUE(tolerant.status().ready);
 
   // A mounting rotation that puts the sensor's z (up) on the statue's y.
   s = ten_sample_window();
@@ -213,6 +230,58 @@ TEST(Conditioning, WindowWithGravityInTheWrongPlaceIsRejected) {
   for (int i = 0; i < 10; ++i) (void)wrong_rotation.condition({0.0, 0.0, 1.0}, true);
   EXPECT_FALSE(wrong_rotation.status().ready);
   EXPECT_EQ(wrong_rotation.status().last_rejection, StartupRejection::kOffsetTooLarge);
+}
+
+// A slow onset: x ramps by 0.1 m/s2 across the window. Its spread (0.03 m/s2) passes, its
+// drift (the halves' means 0.05 m/s2 apart) does not; the same window flat passes.
+TEST(Conditioning, DriftingWindowIsRejected) {
+  ConditioningSettings s = ten_sample_window();
+  s.unit = AccelerationUnit::kMetresPerSecondSquared;
+  Conditioner c = make(s);
+  for (int i = 0; i < 10; ++i) (void)c.condition({0.1 * i / 9.0, 0.0, kG0}, true);
+  EXPECT_FALSE(c.status().ready);
+  EXPECT_EQ(c.status().last_rejection, StartupRejection::kDrifting);
+  EXPECT_EQ(c.status().rejected_drift, 1U);
+  EXPECT_LT(c.status().window_std_m_s2.x(), s.startup_max_std_m_s2);
+  EXPECT_NEAR(c.status().window_drift_m_s2.x(), 0.1 * 5.0 / 9.0, 1e-12);
+  for (int i = 0; i < 10; ++i) (void)c.condition({0.05, 0.0, kG0}, true);
+  EXPECT_TRUE(c.status().ready);
+  EXPECT_EQ(c.status().windows_passed, 1U);
+  EXPECT_NEAR(c.status().offset_m_s2.x(), 0.05, 1e-12);
+}
+
+// Verification: the output stays ready on the offset while a new window is tested; a noisy
+// window is rejected (counted), a quiet one marks the sample that completes it and keeps the
+// offset.
+TEST(Conditioning, VerificationWindowKeepsTheOutputAndTheOffset) {
+  ConditioningSettings s = ten_sample_window();
+  s.unit = AccelerationUnit::kMetresPerSecondSquared;
+  Conditioner c = make(s);
+  c.begin_verification();  // not ready: the start-up window is the test already
+  EXPECT_FALSE(c.status().verifying);
+  for (int i = 0; i < 10; ++i) (void)c.condition({0.02, 0.0, kG0}, false);
+  ASSERT_TRUE(c.status().ready);
+  EXPECT_EQ(c.status().samples_since_window, 0U);
+  EXPECT_EQ(c.condition({0.02, 0.0, kG0}, false).ground_m_s2.x(), 0.0);
+  EXPECT_EQ(c.status().samples_since_window, 1U);
+  c.begin_verification();
+  EXPECT_TRUE(c.status().verifying);
+  for (int i = 0; i < 10; ++i) {
+    const ConditionedSample out = c.condition({i % 2 == 0 ? 1.0 : -1.0, 0.0, kG0}, false);
+    EXPECT_TRUE(out.ready);
+    EXPECT_FALSE(out.window_passed);
+  }
+  EXPECT_EQ(c.status().rejected_noisy, 1U);
+  EXPECT_TRUE(c.status().verifying);
+  for (int i = 0; i < 10; ++i) {
+    const ConditionedSample out = c.condition({0.03, 0.0, kG0}, false);
+    EXPECT_TRUE(out.ready);
+    EXPECT_EQ(out.window_passed, i == 9);
+  }
+  EXPECT_FALSE(c.status().verifying);
+  EXPECT_EQ(c.status().windows_passed, 2U);
+  EXPECT_EQ(c.status().samples_since_window, 1U);
+  EXPECT_NEAR(c.status().offset_m_s2.x(), 0.02, 1e-15);  // kept: tracking follows it, if quiet
 }
 
 TEST(Conditioning, NonFiniteInputIsRefusedAndChangesNothing) {

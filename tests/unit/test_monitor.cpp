@@ -167,7 +167,18 @@ TEST(Monitor, SensorSilenceIsAFaultAndTheEstimatorRestartsAfterIt) {
   ASSERT_GT(fault_at, 0);
   EXPECT_LE(fault_at - last, ns(config.sensor_health.timeout_s + 0.01));
   t = fault_at + ns(1.0);
-  feed_for(4.0);
+  // The estimator restarts at rest after recovery_samples, not calibrated (what the block did
+  // meanwhile is unknown): fault, cause not_calibrated, until a verification window (0.5 s)
+  // of quiet input passes.
+  feed_for(0.2);
+  EXPECT_EQ(monitor.status().estimator_restarts, 2U);
+  EXPECT_TRUE(monitor.status().estimating);
+  EXPECT_FALSE(monitor.status().calibrated);
+  EXPECT_TRUE(monitor.conditioning().verifying);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kFault);
+  feed_for(0.5);
+  EXPECT_TRUE(monitor.status().calibrated);
+  feed_for(3.3);
   EXPECT_EQ(monitor.status().estimator_restarts, 2U);
   EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kNormal);
   EXPECT_EQ(monitor.status().sensor.counters.timeouts, 1U);

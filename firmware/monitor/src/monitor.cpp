@@ -234,6 +234,7 @@ Error Monitor::start(const MonitorConfig& config,
   have_epoch_ = false;
   bus_fault_ = false;
   pending_ack_ = false;
+  evaluated_ = false;
   status_interval_ns_ = std::llround(config.status_interval_s * 1e9);
   next_status_ns_ = 0;
   status_sequence_ = 0;
@@ -259,7 +260,7 @@ std::int64_t Monitor::monitor_time(std::int64_t receive_time_ns) {
 // Quiet: every member of every axis in full contact, and the worst risk low (the offset is
 // tracked only then; the same for every member, whatever their order).
 bool Monitor::quiet() const {
-  bool quiet = status_.estimating && status_.risk < config_.quiet_risk;
+  bool quiet = status_.estimating && status_.calibrated && status_.risk < config_.quiet_risk;
   for (int i = 0; i < status_.axis_count && quiet; ++i) {
     const auto k = static_cast<std::size_t>(i);
     for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
@@ -284,7 +285,7 @@ MonitorUpdate Monitor::on_sensor_sample(int sensor, const monitor::SensorSample&
 
 void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update) {
   if (sensor < 0 || sensor >= sensor_count_) {
-    report(update);
+    report_state(update);
     return;
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
@@ -307,6 +308,10 @@ void Monitor::process(int sensor, const monitor::FedSample& sample) {
   Sensor& s = sensors_[static_cast<std::size_t>(sensor)];
   const monitor::ConditionedSample c = s.conditioner.condition(sample.acceleration_g, quiet());
   if (!c.ready) return;  // start-up window, or refused input (counted by the conditioner)
+  // A verification window passed on the primary: the running estimators are trusted again.
+  if (c.window_passed && sensor == status_.primary && status_.estimating) {
+    status_.calibrated = true;
+  }
   if (sample.restart) {  // a seam: nothing before it connects, nor compares, to what follows
     s.history.clear();
     s.window.reset();
@@ -393,6 +398,11 @@ void Monitor::drive(const HistoryEntry& entry) {
     }
     ++status_.estimator_restarts;
     status_.estimator_start_ns = entry.time_ns - epoch_ns_;
+    // Calibrated only on the sample right after a passing window; else verify a new one.
+    monitor::Conditioner& conditioner =
+        sensors_[static_cast<std::size_t>(status_.primary)].conditioner;
+    status_.calibrated = conditioner.status().samples_since_window <= 1;
+    if (!status_.calibrated) conditioner.begin_verification();
     restart_pending_ = false;
     align_pending_ = false;
     estimate_.clear();
@@ -617,6 +627,8 @@ void Monitor::evaluate(MonitorUpdate& update) {
   input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status_.sensor.cause)
                       : (disagreement || mismatch_fault) ? monitor::AlarmCause::kSensorDisagreement
                                                          : monitor::AlarmCause::kBusError;
+  // Never normal while no estimator runs, or runs on an untrusted start (the start-up rule).
+  input.not_calibrated = !status_.estimating || !status_.calibrated;
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
   pending_ack_ = false;
@@ -629,7 +641,18 @@ void Monitor::evaluate(MonitorUpdate& update) {
   }
   status_.alarm = out.level;
   status_.latched = out.latched_level;
+  evaluated_ = true;
   report(update);
+}
+
+// A status without new input: evaluated once first, so that no status says the alarm policy's
+// initial `normal` (found by fuzz_monitor: a heartbeat frame before any sample).
+void Monitor::report_state(MonitorUpdate& update) {
+  if (evaluated_) {
+    report(update);
+  } else {
+    evaluate(update);
+  }
 }
 
 template <typename Message>
@@ -702,7 +725,7 @@ int Monitor::sensor_of_node(std::uint8_t node) const {
 MonitorUpdate Monitor::on_frame(const hal::TimedFrame& timed) {
   ++frames_.received;
   MonitorUpdate update;
-  if (!take_frame(timed, update)) report(update);  // nothing evaluated: a status may be due
+  if (!take_frame(timed, update)) report_state(update);  // nothing evaluated: a status may be due
   return update;
 }
 

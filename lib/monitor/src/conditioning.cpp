@@ -57,6 +57,9 @@ Error validate(const ConditioningSettings& s) {
       detail::check_duration(s.startup_window_s, "conditioning.startup_window_s", false),
       detail::check_positive(s.startup_max_std_m_s2, "conditioning.startup_max_std_m_s2"),
       detail::check_positive(s.startup_max_offset_m_s2, "conditioning.startup_max_offset_m_s2"),
+      detail::check_positive(s.startup_max_drift_m_s2, "conditioning.startup_max_drift_m_s2"),
+      detail::check_positive(s.startup_gravity_tolerance_m_s2,
+                             "conditioning.startup_gravity_tolerance_m_s2"),
       detail::check_duration(s.tracking_time_constant_s, "conditioning.tracking_time_constant_s",
                              false),
       detail::check_positive(s.tracking_gate_m_s2, "conditioning.tracking_gate_m_s2"),
@@ -79,40 +82,86 @@ Error Conditioner::create(const ConditioningSettings& settings, Conditioner& out
   return ok_error();
 }
 
-void Conditioner::restart_startup() {
-  status_.ready = false;
+void Conditioner::clear_window() {
   status_.window_samples = 0;
-  status_.offset_m_s2.setZero();
-  status_.consecutive_gated = 0;
   window_mean_.setZero();
   window_m2_.setZero();
+  first_half_sum_.setZero();
+}
+
+void Conditioner::restart_startup() {
+  status_.ready = false;
+  status_.verifying = false;
+  status_.offset_m_s2.setZero();
+  status_.consecutive_gated = 0;
+  clear_window();
+}
+
+void Conditioner::begin_verification() {
+  if (!status_.ready) return;  // the start-up window is the test already
+  status_.verifying = true;
+  clear_window();
 }
 
 Eigen::Vector3d Conditioner::to_statue_m_s2(const Eigen::Vector3d& sensor_sample) const {
   return settings_.sensor_to_statue * (unit_scale_ * sensor_sample);
 }
 
-void Conditioner::add_to_window(const Eigen::Vector3d& statue_m_s2) {
+// The quietness test of a full window (conditioning.h), its first failed check.
+StartupRejection Conditioner::quietness(const Eigen::Vector3d& offset) const {
+  if (status_.window_std_m_s2.maxCoeff() > settings_.startup_max_std_m_s2) {
+    return StartupRejection::kTooNoisy;
+  }
+  if (status_.window_drift_m_s2.cwiseAbs().maxCoeff() > settings_.startup_max_drift_m_s2) {
+    return StartupRejection::kDrifting;
+  }
+  if (std::abs(window_mean_.norm() - kStandardGravity) > settings_.startup_gravity_tolerance_m_s2) {
+    return StartupRejection::kNotGravity;
+  }
+  if (offset.cwiseAbs().maxCoeff() > settings_.startup_max_offset_m_s2) {
+    return StartupRejection::kOffsetTooLarge;
+  }
+  return StartupRejection::kNone;
+}
+
+bool Conditioner::add_to_window(const Eigen::Vector3d& statue_m_s2) {
   const std::int64_t n = ++status_.window_samples;
+  const std::int64_t half = status_.window_length / 2;
+  if (n <= half) first_half_sum_ += statue_m_s2;
   const Eigen::Vector3d before = statue_m_s2 - window_mean_;
   window_mean_ += before / static_cast<double>(n);
   window_m2_ += before.cwiseProduct(statue_m_s2 - window_mean_);
-  if (n < status_.window_length) return;
+  if (n < status_.window_length) return false;
 
   status_.window_std_m_s2 = (window_m2_ / static_cast<double>(n - 1)).cwiseSqrt();
+  const Eigen::Vector3d second_half_sum = window_mean_ * static_cast<double>(n) - first_half_sum_;
+  status_.window_drift_m_s2 =
+      second_half_sum / static_cast<double>(n - half) - first_half_sum_ / static_cast<double>(half);
   const Eigen::Vector3d offset = window_mean_ - gravity_up();
-  if (status_.window_std_m_s2.maxCoeff() > settings_.startup_max_std_m_s2) {
-    status_.last_rejection = StartupRejection::kTooNoisy;
-    ++status_.rejected_noisy;
-  } else if (offset.cwiseAbs().maxCoeff() > settings_.startup_max_offset_m_s2) {
-    status_.last_rejection = StartupRejection::kOffsetTooLarge;
-    ++status_.rejected_offset;
-  } else {
-    status_.ready = true;
-    status_.offset_m_s2 = offset;
-    return;
+  status_.last_rejection = quietness(offset);
+  switch (status_.last_rejection) {
+    case StartupRejection::kNone:
+      ++status_.windows_passed;
+      status_.samples_since_window = 0;
+      if (!status_.ready) status_.offset_m_s2 = offset;  // a verification keeps the offset
+      status_.ready = true;
+      status_.verifying = false;
+      return true;
+    case StartupRejection::kTooNoisy:
+      ++status_.rejected_noisy;
+      break;
+    case StartupRejection::kDrifting:
+      ++status_.rejected_drift;
+      break;
+    case StartupRejection::kNotGravity:
+      ++status_.rejected_gravity;
+      break;
+    case StartupRejection::kOffsetTooLarge:
+      ++status_.rejected_offset;
+      break;
   }
-  restart_startup();
+  clear_window();  // a new window begins (the output stays as it was: ready while verifying)
+  return true;
 }
 
 ConditionedSample Conditioner::condition(const Eigen::Vector3d& sensor_sample, bool quiet) {
@@ -124,11 +173,15 @@ ConditionedSample Conditioner::condition(const Eigen::Vector3d& sensor_sample, b
   }
   const Eigen::Vector3d statue = to_statue_m_s2(sensor_sample);
   if (!status_.ready) {
-    add_to_window(statue);
+    (void)add_to_window(statue);
     out.tracking = OffsetTracking::kStartup;
     return out;
   }
+  if (status_.verifying) {
+    out.window_passed = add_to_window(statue) && status_.last_rejection == StartupRejection::kNone;
+  }
   out.ready = true;
+  ++status_.samples_since_window;
   out.ground_m_s2 = statue - gravity_up() - status_.offset_m_s2;
   if (!quiet) {
     out.tracking = OffsetTracking::kNotQuiet;

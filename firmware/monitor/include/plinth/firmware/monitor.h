@@ -51,6 +51,14 @@
 // (at rest, full contact) with the first sample that conditioning marks ready, and starts again
 // at rest on a sample the health tracker marks `restart` (after a fault nothing is known of
 // what happened meanwhile; the fault level shows it).
+//
+// Start-up rule (docs/monitor.md): the estimators' offset and initial state (at rest) are
+// trusted only when a window that passed conditioning's quietness test ends at the sample they
+// start on (`calibrated`). Any other start (after a sensor fault, a failover without
+// continuity) leaves them uncalibrated: they run, but the primary's conditioner verifies a new
+// window and they are calibrated when one passes. The level is never normal while the
+// estimators do not run or are not calibrated: the alarm policy's fault, cause kNotCalibrated
+// (an alarm still shows above it).
 #pragma once
 
 #include <Eigen/Core>
@@ -218,6 +226,9 @@ struct SensorStatus {
 struct MonitorStatus {
   std::int64_t time_ns = 0;  // monitor time of the newest sample (or tick)
   bool estimating = false;   // conditioning ready and the estimators running
+  // Their offset and initial state are trusted (the start-up rule, above); else the level is
+  // fault, cause kNotCalibrated.
+  bool calibrated = false;
   int axis_count = 1;
   std::array<AxisStatus, kMaxAxes> axes{};
   double risk = 0.0;  // the worst axis's total
@@ -393,6 +404,7 @@ class Monitor {
   void update_axes_status(monitor::AlarmInput& input);
   void evaluate(MonitorUpdate& update);
   void report(MonitorUpdate& update);
+  void report_state(MonitorUpdate& update);
   template <typename Message>
   void add_frame(MonitorUpdate& update, const Message& message);
   [[nodiscard]] std::int64_t monitor_time(std::int64_t receive_time_ns);
@@ -418,6 +430,7 @@ class Monitor {
   bool have_epoch_ = false;
   std::int64_t epoch_ns_ = 0;  // receive time of the first sample
   bool bus_fault_ = false;
+  bool evaluated_ = false;  // the alarm policy has evaluated an input since start()
   bool pending_ack_ = false;
   monitor::Acknowledgement ack_;
   std::int64_t status_interval_ns_ = 100'000'000;

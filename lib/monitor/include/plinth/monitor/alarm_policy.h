@@ -31,6 +31,12 @@
 // advisory (the risk behind them is stale while the input is not trusted), which show again,
 // with an event, when the fault ends; their conditions and latches keep evolving beneath.
 //
+// Not calibrated: not_calibrated (the caller has no trusted sensor offset or initial state,
+// so its risk vouches for nothing) shows the fault level, cause kNotCalibrated, at once and for
+// exactly as long as it lasts: it is a state of knowledge, not a flickering input, so no hold
+// keeps it after the caller has earned its estimate. While fault_active is set too, that
+// fault's cause is reported; like every fault it never hides an alarm.
+//
 // Events: one each time the level shown or its latched flag changes (at most two per update:
 // the acknowledgement is applied first, against what the operator saw, then the new input).
 // Sequence numbers start at 0 and increment by one per event, wrapping 255 -> 0. Cause: why the
@@ -99,6 +105,7 @@ struct AlarmInput {
   bool collapse_detected = false;    // the block overturned or fell
   bool fault_active = false;         // sensor or bus trouble
   AlarmCause fault_cause = AlarmCause::kSensorFault;  // reported while fault_active
+  bool not_calibrated = false;  // no trusted offset or initial state (above)
   bool acknowledged = false;  // `acknowledgement` arrived since the last update
   Acknowledgement acknowledgement;
 };
@@ -212,6 +219,8 @@ class AlarmPolicy {
   bool warning_by_forecast_ = false;
   bool alarm_by_forecast_ = false;
   bool out_of_contact_ = false;  // the latest input's out_of_full_contact
+  bool not_calibrated_ = false;  // the latest input's not_calibrated
+  bool fault_input_ = false;     // the latest input's fault (fault_active or an invalid risk)
   AlarmCause fault_cause_ = AlarmCause::kNone;
   AlarmLevel condition_level_ = AlarmLevel::kNormal;
   AlarmLevel latched_level_ = AlarmLevel::kNormal;

@@ -7,12 +7,21 @@
 //   ground = statue - (0, 0, g0) - offset          g0 = 9.80665 m/s2 (kStandardGravity)
 //
 // Offset: the sensor's bias, in the statue frame. A start-up window of startup_window_s of
-// samples (the monitor should be started while the ground is quiet) gives its estimate, the
-// window's mean of statue - (0, 0, g0); until the window is full the output is not ready. At
-// the end the window is rejected and a new one begins when the standard deviation of an axis
-// exceeds startup_max_std_m_s2 (the ground was not quiet) or an offset component exceeds
-// startup_max_offset_m_s2 (a wrong mounting rotation or unit would put gravity there); each
-// rejection is counted and the last one's reason kept.
+// samples gives its estimate, the window's mean of statue - (0, 0, g0); until the window is
+// full the output is not ready. The window is accepted only when it shows the ground was quiet
+// (the quietness test, in this order; the first failed check is the rejection's reason):
+//   spread   the standard deviation of every axis <= startup_max_std_m_s2
+//   drift    the mean of the window's second half minus that of its first half, every axis,
+//            within startup_max_drift_m_s2 (a slow onset, a warming sensor)
+//   gravity  the mean's norm within startup_gravity_tolerance_m_s2 of g0 (a wrong unit or gain)
+//   offset   every offset component within startup_max_offset_m_s2 (a wrong mounting rotation)
+// A rejected window is counted with its reason and a new one begins: while the ground shakes
+// the output stays not ready, however long that lasts.
+//
+// Verification: begin_verification() (the monitor calls it when its estimators start again
+// without a quiet window just before, after a sensor fault) runs the same test on a new window
+// while the output stays ready on the current offset; a passing window sets window_passed on
+// the sample that completes it and leaves the offset as it is (slow tracking follows it).
 //
 // Slow tracking: once ready, a first-order low-pass with time constant tracking_time_constant_s
 // follows the offset (temperature drift), applied to a sample only when the caller says the
@@ -53,6 +62,8 @@ struct ConditioningSettings {
   double startup_window_s = 10.0;    // s, at least 2 samples long
   double startup_max_std_m_s2 = 0.05;     // m/s2, per axis, over the start-up window
   double startup_max_offset_m_s2 = 1.0;   // m/s2, per axis of the estimated offset
+  double startup_max_drift_m_s2 = 0.02;   // m/s2, per axis: second half's mean - first half's
+  double startup_gravity_tolerance_m_s2 = 0.5;  // m/s2: | |window mean| - g0 | at most this
   double tracking_time_constant_s = 600.0;  // s, of the offset's low-pass while quiet
   double tracking_gate_m_s2 = 0.1;  // m/s2: a quiet sample beyond this on an axis is not tracked
 };
@@ -64,6 +75,8 @@ enum class StartupRejection : std::uint8_t {
   kNone = 0,
   kTooNoisy,        // an axis's standard deviation exceeded startup_max_std_m_s2
   kOffsetTooLarge,  // an offset component exceeded startup_max_offset_m_s2
+  kDrifting,        // an axis's mean moved more than startup_max_drift_m_s2 across the window
+  kNotGravity,      // the mean's norm is not g0 within startup_gravity_tolerance_m_s2
 };
 
 // What conditioning did with the offset on one sample.
@@ -75,10 +88,12 @@ enum class OffsetTracking : std::uint8_t {
   kInvalidInput,  // non-finite input: refused
 };
 
-inline constexpr NameTable<StartupRejection, 3> kStartupRejectionNames{{{
+inline constexpr NameTable<StartupRejection, 5> kStartupRejectionNames{{{
     {StartupRejection::kNone, "none"},
     {StartupRejection::kTooNoisy, "start-up window too noisy"},
     {StartupRejection::kOffsetTooLarge, "offset too large (mounting or unit?)"},
+    {StartupRejection::kDrifting, "start-up window drifting"},
+    {StartupRejection::kNotGravity, "mean is not 1 g (unit or gain?)"},
 }}};
 
 inline constexpr NameTable<OffsetTracking, 5> kOffsetTrackingNames{{{
@@ -100,6 +115,7 @@ struct ConditionedSample {
   bool ready = false;  // ground_m_s2 holds a conditioned sample (start-up done, input finite)
   Eigen::Vector3d ground_m_s2 = Eigen::Vector3d::Zero();  // statue frame; z is v_G''
   OffsetTracking tracking = OffsetTracking::kStartup;
+  bool window_passed = false;  // this sample completed a verification window that passed
 };
 
 struct ConditioningStatus {
@@ -109,12 +125,20 @@ struct ConditioningStatus {
   StartupRejection last_rejection = StartupRejection::kNone;
   std::uint64_t rejected_noisy = 0;   // windows rejected as too noisy
   std::uint64_t rejected_offset = 0;  // windows rejected for too large an offset
+  std::uint64_t rejected_drift = 0;   // windows rejected as drifting
+  std::uint64_t rejected_gravity = 0;  // windows rejected for a mean that is not 1 g
+  std::uint64_t windows_passed = 0;    // windows accepted (start-up and verification)
+  bool verifying = false;              // a verification window is collecting (output ready)
+  // Ready samples output since the latest passing window ended (1: the sample right after the
+  // start-up window, or the one completing a verification window).
+  std::uint64_t samples_since_window = 0;
   std::uint64_t invalid_inputs = 0;   // non-finite samples refused
   std::uint64_t tracked = 0;          // samples that moved the offset
   std::uint64_t gated = 0;            // quiet samples the gate kept out
   std::uint64_t consecutive_gated = 0;  // quiet samples gated since the last tracked one
   Eigen::Vector3d offset_m_s2 = Eigen::Vector3d::Zero();  // statue frame (valid when ready)
   Eigen::Vector3d window_std_m_s2 = Eigen::Vector3d::Zero();  // of the last completed window
+  Eigen::Vector3d window_drift_m_s2 = Eigen::Vector3d::Zero();  // of the last completed window
 };
 
 class Conditioner {
@@ -130,6 +154,8 @@ class Conditioner {
 
   // Forgets the offset and starts a new start-up window (for example after a sensor fault).
   void restart_startup();
+  // Once ready: tests a new window for quietness while the output stays ready (above).
+  void begin_verification();
 
   // Unit and rotation alone, m/s2 in the statue frame (gravity and offset still in).
   [[nodiscard]] Eigen::Vector3d to_statue_m_s2(const Eigen::Vector3d& sensor_sample) const;
@@ -138,7 +164,10 @@ class Conditioner {
   [[nodiscard]] const ConditioningSettings& settings() const { return settings_; }
 
  private:
-  void add_to_window(const Eigen::Vector3d& statue_m_s2);
+  // Adds a sample; true when it completed the window (status_.last_rejection says how).
+  [[nodiscard]] bool add_to_window(const Eigen::Vector3d& statue_m_s2);
+  [[nodiscard]] StartupRejection quietness(const Eigen::Vector3d& offset) const;
+  void clear_window();
 
   ConditioningSettings settings_;
   double unit_scale_ = 1.0;     // sensor unit to m/s2
@@ -147,6 +176,7 @@ class Conditioner {
   // Running mean and sum of squared deviations of the window (Welford), statue frame, m/s2.
   Eigen::Vector3d window_mean_ = Eigen::Vector3d::Zero();
   Eigen::Vector3d window_m2_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d first_half_sum_ = Eigen::Vector3d::Zero();  // statue frame, m/s2
 };
 
 }  // namespace plinth::monitor
