@@ -37,8 +37,8 @@ struct RockingScene {
 template <typename T>
 RockingScene<T> rocking_scene(const Scene& s) {
   const CornerGeometry& c = s.corner1;
-  return {T(s.m),         T(s.total_mass), T(s.damping), T(s.stiffness), T(s.g),
-          T(c.inertia),   T(c.offset),     T(s.h)};
+  return {T(s.m), T(s.total_mass), T(s.damping), T(s.stiffness),
+          T(s.g), T(c.inertia),    T(c.offset),  T(s.h)};
 }
 
 using std::cos;
@@ -46,15 +46,15 @@ using std::sin;
 
 // (u, theta, u', theta') -> their derivatives, Eq 8 about corner 1 with the base coupled.
 template <typename T>
-Eigen::Matrix<T, 4, 1> rocking_derivative(const RockingScene<T>& s,
-                                          const Eigen::Matrix<T, 4, 1>& y, T ground) {
+Eigen::Matrix<T, 4, 1> rocking_derivative(const RockingScene<T>& s, const Eigen::Matrix<T, 4, 1>& y,
+                                          T ground) {
   const T sin_t = sin(y[1]);
   const T cos_t = cos(y[1]);
   const T arm_h = s.offset * cos_t + s.h * sin_t;  // b'_i
   const T arm_v = s.h * cos_t - s.offset * sin_t;  // h'_i
   const T coupling = s.m * arm_v;
-  const T force_u = -s.total_mass * ground - s.damping * y[2] - s.stiffness * y[0] +
-                    s.m * y[3] * y[3] * arm_h;
+  const T force_u =
+      -s.total_mass * ground - s.damping * y[2] - s.stiffness * y[0] + s.m * y[3] * y[3] * arm_h;
   const T force_theta = coupling * ground - s.m * s.g * arm_h;
   const T inverse_det = T(1) / (s.total_mass * s.inertia - coupling * coupling);
   Eigen::Matrix<T, 4, 1> d;

@@ -50,8 +50,7 @@ namespace {
 constexpr std::size_t kFeatureSetCount = 12;
 constexpr std::size_t feature_set_index(const Features& f) {
   const std::size_t base = !f.base ? 0 : (!f.base_stops ? 1 : 2);
-  const std::size_t contact =
-      !f.sliding ? 0 : (f.support_edge ? 2 : (f.sliding_stops ? 3 : 1));
+  const std::size_t contact = !f.sliding ? 0 : (f.support_edge ? 2 : (f.sliding_stops ? 3 : 1));
   return 4 * base + contact;
 }
 constexpr const char* kFeatureSetLeftOut[kFeatureSetCount] = {
