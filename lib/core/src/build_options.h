@@ -11,3 +11,10 @@
 #else
 #define PLINTH_FLATTEN
 #endif
+
+// The scene feature sets compiled in (PLINTH_CORE_FEATURE_SETS): bit 4 * base + contact of
+// feature_set_index (simulator.cpp); every set by default. A scene of a set left out is refused
+// by Simulator::create.
+#ifndef PLINTH_CORE_FEATURE_MASK
+#define PLINTH_CORE_FEATURE_MASK 0xFFF
+#endif

@@ -288,7 +288,6 @@ struct EventLogic {
 
   static void apply_reset(Simulator& sim, GuardId id, double t) {
     ++sim.event_count_;
-    const double x_hat = sim.scene_->params.support.clearance;
     switch (id) {
       case GuardId::kRockingOnsetLeft:
         start_rocking(sim, t, Corner::kLeft);
@@ -304,6 +303,16 @@ struct EventLogic {
       case GuardId::kOverturning:
         overturn(sim, t);
         return;
+      default:
+        break;
+    }
+    // Only the guards active_guards<F> gives can cross: the others' resets are compiled out.
+    if constexpr (F.sliding) apply_sliding_reset(sim, id, t);
+    if constexpr (F.base_stops) apply_base_stop_reset(sim, id, t);
+  }
+
+  static void apply_sliding_reset(Simulator& sim, GuardId id, double t) {
+    switch (id) {
       case GuardId::kSlidingOnsetLeft:
         start_sliding(sim, t, -1);
         start_phases_that_hold(sim, t);
@@ -322,6 +331,19 @@ struct EventLogic {
         start_phases_that_hold(sim, t);
         return;
       }
+      default:
+        break;
+    }
+    if constexpr (F.support_edge) apply_support_edge_reset(sim, id, t);
+    if constexpr (F.sliding_stops) {
+      if (id == GuardId::kSlidingStopLeft) sliding_stop_hit(sim, t, -1);
+      if (id == GuardId::kSlidingStopRight) sliding_stop_hit(sim, t, 1);
+    }
+  }
+
+  static void apply_support_edge_reset(Simulator& sim, GuardId id, double t) {
+    const double x_hat = sim.scene_->params.support.clearance;
+    switch (id) {
       case GuardId::kOutOfBaseLeft:
       case GuardId::kOutOfBaseRight: {
         const int side = id == GuardId::kOutOfBaseLeft ? -1 : 1;
@@ -342,12 +364,13 @@ struct EventLogic {
         sim.mode_.phase = Phase::kFell;
         emit_event(sim, t, EventKind::kFell, sim.mode_.overhang);
         return;
-      case GuardId::kSlidingStopLeft:
-        sliding_stop_hit(sim, t, -1);
+      default:
         return;
-      case GuardId::kSlidingStopRight:
-        sliding_stop_hit(sim, t, 1);
-        return;
+    }
+  }
+
+  static void apply_base_stop_reset(Simulator& sim, GuardId id, double t) {
+    switch (id) {
       case GuardId::kBaseStopRight:
         base_stop_hit(sim, t, +1);
         return;
@@ -356,6 +379,8 @@ struct EventLogic {
         return;
       case GuardId::kBaseStopRelease:
         release_base(sim, t);
+        return;
+      default:
         return;
     }
   }

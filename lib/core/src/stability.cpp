@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "build_options.h"
+
 namespace plinth {
 
 namespace {
@@ -94,6 +96,8 @@ double largest_stable_step(const Scene& s, Stepper stepper) {
   if (stepper == Stepper::kRk4Located || stepper == Stepper::kRk4StepEnd || !s.has_base()) {
     return largest_stable_step(s);
   }
+  // A build with rk4_located alone has no other stepper: no step of one is stable.
+  if constexpr (PLINTH_CORE_RK4_ONLY) return 0.0;
   return std::min(largest_stable_step_of(stepper, s.total_mass, s.damping, s.stiffness),
                   largest_stable_step_of(stepper, s.total_mass - s.m, s.damping, s.stiffness));
 }

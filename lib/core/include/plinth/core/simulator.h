@@ -53,6 +53,10 @@ struct SolverSettings {
 // Checks the settings; the Error names the field at fault.
 [[nodiscard]] Error validate(const SolverSettings& settings);
 
+// Refuses a scene whose feature set (Features) this build leaves out (PLINTH_CORE_FEATURE_SETS;
+// every set by default), naming the set; Simulator::create does the same.
+[[nodiscard]] Error validate_feature_set(const Scene& scene);
+
 class Simulator {
  public:
   Simulator() = default;

@@ -16,7 +16,8 @@ namespace plinth {
 // The same for `stepper`: RK4 (either way of taking events) as above; Heun and semi-implicit
 // Euler, the largest step whose one-step map on those two linear systems grows no mode by more
 // than kStableGrowthPerStep per step (Heun's stability region misses the imaginary axis: an
-// undamped base grows by (h omega)^4 / 8 per step at any step).
+// undamped base grows by (h omega)^4 / 8 per step at any step). 0 for those two in a build
+// with rk4_located alone (PLINTH_CORE_RK4_ONLY).
 [[nodiscard]] double largest_stable_step(const Scene& scene, Stepper stepper);
 inline constexpr double kStableGrowthPerStep = 1e-8;
 
