@@ -603,6 +603,7 @@ void apply_overrides(MonitorFile& file, const MonitorOverrides& o) {
       c.startup_window_s = *o.startup_window_s;
     });
   }
+  if (o.no_forecast) config.forecast.enabled = false;
   if (o.stuck_samples) {
     each_sensor([&](monitor::ConditioningSettings&, monitor::SensorHealthSettings& h) {
       h.stuck_samples = *o.stuck_samples;

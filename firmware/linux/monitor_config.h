@@ -71,6 +71,7 @@ struct MonitorOverrides {
   std::optional<double> status_interval_s;  // --status-interval: monitor.status_interval_s
   std::optional<double> startup_window_s;   // --startup-window: every sensor's
   std::optional<int> stuck_samples;         // --stuck-samples: every sensor's
+  bool no_forecast = false;                 // --no-forecast: forecast.enabled = false
   std::optional<std::string> relay_chip;    // --relay-chip: relays.chip
   bool no_relays = false;                   // --no-relays: the file's [relays] ignored
   std::string modbus_listen;                // --modbus HOST:PORT

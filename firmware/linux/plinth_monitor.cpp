@@ -574,6 +574,8 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--mqtt-ca", c.mqtt_ca_file, "TLS: the CA that signed the broker's certificate");
   app.add_option("--mqtt-cert", c.mqtt_cert_file, "TLS: the box's client certificate");
   app.add_option("--mqtt-key", c.mqtt_key_file, "TLS: its private key");
+  app.add_flag("--no-forecast", c.no_forecast,
+               "the box without the forecast (forecast.enabled = false; docs/forecast.md)");
   app.add_flag("--latency", opt.latency,
                "the summary gives each sample's latency, arrival to status ready (median, p99)");
   app.add_option("--stuck-samples", c.stuck_samples,

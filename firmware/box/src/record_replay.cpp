@@ -12,6 +12,7 @@ constexpr double kNoTrackingTimeConstantS = 1e6;  // s: the offset is never trac
 MonitorConfig box_defaults() {
   MonitorConfig config;
   config.conditioning.startup_window_s = kBoxStartupWindowS;
+  config.forecast.enabled = kForecastBuiltIn;  // a microcontroller build may have none
   return config;
 }
 

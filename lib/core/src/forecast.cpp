@@ -19,6 +19,11 @@ int decimation_for(double rate_hz, double input_rate_hz) {
 }  // namespace
 
 Error validate(const ForecastSettings& s, double input_rate_hz) {
+  if (!s.enabled) return ok_error();  // nothing of it runs
+  if (!kForecastBuiltIn) {
+    return {ErrorCode::kInconsistent, "forecast.enabled",
+            "this build has no forecast (PLINTH_FORECAST=OFF): set it false"};
+  }
   if (!within(s.horizon_s, 1e-3, 10.0)) {
     return {ErrorCode::kOutOfRange, "forecast.horizon_s", "must lie in (0, 10] s", 10.0};
   }

@@ -32,8 +32,12 @@
 #include "plinth/core/simulator.h"
 #include "plinth/core/state.h"
 
+// Build-time capacities (lib/core/CMakeLists.txt: cache variables of the same names, public).
 #ifndef PLINTH_MAX_ENSEMBLE_MEMBERS
 #define PLINTH_MAX_ENSEMBLE_MEMBERS 17
+#endif
+#ifndef PLINTH_FORECAST
+#define PLINTH_FORECAST 1
 #endif
 
 namespace plinth {
@@ -41,9 +45,12 @@ namespace plinth {
 // Members per axis: the largest two-level design by default; a build may lower it.
 inline constexpr int kMaxEnsembleMembers = PLINTH_MAX_ENSEMBLE_MEMBERS;
 static_assert(kMaxEnsembleMembers >= 1 && kMaxEnsembleMembers <= kMaxDesignPoints);
+// A build without the forecast (a microcontroller's: its buffers are ~68 KB per axis) refuses
+// forecast.enabled; its Forecaster holds no buffers.
+inline constexpr bool kForecastBuiltIn = PLINTH_FORECAST != 0;
 // The continuation's samples (horizon_s * rate_hz + 1) and the window's (window_s * rate_hz).
-inline constexpr int kMaxContinuationSamples = 2049;
-inline constexpr int kMaxWindowSamples = 1024;
+inline constexpr int kMaxContinuationSamples = kForecastBuiltIn ? 2049 : 1;
+inline constexpr int kMaxWindowSamples = kForecastBuiltIn ? 1024 : 1;
 
 enum class Continuation : std::uint8_t { kRecentWindow = 0, kStrongestWindow = 1 };
 inline constexpr NameTable<Continuation, 2> kContinuationNames{{{
