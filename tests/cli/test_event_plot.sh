@@ -89,7 +89,7 @@ check "a missing capture: exit 1, named" $? "exit $rc: $(cat out.txt)"
 head -n 200 collapse/event-001.log >short.log
 "$plot" --scene "$scene" short.log >out.txt 2>&1
 rc=$?
-[ $rc -eq 1 ] && grep -q "never started" out.txt
+[ $rc -eq 1 ] && grep -qE "never started|never ran" out.txt
 check "a capture too short to start the estimators: exit 1, said" $? "exit $rc: $(cat out.txt)"
 "$plot" collapse/event-001.log >out.txt 2>&1
 rc=$?

@@ -92,8 +92,10 @@ if expect_success "replay: --frames-out, one axis" --scene "$ECCENTRIC" --replay
     pass "--frames-out, one axis: frames agree with the JSON lines"
   else fail "--frames-out, one axis" "$problem"; fi
 fi
+# Two axes without the forecast: the status line's probability is the highest of the axes, so
+# the frames' per-axis forecast is checked on one axis (above) and in test_can_frames.
 if expect_success "replay: --frames-out, two axes" --scene "$ISOLATED" --scene-y "$ECCENTRIC" \
-    --replay "$AT2" --replay-y "$AT2_270" --scale 10 --frames-out "$TMP/frames2.log"; then
+    --replay "$AT2" --replay-y "$AT2_270" --scale 10 --no-forecast --frames-out "$TMP/frames2.log"; then
   if problem=$(python3 "$FRAMES_CHECK" "$TMP/frames2.log" --json "$TMP/stdout"); then
     pass "--frames-out, two axes: frames agree with the JSON lines"
   else fail "--frames-out, two axes" "$problem"; fi
@@ -143,7 +145,9 @@ iface = lines[0].split()[1]
 t = float(lines[len(lines) // 2].split()[0].strip("()"))
 extra = ["351#C90D0C11290928FE", "350#0000FF09FFFF6400", "350#1127000100000000",
          "351#E803050364002800"]
-out = lines[: len(lines) // 2 + 1] + ["(%.6f) %s %s" % (t, iface, f) for f in extra]
+# Each a microsecond apart: a log's time never stands still for one identifier (docs/limits.md).
+out = lines[: len(lines) // 2 + 1] + ["(%.6f) %s %s" % (t + 1e-6 * k, iface, f)
+                                      for k, f in enumerate(extra)]
 open(sys.argv[2], "w").write("\n".join(out + lines[len(lines) // 2 + 1:]) + "\n")
 PY
   if expect_success "candump log with CollapseForecast frames" --scene "$ISOLATED" \

@@ -43,7 +43,8 @@ alarm = [l for l in lines if l["type"] == "alarm"][-1]
 levels = ["normal", "advisory", "warning", "alarm", "fault"]
 phases = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "fell"]
 causes = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
-          "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault"]
+          "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
+          "collapse_forecast", "not_calibrated"]
 def check(name, address, expected):
     assert regs.get(address) == expected, "%s (register %d): %s, status line says %s" % (
         name, address, regs.get(address), expected)
@@ -149,7 +150,8 @@ lines = [json.loads(l) for l in open(sys.argv[1])]
 regs = dict(tuple(map(int, l.split())) for l in open(sys.argv[2]) if l.strip())
 command = [l for l in lines if l["type"] == "command"][0]
 assert int(sys.argv[3]) == 3, "latched before: %s" % sys.argv[3]
-assert command["level"] == "alarm" and command["sequence"] == 4, command
+raised = [l for l in lines if l["type"] == "alarm" and l["level"] == "alarm"][0]
+assert command["level"] == "alarm" and command["sequence"] == raised["sequence"], command
 assert command["outcome"] == "released, condition holds", command
 ack = [l for l in lines if l["type"] == "alarm"][-1]
 assert ack["cause"] == "acknowledged" and ack["latched"] is False, ack

