@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <set>
+#include <utility>
 #include <vector>
 
 #include "plinth/core/ensemble_design.h"
@@ -112,9 +113,11 @@ EstimatorSettings estimator_settings() {
 }
 
 // A harness: `n` estimators on `scenes`, one forecaster, fed a signal sample by sample.
+// The estimators refer to their scenes: the ensemble keeps its own copy (ASan found the
+// estimators reading a temporary's).
 struct Ensemble {
-  explicit Ensemble(const std::vector<Scene>& scenes, const ForecastSettings& fs)
-      : members(scenes.size()) {
+  explicit Ensemble(std::vector<Scene> statues, const ForecastSettings& fs)
+      : scenes(std::move(statues)), members(scenes.size()) {
     for (std::size_t i = 0; i < scenes.size(); ++i) {
       EXPECT_TRUE(members[i].start(scenes[i], estimator_settings(), {}).ok());
     }
@@ -124,6 +127,7 @@ struct Ensemble {
     for (PlanarEstimator& e : members) e.push({horizontal, 0.0});
     forecaster.on_sample({horizontal, 0.0}, members[0].time(), members);
   }
+  std::vector<Scene> scenes;
   std::vector<PlanarEstimator> members;
   Forecaster forecaster;
 };
