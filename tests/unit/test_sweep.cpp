@@ -401,7 +401,7 @@ TEST(Sweep, TwoParameterMapMatchesOneParameterSweeps) {
         plan_thresholds(sweep_scene(base, SweepParameter::kEpsilon, eps).params, brienza(),
                         SweepParameter::kLambda, lambda, settings));
     for (std::size_t i = 0; i < 2; ++i) {
-      const std::string& t =
+      const std::string t =  // a copy: csv_fields returns a temporary
           csv_fields(rows[i])[1 + static_cast<std::size_t>(SweepEvent::kOverturned)];
       found += t.empty() ? 0u : 1u;
       EXPECT_EQ(cells[2 * i + j], map.keys[2 * i + j] + "," + t);
