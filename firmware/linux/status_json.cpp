@@ -4,6 +4,7 @@
 
 #include "plinth/core/state.h"
 #include "plinth/hal/can_codec.h"
+#include "plinth/host/json_text.h"
 #include "plinth/host/run_output.h"
 
 namespace plinth::firmware {
@@ -15,22 +16,7 @@ double seconds(std::int64_t time_ns, double t_origin) {
   return static_cast<double>(time_ns) * 1e-9 - t_origin;
 }
 
-std::string quoted(std::string_view text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char escaped[8];
-      std::snprintf(escaped, sizeof escaped, "\\u%04x", static_cast<unsigned>(c));
-      out += escaped;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
+std::string quoted(std::string_view text) { return plinth::host::json_quoted(text); }
 
 // `digits` decimals ("%.*f"), or `digits` significant digits ("%.*g").
 std::string formatted(double value, int digits, bool fixed) {

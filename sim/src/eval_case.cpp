@@ -10,6 +10,7 @@
 #include "plinth/core/risk.h"
 #include "plinth/core/simulator.h"
 #include "plinth/firmware/monitor.h"
+#include "plinth/firmware/record_replay.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_sampling.h"
 
@@ -64,19 +65,14 @@ Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& setti
   return truth;
 }
 
-// The box's configuration for an ideal ground sensor in m/s2 (no bias to track, no noise: the
-// stuck-value check is off), as plinth-monitor --replay sets it for a record.
+// The box's configuration: a record replay's (firmware/box record_replay.h), as plinth-monitor
+// --replay sets it, with the evaluation's rate, steps, forecast and start-up window.
 fw::MonitorConfig box_config(const BoxSettings& box) {
-  fw::MonitorConfig config;
-  config.estimator.sample_rate_hz = box.rate_hz;
+  fw::MonitorConfig config = fw::box_defaults();
   config.estimator.steps_per_sample = box.steps_per_sample;
   config.forecast = box.forecast;
-  config.conditioning.unit = monitor::AccelerationUnit::kMetresPerSecondSquared;
   config.conditioning.startup_window_s = box.startup_window_s;
-  config.conditioning.tracking_time_constant_s = 1e6;
-  config.sensor_health.stuck_samples = 0;
-  config.sensor_health.full_scale_g = 1e6;
-  config.sensor_health.max_valid_g = 1e6;
+  fw::configure_record_replay(config, box.rate_hz);
   return config;
 }
 
@@ -118,20 +114,17 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
   const std::vector<double> v = c.record->vertical.empty()
                                     ? std::vector<double>()
                                     : host::resample(c.record->vertical_signal(), rate, count);
-  const auto lead_in = static_cast<std::size_t>(std::llround(box.startup_window_s * rate) +
-                                                config.sensor_health.recovery_samples - 1);
+  const auto lead_in = static_cast<std::size_t>(fw::record_replay_lead_in(config));
   run.risk_crossing_s.assign(grids.risk.size(), -1.0);
   run.probability_crossing_s.assign(grids.probability.size(), -1.0);
   run.nominal_risk_crossing_s.assign(grids.risk.size(), -1.0);
   const Scene& nominal = c.scene->members.front();
   for (std::size_t n = 0; n < lead_in + count; ++n) {
-    monitor::SensorSample s;
-    s.receive_time_ns = std::llround(static_cast<double>(n) / rate * 1e9);
-    s.sequence = static_cast<std::uint8_t>(n & 0xFF);
-    const std::size_t k = n - lead_in;
-    s.acceleration_g = n < lead_in ? Eigen::Vector3d(0.0, 0.0, kStandardGravity)
-                                   : Eigen::Vector3d(gamma * h[k], 0.0,
-                                                     kStandardGravity + (v.empty() ? 0.0 : gamma * v[k]));
+    const std::size_t k = n < lead_in ? 0 : n - lead_in;
+    const Eigen::Vector3d ground(gamma * h[k], 0.0,
+                                 kStandardGravity + (v.empty() ? 0.0 : gamma * v[k]));
+    const monitor::SensorSample s =
+        fw::record_replay_sample(config, static_cast<std::int64_t>(n), ground, kStandardGravity);
     (void)monitor->on_sample(s);
     if (n < lead_in) continue;
     const double t = static_cast<double>(k) / rate;

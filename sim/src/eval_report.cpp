@@ -15,6 +15,7 @@
 #include <string>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/json_text.h"
 
 extern char** environ;
 
@@ -91,26 +92,10 @@ std::string outcome_json(const Outcome& o) {
          "}";
 }
 
-std::string json_string(const std::string& text) {
-  std::string out = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buffer[8];
-      std::snprintf(buffer, sizeof buffer, "\\u%04x", c);
-      out += buffer;
-    } else {
-      out += c;
-    }
-  }
-  return out + "\"";
-}
-
 std::string names_json(const std::vector<std::string>& names) {
   std::string out = "[";
-  for (std::size_t i = 0; i < names.size(); ++i) out += (i ? ", " : "") + json_string(names[i]);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    out += (i ? ", " : "") + host::json_quoted(names[i]);
   return out + "]";
 }
 
@@ -190,20 +175,20 @@ std::string report_json(const Report& report, const CrossingGrids& grids) {
   for (std::size_t i = 0; i < report.levels.size(); ++i) {
     const LevelReport& l = report.levels[i];
     out += i ? ", " : "";
-    out += "{\"level\": " + json_string(l.level) + ", \"shown\": " + outcome_json(l.shown) +
+    out += "{\"level\": " + host::json_quoted(l.level) + ", \"shown\": " + outcome_json(l.shown) +
            ", \"reactive\": " + outcome_json(l.reactive) + ", \"folds\": [";
     for (std::size_t f = 0; f < l.folds.size(); ++f) {
       const FoldResult& fold = l.folds[f];
       out += f ? ", " : "";
       out += "{\"calibration_records\": " + names_json(fold.calibration_records) +
-             ", \"report_records\": " + names_json(fold.report_records) + ", \"rule\": " +
-             json_string(describe_rule(fold.chosen.point.rule, grids)) +
+             ", \"report_records\": " + names_json(fold.report_records) +
+             ", \"rule\": " + host::json_quoted(describe_rule(fold.chosen.point.rule, grids)) +
              ", \"meets_target\": " + (fold.chosen.meets_target ? "true" : "false") +
              ", \"calibration\": " + outcome_json(fold.chosen.point.outcome) +
              ", \"held_out\": " + outcome_json(fold.held_out) + "}";
     }
     out += "], \"all_records\": {\"rule\": " +
-           json_string(describe_rule(l.all_records.point.rule, grids)) +
+           host::json_quoted(describe_rule(l.all_records.point.rule, grids)) +
            ", \"meets_target\": " + (l.all_records.meets_target ? "true" : "false") +
            ", \"outcome\": " + outcome_json(l.all_records.point.outcome) + "}}";
   }
