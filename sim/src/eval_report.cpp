@@ -1,23 +1,17 @@
 #include "eval_report.h"
 
-#include <fcntl.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
+#include <stdlib.h>  // mkdtemp
 
 #include <algorithm>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <set>
 #include <string>
 
+#include "gnuplot.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/json_text.h"
-
-extern char** environ;
 
 namespace plinth::eval {
 namespace {
@@ -206,30 +200,6 @@ void write_series(const std::string& path, const std::vector<Outcome>& outcomes)
   if (!out) throw InputError(path + ": cannot write the plot's data");
 }
 
-void run_gnuplot(const std::string& script_path, const std::string& error_path) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 2, error_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC,
-                                   0600);
-  const std::string program = "gnuplot";
-  std::vector<char*> argv = {const_cast<char*>(program.c_str()),  // posix_spawnp's signature
-                             const_cast<char*>(script_path.c_str()), nullptr};
-  pid_t pid = 0;
-  const int spawned = posix_spawnp(&pid, "gnuplot", &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (spawned != 0) {
-    throw InputError("--plot: cannot run gnuplot (Debian package gnuplot-nox): " +
-                     std::string(std::strerror(spawned)));
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-    std::ifstream in(error_path);
-    const std::string message((std::istreambuf_iterator<char>(in)), {});
-    throw InputError("--plot: gnuplot failed: " + message);
-  }
-}
-
 }  // namespace
 
 void plot_roc(const EvalTable& table, const std::string& png_path) {
@@ -263,7 +233,7 @@ void plot_roc(const EvalTable& table, const std::string& png_path) {
        << "'" << dir << "/probability.dat' using 1:2 with linespoints title 'forecast probability'\n";
     if (!gp) throw InputError("--plot: cannot write the gnuplot script");
   }
-  run_gnuplot((folder / "roc.gp").string(), (folder / "gnuplot.err").string());
+  cli::run_gnuplot((folder / "roc.gp").string(), {});
   const std::string temporary = png_path + ".tmp";
   std::error_code ec;
   std::filesystem::copy_file(folder / "roc.png", temporary,
