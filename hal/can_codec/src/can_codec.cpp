@@ -10,7 +10,7 @@ namespace plinth::can {
 namespace {
 
 // ---------------------------------------------------------------------------------------------
-// Signal tables: one row per DBC SG_ line (tests/unit/test_can_codec.cpp compares them).
+// Signal tables: one row per DBC SG_ line (tests/unit/hal/test_can_codec.cpp compares them).
 
 constexpr std::int64_t kU8Max = 255;
 constexpr std::int64_t kU16Max = 65535;

@@ -3,7 +3,7 @@
 // hal/can_codec/plinth.dbc is the reference: every frame is classic CAN, 8 data bytes, an
 // 11-bit standard identifier in 0x300-0x37F, every signal Intel (little-endian) byte order. The
 // signal tables below (signal_layouts) carry the DBC's start bit, length, signedness, factor,
-// offset and raw range; tests/unit/test_can_codec.cpp checks them against the DBC file.
+// offset and raw range; tests/unit/hal/test_can_codec.cpp checks them against the DBC file.
 //
 // Encoding refuses what it cannot represent (never clamps): a non-finite value, a value that
 // rounds to a raw value outside the signal's DBC range, an enum value outside its VAL_ table,

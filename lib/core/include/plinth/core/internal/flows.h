@@ -415,7 +415,7 @@ struct SlideRockingSystem {
 
 // Slide-rocking, Eqs 10-12 (about a body corner) or Eqs 13-14 (overhanging the support): the
 // Lagrange equations M(q) q'' = f with the kinetic friction -mu_k sign(x') Y on x, Y being linear
-// in q''. Assembled from the kinematics of C; tests/unit/test_sliding.cpp checks every printed
+// in q''. Assembled from the kinematics of C; tests/unit/core/test_sliding.cpp checks every printed
 // equation's residual on the result. Solved by the adjugate (one division): the consistency
 // guard keeps det(M) at least kPainleveMargin times the frictionless one.
 [[nodiscard]] inline Accelerations slide_rocking_flow(const Scene& s, const SlideRockingSystem& k,

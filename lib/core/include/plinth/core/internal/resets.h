@@ -134,7 +134,7 @@ inline void sliding_stop_reset(Mode& mode, State& y) {
 // The printed Eqs 31-32 stop the block (x'+ = 0) and give the base u'+ = u'- + eta_s m x'-/(m+m_b):
 // with eta_s < 1 the momentum (1 - eta_s) m x'- goes nowhere (the stops are on the base, which
 // only the visco-elastic device holds, and it carries no impulse), and energy can grow when the
-// base moves against the slide (tests/unit/test_sliding.cpp, SlidingStops). Here the horizontal
+// base moves against the slide (tests/unit/core/test_sliding.cpp, SlidingStops). Here the horizontal
 // momentum is kept for every eta_s and energy never grows; eta_s keeps the meaning it has for
 // the base stops (Eq 29). At eta_s = 0 this is the printed Eq 32 with eta_s = 1 exactly.
 // Afterwards the block slides away from the stop (or, if x'+ = 0, the caller makes it stick).
@@ -168,7 +168,7 @@ inline void tangential_impact_reset(const Scene& s, Mode& mode, State& y) {
 // can create energy (the kinetic energy has the cross term -m h'_i u' theta'). The stop's
 // impulse acts on u alone; through the mass matrix of Eq 8 it changes
 //   delta u' = I_i P / D,  delta theta' = m h'_i P / D   =>  delta theta' = (m h'_i / I_i) delta u'
-// which is Eq 29 for u' and never adds energy for eta_i <= 1 (tests/unit/test_isolated.cpp).
+// which is Eq 29 for u' and never adds energy for eta_i <= 1 (tests/unit/core/test_isolated.cpp).
 // While sliding, the block's absolute velocity is kept (x' changes by -delta u').
 inline void base_stop_reset(const Scene& s, int side, const Mode& mode, State& y) {
   coordinate_impulse_reset(s, mode, true, kUDot, -s.params.base_stops.restitution * y[kUDot], y);
@@ -188,7 +188,7 @@ inline void base_stop_hold_reset(const Scene& s, int side, Mode& mode, State& y)
 //
 // The paper keeps the sliding velocity through the impact (Eqs 21-22 with x' unchanged). That
 // can add energy: Eq 21's angular momentum leaves out what x' contributes about the new corner
-// (tests/unit/test_sliding.cpp, SlideRocking). Here the impact is a rigid-body impact at the new
+// (tests/unit/core/test_sliding.cpp, SlideRocking). Here the impact is a rigid-body impact at the new
 // corner with a plastic normal impulse Pn and a Coulomb tangential impulse Pt, the old corner
 // lifting off (as in Housner's impact):
 //   M_new q'+ = G_new^T M_free v-  +  e_x Pt,         Pn = m n.(v_C+ - v_C-),
