@@ -298,7 +298,7 @@ SocketCanOpenResult SocketCanPort::open(std::string_view interface_name,
     if (e == EAFNOSUPPORT) {
       return open_failure(OpenError::kNoCanSupport, e, name,
                           "this kernel has no CAN support (socket(AF_CAN) refused; a kernel "
-                          "built with CONFIG_CAN, or user-mode Linux: tools/uml-vcan.sh)");
+                          "built with CONFIG_CAN, or a guest kernel: tools/vcan-bus.sh)");
     }
     if (e == EPROTONOSUPPORT) {
       return open_failure(OpenError::kNoCanSupport, e, name,
