@@ -7,7 +7,6 @@
 #include <string>
 
 #include "plinth/core/excitation.h"
-#include "plinth/core/risk.h"
 #include "plinth/core/simulator.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/firmware/record_replay.h"
@@ -118,7 +117,6 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
   run.risk_crossing_s.assign(grids.risk.size(), -1.0);
   run.probability_crossing_s.assign(grids.probability.size(), -1.0);
   run.nominal_risk_crossing_s.assign(grids.risk.size(), -1.0);
-  const Scene& nominal = c.scene->members.front();
   for (std::size_t n = 0; n < lead_in + count; ++n) {
     const std::size_t k = n < lead_in ? 0 : n - lead_in;
     const Eigen::Vector3d ground(gamma * h[k], 0.0,
@@ -134,9 +132,7 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
     if (!status.estimating) continue;
     note_crossings(grids.risk, status.risk, t, run.risk_crossing_s);
     note_crossings(grids.probability, status.probability, t, run.probability_crossing_s);
-    const PlanarEstimator& est = monitor->estimator(0);
-    note_crossings(grids.risk, overturning_risk(nominal, est.mode(), est.state(), config.risk).total,
-                   t, run.nominal_risk_crossing_s);
+    note_crossings(grids.risk, status.axes[0].nominal_risk.total, t, run.nominal_risk_crossing_s);
   }
 }
 

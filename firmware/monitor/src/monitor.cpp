@@ -569,6 +569,7 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
     const PlanarEstimator& e = ensembles_[k][m];
     const Risk r = overturning_risk(scenes_[k][m], e.mode(), e.state(), config_.risk);
+    if (m == 0) axis.nominal_risk = r;
     if (m == 0 || r.total > axis.risk.total) {
       axis.risk = r;
       axis.worst_member = static_cast<int>(m);

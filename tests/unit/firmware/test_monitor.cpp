@@ -238,8 +238,8 @@ TEST(Monitor, RefusesBadConfigurationNamingTheField) {
 }
 
 // An ensemble: a member's estimate does not depend on where it stands in the ensemble (the
-// offset tracking waits for every member); the axis's risk is the worst member's, its mode and
-// state the nominal statue's (member 0).
+// offset tracking waits for every member); the axis's risk is the worst member's, its mode,
+// state and nominal_risk the nominal statue's (member 0).
 TEST(Monitor, EnsembleMembersFollowTheirOwnStatues) {
   std::vector<Scene> statues;
   for (const double height_factor : {1.0, 0.87, 1.13}) {  // slenderness 3, 2.6, 3.4
@@ -262,16 +262,20 @@ TEST(Monitor, EnsembleMembersFollowTheirOwnStatues) {
     (void)first.on_sample(input.sample(n));
     (void)second.on_sample(same.sample(n));
     double worst = 0.0;
+    double nominal = 0.0;
     for (int m = 0; m < 3; ++m) {
       const PlanarEstimator& e = first.member(0, m);
       ASSERT_EQ(e.state(), second.member(0, (m + 2) % 3).state()) << n << " " << m;
-      worst = std::fmax(worst, overturning_risk(statues[static_cast<std::size_t>(m)], e.mode(),
-                                                e.state(), config.risk).total);
+      const double r = overturning_risk(statues[static_cast<std::size_t>(m)], e.mode(),
+                                        e.state(), config.risk).total;
+      worst = std::fmax(worst, r);
+      if (m == 0) nominal = r;
     }
     const fw::AxisStatus& axis = first.status().axes[0];
     if (!first.status().estimating) continue;
     ASSERT_EQ(axis.state, first.member(0, 0).state());
     ASSERT_EQ(axis.risk.total, worst);
+    ASSERT_EQ(axis.nominal_risk.total, nominal);
     ASSERT_EQ(axis.risk.total, second.status().axes[0].risk.total);
     worst_not_nominal = worst_not_nominal || (axis.worst_member != 0 && worst > 0.0);
     if (axis.forecast.valid) {

@@ -183,6 +183,7 @@ struct AxisStatus {
   Mode mode;  // the nominal statue's (member 0)
   State state = State::Zero();
   Risk risk;             // the worst member's (the highest total)
+  Risk nominal_risk;     // member 0's: the scene file's statue alone, as a box without ensemble
   int members = 1;       // the ensemble's size
   int worst_member = 0;  // whose risk that is
   ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
