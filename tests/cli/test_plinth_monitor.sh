@@ -21,7 +21,7 @@ AT2_270=$SRC/sim/data/records/irpinia1980_brienza_270.AT2
 
 # check_output FILE PYTHON: runs a Python check on the monitor's JSON lines; prints the problem.
 check_output() {
-  python3 - "$1" "$2" <<'PY'
+  python3 - "$1" "$2" 2>&1 <<'PY'
 import json, sys
 lines = [json.loads(l) for l in open(sys.argv[1])]
 ns = {"json": json, "lines": lines, "status": [l for l in lines if l["type"] == "status"],
@@ -37,7 +37,7 @@ assert len(ns["summary"]) == 1 and lines[-1]["type"] == "summary", "one summary,
 try:
     exec(sys.argv[2], ns)
 except AssertionError as e:
-    print(e)
+    print(str(e) or "an assertion without a message failed")
 PY
 }
 
