@@ -22,8 +22,8 @@ using host::EvalLevel;
 using host::EvalRun;
 using host::EvalTable;
 using host::InputError;
-using host::Outcome;
 using host::Rule;
+using host::WarningOutcome;
 
 // The alarm policy's default risk thresholds (alarm_policy.h): today's reactive box.
 constexpr double kDefaultRiskOn[host::kEvalLevels] = {0.1, 0.5, 0.8};
@@ -45,7 +45,7 @@ int grid_index(const std::vector<double>& grid, double value) {
   return best;
 }
 
-Outcome nominal_risk_outcome(const std::vector<EvalRun>& runs, int index) {
+WarningOutcome nominal_risk_outcome(const std::vector<EvalRun>& runs, int index) {
   return host::outcome_of(runs, [index](const EvalRun& r) {
     return index < 0 ? -1.0 : r.nominal_risk_crossing_s[static_cast<std::size_t>(index)];
   });
@@ -65,7 +65,7 @@ const host::LevelTarget& target_of(const CalibrationTargets& t, std::size_t leve
   return level == 0 ? t.advisory : level == 1 ? t.warning : t.alarm;
 }
 
-std::string outcome_text(const Outcome& o) {
+std::string outcome_text(const WarningOutcome& o) {
   return std::to_string(o.hits) + "/" + std::to_string(o.collapses) + " hit, " +
          std::to_string(o.misses) + " missed, false alarms " + std::to_string(o.false_alarms) +
          "/" + std::to_string(o.quiet_runs) + " (" + number(100.0 * o.false_alarm_rate(), 1) +
@@ -74,7 +74,7 @@ std::string outcome_text(const Outcome& o) {
          " s, 10th pct " + number(o.lead_quantile(0.1), 2) + " s";
 }
 
-std::string outcome_json(const Outcome& o) {
+std::string outcome_json(const WarningOutcome& o) {
   return "{\"collapses\": " + std::to_string(o.collapses) + ", \"hits\": " +
          std::to_string(o.hits) + ", \"misses\": " + std::to_string(o.misses) +
          ", \"quiet_runs\": " + std::to_string(o.quiet_runs) + ", \"false_alarms\": " +
@@ -192,9 +192,9 @@ std::string report_json(const Report& report, const CrossingGrids& grids) {
 namespace {
 
 // One series of the ROC: false-alarm rate (%) and median lead (s) per threshold.
-void write_series(const std::string& path, const std::vector<Outcome>& outcomes) {
+void write_series(const std::string& path, const std::vector<WarningOutcome>& outcomes) {
   std::ofstream out(path);
-  for (const Outcome& o : outcomes) {
+  for (const WarningOutcome& o : outcomes) {
     out << 100.0 * o.false_alarm_rate() << ' ' << o.lead_quantile(0.5) << ' ' << o.misses << '\n';
   }
   if (!out) throw InputError(path + ": cannot write the plot's data");
@@ -207,7 +207,7 @@ void plot_roc(const EvalTable& table, const std::string& png_path) {
   if (::mkdtemp(folder_template) == nullptr) throw InputError("--plot: cannot make a temporary folder");
   const std::filesystem::path folder(folder_template);
   const auto series = [&](const char* name, std::size_t n, auto outcome) {
-    std::vector<Outcome> outcomes;
+    std::vector<WarningOutcome> outcomes;
     for (std::size_t i = 0; i < n; ++i) outcomes.push_back(outcome(static_cast<int>(i)));
     write_series((folder / name).string(), outcomes);
   };

@@ -22,13 +22,13 @@ struct FoldResult {
   std::vector<std::string> calibration_records;
   std::vector<std::string> report_records;
   host::Choice chosen;           // on the calibration records
-  host::Outcome held_out;        // the same rule on the report records
+  host::WarningOutcome held_out;  // the same rule on the report records
 };
 
 struct LevelReport {
   std::string level;
-  host::Outcome shown;     // as the box showed it (its configured thresholds)
-  host::Outcome reactive;  // today's box: the nominal statue's risk at the default threshold
+  host::WarningOutcome shown;     // as the box showed it (its configured thresholds)
+  host::WarningOutcome reactive;  // today's box: the nominal statue's risk at the default threshold
   std::vector<FoldResult> folds;  // two: calibrated on one half, reported on the other
   host::Choice all_records;       // the rule chosen on every record (the shipped defaults)
 };

@@ -110,11 +110,11 @@ CrossingGrids default_crossing_grids() {
   return g;
 }
 
-double Outcome::false_alarm_rate() const {
+double WarningOutcome::false_alarm_rate() const {
   return quiet_runs > 0 ? static_cast<double>(false_alarms) / quiet_runs : 0.0;
 }
 
-double Outcome::lead_quantile(double q) const {
+double WarningOutcome::lead_quantile(double q) const {
   if (leads_s.empty()) return -1.0;
   std::vector<double> sorted = leads_s;
   std::sort(sorted.begin(), sorted.end());
@@ -126,7 +126,7 @@ double Outcome::lead_quantile(double q) const {
   return sorted[below] + w * (sorted[above] - sorted[below]);
 }
 
-Outcome level_outcome(const std::vector<EvalRun>& runs, EvalLevel level) {
+WarningOutcome level_outcome(const std::vector<EvalRun>& runs, EvalLevel level) {
   return outcome_of(runs, [level](const EvalRun& r) {
     return r.first_shown_s[static_cast<std::size_t>(level)];
   });
@@ -167,12 +167,12 @@ std::vector<RocPoint> roc(const std::vector<EvalRun>& runs, const CrossingGrids&
 Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& target) {
   // Safety first: 0 meets both; 1 misses no more than allowed, too many false alarms; 2 within
   // the rate, more misses; 3 neither.
-  const auto rank = [&](const Outcome& o) {
+  const auto rank = [&](const WarningOutcome& o) {
     const bool misses_ok = o.misses <= target.max_misses;
     const bool rate_ok = o.false_alarm_rate() <= target.max_false_alarm_rate;
     return misses_ok ? (rate_ok ? 0 : 1) : (rate_ok ? 2 : 3);
   };
-  const auto lead = [](const Outcome& o) { return o.lead_quantile(0.5); };
+  const auto lead = [](const WarningOutcome& o) { return o.lead_quantile(0.5); };
   Choice best;
   for (const RocPoint& p : points) {
     const int ra = rank(p.outcome);
@@ -180,8 +180,8 @@ Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& targe
       best = {true, ra == 0, p};
       continue;
     }
-    const Outcome& a = p.outcome;
-    const Outcome& b = best.point.outcome;
+    const WarningOutcome& a = p.outcome;
+    const WarningOutcome& b = best.point.outcome;
     const int rb = rank(b);
     bool better = false;
     if (ra != rb) {

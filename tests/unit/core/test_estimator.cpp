@@ -5,11 +5,13 @@
 #include <string>
 #include <vector>
 
+#include "bundled_records.h"
 #include "plinth/core/estimator.h"
 #include "plinth/core/risk.h"
 #include "plinth/core/stability.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
+#include "test_paths.h"
 #include "test_support.h"
 
 namespace plinth {
@@ -17,12 +19,9 @@ namespace {
 
 using testing::RecordingSink;
 
-const std::string kSource = PLINTH_SOURCE_DIR;
+using ::plinth::testing::kSource;
 
-host::Record brienza() {
-  return host::read_at2(kSource + "/sim/data/records/irpinia1980_brienza_000.AT2",
-                        kStandardGravity);
-}
+using testing::brienza;
 
 // The estimator fed sample by sample gives what the simulator gives on the whole record at the
 // same step: the same events at the same times, the same state at the end.

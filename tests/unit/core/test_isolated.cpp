@@ -5,6 +5,7 @@
 #include <random>
 #include <string>
 
+#include "bundled_records.h"
 #include "plinth/core/energy.h"
 #include "plinth/core/internal/resets.h"
 #include "plinth/host/record_io.h"
@@ -158,11 +159,7 @@ TEST(Resets, PrintedEq29WithThetaDotUnchangedCanCreateEnergy) {
   EXPECT_NEAR(mechanical_energy(s, mode, ours), before, 1e-9 * before);  // eta = 1: elastic
 }
 
-host::Record brienza() {
-  return host::read_at2(
-      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
-      kStandardGravity);
-}
+using testing::brienza;
 
 // Eq 28: the base never passes its stops, and each hit reverses u' by eta_i (Eq 29).
 TEST(BaseStops, BoundTheBaseAndReverseItsVelocity) {

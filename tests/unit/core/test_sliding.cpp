@@ -30,11 +30,7 @@ using internal::sliding_stop_hit_reset;
 using testing::make;
 using testing::RecordingSink;
 
-SceneParams with_friction(SceneParams p, double mu_s, double mu_k) {
-  p.has_friction = true;
-  p.friction = {mu_s, mu_k};
-  return p;
-}
+using testing::with_friction;
 
 // A sampled harmonic ground acceleration A sin(omega t), fine enough that the linear
 // interpolation error (~ (omega dt)^2 / 8) stays below 1e-8.

@@ -163,11 +163,7 @@ struct SampledInput {
   }
 };
 
-SceneParams with_friction(SceneParams p, double mu_s, double mu_k) {
-  p.has_friction = true;
-  p.friction = {mu_s, mu_k};
-  return p;
-}
+using testing::with_friction;
 
 // Stick-slip at zero velocity: the ground pushes the block exactly at the friction limit
 // (mu_s = mu_k = 0.2, u_G'' = 0.2 g), wiggling by 1e-6 of it, so that x' keeps returning to 0

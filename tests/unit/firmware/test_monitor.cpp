@@ -6,9 +6,11 @@
 #include <string>
 #include <vector>
 
+#include "bundled_records.h"
 #include "monitor_input.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/record_io.h"
+#include "test_paths.h"
 #include "test_support.h"
 
 namespace plinth {
@@ -17,14 +19,11 @@ namespace {
 namespace fw = firmware;
 using testing::RecordingSink;
 
-const std::string kSource = PLINTH_SOURCE_DIR;
+using ::plinth::testing::kSource;
 
-host::Record brienza() {
-  return host::read_at2(kSource + "/sim/data/records/irpinia1980_brienza_000.AT2",
-                        kStandardGravity);
-}
+using testing::brienza;
 
-std::int64_t ns(double seconds) { return std::llround(seconds * 1e9); }
+using ::plinth::testing::ns;
 
 // A record replayed as exact samples (m/s2, z reads g): after the lead-in the estimator starts
 // at the record's first sample and gives the simulator's events at the simulator's times.

@@ -3,22 +3,17 @@
 
 #include <string>
 
+#include "box_file_error.h"
 #include "monitor_config.h"
 #include "plinth/host/input_error.h"
+#include "test_paths.h"
 
 namespace plinth::firmware {
 namespace {
 
-const std::string kSource = PLINTH_SOURCE_DIR;
+using ::plinth::testing::kSource;
 
-std::string error_of(const std::string& text) {
-  try {
-    (void)load_monitor_text(text, "/etc/plinth/box.toml", MonitorConfig{});
-  } catch (const host::InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::box_file_error;
 
 TEST(MonitorConfigFile, TheExampleSetsEveryField) {
   const MonitorFile f = load_monitor_file(kSource + "/firmware/monitor.example.toml", MonitorConfig{});
@@ -50,7 +45,7 @@ TEST(MonitorConfigFile, TheForecastsKeys) {
   EXPECT_EQ(f.config.forecast.horizon_s, 3.0);
   EXPECT_EQ(f.config.alarm.alarm_forecast.on, 0.6);
   EXPECT_EQ(f.config.alarm.alarm_forecast.off, 0.5);
-  EXPECT_NE(error_of("[forecast]\ncontinuation = \"crystal_ball\"\n")
+  EXPECT_NE(box_file_error("[forecast]\ncontinuation = \"crystal_ball\"\n")
                 .find("box.toml:2: forecast.continuation: expected \"recent_window\" or "
                       "\"strongest_window\""),
             std::string::npos);
@@ -78,34 +73,35 @@ TEST(MonitorConfigFile, ValuesOverTheDefaults) {
 }
 
 TEST(MonitorConfigFile, BadInputNamesFileLineAndKey) {
-  EXPECT_EQ(error_of("[estimator]\nsteps = 4\n"),
+  EXPECT_EQ(box_file_error("[estimator]\nsteps = 4\n"),
             "/etc/plinth/box.toml:2: estimator.steps: unknown key (docs/monitor.md lists them)");
-  EXPECT_EQ(error_of("[estimator]\nsample_rate_hz = \"fast\"\n"),
+  EXPECT_EQ(box_file_error("[estimator]\nsample_rate_hz = \"fast\"\n"),
             "/etc/plinth/box.toml:2: estimator.sample_rate_hz: expected a number");
-  EXPECT_EQ(error_of("[estimator]\nstepper = \"rk45\"\n"),
+  EXPECT_EQ(box_file_error("[estimator]\nstepper = \"rk45\"\n"),
             "/etc/plinth/box.toml:2: estimator.stepper: expected \"rk4_located\", "
             "\"rk4_step_end\", \"heun_located\" or \"semi_implicit_euler\"");
-  EXPECT_EQ(error_of("[sensor_health]\n\ntimeout_s = 0.001\n").rfind(
-                "/etc/plinth/box.toml:3: sensor_health.timeout_s: ", 0),
+  EXPECT_EQ(box_file_error("[sensor_health]\n\ntimeout_s = 0.001\n")
+                .rfind("/etc/plinth/box.toml:3: sensor_health.timeout_s: ", 0),
             0U);
-  EXPECT_EQ(error_of("[alarm_policy]\nwarning = { on = 0.5, off = 0.6 }\n").rfind(
-                "/etc/plinth/box.toml:2: alarm_policy.warning.off: ", 0),
+  EXPECT_EQ(box_file_error("[alarm_policy]\nwarning = { on = 0.5, off = 0.6 }\n")
+                .rfind("/etc/plinth/box.toml:2: alarm_policy.warning.off: ", 0),
             0U);
-  EXPECT_EQ(error_of("[conditioning]\nsensor_to_statue = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]\n")
-                .rfind("/etc/plinth/box.toml:2: conditioning.sensor_to_statue: ", 0),
-            0U);
-  EXPECT_EQ(error_of("[conditioning]\nsensor_to_statue = [[1, 0], [0, 1]]\n"),
+  EXPECT_EQ(
+      box_file_error("[conditioning]\nsensor_to_statue = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]\n")
+          .rfind("/etc/plinth/box.toml:2: conditioning.sensor_to_statue: ", 0),
+      0U);
+  EXPECT_EQ(box_file_error("[conditioning]\nsensor_to_statue = [[1, 0], [0, 1]]\n"),
             "/etc/plinth/box.toml:2: conditioning.sensor_to_statue: expected three rows of three "
             "numbers (statue = R sensor)");
-  EXPECT_EQ(error_of("[conditioning]\nunit = \"gal\"\n"),
+  EXPECT_EQ(box_file_error("[conditioning]\nunit = \"gal\"\n"),
             "/etc/plinth/box.toml:2: conditioning.unit: expected \"g\" or \"m/s2\", got \"gal\"");
-  EXPECT_EQ(error_of("[monitor]\nground_node = 16\n"),
+  EXPECT_EQ(box_file_error("[monitor]\nground_node = 16\n"),
             "/etc/plinth/box.toml:2: monitor.ground_node: must lie in [1, 15]");
-  EXPECT_EQ(error_of("[estimator]\nsample_rate_hz = nan\n").rfind(
-                "/etc/plinth/box.toml:2: estimator.sample_rate_hz: ", 0),
+  EXPECT_EQ(box_file_error("[estimator]\nsample_rate_hz = nan\n")
+                .rfind("/etc/plinth/box.toml:2: estimator.sample_rate_hz: ", 0),
             0U);
-  EXPECT_NE(error_of("[estimator\n").find("TOML syntax error"), std::string::npos);
-  EXPECT_EQ(error_of("[alarm_policy]\nlatch_alarm = 1\n"),
+  EXPECT_NE(box_file_error("[estimator\n").find("TOML syntax error"), std::string::npos);
+  EXPECT_EQ(box_file_error("[alarm_policy]\nlatch_alarm = 1\n"),
             "/etc/plinth/box.toml:2: alarm_policy.latch_alarm: expected true or false");
   try {
     (void)load_monitor_file("/nowhere/box.toml", MonitorConfig{});
@@ -142,7 +138,7 @@ TEST(MonitorConfigFile, StatusInterval) {
                                           "/etc/plinth/box.toml", MonitorConfig{});
   EXPECT_EQ(f.config.status_interval_s, 0.5);
   EXPECT_EQ(MonitorConfig{}.status_interval_s, 0.1);
-  EXPECT_EQ(error_of("[monitor]\nstatus_interval_s = 0\n"),
+  EXPECT_EQ(box_file_error("[monitor]\nstatus_interval_s = 0\n"),
             "/etc/plinth/box.toml:2: monitor.status_interval_s: must lie in [1e-9, 1e6] s");
 }
 

@@ -7,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "box_file_error.h"
 #include "monitor_config.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/input_error.h"
@@ -352,14 +353,7 @@ TEST(MonitorSensors, RefusesBadSensorListsNamingTheSensor) {
 // ---------------------------------------------------------------------------------------------
 // The configuration file's [[sensor]] tables (firmware/linux/monitor_config.h).
 
-std::string error_of(const std::string& text) {
-  try {
-    (void)fw::load_monitor_text(text, "/etc/plinth/box.toml", fw::MonitorConfig{});
-  } catch (const host::InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+using testing::box_file_error;
 
 TEST(MonitorSensorsFile, SensorTablesOverTheDefaults) {
   const fw::MonitorFile f = fw::load_monitor_text(
@@ -395,38 +389,41 @@ TEST(MonitorSensorsFile, SensorTablesOverTheDefaults) {
 }
 
 TEST(MonitorSensorsFile, BadSensorTablesNameFileLineAndKey) {
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 1\n"),
+  EXPECT_EQ(box_file_error("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 1\n"),
             "/etc/plinth/box.toml:4: sensor[1].node: node 1 is already sensor[0]'s");
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 2\nrole = \"roof\"\n"),
-            "/etc/plinth/box.toml:5: sensor[1].role: expected \"ground\" or \"plate\", got \"roof\"");
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 2\nrole = \"plate\"\n"
-                     "[[sensor]]\nnode = 3\nrole = \"plate\"\n"),
+  EXPECT_EQ(
+      box_file_error("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 2\nrole = \"roof\"\n"),
+      "/etc/plinth/box.toml:5: sensor[1].role: expected \"ground\" or \"plate\", got \"roof\"");
+  EXPECT_EQ(box_file_error("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 2\nrole = \"plate\"\n"
+                           "[[sensor]]\nnode = 3\nrole = \"plate\"\n"),
             "/etc/plinth/box.toml:8: sensor[2].role: a second plate sensor: at most one");
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 1\nrole = \"plate\"\n"),
+  EXPECT_EQ(box_file_error("[[sensor]]\nnode = 1\nrole = \"plate\"\n"),
             "/etc/plinth/box.toml:3: sensor[0].role: no ground sensor: at least one must drive "
             "the estimators");
-  EXPECT_EQ(error_of("[[sensor]]\nrole = \"ground\"\n"),
+  EXPECT_EQ(box_file_error("[[sensor]]\nrole = \"ground\"\n"),
             "/etc/plinth/box.toml:1: sensor[0]: no node (each [[sensor]] gives its CAN node)");
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 16\n"),
+  EXPECT_EQ(box_file_error("[[sensor]]\nnode = 16\n"),
             "/etc/plinth/box.toml:2: sensor[0].node: must lie in [1, 15]");
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 1\nnodes = 2\n"),
+  EXPECT_EQ(box_file_error("[[sensor]]\nnode = 1\nnodes = 2\n"),
             "/etc/plinth/box.toml:3: sensor[0].nodes: unknown key (docs/monitor.md lists them)");
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 1\nunit = \"gal\"\n"),
+  EXPECT_EQ(box_file_error("[[sensor]]\nnode = 1\nunit = \"gal\"\n"),
             "/etc/plinth/box.toml:3: sensor[0].unit: expected \"g\" or \"m/s2\", got \"gal\"");
-  EXPECT_EQ(error_of("[monitor]\nground_node = 2\n[[sensor]]\nnode = 1\n"),
+  EXPECT_EQ(box_file_error("[monitor]\nground_node = 2\n[[sensor]]\nnode = 1\n"),
             "/etc/plinth/box.toml:2: monitor.ground_node: not with [[sensor]] tables (each gives "
             "its node)");
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 2\nsensor_health.timeout_s = 1.0\n")
-                .rfind("/etc/plinth/box.toml:5: sensor[1].sensor_health.timeout_s: ", 0),
-            0U);
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 1\nsensor_to_statue = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]\n")
+  EXPECT_EQ(
+      box_file_error("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 2\nsensor_health.timeout_s = 1.0\n")
+          .rfind("/etc/plinth/box.toml:5: sensor[1].sensor_health.timeout_s: ", 0),
+      0U);
+  EXPECT_EQ(box_file_error(
+                "[[sensor]]\nnode = 1\nsensor_to_statue = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]\n")
                 .rfind("/etc/plinth/box.toml:3: sensor[0].sensor_to_statue: ", 0),
             0U);
-  EXPECT_EQ(error_of("[redundancy]\nwindow_s = 0.001\n").rfind(
-                "/etc/plinth/box.toml:2: redundancy.window_s: ", 0),
+  EXPECT_EQ(box_file_error("[redundancy]\nwindow_s = 0.001\n")
+                .rfind("/etc/plinth/box.toml:2: redundancy.window_s: ", 0),
             0U);
-  EXPECT_EQ(error_of("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 2\n[[sensor]]\nnode = 3\n"
-                     "[[sensor]]\nnode = 4\n[[sensor]]\nnode = 5\n"),
+  EXPECT_EQ(box_file_error("[[sensor]]\nnode = 1\n[[sensor]]\nnode = 2\n[[sensor]]\nnode = 3\n"
+                           "[[sensor]]\nnode = 4\n[[sensor]]\nnode = 5\n"),
             "/etc/plinth/box.toml:9: sensor[4]: at most 4 sensors");
 }
 

@@ -13,6 +13,7 @@
 
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/record_io.h"
+#include "test_paths.h"
 #include "test_support.h"
 
 namespace plinth {
@@ -23,11 +24,11 @@ using monitor::AlarmCause;
 using monitor::AlarmLevel;
 namespace can = plinth::can;
 
-const std::string kSource = PLINTH_SOURCE_DIR;
+using ::plinth::testing::kSource;
 constexpr double kRateHz = 200.0;  // the sensor rate of the candump log
 constexpr double kNoiseG = 3e-4;   // sensor noise, standard deviation, g
 
-std::int64_t ns(double seconds) { return std::llround(seconds * 1e9); }
+using ::plinth::testing::ns;
 
 host::Record record(const std::string& stem) {
   return host::read_record(kSource + "/sim/data/records/" + stem + ".AT2", kStandardGravity);

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "box_file_error.h"
 #include "monitor_config.h"
 #include "plinth/host/input_error.h"
 #include "relay_fake.h"
@@ -131,13 +132,9 @@ TEST(RelayOutputs, AFailedWriteIsCountedAndTriedAgain) {
   EXPECT_TRUE(b.backend->level(2));
 }
 
-std::string error_of(const std::string& text) {
-  try {
-    (void)load_monitor_text(text, "box.toml", MonitorConfig{});
-  } catch (const host::InputError& e) {
-    return e.what();
-  }
-  return "";
+// Messages name the file box.toml.
+std::string relay_file_error(const std::string& text) {
+  return testing::box_file_error(text, "box.toml");
 }
 
 TEST(RelayConfig, OffsetsPolarityAndTheChip) {
@@ -157,19 +154,21 @@ TEST(RelayConfig, OffsetsPolarityAndTheChip) {
 }
 
 TEST(RelayConfig, BadTablesNameTheKeyAndTheLine) {
-  EXPECT_EQ(error_of("[relays]\nchip = \"gpiochip0\"\nadvisory = 1\nalarm = 1\n"),
+  EXPECT_EQ(relay_file_error("[relays]\nchip = \"gpiochip0\"\nadvisory = 1\nalarm = 1\n"),
             "box.toml:4: relays.alarm: line 1 is already relays.advisory's");
-  EXPECT_EQ(error_of("[relays]\nalarm = 3\n"), "box.toml: relays: lines without relays.chip");
-  EXPECT_EQ(error_of("[relays]\nchip = \"gpiochip0\"\n"),
+  EXPECT_EQ(relay_file_error("[relays]\nalarm = 3\n"),
+            "box.toml: relays: lines without relays.chip");
+  EXPECT_EQ(relay_file_error("[relays]\nchip = \"gpiochip0\"\n"),
             "box.toml:2: relays.chip: no relay lines (advisory, warning, alarm, fault)");
-  EXPECT_EQ(error_of("[relays]\nchip = \"gpiochip0\"\nalarm = -2\n"),
+  EXPECT_EQ(relay_file_error("[relays]\nchip = \"gpiochip0\"\nalarm = -2\n"),
             "box.toml:3: relays.alarm: line offset must lie in [0, 1023]");
-  EXPECT_EQ(error_of("[relays]\nchip = \"gpiochip0\"\nalarm = \"GPIO17\"\n"),
+  EXPECT_EQ(relay_file_error("[relays]\nchip = \"gpiochip0\"\nalarm = \"GPIO17\"\n"),
             "box.toml:3: relays.alarm: expected an integer (a line offset)");
-  EXPECT_EQ(error_of("[relays]\nchip = \"gpiochip0\"\nsiren = 3\n"),
+  EXPECT_EQ(relay_file_error("[relays]\nchip = \"gpiochip0\"\nsiren = 3\n"),
             "box.toml:3: relays.siren: unknown key (docs/monitor.md lists them)");
-  EXPECT_EQ(error_of("[relays]\nchip = \"gpiochip0\"\nalarm = 2\nwarning.active_low = true\n"),
-            "box.toml:4: relays.warning: no line");
+  EXPECT_EQ(
+      relay_file_error("[relays]\nchip = \"gpiochip0\"\nalarm = 2\nwarning.active_low = true\n"),
+      "box.toml:4: relays.warning: no line");
 }
 
 TEST(RelayConfig, TheCommandLineReplacesTheChipOrTurnsTheRelaysOff) {
@@ -228,9 +227,9 @@ TEST(WatchdogConfig, NotifyAndTheTestOnlyStall) {
                                           "box.toml", MonitorConfig{});
   EXPECT_FALSE(f.watchdog.notify);
   EXPECT_EQ(f.watchdog.test_stall_after_s, 2.5);
-  EXPECT_EQ(error_of("[watchdog]\ntest_stall_after_s = -1\n"),
+  EXPECT_EQ(relay_file_error("[watchdog]\ntest_stall_after_s = -1\n"),
             "box.toml:2: watchdog.test_stall_after_s: must be a finite number of seconds >= 0");
-  EXPECT_EQ(error_of("[watchdog]\nnotify = 1\n"),
+  EXPECT_EQ(relay_file_error("[watchdog]\nnotify = 1\n"),
             "box.toml:2: watchdog.notify: expected true or false");
 }
 

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "plinth/core/scene.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_io.h"
 
@@ -29,7 +30,6 @@ std::string lowercase_for_test(std::string text) {
   return text;
 }
 
-constexpr double kGravity = 9.80665;  // m/s2
 const std::string kRecordsDir = PLINTH_SOURCE_DIR "/sim/data/records/";
 
 // The message of the InputError thrown by read, or "" (and a failure) when none is thrown.
@@ -60,13 +60,13 @@ class BundledRecordTest : public ::testing::TestWithParam<BundledRecord> {};
 
 TEST_P(BundledRecordTest, MatchesSourcesTable) {
   const BundledRecord& expected = GetParam();
-  const Record record = read_record(kRecordsDir + expected.file, kGravity);
+  const Record record = read_record(kRecordsDir + expected.file, kStandardGravity);
 
   EXPECT_EQ(record.name, expected.name);
   ASSERT_EQ(record.horizontal.size(), expected.npts);
   EXPECT_DOUBLE_EQ(record.dt, expected.dt);
   EXPECT_TRUE(record.vertical.empty());
-  EXPECT_NEAR(record.peak_horizontal() / kGravity, expected.pga, 1e-4);
+  EXPECT_NEAR(record.peak_horizontal() / kStandardGravity, expected.pga, 1e-4);
 
   std::size_t peak_index = 0;
   for (std::size_t i = 0; i < record.horizontal.size(); ++i) {
@@ -133,16 +133,16 @@ INSTANTIATE_TEST_SUITE_P(
     });
 
 TEST(BundledRecords, BrienzaFirstAndLastValuesConvertFromG) {
-  const Record record = read_at2(kRecordsDir + "irpinia1980_brienza_000.AT2", kGravity);
+  const Record record = read_at2(kRecordsDir + "irpinia1980_brienza_000.AT2", kStandardGravity);
   ASSERT_EQ(record.horizontal.size(), 12064U);
-  EXPECT_DOUBLE_EQ(record.horizontal.front(), -.3251592E-05 * kGravity);
-  EXPECT_DOUBLE_EQ(record.horizontal.back(), .1152733E-04 * kGravity);
-  EXPECT_NEAR(record.peak_horizontal(), 0.2196351 * kGravity, 1e-12);
+  EXPECT_DOUBLE_EQ(record.horizontal.front(), -.3251592E-05 * kStandardGravity);
+  EXPECT_DOUBLE_EQ(record.horizontal.back(), .1152733E-04 * kStandardGravity);
+  EXPECT_NEAR(record.peak_horizontal(), 0.2196351 * kStandardGravity, 1e-12);
 }
 
 TEST(BundledRecords, SecGluedToDtIsRead) {
   // Line 4 reads "NPTS=   7769, DT=   .00244SEC,   4 POLE @ ...".
-  const Record record = read_at2(kRecordsDir + "friuli1976-09-11_buia_NS.AT2", kGravity);
+  const Record record = read_at2(kRecordsDir + "friuli1976-09-11_buia_NS.AT2", kStandardGravity);
   EXPECT_DOUBLE_EQ(record.dt, 0.00244);
   EXPECT_EQ(record.horizontal.size(), 7769U);
 }
@@ -220,9 +220,9 @@ TEST_F(At2Test, ReadsValuesNameAndDt) {
 TEST_F(At2Test, GluedSecAndExponentDt) {
   const std::string glued =
       write("glued.AT2", at2_text("NPTS=7, DT=   .00244SEC, 4 POLE", kSevenValues));
-  EXPECT_DOUBLE_EQ(read_at2(glued, kGravity).dt, 0.00244);
+  EXPECT_DOUBLE_EQ(read_at2(glued, kStandardGravity).dt, 0.00244);
   const std::string exponent = write("exp.AT2", at2_text("NPTS= 7 DT= 2.5E-03 SEC", kSevenValues));
-  EXPECT_DOUBLE_EQ(read_at2(exponent, kGravity).dt, 0.0025);
+  EXPECT_DOUBLE_EQ(read_at2(exponent, kStandardGravity).dt, 0.0025);
 }
 
 TEST_F(At2Test, CrlfLineEndingsAreAccepted) {
@@ -238,14 +238,14 @@ TEST_F(At2Test, CrlfLineEndingsAreAccepted) {
 
 TEST_F(At2Test, MissingFile) {
   const std::string path = (dir_ / "absent.AT2").string();
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path));
   EXPECT_THAT(message, HasSubstr("cannot open"));
 }
 
 TEST_F(At2Test, TruncatedHeader) {
   const std::string path = write("short.AT2", kAt2Title + kAt2Event);
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":3:"));
   EXPECT_THAT(message, HasSubstr("truncated header"));
 }
@@ -254,7 +254,7 @@ TEST_F(At2Test, AccelerationUnitsOtherThanGConvert) {
   const std::string path =
       write("cms2.AT2", kAt2Title + kAt2Event + "ACCELERATION TIME SERIES IN UNITS OF CM/S/S\n" +
                             "NPTS= 7, DT= .01 SEC\n" + kSevenValues);
-  const Record record = read_at2(path, kGravity);
+  const Record record = read_at2(path, kStandardGravity);
   ASSERT_EQ(record.horizontal.size(), 7U);
   EXPECT_DOUBLE_EQ(record.horizontal[2], 0.3 * 0.01);
 }
@@ -263,7 +263,7 @@ TEST_F(At2Test, UnitsThatAreNoAcceleration) {
   const std::string path =
       write("cms.AT2", kAt2Title + kAt2Event + "ACCELERATION TIME SERIES IN UNITS OF CM/S\n" +
                            "NPTS= 7, DT= .01 SEC\n" + kSevenValues);
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":3:"));
   EXPECT_THAT(message, HasSubstr("units are 'CM/S', expected G"));
 }
@@ -273,7 +273,8 @@ TEST_F(At2Test, VelocityAndDisplacementFilesAreRefused) {
     const std::string path =
         write("v.VT2", kAt2Title + kAt2Event + kind + " TIME SERIES IN UNITS OF CM/S\n" +
                            "NPTS= 7, DT= .01 SEC\n" + kSevenValues);
-    const std::string message = input_error_message([&] { return read_record(path, kGravity); });
+    const std::string message =
+        input_error_message([&] { return read_record(path, kStandardGravity); });
     EXPECT_THAT(message, HasSubstr(path + ":3: this is a " + lowercase_for_test(kind) + " file"))
         << kind;
     EXPECT_THAT(message, HasSubstr("expected an acceleration time series")) << kind;
@@ -282,21 +283,21 @@ TEST_F(At2Test, VelocityAndDisplacementFilesAreRefused) {
 
 TEST_F(At2Test, MissingNpts) {
   const std::string path = write("nonpts.AT2", at2_text("DT= .01 SEC", kSevenValues));
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":4:"));
   EXPECT_THAT(message, HasSubstr("cannot find NPTS="));
 }
 
 TEST_F(At2Test, ZeroNpts) {
   const std::string path = write("zeronpts.AT2", at2_text("NPTS= 0, DT= .01 SEC", ""));
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":4:"));
   EXPECT_THAT(message, HasSubstr("NPTS must be positive"));
 }
 
 TEST_F(At2Test, NegativeNptsIsNotAWholeNumber) {
   const std::string path = write("negnpts.AT2", at2_text("NPTS= -7, DT= .01 SEC", kSevenValues));
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":4:"));
   EXPECT_THAT(message, HasSubstr("cannot find NPTS= (a positive whole number) in the header "
                                  "line, found '-7'"));
@@ -304,14 +305,14 @@ TEST_F(At2Test, NegativeNptsIsNotAWholeNumber) {
 
 TEST_F(At2Test, MissingDt) {
   const std::string path = write("nodt.AT2", at2_text("NPTS= 7, SEC", kSevenValues));
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":4:"));
   EXPECT_THAT(message, HasSubstr("cannot find DT="));
 }
 
 TEST_F(At2Test, ZeroDt) {
   const std::string path = write("zerodt.AT2", at2_text("NPTS= 7, DT= .0000 SEC", kSevenValues));
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":4:"));
   EXPECT_THAT(message, HasSubstr("DT must be positive"));
 }
@@ -320,7 +321,7 @@ TEST_F(At2Test, TokenThatIsNotANumber) {
   const std::string path = write("token.AT2", at2_text("NPTS= 7, DT= .01 SEC",
                                                        "   .1E+00 .2E+00 .3E+00 .4E+00 .5E+00\n"
                                                        "   .6E+00 .7E+00X\n"));
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":6:"));
   EXPECT_THAT(message, HasSubstr("'.7E+00X' is not a number"));
 }
@@ -329,25 +330,26 @@ TEST_F(At2Test, NanAndInfinityAreNotFinite) {
   for (const std::string bad : {"NaN", "-inf", "1E+999"}) {
     const std::string path =
         write("nan.AT2", at2_text("NPTS= 2, DT= .01 SEC", ".1E+00 " + bad + "\n"));
-    const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+    const std::string message =
+        input_error_message([&] { return read_at2(path, kStandardGravity); });
     EXPECT_THAT(message, HasSubstr(path + ":5:")) << bad;
     EXPECT_THAT(message, HasSubstr("'" + bad + "'")) << bad;
   }
   const std::string path = write("nan.AT2", at2_text("NPTS= 2, DT= .01 SEC", ".1E+00 nan\n"));
-  EXPECT_THAT(input_error_message([&] { return read_at2(path, kGravity); }),
+  EXPECT_THAT(input_error_message([&] { return read_at2(path, kStandardGravity); }),
               HasSubstr("is not finite"));
 }
 
 TEST_F(At2Test, FewerValuesThanNpts) {
   const std::string path = write("few.AT2", at2_text("NPTS= 9, DT= .01 SEC", kSevenValues));
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":6:"));
   EXPECT_THAT(message, HasSubstr("truncated data: found 7 values, NPTS=9"));
 }
 
 TEST_F(At2Test, MoreValuesThanNpts) {
   const std::string path = write("many.AT2", at2_text("NPTS= 6, DT= .01 SEC", kSevenValues));
-  const std::string message = input_error_message([&] { return read_at2(path, kGravity); });
+  const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":6:"));
   EXPECT_THAT(message, HasSubstr("more values than NPTS=6"));
 }
@@ -372,7 +374,7 @@ TEST_F(CsvTest, GravityUnitsConvert) {
 
 TEST_F(CsvTest, MetresPerSecondSquaredAreKept) {
   const std::string path = write("ms2.csv", "t [s],a [M/S2]\n0,1.5\n0.005,-2\n");
-  const Record record = read_csv_record(path, kGravity);
+  const Record record = read_csv_record(path, kStandardGravity);
   ASSERT_EQ(record.horizontal.size(), 2U);
   EXPECT_DOUBLE_EQ(record.horizontal[0], 1.5);
   EXPECT_DOUBLE_EQ(record.horizontal[1], -2.0);
@@ -382,7 +384,7 @@ TEST_F(CsvTest, MetresPerSecondSquaredAreKept) {
 TEST_F(CsvTest, GalAndCentimetresPerSecondSquaredConvert) {
   for (const std::string unit : {"gal", "Gal", "cm/s2"}) {
     const std::string path = write("gal.csv", "t,a [" + unit + "]\n0,250\n0.02,-981\n");
-    const Record record = read_csv_record(path, kGravity);
+    const Record record = read_csv_record(path, kStandardGravity);
     ASSERT_EQ(record.horizontal.size(), 2U) << unit;
     EXPECT_DOUBLE_EQ(record.horizontal[0], 2.5) << unit;
     EXPECT_DOUBLE_EQ(record.horizontal[1], -9.81) << unit;
@@ -428,7 +430,7 @@ class CsvErrorTest : public RecordFileTest {
  protected:
   std::string error_for(const std::string& text) {
     path_ = write("bad.csv", text);
-    return input_error_message([&] { return read_csv_record(path_, kGravity); });
+    return input_error_message([&] { return read_csv_record(path_, kStandardGravity); });
   }
   std::string path_;
 };
@@ -507,7 +509,8 @@ TEST_F(CsvErrorTest, EmptyFileHasNoHeader) {
 
 TEST_F(CsvErrorTest, MissingFile) {
   const std::string path = (dir_ / "absent.csv").string();
-  const std::string message = input_error_message([&] { return read_csv_record(path, kGravity); });
+  const std::string message =
+      input_error_message([&] { return read_csv_record(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path));
   EXPECT_THAT(message, HasSubstr("cannot open"));
 }
@@ -531,7 +534,7 @@ TEST_F(ReadRecordTest, ContentDecidesOverTheExtension) {
   EXPECT_EQ(read_record(write("record.csv", at2), 1.0).horizontal.size(), 7U);
   EXPECT_DOUBLE_EQ(read_record(write("record.dat", "t,a [g]\n0,1\n0.25,2\n"), 1.0).dt, 0.25);
   const std::string esm = "SAMPLING_INTERVAL_S: 0.01\nNDATA: 2\nUNITS: cm/s^2\n1.5\n-2\n";
-  const Record record = read_record(write("record.AT2", esm), kGravity);
+  const Record record = read_record(write("record.AT2", esm), kStandardGravity);
   ASSERT_EQ(record.horizontal.size(), 2U);
   EXPECT_DOUBLE_EQ(record.horizontal[1], -0.02);
 }
@@ -584,7 +587,7 @@ TEST_P(PublishedRecordTest, ReadsAsPublished) {
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   ASSERT_EQ(detect_record_format(text), expected.format);
 
-  const Record record = read_record(path, kGravity);
+  const Record record = read_record(path, kStandardGravity);
   EXPECT_EQ(record.name, expected.name);
   EXPECT_DOUBLE_EQ(record.dt, expected.dt);
   ASSERT_EQ(record.horizontal.size(), expected.npts);
@@ -601,18 +604,18 @@ INSTANTIATE_TEST_SUITE_P(
         // pre-NGA PEER: "... IN UNITS OF G. FILTER POINTS: ...", lower-case "dt=", no SEC
         PublishedRecord{"ISE-WE.AT2", RecordFormat::kAt2,
                         "LAZIO-ABRUZZO EQ, 05/07/84, 17:50, ISERNIA-SANT'AGAPITO, WE", 6557,
-                        0.00244, -0.06757362, 1255, -2.344583e-06, -0.0001243218, kGravity},
+                        0.00244, -0.06757362, 1255, -2.344583e-06, -0.0001243218, kStandardGravity},
         // pre-NGA PEER: "... IN UNITS OF G. FILTER POINTS: ...", "NPTS=  1500, DT= .02000 SEC"
         PublishedRecord{"CPM000.AT2", RecordFormat::kAt2,
                         "CAPE MENDOCINO 04/25/92 1806, CAPE MENDOCINO, 000 (CDMG STATION 89005)",
-                        1500, 0.02, 1.497307, 150, 0.01193831, -0.004241918, kGravity},
+                        1500, 0.02, 1.497307, 150, 0.01193831, -0.004241918, kStandardGravity},
         // Pacific Engineering and Analysis: "... TIME HISTORY IN UNITS OF G" padded with spaces
         PublishedRecord{"ARL360.at2", RecordFormat::kAt2, "NORTHRIDGE 01/17/94 1231, ARLETA, 360",
-                        2000, 0.02, 0.3080574, 255, 0.001297983, -0.0001822073, kGravity},
+                        2000, 0.02, 0.3080574, 255, 0.001297983, -0.0001822073, kStandardGravity},
         // NGA-West1: "4096    0.0100    NPTS, DT"
         PublishedRecord{"NIS090.AT2", RecordFormat::kAt2,
                         "KOBE 01/16/95 2046, NISHI-AKASHI, 090 (CUE)", 4096, 0.01, -0.502749, 709,
-                        2.33833e-07, 4.96963e-05, kGravity},
+                        2.33833e-07, 4.96963e-05, kStandardGravity},
         // ESM: 64 "KEY: value" lines, cm/s^2, one value per line
         PublishedRecord{"HL.DLFA..HNE.D.20190728.160908.C.ACC.ASC", RecordFormat::kEsm,
                         "GREECE, 20190728, HL.DLFA, HNE", 13876, 0.005, -0.227973, 7262, 0.0,
@@ -629,7 +632,7 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(PublishedRecords, EsmPeakMatchesItsHeader) {
   // The header's own PGA_CM/S^2: -0.227973 and TIME_PGA_S: 36.310000.
   const Record record =
-      read_record(kVariantsDir + "HL.DLFA..HNE.D.20190728.160908.C.ACC.ASC", kGravity);
+      read_record(kVariantsDir + "HL.DLFA..HNE.D.20190728.160908.C.ACC.ASC", kStandardGravity);
   std::size_t peak = 0;
   for (std::size_t i = 0; i < record.horizontal.size(); ++i) {
     if (std::abs(record.horizontal[i]) > std::abs(record.horizontal[peak])) peak = i;
@@ -707,7 +710,7 @@ class EsmErrorTest : public RecordFileTest {
     std::string text = kEsmHeader;
     if (!from.empty()) text.replace(text.find(from), from.size(), to);
     path_ = write("bad.ASC", text + values);
-    return input_error_message([&] { return read_esm(path_, kGravity); });
+    return input_error_message([&] { return read_esm(path_, kStandardGravity); });
   }
   std::string path_;
 };
@@ -753,10 +756,10 @@ TEST_F(RecordLimitTest, HeaderImpliesTooMuch) {
 TEST_F(RecordLimitTest, ValuesBeyondAnAccelerogram) {
   const std::string path = write("huge.AT2", at2_text("NPTS= 2, DT= .01 SEC", ".1E+00 1.7E+308\n"));
   EXPECT_THAT(
-      input_error_message([&] { return read_record(path, kGravity); }),
+      input_error_message([&] { return read_record(path, kStandardGravity); }),
       HasSubstr(path + ":5: value '1.7E+308' is beyond the 100 g an accelerogram can hold"));
   const std::string csv = write("huge.csv", "t,a [m/s2]\n0,1\n0.01,1e6\n");
-  EXPECT_THAT(input_error_message([&] { return read_record(csv, kGravity); }),
+  EXPECT_THAT(input_error_message([&] { return read_record(csv, kStandardGravity); }),
               HasSubstr(csv + ":3: value '1e6' is beyond the 100 g"));
 }
 

@@ -5,13 +5,12 @@
 #include <string>
 #include <vector>
 
+#include "plinth/core/scene.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_sampling.h"
 
 namespace plinth::host {
 namespace {
-
-constexpr double kGravity = 9.80665;  // m/s2
 
 Record record_of(std::vector<double> horizontal, double dt) {
   Record r;
@@ -22,7 +21,7 @@ Record record_of(std::vector<double> horizontal, double dt) {
 
 std::string scale_error(const Record& r, const std::string& pga) {
   try {
-    (void)record_scale(r, "quake.AT2", pga, std::nullopt, kGravity);
+    (void)record_scale(r, "quake.AT2", pga, std::nullopt, kStandardGravity);
   } catch (const InputError& e) {
     return e.what();
   }
@@ -30,10 +29,10 @@ std::string scale_error(const Record& r, const std::string& pga) {
 }
 
 TEST(RecordScale, PgaOverThePeakElseTheScaleElseOne) {
-  const Record r = record_of({0.0, -2.0 * kGravity, 1.0}, 0.01);
-  EXPECT_DOUBLE_EQ(record_scale(r, "quake.AT2", "0.5g", std::nullopt, kGravity), 0.25);
-  EXPECT_DOUBLE_EQ(record_scale(r, "quake.AT2", "", -3.0, kGravity), -3.0);
-  EXPECT_DOUBLE_EQ(record_scale(r, "quake.AT2", "", std::nullopt, kGravity), 1.0);
+  const Record r = record_of({0.0, -2.0 * kStandardGravity, 1.0}, 0.01);
+  EXPECT_DOUBLE_EQ(record_scale(r, "quake.AT2", "0.5g", std::nullopt, kStandardGravity), 0.25);
+  EXPECT_DOUBLE_EQ(record_scale(r, "quake.AT2", "", -3.0, kStandardGravity), -3.0);
+  EXPECT_DOUBLE_EQ(record_scale(r, "quake.AT2", "", std::nullopt, kStandardGravity), 1.0);
 }
 
 TEST(RecordScale, OneMessagePerProblem) {
@@ -44,7 +43,7 @@ TEST(RecordScale, OneMessagePerProblem) {
   EXPECT_EQ(scale_error(r, "0g").rfind("--pga 0g: must be greater than zero", 0), 0U);
   EXPECT_EQ(scale_error(r, "500g"),
             "--pga 500g: the scaled record's peak would be 500 g, limit 100 g");
-  EXPECT_THROW((void)record_scale(r, "quake.AT2", "", 1e308, kGravity), InputError);
+  EXPECT_THROW((void)record_scale(r, "quake.AT2", "", 1e308, kStandardGravity), InputError);
   EXPECT_NE(scale_error(r, "0.3").find("--pga"), std::string::npos);  // no unit
   EXPECT_EQ(scale_error(record_of({0.0, 0.0}, 0.01), "0.3g"),
             "quake.AT2: record is all zeros, cannot scale to --pga");

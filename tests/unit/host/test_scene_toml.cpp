@@ -10,6 +10,7 @@
 #include <numbers>
 #include <string>
 
+#include "expect_text.h"
 #include "plinth/core/scene.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/scene_toml.h"
@@ -37,10 +38,6 @@ std::string error_of(const std::function<void()>& load) {
 std::string error_of_text(const std::string& text) {
   return error_of([&] { (void)load_scene_text(text, "test.toml"); });
 }
-
-#define EXPECT_HAS(haystack, needle)                                                   \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos)                     \
-      << "expected \"" << (needle) << "\" in \"" << (haystack) << "\""
 
 // The reference block on the reference base, with `extra` appended inside [block] (before
 // [base]) and `tail` after [base].

@@ -6,6 +6,7 @@
 #include <functional>
 #include <string>
 
+#include "expect_text.h"
 #include "plinth/core/ensemble_design.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/scene_toml.h"
@@ -35,9 +36,6 @@ std::string error_of(const std::string& text) {
   ADD_FAILURE() << "no InputError thrown";
   return "";
 }
-
-#define EXPECT_HAS(haystack, needle) \
-  EXPECT_NE(std::string(haystack).find(needle), std::string::npos) << (haystack)
 
 TEST(SceneUncertainty, NoTableMeansOneMemberTheNominalScene) {
   const UncertainScene s = load_uncertain_scene_text(kIsolated, "s.toml");

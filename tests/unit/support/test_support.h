@@ -85,4 +85,11 @@ double bisect_threshold(Predicate occurs, double low, double high, double width)
   return 0.5 * (low + high);
 }
 
+// The scene with Coulomb friction between block and base: static mu_s, kinetic mu_k.
+inline SceneParams with_friction(SceneParams p, double mu_s, double mu_k) {
+  p.has_friction = true;
+  p.friction = {mu_s, mu_k};
+  return p;
+}
+
 }  // namespace plinth::testing

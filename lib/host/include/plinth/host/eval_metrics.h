@@ -58,7 +58,7 @@ struct EvalRun {
 };
 
 // What a rule (or a level) did over a set of runs.
-struct Outcome {
+struct WarningOutcome {
   int collapses = 0;
   int hits = 0;
   int misses = 0;
@@ -74,8 +74,8 @@ struct Outcome {
 
 // The outcome of the rule whose first time in each run is `first_time(run)` (-1: never).
 template <class FirstTime>
-[[nodiscard]] Outcome outcome_of(const std::vector<EvalRun>& runs, FirstTime first_time) {
-  Outcome o;
+[[nodiscard]] WarningOutcome outcome_of(const std::vector<EvalRun>& runs, FirstTime first_time) {
+  WarningOutcome o;
   for (const EvalRun& r : runs) {
     const double t = first_time(r);
     if (r.collapsed) {
@@ -94,7 +94,7 @@ template <class FirstTime>
   return o;
 }
 
-[[nodiscard]] Outcome level_outcome(const std::vector<EvalRun>& runs, EvalLevel level);
+[[nodiscard]] WarningOutcome level_outcome(const std::vector<EvalRun>& runs, EvalLevel level);
 
 // A rule of the alarm policy's form: shown once the worst member's risk reaches `risk` or the
 // forecast probability reaches `probability` (index into the grids; -1: that signal unused).
@@ -106,7 +106,7 @@ struct Rule {
 
 struct RocPoint {
   Rule rule;
-  Outcome outcome;
+  WarningOutcome outcome;
 };
 // Every rule of the grids (each signal alone, and every pair), with its outcome.
 [[nodiscard]] std::vector<RocPoint> roc(const std::vector<EvalRun>& runs,
