@@ -34,8 +34,8 @@ using Matrix4r = Eigen::Matrix<Real, 4, 4>;
 using Time = double;
 
 // Tolerances chosen for double, scaled to Real's epsilon (2.2e-16 double, 1.2e-7 float). Each is
-// the double value in a double build (bit for bit what it was) and the same number of roundings,
-// or the nearest sensible multiple of epsilon, in a float build.
+// the double value in a double build (bit for bit what it was) and a small multiple of epsilon in
+// a float build, where the double value lies below float's resolution.
 namespace real_tolerance {
 inline constexpr Real kEpsilon = std::numeric_limits<Real>::epsilon();
 inline constexpr bool kSingle = sizeof(Real) < sizeof(double);
