@@ -53,8 +53,10 @@ monitor::SensorSample record_replay_sample(const MonitorConfig& config, std::int
   monitor::SensorSample sample;
   sample.receive_time_ns = std::llround(static_cast<double>(n) * period * 1e9);
   sample.sequence = static_cast<std::uint8_t>(n & 0xFF);
-  sample.acceleration_g =
-      n < record_replay_lead_in(config) ? Eigen::Vector3d(0.0, 0.0, gravity) : ground_m_s2;
+  // The record's samples are double (a host's file); the monitor takes Real (plinth/core/real.h).
+  sample.acceleration_g = n < record_replay_lead_in(config)
+                              ? Vector3r(0, 0, static_cast<Real>(gravity))
+                              : Vector3r(ground_m_s2.cast<Real>());
   return sample;
 }
 

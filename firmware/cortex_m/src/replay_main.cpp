@@ -127,6 +127,9 @@ extern "C" int plinth_board_main() {
     hal::TextLine line(text, sizeof text);
     line.put("# plinth box on mps2-an386: ").put(replay.name).put(": plinth-monitor ");
     print(line.put(replay.command));
+    // The scalar of the model's arithmetic (plinth/core/real.h): the host comparison's rule
+    // (tests/cli/mcu_replay_check.py) follows it.
+    hal::semihosting::write(sizeof(Real) == sizeof(double) ? "# real=double\n" : "# real=float\n");
   }
   if (Error e = make_scene(replay.scene_x, g_scenes[0]); !e.ok()) return fail("scene x", e);
   if (replay.has_scene_y) {
@@ -188,6 +191,8 @@ extern "C" int plinth_board_main() {
   line.put(" final_phase=").put(phase_name(s.axes[0].mode.phase));
   line.put(" alarm=").put(monitor::alarm_level_name(s.alarm));
   line.put(" phase_events=").decimal(events_x.count + events_y.count);
+  line.put(" sample_period_ns=")
+      .decimal(static_cast<std::uint64_t>(std::llround(config.estimator.sample_period() * 1e9)));
   line.put(" frames=")
       .decimal(can.frames_sent())
       .put(" send_errors=")

@@ -77,7 +77,7 @@ extern "C" int plinth_board_main() {
   Simulator rocking;
   if (!Simulator::create(g_scene, Excitation::none(), settings, rocking).ok()) ok = false;
   State y = State::Zero();
-  y[kTheta] = 0.05;
+  y[kTheta] = Real(0.05);
   rocking.start_from({Phase::kRocking, Corner::kLeft}, y);
   start = board::ticks();
   while (rocking.step_count() < kMaxRockingSteps && rocking.mode().phase == Phase::kRocking) {
@@ -86,14 +86,15 @@ extern "C" int plinth_board_main() {
   const std::uint32_t rocking_ticks = board::ticks() - start;
   ok = report("rocking", rocking_ticks, rocking.step_count(), "steps") && ok;
 
-  double sink = 0.0;
+  Real sink = 0;
   start = board::ticks();
   for (int i = 0; i < kPropagatorRuns; ++i) {
-    sink +=
-        internal::FullContactPropagator::make(g_scene, settings.step * (0.5 + 0.01 * i)).phi[0][0];
+    const auto partial_step = static_cast<Real>(settings.step * (0.5 + 0.01 * i));
+    sink += internal::FullContactPropagator::make(g_scene, partial_step).phi[0][0];
   }
   const std::uint32_t propagator_ticks = board::ticks() - start;
-  ok = report("propagator_make", propagator_ticks, kPropagatorRuns, "calls") && ok && sink > 0.0;
+  ok =
+      report("propagator_make", propagator_ticks, kPropagatorRuns, "calls") && ok && sink > Real(0);
 
   hal::semihosting::write(ok ? "# end: ok\n" : "# end: FAILED\n");
   return ok ? 0 : 1;

@@ -147,7 +147,9 @@ monitor::SensorSample sample_of(const can::SensorAcceleration& message,
   sample.receive_time_ns = receive_time_ns;
   sample.sequence = message.sequence;
   sample.status = message.status;
-  sample.acceleration_g = Eigen::Vector3d(message.ax_g, message.ay_g, message.az_g);
+  // The codec's physical values are double; the monitor's arithmetic is Real (plinth/core/real.h).
+  sample.acceleration_g = Vector3r(static_cast<Real>(message.ax_g), static_cast<Real>(message.ay_g),
+                                   static_cast<Real>(message.az_g));
   return sample;
 }
 

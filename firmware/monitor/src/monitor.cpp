@@ -371,7 +371,7 @@ void Monitor::drain_primary() {
   while (consumed_ < h.pushed) drive(h.at(consumed_++));
 }
 
-void Monitor::push_estimators(const Eigen::Vector3d& g) {
+void Monitor::push_estimators(const Vector3r& g) {
   for (int i = 0; i < status_.axis_count; ++i) {
     const auto k = static_cast<std::size_t>(i);
     const GroundAcceleration ground{g[i], g.z()};
@@ -415,7 +415,7 @@ void Monitor::drive(const HistoryEntry& entry) {
     const long n = std::lround(periods);
     if (n < 1) return;  // at or before the estimators' newest sample: taken already
     for (long j = 1; j < n; ++j) {
-      const double w = static_cast<double>(j) / static_cast<double>(n);
+      const auto w = static_cast<Real>(static_cast<double>(j) / static_cast<double>(n));
       push_estimators(last_ground_ + w * (entry.value - last_ground_));
     }
     push_estimators(entry.value);
@@ -440,8 +440,7 @@ void Monitor::drive(const HistoryEntry& entry) {
 
 // The reference's value at `time_ns`: interpolated between its samples around it (at most two
 // periods apart), else its nearest within one period. False: none.
-bool Monitor::reference_at(const History& reference, std::int64_t time_ns,
-                           Eigen::Vector3d& value) const {
+bool Monitor::reference_at(const History& reference, std::int64_t time_ns, Vector3r& value) const {
   const std::uint64_t from = reference.valid_from();
   if (from >= reference.pushed) return false;
   std::uint64_t after = reference.pushed;  // the first entry later than time_ns
@@ -452,8 +451,8 @@ bool Monitor::reference_at(const History& reference, std::int64_t time_ns,
     const HistoryEntry& a = reference.at(after - 1);
     const HistoryEntry& b = reference.at(after);
     if (b.time_ns - a.time_ns <= 2 * period_ns_ && !b.restart) {
-      const double w = static_cast<double>(time_ns - a.time_ns) /
-                       static_cast<double>(b.time_ns - a.time_ns);
+      const auto w = static_cast<Real>(static_cast<double>(time_ns - a.time_ns) /
+                                       static_cast<double>(b.time_ns - a.time_ns));
       value = a.value + w * (b.value - a.value);
       return true;
     }
@@ -487,7 +486,7 @@ void Monitor::check_sensor(int sensor) {
     // entry is then pushed out of the history and counted unpaired).
     if (reference.empty() || reference.newest().time_ns < e.time_ns) break;
     ++s.checked;
-    Eigen::Vector3d r = Eigen::Vector3d::Zero();
+    Vector3r r = Vector3r::Zero();
     if (!reference_at(reference, e.time_ns, r)) {
       ++st.unpaired;
       continue;
@@ -495,7 +494,7 @@ void Monitor::check_sensor(int sensor) {
     ++st.pairs;
     double square = 0.0;
     for (int c = 0; c < components; ++c) {
-      const double d = e.value[c] - r[c];
+      const auto d = static_cast<double>(e.value[c] - r[c]);
       square += d * d;
     }
     s.window.add(square);
@@ -580,7 +579,7 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
 
 // The axes' part of the status (mode, state, risk), and the alarm policy's input from them.
 void Monitor::update_axes_status(monitor::AlarmInput& input) {
-  double risk = 0.0;
+  Real risk = 0;
   bool moving = false;
   bool collapse = false;
   status_.probability = 0.0;
@@ -609,9 +608,9 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
       }
     }
   }
-  status_.risk = risk;
+  status_.risk = static_cast<double>(risk);
   input.risk = risk;
-  input.probability = status_.probability;
+  input.probability = static_cast<Real>(status_.probability);
   input.out_of_full_contact = moving;
   input.collapse_detected = collapse;
 }

@@ -6,10 +6,10 @@ namespace {
 
 // Column `column` of a 2^k-run design at run `run`: the product of the base factors whose bits
 // are set in `column` (column 1 = A, 2 = B, 3 = AB, ...), each factor -1 or +1 by the run's bit.
-double interaction(unsigned column, unsigned run) {
-  double sign = 1.0;
+Real interaction(unsigned column, unsigned run) {
+  Real sign = 1.0;
   for (unsigned bit = 0; (1U << bit) <= column; ++bit) {
-    if ((column >> bit & 1U) != 0U) sign *= (run >> bit & 1U) != 0U ? 1.0 : -1.0;
+    if ((column >> bit & 1U) != 0U) sign *= (run >> bit & 1U) != 0U ? Real(1) : -Real(1);
   }
   return sign;
 }

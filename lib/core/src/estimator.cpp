@@ -18,7 +18,8 @@ Error validate(const EstimatorSettings& st, const Scene& scene) {
   solver.step = st.step();
   PLINTH_TRY(validate(solver));
   PLINTH_TRY(validate_feature_set(scene));
-  if (const double limit = largest_stable_step(scene, solver.stepper); solver.step > limit) {
+  if (const auto limit = static_cast<Time>(largest_stable_step(scene, solver.stepper));
+      solver.step > limit) {
     return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
             "gives a solver step too large for a stable integration of this scene's base; "
             "raise it so that 1 / (rate * steps) is below the limit",

@@ -14,6 +14,7 @@
 #include "plinth/core/internal/guards.h"
 #include "plinth/core/internal/resets.h"
 #include "plinth/core/internal/steppers.h"
+#include "plinth/core/real.h"
 #include "plinth/core/simulator.h"
 #include "step_interval.h"
 
@@ -59,8 +60,8 @@ struct EventLogic {
 
   static ActiveGuards guards_of(const Mode& mode) { return active_guards<F>(mode); }
 
-  static void emit_event(Simulator& sim, double t, EventKind kind, int side = 0,
-                         double before = 0.0, double after = 0.0) {
+  static void emit_event(Simulator& sim, Time t, EventKind kind, int side = 0,
+                         Real before = Real(0), Real after = Real(0)) {
     Event e;
     e.t = t;
     e.kind = kind;
@@ -80,28 +81,26 @@ struct EventLogic {
   // friction gives it; then Eq 16/17 (rocking) with the accelerations of the new phase. (When
   // both hold at once in full contact, e.g. right after an impulse whose damper force jumps
   // past both thresholds, the block slides, and rocks too only if Eq 17 holds while sliding.)
-  static void start_phases_that_hold(Simulator& sim, double t) {
+  static void start_phases_that_hold(Simulator& sim, Time t) {
     const Scene& s = *sim.scene_;
     const GroundAcceleration ag = sim.excitation_.at(t);
     for (int pass = 0; pass < 2 && !sim.mode_.terminal(); ++pass) {
       const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
       if constexpr (F.sliding) {
         if (!sim.mode_.sliding()) {
-          const double left =
-              guard_value(GuardId::kSlidingOnsetLeft, s, sim.mode_, sim.y_, ag, acc);
-          const double right =
+          const Real left = guard_value(GuardId::kSlidingOnsetLeft, s, sim.mode_, sim.y_, ag, acc);
+          const Real right =
               guard_value(GuardId::kSlidingOnsetRight, s, sim.mode_, sim.y_, ag, acc);
-          if (left >= 0.0 || right >= 0.0) {
+          if (left >= Real(0) || right >= Real(0)) {
             start_sliding(sim, t, left >= right ? -1 : 1);
             continue;
           }
         }
       }
       if (!sim.mode_.rocking()) {
-        const double left = guard_value(GuardId::kRockingOnsetLeft, s, sim.mode_, sim.y_, ag, acc);
-        const double right =
-            guard_value(GuardId::kRockingOnsetRight, s, sim.mode_, sim.y_, ag, acc);
-        if (left >= 0.0 || right >= 0.0) {
+        const Real left = guard_value(GuardId::kRockingOnsetLeft, s, sim.mode_, sim.y_, ag, acc);
+        const Real right = guard_value(GuardId::kRockingOnsetRight, s, sim.mode_, sim.y_, ag, acc);
+        if (left >= Real(0) || right >= Real(0)) {
           start_rocking(sim, t, left >= right ? Corner::kLeft : Corner::kRight);
           continue;
         }
@@ -110,17 +109,17 @@ struct EventLogic {
     }
   }
 
-  static void start_rocking(Simulator& sim, double t, Corner corner) {
+  static void start_rocking(Simulator& sim, Time t, Corner corner) {
     rocking_onset_reset(corner, sim.mode_, sim.y_);
     emit_event(sim, t, EventKind::kRockingStart);
   }
 
-  static void start_sliding(Simulator& sim, double t, int direction) {
+  static void start_sliding(Simulator& sim, Time t, int direction) {
     sliding_onset_reset(direction, sim.mode_);
     emit_event(sim, t, EventKind::kSlidingStart, direction);
   }
 
-  static void stop_rocking(Simulator& sim, double t, double theta_dot_before) {
+  static void stop_rocking(Simulator& sim, Time t, Real theta_dot_before) {
     rocking_stop_reset(*sim.scene_, base_moves(sim.mode_), sim.mode_, sim.y_);
     emit_event(sim, t, EventKind::kRockingStop, 0, theta_dot_before);
   }
@@ -130,25 +129,26 @@ struct EventLogic {
   // towards the stop. A hit seen up to a step late has gained up to |a| dt, so with restitution
   // eta rebounds settle near eta |a| dt / (1 - eta) instead of dying out (the Zeno sequence the
   // located methods resolve and settle): k = eta / (1 - eta), within [4, 32] steps.
-  static constexpr double kStepEndRestStepsMin = 4.0;
-  static constexpr double kStepEndRestStepsMax = 32.0;
+  static constexpr Real kStepEndRestStepsMin = 4.0;
+  static constexpr Real kStepEndRestStepsMax = 32.0;
   // `acceleration()` gives a (computed only for step-end methods).
   template <class Acceleration>
-  static double slowest_rebound(const Simulator& sim, double rest_speed, Acceleration acceleration,
-                                double restitution) {
+  static Real slowest_rebound(const Simulator& sim, Real rest_speed, Acceleration acceleration,
+                              Real restitution) {
     if (!sim.events_at_step_ends_) return rest_speed;
-    const double steps =
-        restitution < 1.0 ? restitution / (1.0 - restitution) : kStepEndRestStepsMax;
+    const Real steps =
+        restitution < Real(1) ? restitution / (Real(1) - restitution) : kStepEndRestStepsMax;
     return std::max(rest_speed, std::clamp(steps, kStepEndRestStepsMin, kStepEndRestStepsMax) *
-                                    std::fabs(acceleration()) * sim.settings_.step);
+                                    std::fabs(acceleration()) *
+                                    static_cast<Real>(sim.settings_.step));
   }
 
   // Impact at theta = 0 (Eqs 21-24; with friction, the Coulomb impact of resets.h), or the end
   // of rocking when it leaves less rocking energy than the rest criterion's fraction of the new
   // pivot's overturning barrier.
-  static void rocking_impact(Simulator& sim, double t) {
+  static void rocking_impact(Simulator& sim, Time t) {
     const Scene& s = *sim.scene_;
-    const double before = sim.y_[kThetaDot];
+    const Real before = sim.y_[kThetaDot];
     const bool was_sliding = sim.mode_.sliding();
     Mode mode = sim.mode_;
     State y = sim.y_;
@@ -158,16 +158,16 @@ struct EventLogic {
       rocking_impact_reset(s, base_moves(mode), mode, y);
     }
     const CornerGeometry to = pivot_of(s, mode, y).geometry;
-    const double after = y[kThetaDot];
-    const double barrier = s.m * s.g * (to.radius - s.h);
+    const Real after = y[kThetaDot];
+    const Real barrier = s.m * s.g * (to.radius - s.h);
     sim.mode_ = mode;
     sim.y_ = y;
     // Taken at step ends, impacts closer than a few steps apart are chatter (see slowest_rebound).
-    const double slowest = slowest_rebound(
-        sim, 0.0, [&] { return accelerations(s, mode, y, sim.excitation_.at(t)).theta; },
-        before != 0.0 ? std::fabs(after / before) : 0.0);
-    if (after * before <= 0.0 || std::fabs(after) < slowest ||
-        0.5 * to.inertia * after * after < sim.settings_.rest_energy_ratio * barrier) {
+    const Real slowest = slowest_rebound(
+        sim, Real(0), [&] { return accelerations(s, mode, y, sim.excitation_.at(t)).theta; },
+        before != Real(0) ? std::fabs(after / before) : Real(0));
+    if (after * before <= Real(0) || std::fabs(after) < slowest ||
+        Real(0.5) * to.inertia * after * after < sim.settings_.rest_energy_ratio * barrier) {
       stop_rocking(sim, t, before);
     } else {
       emit_event(sim, t, EventKind::kImpact, 0, before, after);
@@ -184,16 +184,16 @@ struct EventLogic {
 
   // x' reached 0: the block sticks if static friction can hold it (Eq 15 or 18 not met in the
   // sticking phase), otherwise it slides back the other way.
-  static void sliding_stopped(Simulator& sim, double t) {
+  static void sliding_stopped(Simulator& sim, Time t) {
     const Scene& s = *sim.scene_;
     sliding_stop_reset(sim.mode_, sim.y_);
     const GroundAcceleration ag = sim.excitation_.at(t);
     const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
     const ContactForce f = sticking_contact_force(s, sim.mode_, sim.y_, ag, acc);
-    const int direction = f.tangential > 0.0 ? -1 : 1;
+    const int direction = f.tangential > Real(0) ? -1 : 1;
     // Strictly: with mu_s = 0 and no force at all the block stays put rather than "sliding" at
     // zero speed, re-stopping every step.
-    if (sliding_onset_guard(s, sim.mode_, sim.y_, direction, f) > 0.0) {
+    if (sliding_onset_guard(s, sim.mode_, sim.y_, direction, f) > Real(0)) {
       sliding_onset_reset(direction, sim.mode_);
       emit_event(sim, t, EventKind::kSlidingStart, direction);
       return;
@@ -205,17 +205,17 @@ struct EventLogic {
   // |x| reached x_hat (Eqs 30-32 with restitution, resets.h): the block rebounds from the stop,
   // or sticks against it once the rebound is slower than settings.slide_rest_speed (this ends
   // the Zeno sequence of ever smaller rebounds of a block pressed against the stop).
-  static void sliding_stop_hit(Simulator& sim, double t, int side) {
+  static void sliding_stop_hit(Simulator& sim, Time t, int side) {
     const Scene& s = *sim.scene_;
-    const double before = sim.y_[kXDot];
-    const double rebound = s.params.sliding_stops.restitution * std::fabs(before);
-    const double slowest = slowest_rebound(
+    const Real before = sim.y_[kXDot];
+    const Real rebound = s.params.sliding_stops.restitution * std::fabs(before);
+    const Real slowest = slowest_rebound(
         sim, sim.settings_.slide_rest_speed,
         [&] { return accelerations(s, sim.mode_, sim.y_, sim.excitation_.at(t)).x; },
         s.params.sliding_stops.restitution);
     if (rebound < slowest) {
-      coordinate_impulse_reset(s, sim.mode_, base_moves(sim.mode_), kXDot, 0.0, sim.y_);
-      sim.y_[kX] = side * s.params.support.clearance;
+      coordinate_impulse_reset(s, sim.mode_, base_moves(sim.mode_), kXDot, Real(0), sim.y_);
+      sim.y_[kX] = static_cast<Real>(side) * s.params.support.clearance;
       sliding_stop_reset(sim.mode_, sim.y_);
       emit_event(sim, t, EventKind::kSlideStopHit, side, before, sim.y_[kUDot]);
       start_phases_that_hold(sim, t);
@@ -225,13 +225,13 @@ struct EventLogic {
     emit_event(sim, t, EventKind::kSlideStopHit, side, before, sim.y_[kUDot]);
   }
 
-  static void base_stop_hit(Simulator& sim, double t, int side) {
+  static void base_stop_hit(Simulator& sim, Time t, int side) {
     const Scene& s = *sim.scene_;
-    const double before = sim.y_[kUDot];
+    const Real before = sim.y_[kUDot];
     base_stop_reset(s, side, sim.mode_, sim.y_);
     emit_event(sim, t, EventKind::kBaseStopHit, side, before, sim.y_[kUDot]);
     if (sim.mode_.sliding()) keep_sliding_consistent(sim, t);
-    const double slowest = slowest_rebound(
+    const Real slowest = slowest_rebound(
         sim, sim.settings_.base_rest_speed,
         [&] { return accelerations(s, sim.mode_, sim.y_, sim.excitation_.at(t)).u; },
         s.params.base_stops.restitution);
@@ -239,32 +239,33 @@ struct EventLogic {
   }
 
   // An impulse on the base changes x' while sliding: the phase follows its new sign.
-  static void keep_sliding_consistent(Simulator& sim, double t) {
-    const double x_dot = sim.y_[kXDot];
-    if (x_dot * sim.mode_.slide_direction > 0.0) return;
-    if (x_dot == 0.0) {
+  static void keep_sliding_consistent(Simulator& sim, Time t) {
+    const Real x_dot = sim.y_[kXDot];
+    if (x_dot * sim.mode_.slide_direction > Real(0)) return;
+    if (x_dot == Real(0)) {
       sliding_stopped(sim, t);
       return;
     }
-    sim.mode_.slide_direction = static_cast<std::int8_t>(x_dot > 0.0 ? 1 : -1);
+    sim.mode_.slide_direction = static_cast<std::int8_t>(x_dot > Real(0) ? 1 : -1);
     emit_event(sim, t, EventKind::kSlidingStart, sim.mode_.slide_direction);
   }
 
   // The base's rebound is too slow to matter: if the stop pushes back, the base rests on it.
-  static void hold_if_pushed(Simulator& sim, double t, int side) {
+  static void hold_if_pushed(Simulator& sim, Time t, int side) {
     const Scene& s = *sim.scene_;
     Mode held = sim.mode_;
     held.held_stop = static_cast<std::int8_t>(side);
     const GroundAcceleration ag = sim.excitation_.at(t);
-    const double reaction =
+    const Real reaction =
         base_stop_reaction(s, held, sim.y_, ag, accelerations(s, held, sim.y_, ag));
-    if (side * reaction > 0.0) return;  // the stop would have to pull: the base moves away
+    if (static_cast<Real>(side) * reaction > Real(0))
+      return;  // the stop would have to pull: the base moves away
     base_stop_hold_reset(s, side, sim.mode_, sim.y_);
     emit_event(sim, t, EventKind::kBaseStopHeld, side);
     start_phases_that_hold(sim, t);
   }
 
-  static void release_base(Simulator& sim, double t) {
+  static void release_base(Simulator& sim, Time t) {
     const int side = sim.mode_.held_stop;
     sim.mode_.held_stop = 0;
     emit_event(sim, t, EventKind::kBaseStopReleased, side);
@@ -274,7 +275,7 @@ struct EventLogic {
   // |theta| passed the pivot's critical angle: C is over the pivot. About the support's corner
   // that is C passing the support's edge, so the block falls off the base; about its own corner
   // it overturns.
-  static void overturn(Simulator& sim, double t) {
+  static void overturn(Simulator& sim, Time t) {
     const Pivot pivot = pivot_of(*sim.scene_, sim.mode_, sim.y_);
     sim.y_[kTheta] = pivot.geometry.sign * pivot.geometry.critical_angle;
     if (pivot.overhanging) {
@@ -286,7 +287,7 @@ struct EventLogic {
     emit_event(sim, t, EventKind::kOverturned);
   }
 
-  static void apply_reset(Simulator& sim, GuardId id, double t) {
+  static void apply_reset(Simulator& sim, GuardId id, Time t) {
     ++sim.event_count_;
     switch (id) {
       case GuardId::kRockingOnsetLeft:
@@ -311,7 +312,7 @@ struct EventLogic {
     if constexpr (F.base_stops) apply_base_stop_reset(sim, id, t);
   }
 
-  static void apply_sliding_reset(Simulator& sim, GuardId id, double t) {
+  static void apply_sliding_reset(Simulator& sim, GuardId id, Time t) {
     switch (id) {
       case GuardId::kSlidingOnsetLeft:
         start_sliding(sim, t, -1);
@@ -325,7 +326,7 @@ struct EventLogic {
         sliding_stopped(sim, t);
         return;
       case GuardId::kSlidingInconsistent: {
-        const double before = sim.y_[kXDot];
+        const Real before = sim.y_[kXDot];
         tangential_impact_reset(*sim.scene_, sim.mode_, sim.y_);
         emit_event(sim, t, EventKind::kSlidingStop, 0, before);
         start_phases_that_hold(sim, t);
@@ -341,13 +342,13 @@ struct EventLogic {
     }
   }
 
-  static void apply_support_edge_reset(Simulator& sim, GuardId id, double t) {
-    const double x_hat = sim.scene_->params.support.clearance;
+  static void apply_support_edge_reset(Simulator& sim, GuardId id, Time t) {
+    const Real x_hat = sim.scene_->params.support.clearance;
     switch (id) {
       case GuardId::kOutOfBaseLeft:
       case GuardId::kOutOfBaseRight: {
         const int side = id == GuardId::kOutOfBaseLeft ? -1 : 1;
-        sim.y_[kX] = side * x_hat;
+        sim.y_[kX] = static_cast<Real>(side) * x_hat;
         sim.mode_.overhang = static_cast<std::int8_t>(side);
         emit_event(sim, t, EventKind::kOutOfBase, side);
         if (!sim.mode_.rocking()) start_phases_that_hold(sim, t);
@@ -355,7 +356,7 @@ struct EventLogic {
       }
       case GuardId::kBackOnBase: {
         const int side = sim.mode_.overhang;
-        sim.y_[kX] = side * x_hat;
+        sim.y_[kX] = static_cast<Real>(side) * x_hat;
         sim.mode_.overhang = 0;
         emit_event(sim, t, EventKind::kBackOnBase, side);
         return;
@@ -369,7 +370,7 @@ struct EventLogic {
     }
   }
 
-  static void apply_base_stop_reset(Simulator& sim, GuardId id, double t) {
+  static void apply_base_stop_reset(Simulator& sim, GuardId id, Time t) {
     switch (id) {
       case GuardId::kBaseStopRight:
         base_stop_hit(sim, t, +1);
@@ -387,7 +388,7 @@ struct EventLogic {
 
   // Chatter within one step (Zeno): bring rocking to rest, stop sliding, and hold a base that
   // sits on a stop.
-  static void settle_chatter(Simulator& sim, double t) {
+  static void settle_chatter(Simulator& sim, Time t) {
     if (sim.mode_.rocking()) stop_rocking(sim, t, sim.y_[kThetaDot]);
     if constexpr (F.sliding) {
       // Stick-slip chatter: the block sticks for the rest of the step; the next step's guards
@@ -398,9 +399,10 @@ struct EventLogic {
       }
     }
     if constexpr (F.base_stops) {
-      const double u_max = sim.scene_->params.base_stops.max_displacement;
-      if (sim.mode_.held_stop == 0 && std::fabs(sim.y_[kU]) >= u_max * (1.0 - 1e-9)) {
-        hold_if_pushed(sim, t, sim.y_[kU] > 0.0 ? +1 : -1);
+      const Real u_max = sim.scene_->params.base_stops.max_displacement;
+      if (sim.mode_.held_stop == 0 &&
+          std::fabs(sim.y_[kU]) >= u_max * (Real(1) - real_tolerance::kAtStop)) {
+        hold_if_pushed(sim, t, sim.y_[kU] > Real(0) ? +1 : -1);
       }
     }
     ++sim.chatter_steps_;
@@ -414,42 +416,43 @@ struct EventLogic {
   // the end's horizontal ground acceleration is kept, as the next step's start. Otherwise (a
   // guard at or past 0, or not a number) returns false, nothing changed, and the step's interval
   // runs (ExactFullContact in phase_kernels.h).
-  static bool quiet_full_contact_step(Simulator& sim, double t0, double t_end) {
+  static bool quiet_full_contact_step(Simulator& sim, Time t0, Time t_end) {
     if constexpr (!F.base) {
       return false;
     } else {
       const Mode& mode = sim.mode_;
-      const double h = t_end - t0;
+      const auto h = static_cast<Real>(t_end - t0);
       State& y = sim.y_;
       // x and theta at rest, as every reset into full contact leaves them (a state given to
       // start_from may not: the interval advances it).
-      if (mode.held_stop != 0 || mode.overhang != 0 || y[kXDot] != 0.0 || y[kThetaDot] != 0.0 ||
-          t0 + h != t_end) {
+      if (mode.held_stop != 0 || mode.overhang != 0 || y[kXDot] != Real(0) ||
+          y[kThetaDot] != Real(0) || t0 + static_cast<Time>(h) != t_end) {
         return false;
       }
       const Scene& s = *sim.scene_;
-      const double a0 = sim.quiet_ground_step_ == sim.step_count_
-                            ? sim.quiet_ground_horizontal_
-                            : kernels::Base::ground(sim.excitation_, t0).horizontal;
+      const Real a0 = sim.quiet_ground_step_ == sim.step_count_
+                          ? sim.quiet_ground_horizontal_
+                          : kernels::Base::ground(sim.excitation_, t0).horizontal;
       const GroundAcceleration a1 = kernels::Base::ground(sim.excitation_, t_end);
-      double u = y[kU];
-      double u_dot = y[kUDot];
+      Real u = y[kU];
+      Real u_dot = y[kUDot];
       sim.propagator_.advance(u, u_dot, a0, a1.horizontal);
-      const Accelerations acc{full_contact_base_acceleration(s, u, u_dot, a1.horizontal), 0.0, 0.0};
-      if (!(rocking_onset_guard(s, s.corner1.sign, s.corner1.onset_ratio, acc, a1) < 0.0 &&
-            rocking_onset_guard(s, s.corner2.sign, s.corner2.onset_ratio, acc, a1) < 0.0)) {
+      const Accelerations acc{full_contact_base_acceleration(s, u, u_dot, a1.horizontal), Real(0),
+                              Real(0)};
+      if (!(rocking_onset_guard(s, s.corner1.sign, s.corner1.onset_ratio, acc, a1) < Real(0) &&
+            rocking_onset_guard(s, s.corner2.sign, s.corner2.onset_ratio, acc, a1) < Real(0))) {
         return false;
       }
       if constexpr (F.sliding) {
         // Eq 15 (x stays: sliding_onset_guard's test of the sliding stops holds as it did).
         const ContactForce f = sticking_contact_force(s, mode, y, a1, acc, SinCos{});
-        if (!(sliding_onset_guard(s, mode, y, -1, f, SinCos{}) < 0.0 &&
-              sliding_onset_guard(s, mode, y, 1, f, SinCos{}) < 0.0)) {
+        if (!(sliding_onset_guard(s, mode, y, -1, f, SinCos{}) < Real(0) &&
+              sliding_onset_guard(s, mode, y, 1, f, SinCos{}) < Real(0))) {
           return false;
         }
       }
       if constexpr (F.base_stops) {
-        if (!(std::fabs(u) - s.params.base_stops.max_displacement < 0.0)) return false;
+        if (!(std::fabs(u) - s.params.base_stops.max_displacement < Real(0))) return false;
       }
       y[kU] = u;
       y[kUDot] = u_dot;
@@ -460,7 +463,7 @@ struct EventLogic {
     }
   }
 
-  static Accelerations current_accelerations(const Simulator& sim, double t, const State& y) {
+  static Accelerations current_accelerations(const Simulator& sim, Time t, const State& y) {
     return accelerations(*sim.scene_, sim.mode_, y, sim.excitation_.at(t));
   }
 

@@ -5,14 +5,14 @@
 
 namespace plinth {
 
-GroundAcceleration Excitation::pulse_at(double t) const {
+GroundAcceleration Excitation::pulse_at(Time t) const {
   if (t < 0.0 || t > period) return {};
-  const double phase = 2.0 * std::numbers::pi * t / period;
+  const auto phase = static_cast<Real>(2.0 * std::numbers::pi * t / period);
   return {amplitude * (kind == ExcitationKind::kSinePulse ? std::sin(phase) : std::cos(phase)),
-          0.0};
+          Real(0)};
 }
 
-double Excitation::duration() const {
+Time Excitation::duration() const {
   switch (kind) {
     case ExcitationKind::kNone:
       return 0.0;
@@ -28,7 +28,7 @@ double Excitation::duration() const {
   return 0.0;
 }
 
-Excitation Excitation::record(SampledSignal h, SampledSignal v, double gamma) {
+Excitation Excitation::record(SampledSignal h, SampledSignal v, Real gamma) {
   Excitation e;
   e.kind = ExcitationKind::kRecord;
   e.horizontal = h;
@@ -37,7 +37,7 @@ Excitation Excitation::record(SampledSignal h, SampledSignal v, double gamma) {
   return e;
 }
 
-Excitation Excitation::sine_pulse(double amplitude, double period) {
+Excitation Excitation::sine_pulse(Real amplitude, Time period) {
   Excitation e;
   e.kind = ExcitationKind::kSinePulse;
   e.amplitude = amplitude;
@@ -45,7 +45,7 @@ Excitation Excitation::sine_pulse(double amplitude, double period) {
   return e;
 }
 
-Excitation Excitation::cosine_pulse(double amplitude, double period) {
+Excitation Excitation::cosine_pulse(Real amplitude, Time period) {
   Excitation e;
   e.kind = ExcitationKind::kCosinePulse;
   e.amplitude = amplitude;

@@ -118,7 +118,8 @@ void Forecaster::on_sample(GroundAcceleration sample, double time_s,
   sum_.horizontal += sample.horizontal;
   sum_.vertical += sample.vertical;
   if (++summed_ >= decimation_) {
-    push_window({sum_.horizontal / summed_, sum_.vertical / summed_});
+    push_window(
+        {sum_.horizontal / static_cast<Real>(summed_), sum_.vertical / static_cast<Real>(summed_)});
     sum_ = {};
     summed_ = 0;
   }
@@ -175,8 +176,8 @@ void Forecaster::fill_continuation() {
   }
   for (int i = 0; i < continuation_length_; ++i) {
     const GroundAcceleration& a = (*source)[static_cast<std::size_t>((first + i) % window_length_)];
-    horizontal_[static_cast<std::size_t>(i)] = scale * a.horizontal;
-    vertical_[static_cast<std::size_t>(i)] = scale * a.vertical;
+    horizontal_[static_cast<std::size_t>(i)] = scale * static_cast<double>(a.horizontal);
+    vertical_[static_cast<std::size_t>(i)] = scale * static_cast<double>(a.vertical);
   }
 }
 

@@ -6,23 +6,23 @@
 namespace plinth::internal {
 namespace {
 
-using Matrix4 = Eigen::Matrix4d;
+using Matrix4 = Matrix4r;
 
 // exp(a) by scaling and squaring with a Taylor series: |a| / 2^j <= 1/2, terms up to the
 // 24th (0.5^25 / 25! is below 1e-32).
 Matrix4 exponential(const Matrix4& a) {
-  const double norm = a.cwiseAbs().colwise().sum().maxCoeff();
+  const Real norm = a.cwiseAbs().colwise().sum().maxCoeff();
   int squarings = 0;
-  double scale = 1.0;
-  while (norm * scale > 0.5 && squarings < 60) {
-    scale *= 0.5;
+  Real scale = 1.0;
+  while (norm * scale > Real(0.5) && squarings < 60) {
+    scale *= Real(0.5);
     ++squarings;
   }
   const Matrix4 scaled = a * scale;
   Matrix4 sum = Matrix4::Identity();
   Matrix4 term = Matrix4::Identity();
   for (int n = 1; n <= 24; ++n) {
-    term = term * scaled / static_cast<double>(n);
+    term = term * scaled / static_cast<Real>(n);
     sum += term;
   }
   for (int i = 0; i < squarings; ++i) sum = sum * sum;
@@ -31,7 +31,7 @@ Matrix4 exponential(const Matrix4& a) {
 
 }  // namespace
 
-FullContactPropagator FullContactPropagator::make(const Scene& s, double h) {
+FullContactPropagator FullContactPropagator::make(const Scene& s, Real h) {
   FullContactPropagator p;
   p.step = h;
   if (!s.has_base()) return p;
@@ -40,7 +40,7 @@ FullContactPropagator FullContactPropagator::make(const Scene& s, double h) {
   a(0, 1) = 1.0;
   a(1, 0) = -s.stiffness / s.total_mass;
   a(1, 1) = -s.damping / s.total_mass;
-  a(1, 2) = -1.0;
+  a(1, 2) = -Real(1);
   a(2, 3) = 1.0;
   const Matrix4 e = exponential(a * h);
   // z(h) = e z(0) with a' = (a1 - a0) / h: Gamma0 = e(:, 2) - e(:, 3) / h, Gamma1 = e(:, 3) / h.

@@ -8,6 +8,7 @@
 #include "plinth/core/excitation.h"
 #include "plinth/core/internal/flows.h"
 #include "plinth/core/internal/full_contact_propagator.h"
+#include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 
@@ -17,7 +18,7 @@ struct Context {
   const Scene& scene;
   const Excitation& excitation;
   const FullContactPropagator& propagator;  // over one step (exact full contact)
-  double full_step;  // the interval's length when it is a whole step, s; else 0
+  Real full_step;  // the interval's length when it is a whole step, s; else 0
   const Mode& mode;
   const State& y0;
 };
@@ -36,18 +37,17 @@ struct Base {
 
   // Without excitation (free motion, the benchmarks) no call at all.
   // Inlined also where the solver is not flattened (the quiet full-contact step).
-  [[nodiscard, gnu::always_inline]] static GroundAcceleration ground(const Excitation& e,
-                                                                     double t) {
+  [[nodiscard, gnu::always_inline]] static GroundAcceleration ground(const Excitation& e, Time t) {
     return e.kind == ExcitationKind::kNone ? GroundAcceleration{} : e.at(t);
   }
-  [[nodiscard]] GroundAcceleration ground(double t) const { return ground(*excitation, t); }
+  [[nodiscard]] GroundAcceleration ground(Time t) const { return ground(*excitation, t); }
 };
 
 // What rocking kernels share: sin and cos at every point of the interval (its stages, its end,
 // the points where an event is located) from those of its start, theta0, computed once by
 // sin_cos (not carried over from the last step: no drift of roundings).
 struct Turning : Base {
-  double theta0;
+  Real theta0;
   SinCos trig0;
 
   explicit Turning(const Context& c)
@@ -91,17 +91,18 @@ struct ExactFullContact : FullContact {
   static constexpr bool kExact = true;
 
   const FullContactPropagator* propagator;
-  double full_step;
+  Real full_step;
 
   explicit ExactFullContact(const Context& c)
       : FullContact(c), propagator(&c.propagator), full_step(c.full_step) {}
 
-  [[nodiscard]] State advance(double t, const State& y, const FlowPoint& start, double h,
+  [[nodiscard]] State advance(Time t, const State& y, const FlowPoint& start, Real h,
                               const GroundAcceleration* end_ground) const {
     State next = y;
     next.head<3>() += h * y.tail<3>();  // x and theta stay (their rates are 0 in full contact)
     if (!moves) return next;
-    const double a1 = (end_ground != nullptr ? *end_ground : ground(t + h)).horizontal;
+    const Real a1 =
+        (end_ground != nullptr ? *end_ground : ground(t + static_cast<Time>(h))).horizontal;
     next[kU] = y[kU];
     if (h == full_step) {  // a whole step: its t_end - t0 differs from the step by roundings
       propagator->advance(next[kU], next[kUDot], start.ground.horizontal, a1);
@@ -149,7 +150,7 @@ struct Rocking : Turning {
   // The lever arms at a stage turned from the start's (lever_arms_turned): the stages' chain of
   // dependent operations skips sin and cos. Beyond kStageAngle, from sin_cos_near.
   [[nodiscard]] LeverArms arms(const State& y) const {
-    const double d = y[kTheta] - theta0;
+    const Real d = y[kTheta] - theta0;
     if (std::fabs(d) <= kStageAngle) return lever_arms_turned(arms0, d);
     return lever_arms(*s, pivot.offset, trig(y));
   }

@@ -11,16 +11,17 @@ constexpr Error fail(ErrorCode code, const char* field, const char* reason) {
 }
 
 // Checks `value` is finite and strictly positive.
-Error check_positive(double value, const char* field) {
+Error check_positive(Real value, const char* field) {
   if (!std::isfinite(value)) return fail(ErrorCode::kNotFinite, field, "must be a finite number");
-  if (value <= 0.0) return fail(ErrorCode::kOutOfRange, field, "must be greater than zero");
+  if (value <= Real(0)) return fail(ErrorCode::kOutOfRange, field, "must be greater than zero");
   return ok_error();
 }
 
 // Checks `value` is finite and in [0, 1].
-Error check_unit_interval(double value, const char* field) {
+Error check_unit_interval(Real value, const char* field) {
   if (!std::isfinite(value)) return fail(ErrorCode::kNotFinite, field, "must be a finite number");
-  if (value < 0.0 || value > 1.0) return fail(ErrorCode::kOutOfRange, field, "must lie in [0, 1]");
+  if (value < Real(0) || value > Real(1))
+    return fail(ErrorCode::kOutOfRange, field, "must lie in [0, 1]");
   return ok_error();
 }
 
@@ -44,7 +45,7 @@ Error validate(const SceneParams& p) {
     if (!std::isfinite(p.base.damping_ratio)) {
       return fail(ErrorCode::kNotFinite, "base.damping_ratio", "must be a finite number");
     }
-    if (p.base.damping_ratio < 0.0 || p.base.damping_ratio >= 1.0) {
+    if (p.base.damping_ratio < Real(0) || p.base.damping_ratio >= Real(1)) {
       return fail(ErrorCode::kOutOfRange, "base.damping_ratio", "must lie in [0, 1)");
     }
   }
@@ -63,10 +64,10 @@ Error validate(const SceneParams& p) {
     if (!std::isfinite(f.kinetic_coefficient)) {
       return fail(ErrorCode::kNotFinite, "friction.kinetic", "must be a finite number");
     }
-    if (f.static_coefficient < 0.0) {
+    if (f.static_coefficient < Real(0)) {
       return fail(ErrorCode::kOutOfRange, "friction.static", "must not be negative");
     }
-    if (f.kinetic_coefficient < 0.0) {
+    if (f.kinetic_coefficient < Real(0)) {
       return fail(ErrorCode::kOutOfRange, "friction.kinetic", "must not be negative");
     }
     if (f.kinetic_coefficient > f.static_coefficient) {
@@ -91,7 +92,7 @@ Error validate(const SceneParams& p) {
   return ok_error();
 }
 
-CornerGeometry make_corner(double distance, double sign, double h, double m, double inertia_c) {
+CornerGeometry make_corner(Real distance, Real sign, Real h, Real m, Real inertia_c) {
   CornerGeometry c;
   c.offset = sign * distance;
   c.radius = std::hypot(distance, h);
@@ -104,7 +105,7 @@ CornerGeometry make_corner(double distance, double sign, double h, double m, dou
 
 }  // namespace
 
-CornerGeometry corner_geometry(const Scene& s, double distance, double sign) {
+CornerGeometry corner_geometry(const Scene& s, Real distance, Real sign) {
   return make_corner(distance, sign, s.h, s.m, s.inertia_c);
 }
 
@@ -119,14 +120,14 @@ Error make_scene(const SceneParams& params, Scene& out) {
   s.g = params.gravity;
   s.b1 = s.b + params.block.eccentricity;
   s.b2 = s.b - params.block.eccentricity;
-  s.corner1 = make_corner(s.b1, +1.0, s.h, s.m, s.inertia_c);
-  s.corner2 = make_corner(s.b2, -1.0, s.h, s.m, s.inertia_c);
+  s.corner1 = make_corner(s.b1, +Real(1), s.h, s.m, s.inertia_c);
+  s.corner2 = make_corner(s.b2, -Real(1), s.h, s.m, s.inertia_c);
   s.impact_inertia = s.inertia_c + s.m * (s.h * s.h - s.b1 * s.b2);
   if (params.has_base) {
     s.total_mass = s.m + params.base.mass;
-    s.omega = 2.0 * std::numbers::pi / params.base.period;
+    s.omega = Real(2) * std::numbers::pi_v<Real> / params.base.period;
     s.stiffness = s.total_mass * s.omega * s.omega;                        // Eq 26
-    s.damping = 2.0 * params.base.damping_ratio * s.total_mass * s.omega;  // Eq 26
+    s.damping = Real(2) * params.base.damping_ratio * s.total_mass * s.omega;  // Eq 26
   } else {
     s.total_mass = s.m;
   }

@@ -23,21 +23,21 @@ Error validate(const SolverSettings& st) {
     return {ErrorCode::kOutOfRange, "solver.stepper",
             "must be rk4_located: this build has no other (PLINTH_CORE_RK4_ONLY)"};
   }
-  if (!std::isfinite(st.rest_energy_ratio) || st.rest_energy_ratio <= 0.0 ||
-      st.rest_energy_ratio >= 1.0) {
+  if (!std::isfinite(st.rest_energy_ratio) || st.rest_energy_ratio <= Real(0) ||
+      st.rest_energy_ratio >= Real(1)) {
     return {ErrorCode::kOutOfRange, "solver.rest_energy_ratio", "must lie in (0, 1)"};
   }
-  if (!std::isfinite(st.base_rest_speed) || st.base_rest_speed < 0.0) {
+  if (!std::isfinite(st.base_rest_speed) || st.base_rest_speed < Real(0)) {
     return {ErrorCode::kOutOfRange, "solver.base_rest_speed", "must be finite and not negative"};
   }
-  if (!std::isfinite(st.slide_rest_speed) || st.slide_rest_speed < 0.0) {
+  if (!std::isfinite(st.slide_rest_speed) || st.slide_rest_speed < Real(0)) {
     return {ErrorCode::kOutOfRange, "solver.slide_rest_speed", "must be finite and not negative"};
   }
   if (st.max_events_per_step < 1) {
     return {ErrorCode::kOutOfRange, "solver.max_events_per_step", "must be at least 1"};
   }
-  if (!std::isfinite(st.event_time_tolerance) || st.event_time_tolerance <= 0.0 ||
-      st.event_time_tolerance > 0.1) {
+  if (!std::isfinite(st.event_time_tolerance) || st.event_time_tolerance <= Real(0) ||
+      st.event_time_tolerance > Real(0.1)) {
     return {ErrorCode::kOutOfRange, "solver.event_time_tolerance", "must lie in (0, 0.1]"};
   }
   return ok_error();
@@ -108,7 +108,8 @@ Error validate_feature_set(const Scene& scene) {
 Error Simulator::create(const Scene& scene, const Excitation& excitation,
                         const SolverSettings& settings, Simulator& out) {
   PLINTH_TRY(validate(settings));
-  if (const double limit = largest_stable_step(scene, settings.stepper); settings.step > limit) {
+  if (const auto limit = static_cast<Time>(largest_stable_step(scene, settings.stepper));
+      settings.step > limit) {
     return {ErrorCode::kOutOfRange, "solver.step",
             "is too large for a stable integration of this scene's base (stiff or light base)",
             limit};
@@ -119,7 +120,8 @@ Error Simulator::create(const Scene& scene, const Excitation& excitation,
   sim.settings_ = settings;
   sim.events_at_step_ends_ = settings.stepper == Stepper::kRk4StepEnd;
   if (settings.exact_full_contact) {
-    sim.propagator_ = internal::FullContactPropagator::make(scene, settings.step);
+    sim.propagator_ =
+        internal::FullContactPropagator::make(scene, static_cast<Real>(settings.step));
   }
   const Features f = features_of(scene);
   PLINTH_TRY(validate_feature_set(scene));
@@ -142,13 +144,13 @@ void Simulator::start_from(const Mode& mode, const State& state) {
   event_count_ = 0;
   mode_ = mode;
   y_ = state;
-  start_phases_fn_(*this, 0.0);
+  start_phases_fn_(*this, Real(0));
   refresh_guards();
 }
 
 void Simulator::start_at_rest() { start_from(Mode{}, State::Zero()); }
 
-void Simulator::start_with_impulse(double impulse) {
+void Simulator::start_with_impulse(Real impulse) {
   State y = State::Zero();
   Mode mode;
   if (scene_->has_base()) {
@@ -157,10 +159,10 @@ void Simulator::start_with_impulse(double impulse) {
     return;
   }
   start_from(mode, y);
-  if (impulse == 0.0) return;
+  if (impulse == Real(0)) return;
   // On the ground, the block moves at +I relative to it and is caught by the corner ahead:
   // angular momentum about that corner, -m h I = I_i theta'(0+).
-  const Corner corner = impulse > 0.0 ? Corner::kRight : Corner::kLeft;
+  const Corner corner = impulse > Real(0) ? Corner::kRight : Corner::kLeft;
   mode_.phase = Phase::kRocking;
   mode_.corner = corner;
   y_[kThetaDot] = -scene_->m * scene_->h * impulse / scene_->corner(corner).inertia;
@@ -177,8 +179,8 @@ void Simulator::start_with_impulse(double impulse) {
 // One step by intervals: the stepper in the current mode, then event after event.
 void Simulator::step_intervals() {
   if (mode_.terminal()) return;
-  const double t_end = static_cast<double>(step_count_ + 1) * settings_.step;
-  double t0 = time();
+  const Time t_end = static_cast<Time>(step_count_ + 1) * settings_.step;
+  Time t0 = time();
   if (interval_fns_[static_cast<std::size_t>(mode_.phase)](*this, t0, t_end, true, true)) {
     finish_step(t0, t_end);
   }
@@ -187,7 +189,7 @@ void Simulator::step_intervals() {
 
 // The rest of a step after its first event, at t0: the new mode to t_end, event after event;
 // past max_events_per_step, chatter is settled and the step ends without guards.
-void Simulator::finish_step(double t0, double t_end) {
+void Simulator::finish_step(Time t0, Time t_end) {
   int events = 0;
   bool guards_live = true;
   do {

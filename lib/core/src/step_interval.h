@@ -11,6 +11,7 @@
 #include "phase_kernels.h"
 #include "plinth/core/internal/flows.h"
 #include "plinth/core/internal/guards.h"
+#include "plinth/core/real.h"
 #include "plinth/core/simulator.h"
 
 namespace plinth::internal {
@@ -20,8 +21,8 @@ namespace plinth::internal {
 // reset applied.
 template <class Method, class Kernel>
 struct StepInterval {
-  static State advance_state(const Kernel& k, double t, const State& y, const FlowPoint& start,
-                             double h, const GroundAcceleration* end_ground = nullptr) {
+  static State advance_state(const Kernel& k, Time t, const State& y, const FlowPoint& start,
+                             Real h, const GroundAcceleration* end_ground = nullptr) {
     if constexpr (Kernel::kExact) {
       return k.advance(t, y, start, h, end_ground);
     } else {
@@ -46,16 +47,16 @@ struct StepInterval {
     bool any = false;
     for (int i = 0; i < guards.count; ++i) {
       const auto k = static_cast<std::size_t>(i);
-      const double b = step_guard_value(guards.ids[k], s, mode, y, p);
-      const double a = start[k];
+      const Real b = step_guard_value(guards.ids[k], s, mode, y, p);
+      const Real a = start[k];
       out[k] = b;
-      any = any || (a <= 0.0 && b >= 0.0 && (a < 0.0 || b > 0.0));
+      any = any || (a <= Real(0) && b >= Real(0) && (a < Real(0) || b > Real(0)));
     }
     return any;
   }
 
-  static double guard_at_time(const Simulator& sim, const Kernel& k, const Mode& mode, GuardId id,
-                              double t, const State& y) {
+  static Real guard_at_time(const Simulator& sim, const Kernel& k, const Mode& mode, GuardId id,
+                            Time t, const State& y) {
     const FlowPoint p = k.point(y, k.ground(t));
     return guard_value(id, *sim.scene_, mode, y, p.ground, p.acc, p.trig);
   }
@@ -64,30 +65,32 @@ struct StepInterval {
   // the witness tau -> g(t0 + tau, advance_state(y0, tau)) is bracketed by g(a) < 0 <= g(b) and its
   // root found by the Illinois variant of regula falsi, with a bisection whenever an update
   // fails to halve the bracket. Returns the bracket's upper end, where the guard holds.
-  [[gnu::noinline]] static double locate_crossing(const Simulator& sim, const Kernel& k,
-                                                  const Mode& mode, GuardId id, double t0,
-                                                  const State& y0, const FlowPoint& start, double a,
-                                                  double fa, double b, double fb) {
-    const double tolerance = sim.settings_.event_time_tolerance * sim.settings_.step;
+  [[gnu::noinline]] static Real locate_crossing(const Simulator& sim, const Kernel& k,
+                                                const Mode& mode, GuardId id, Time t0,
+                                                const State& y0, const FlowPoint& start, Real a,
+                                                Real fa, Real b, Real fb) {
+    const Real tolerance =
+        sim.settings_.event_time_tolerance * static_cast<Real>(sim.settings_.step);
     int last_side = 0;
     bool bisect = false;
     for (int iteration = 0; iteration < 200 && b - a > tolerance; ++iteration) {
-      const double width = b - a;
-      double c = bisect ? 0.5 * (a + b) : (a * fb - b * fa) / (fb - fa);
-      if (!(c > a && c < b)) c = 0.5 * (a + b);
-      const double fc = guard_at_time(sim, k, mode, id, t0 + c, advance_state(k, t0, y0, start, c));
-      if (fc >= 0.0) {
+      const Real width = b - a;
+      Real c = bisect ? Real(0.5) * (a + b) : (a * fb - b * fa) / (fb - fa);
+      if (!(c > a && c < b)) c = Real(0.5) * (a + b);
+      const Real fc = guard_at_time(sim, k, mode, id, t0 + static_cast<Time>(c),
+                                    advance_state(k, t0, y0, start, c));
+      if (fc >= Real(0)) {
         b = c;
         fb = fc;
-        if (last_side == 1) fa *= 0.5;
+        if (last_side == 1) fa *= Real(0.5);
         last_side = 1;
       } else {
         a = c;
         fa = fc;
-        if (last_side == -1) fb *= 0.5;
+        if (last_side == -1) fb *= Real(0.5);
         last_side = -1;
       }
-      bisect = (b - a) > 0.5 * width;
+      bisect = (b - a) > Real(0.5) * width;
     }
     return b;
   }
@@ -98,16 +101,16 @@ struct StepInterval {
   // and may come back within the same step, so the step is probed for the excursion below 0
   // and the return is located from there. An excursion too small to see is taken as an event
   // at the end of the interval.
-  static double crossing_time(const Simulator& sim, const Kernel& k, const Mode& mode, GuardId id,
-                              double t0, const State& y0, const FlowPoint& start, double h,
-                              double g_start, double g_end) {
-    if (g_start < 0.0)
-      return locate_crossing(sim, k, mode, id, t0, y0, start, 0.0, g_start, h, g_end);
-    for (const double fraction : {0.0625, 0.25, 0.5, 0.75}) {
-      const double tau = fraction * h;
-      const double g =
-          guard_at_time(sim, k, mode, id, t0 + tau, advance_state(k, t0, y0, start, tau));
-      if (g < 0.0) return locate_crossing(sim, k, mode, id, t0, y0, start, tau, g, h, g_end);
+  static Real crossing_time(const Simulator& sim, const Kernel& k, const Mode& mode, GuardId id,
+                            Time t0, const State& y0, const FlowPoint& start, Real h, Real g_start,
+                            Real g_end) {
+    if (g_start < Real(0))
+      return locate_crossing(sim, k, mode, id, t0, y0, start, Real(0), g_start, h, g_end);
+    for (const Real fraction : {Real(0.0625), Real(0.25), Real(0.5), Real(0.75)}) {
+      const Real tau = fraction * h;
+      const Real g = guard_at_time(sim, k, mode, id, t0 + static_cast<Time>(tau),
+                                   advance_state(k, t0, y0, start, tau));
+      if (g < Real(0)) return locate_crossing(sim, k, mode, id, t0, y0, start, tau, g, h, g_end);
     }
     return h;
   }
@@ -115,43 +118,45 @@ struct StepInterval {
   // The guard that crossed first, and when (tau from t0); tau is infinite when none did.
   struct Crossing {
     GuardId id = GuardId::kRockingImpact;
-    double tau = std::numeric_limits<double>::infinity();
+    Real tau = std::numeric_limits<Real>::infinity();
   };
 
   // Out of line: the step's hot path only checks that no guard changed sign (evaluate_end_guards).
   [[gnu::noinline]] static Crossing earliest_crossing(const Simulator& sim, const Kernel& k,
                                                       const Mode& mode, const ActiveGuards& guards,
-                                                      double t0, const State& y0,
-                                                      const FlowPoint& start, double h,
+                                                      Time t0, const State& y0,
+                                                      const FlowPoint& start, Real h,
                                                       const GuardValues& g_start,
                                                       const GuardValues& g_end) {
     Crossing first;
     for (int i = 0; i < guards.count; ++i) {
       const auto j = static_cast<std::size_t>(i);
-      const double a = g_start[j];
-      const double b = g_end[j];
+      const Real a = g_start[j];
+      const Real b = g_end[j];
       if constexpr (Method::kLocated) {
-        if (a > 0.0 || b < 0.0 || (a == 0.0 && b == 0.0)) continue;
-        const double tau = crossing_time(sim, k, mode, guards.ids[j], t0, y0, start, h, a, b);
+        if (a > Real(0) || b < Real(0) || (a == Real(0) && b == Real(0))) continue;
+        const Real tau = crossing_time(sim, k, mode, guards.ids[j], t0, y0, start, h, a, b);
         if (tau < first.tau) first = {guards.ids[j], tau};
       } else {
         // No location: the crossing seen at the step's end; the guards are ranked by where
         // their straight line between the ends crosses zero.
-        if (!(a < 0.0 && b >= 0.0)) continue;
-        const double tau = h * (a / (a - b));
+        if (!(a < Real(0) && b >= Real(0))) continue;
+        const Real tau = h * (a / (a - b));
         if (tau < first.tau) first = {guards.ids[j], tau};
       }
     }
     return first;
   }
 
-  PLINTH_FLATTEN static bool advance_interval(Simulator& sim, double& t0, double t_end,
+  PLINTH_FLATTEN static bool advance_interval(Simulator& sim, Time& t0, Time t_end,
                                               bool guards_live, bool full_step) {
     const Scene& s = *sim.scene_;
     const Mode mode = sim.mode_;
     const State& y0 = sim.y_;  // replaced only once y1 (or the event's state) is complete
-    const double h = t_end - t0;
-    Kernel k({s, sim.excitation_, sim.propagator_, full_step ? h : 0.0, mode, y0});
+    // The interval's length, and below the offsets inside it, in Real; the times themselves in
+    // Time.
+    const auto h = static_cast<Real>(t_end - t0);
+    Kernel k({s, sim.excitation_, sim.propagator_, full_step ? h : Real(0), mode, y0});
     static constexpr ActiveGuards kNone{};
     const ActiveGuards& guards = guards_live ? sim.active_guards_ : kNone;
     // The start: kept from the end of the last step when it had no event.
@@ -163,7 +168,8 @@ struct StepInterval {
       evaluate_guards(s, mode, guards, y0, start, g_start);
     }
     const GroundAcceleration end_ground = k.ground(t_end);
-    const State y1 = advance_state(k, t0, y0, start, h, t0 + h == t_end ? &end_ground : nullptr);
+    const State y1 = advance_state(k, t0, y0, start, h,
+                                   t0 + static_cast<Time>(h) == t_end ? &end_ground : nullptr);
     FlowPoint& end = sim.points_[next];
     GuardValues& g_end = sim.guard_values_[next];
     end = k.point(y1, end_ground);
@@ -181,7 +187,7 @@ struct StepInterval {
     sim.cache_valid_ = false;
     if constexpr (Method::kLocated) {
       sim.y_ = advance_state(k, t0, y0, start, first.tau);
-      t0 += first.tau;
+      t0 += static_cast<Time>(first.tau);
     } else {
       sim.y_ = y1;
       t0 = t_end;

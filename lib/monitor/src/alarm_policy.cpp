@@ -15,11 +15,11 @@ constexpr AlarmLevel higher(AlarmLevel a, AlarmLevel b) { return rank(a) >= rank
 Error check_thresholds(const RiskThresholds& t, const char* on_field, const char* off_field) {
   if (!std::isfinite(t.on)) return {ErrorCode::kNotFinite, on_field, "must be finite"};
   if (!std::isfinite(t.off)) return {ErrorCode::kNotFinite, off_field, "must be finite"};
-  if (t.on < 0.0 || t.on > 1.0) {
-    return {ErrorCode::kOutOfRange, on_field, "must lie in [0, 1]", 1.0};
+  if (t.on < Real(0) || t.on > Real(1)) {
+    return {ErrorCode::kOutOfRange, on_field, "must lie in [0, 1]", Real(1)};
   }
-  if (t.off < 0.0 || t.off > 1.0) {
-    return {ErrorCode::kOutOfRange, off_field, "must lie in [0, 1]", 1.0};
+  if (t.off < Real(0) || t.off > Real(1)) {
+    return {ErrorCode::kOutOfRange, off_field, "must lie in [0, 1]", Real(1)};
   }
   if (t.off >= t.on) {
     return {ErrorCode::kInconsistent, off_field, "must be below the level's on threshold", t.on};
@@ -42,11 +42,11 @@ Error check_order(const RiskThresholds& lower, const RiskThresholds& upper, cons
 }
 
 // A threshold with hysteresis: start at `on`, hold down to `off`.
-bool above(const detail::HeldCondition& held, const RiskThresholds& t, double value) {
+bool above(const detail::HeldCondition& held, const RiskThresholds& t, Real value) {
   return value >= (held.active ? t.off : t.on);
 }
 
-bool valid_fraction(double v) { return std::isfinite(v) && v >= 0.0 && v <= 1.0; }
+bool valid_fraction(Real v) { return std::isfinite(v) && v >= Real(0) && v <= Real(1); }
 
 }  // namespace
 

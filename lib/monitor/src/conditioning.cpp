@@ -11,7 +11,7 @@ namespace plinth::monitor {
 namespace {
 
 // What a sensor at rest reads in the statue frame, m/s2 (the support pushes up).
-Eigen::Vector3d gravity_up() { return {0.0, 0.0, kStandardGravity}; }
+Vector3r gravity_up() { return {Real(0), Real(0), kStandardGravity}; }
 
 // Samples in the start-up window; validate() checks it is at least 2.
 std::int64_t window_length(const ConditioningSettings& s) {
@@ -19,27 +19,26 @@ std::int64_t window_length(const ConditioningSettings& s) {
 }
 
 Error validate_rotation(const ConditioningSettings& s) {
-  const double tol = s.rotation_tolerance;
-  if (!std::isfinite(tol) || tol <= 0.0 || tol > 0.1) {
+  const Real tol = s.rotation_tolerance;
+  if (!std::isfinite(tol) || tol <= Real(0) || tol > Real(0.1)) {
     return {ErrorCode::kOutOfRange, "conditioning.rotation_tolerance", "must lie in (0, 0.1]",
-            0.1};
+            Real(0.1)};
   }
-  const Eigen::Matrix3d& r = s.sensor_to_statue;
+  const Matrix3r& r = s.sensor_to_statue;
   if (!r.allFinite()) {
     return {ErrorCode::kNotFinite, "conditioning.sensor_to_statue", "must be finite"};
   }
-  const double orthonormality =
-      (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  const Real orthonormality = (r.transpose() * r - Matrix3r::Identity()).cwiseAbs().maxCoeff();
   if (orthonormality > tol) {
     return {ErrorCode::kInconsistent, "conditioning.sensor_to_statue",
             "is not orthonormal (R^T R - I exceeds rotation_tolerance)", tol};
   }
-  const double det = r.determinant();
-  if (std::abs(det - 1.0) > tol) {
+  const Real det = r.determinant();
+  if (std::abs(det - Real(1)) > tol) {
     return {ErrorCode::kInconsistent, "conditioning.sensor_to_statue",
-            det < 0.0 ? "has determinant -1: a reflection (an axis reversed), not a rotation"
-                      : "has a determinant other than +1",
-            1.0};
+            det < Real(0) ? "has determinant -1: a reflection (an axis reversed), not a rotation"
+                          : "has a determinant other than +1",
+            Real(1)};
   }
   return ok_error();
 }
@@ -76,8 +75,10 @@ Error Conditioner::create(const ConditioningSettings& settings, Conditioner& out
   PLINTH_TRY(validate(settings));
   out = Conditioner{};
   out.settings_ = settings;
-  out.unit_scale_ = settings.unit == AccelerationUnit::kStandardGravity ? kStandardGravity : 1.0;
-  out.tracking_gain_ = -std::expm1(-settings.sample_period_s / settings.tracking_time_constant_s);
+  out.unit_scale_ =
+      settings.unit == AccelerationUnit::kStandardGravity ? kStandardGravity : Real(1);
+  out.tracking_gain_ =
+      static_cast<Real>(-std::expm1(-settings.sample_period_s / settings.tracking_time_constant_s));
   out.status_.window_length = window_length(settings);
   return ok_error();
 }
@@ -103,12 +104,12 @@ void Conditioner::begin_verification() {
   clear_window();
 }
 
-Eigen::Vector3d Conditioner::to_statue_m_s2(const Eigen::Vector3d& sensor_sample) const {
+Vector3r Conditioner::to_statue_m_s2(const Vector3r& sensor_sample) const {
   return settings_.sensor_to_statue * (unit_scale_ * sensor_sample);
 }
 
 // The quietness test of a full window (conditioning.h), its first failed check.
-StartupRejection Conditioner::quietness(const Eigen::Vector3d& offset) const {
+StartupRejection Conditioner::quietness(const Vector3r& offset) const {
   if (status_.window_std_m_s2.maxCoeff() > settings_.startup_max_std_m_s2) {
     return StartupRejection::kTooNoisy;
   }
@@ -124,20 +125,20 @@ StartupRejection Conditioner::quietness(const Eigen::Vector3d& offset) const {
   return StartupRejection::kNone;
 }
 
-bool Conditioner::add_to_window(const Eigen::Vector3d& statue_m_s2) {
+bool Conditioner::add_to_window(const Vector3r& statue_m_s2) {
   const std::int64_t n = ++status_.window_samples;
   const std::int64_t half = status_.window_length / 2;
   if (n <= half) first_half_sum_ += statue_m_s2;
-  const Eigen::Vector3d before = statue_m_s2 - window_mean_;
-  window_mean_ += before / static_cast<double>(n);
+  const Vector3r before = statue_m_s2 - window_mean_;
+  window_mean_ += before / static_cast<Real>(n);
   window_m2_ += before.cwiseProduct(statue_m_s2 - window_mean_);
   if (n < status_.window_length) return false;
 
-  status_.window_std_m_s2 = (window_m2_ / static_cast<double>(n - 1)).cwiseSqrt();
-  const Eigen::Vector3d second_half_sum = window_mean_ * static_cast<double>(n) - first_half_sum_;
+  status_.window_std_m_s2 = (window_m2_ / static_cast<Real>(n - 1)).cwiseSqrt();
+  const Vector3r second_half_sum = window_mean_ * static_cast<Real>(n) - first_half_sum_;
   status_.window_drift_m_s2 =
-      second_half_sum / static_cast<double>(n - half) - first_half_sum_ / static_cast<double>(half);
-  const Eigen::Vector3d offset = window_mean_ - gravity_up();
+      second_half_sum / static_cast<Real>(n - half) - first_half_sum_ / static_cast<Real>(half);
+  const Vector3r offset = window_mean_ - gravity_up();
   status_.last_rejection = quietness(offset);
   switch (status_.last_rejection) {
     case StartupRejection::kNone:
@@ -164,14 +165,14 @@ bool Conditioner::add_to_window(const Eigen::Vector3d& statue_m_s2) {
   return true;
 }
 
-ConditionedSample Conditioner::condition(const Eigen::Vector3d& sensor_sample, bool quiet) {
+ConditionedSample Conditioner::condition(const Vector3r& sensor_sample, bool quiet) {
   ConditionedSample out;
   if (!sensor_sample.allFinite()) {
     ++status_.invalid_inputs;
     out.tracking = OffsetTracking::kInvalidInput;
     return out;
   }
-  const Eigen::Vector3d statue = to_statue_m_s2(sensor_sample);
+  const Vector3r statue = to_statue_m_s2(sensor_sample);
   if (!status_.ready) {
     (void)add_to_window(statue);
     out.tracking = OffsetTracking::kStartup;

@@ -2,6 +2,7 @@
 
 #include <bit>
 #include <cmath>
+#include <type_traits>
 
 #include "settings_checks.h"
 
@@ -17,9 +18,10 @@ std::uint8_t sequence_delta(std::uint8_t to, std::uint8_t from) {
 // Half the counter's range: a delta at or above it reads as behind, not ahead.
 constexpr std::uint8_t kSequenceHalfRange = 128;
 
-bool bit_identical(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+bool bit_identical(const Vector3r& a, const Vector3r& b) {
+  using Bits = std::conditional_t<sizeof(Real) == 8, std::uint64_t, std::uint32_t>;
   for (Eigen::Index i = 0; i < 3; ++i) {
-    if (std::bit_cast<std::uint64_t>(a[i]) != std::bit_cast<std::uint64_t>(b[i])) return false;
+    if (std::bit_cast<Bits>(a[i]) != std::bit_cast<Bits>(b[i])) return false;
   }
   return true;
 }
@@ -35,25 +37,26 @@ Error validate(const SensorHealthSettings& s) {
   }));
   if (s.max_bridge_samples < 0 || s.max_bridge_samples > kMaxBridgeSamples) {
     return {ErrorCode::kOutOfRange, "sensor_health.max_bridge_samples", "must lie in 0..15",
-            static_cast<double>(kMaxBridgeSamples)};
+            static_cast<Real>(kMaxBridgeSamples)};
   }
-  const double longest_bridge_s = (s.max_bridge_samples + 1) * s.sample_period_s;
+  const Time longest_bridge_s = (s.max_bridge_samples + 1) * s.sample_period_s;
   if (s.timeout_s <= longest_bridge_s) {
     return {ErrorCode::kInconsistent, "sensor_health.timeout_s",
             "must exceed the longest bridgeable gap, (max_bridge_samples + 1) sample periods",
             longest_bridge_s};
   }
-  const double wrap_s = kSequenceHalfRange * s.sample_period_s;
+  const Time wrap_s = kSequenceHalfRange * s.sample_period_s;
   if (s.timeout_s >= wrap_s) {
     return {ErrorCode::kInconsistent, "sensor_health.timeout_s",
             "must be shorter than 128 sample periods (the sequence counter's half range)", wrap_s};
   }
   if (s.recovery_samples < 1) {
-    return {ErrorCode::kOutOfRange, "sensor_health.recovery_samples", "must be at least 1", 1.0};
+    return {ErrorCode::kOutOfRange, "sensor_health.recovery_samples", "must be at least 1",
+            Real(1)};
   }
   if (s.stuck_samples < 0 || s.stuck_samples == 1) {
     return {ErrorCode::kOutOfRange, "sensor_health.stuck_samples",
-            "must be 0 (check off) or at least 2", 2.0};
+            "must be 0 (check off) or at least 2", Real(2)};
   }
   if (s.max_valid_g < s.full_scale_g) {
     return {ErrorCode::kInconsistent, "sensor_health.max_valid_g",
@@ -185,7 +188,7 @@ void SensorHealthTracker::feed(SensorUpdate& update, const SensorSample& sample,
     const std::int64_t span_ns = elapsed_ns > 0 ? elapsed_ns : 0;  // a clock step back: no time
     for (int k = 1; k <= slots; ++k) {
       FedSample& b = update.fed[update.fed_count++];
-      const double fraction = static_cast<double>(k) / static_cast<double>(slots + 1);
+      const Real fraction = static_cast<Real>(k) / static_cast<Real>(slots + 1);
       b.time_ns = last_accepted_time_ns_ + span_ns * k / (slots + 1);
       b.sequence = static_cast<std::uint8_t>(last_accepted_sequence_ + k);
       b.acceleration_g = last_accepted_g_ + fraction * (sample.acceleration_g - last_accepted_g_);

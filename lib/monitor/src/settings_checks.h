@@ -6,17 +6,18 @@
 #include <initializer_list>
 
 #include "plinth/core/error.h"
+#include "plinth/core/real.h"
 
 namespace plinth::monitor::detail {
 
 // Longest duration a setting may name, s (11.6 days): keeps every duration exact to the
 // nanosecond in an int64 and catches a value typed in the wrong unit.
-inline constexpr double kMaxDurationS = 1e6;
+inline constexpr Time kMaxDurationS = 1e6;
 
 inline constexpr std::int64_t kNanosecondsPerSecond = 1'000'000'000;
 
 // A duration setting: finite, within [0, kMaxDurationS], and above zero unless `zero_allowed`.
-[[nodiscard]] inline Error check_duration(double seconds, const char* field, bool zero_allowed) {
+[[nodiscard]] inline Error check_duration(Time seconds, const char* field, bool zero_allowed) {
   if (!std::isfinite(seconds)) {
     return {ErrorCode::kNotFinite, field, "must be a finite number of seconds"};
   }
@@ -31,9 +32,10 @@ inline constexpr std::int64_t kNanosecondsPerSecond = 1'000'000'000;
 }
 
 // A positive finite quantity in the field's unit.
-[[nodiscard]] inline Error check_positive(double value, const char* field) {
+[[nodiscard]] inline Error check_positive(Real value, const char* field) {
   if (!std::isfinite(value)) return {ErrorCode::kNotFinite, field, "must be finite"};
-  if (value <= 0.0) return {ErrorCode::kOutOfRange, field, "must be greater than zero", 0.0};
+  if (value <= Real(0))
+    return {ErrorCode::kOutOfRange, field, "must be greater than zero", Real(0)};
   return ok_error();
 }
 
@@ -47,8 +49,8 @@ inline constexpr std::int64_t kNanosecondsPerSecond = 1'000'000'000;
 }
 
 // Seconds (already checked by check_duration) to the nearest nanosecond.
-[[nodiscard]] inline std::int64_t to_ns(double seconds) {
-  const double ns = seconds * static_cast<double>(kNanosecondsPerSecond);
+[[nodiscard]] inline std::int64_t to_ns(Time seconds) {
+  const Time ns = seconds * static_cast<Time>(kNanosecondsPerSecond);
   return static_cast<std::int64_t>(std::llround(ns));
 }
 

@@ -72,6 +72,7 @@
 #include "plinth/core/events.h"
 #include "plinth/core/forecast.h"
 #include "plinth/core/name_table.h"
+#include "plinth/core/real.h"
 #include "plinth/core/risk.h"
 #include "plinth/core/scene.h"
 #include "plinth/hal/can_codec.h"
@@ -342,7 +343,7 @@ class Monitor {
   // A conditioned sample, statue frame, m/s2, at its receive time.
   struct HistoryEntry {
     std::int64_t time_ns = 0;  // receive clock
-    Eigen::Vector3d value = Eigen::Vector3d::Zero();
+    Vector3r value = Vector3r::Zero();
     bool restart = false;  // the health tracker's restart mark
   };
   // The last kSensorHistory entries of a stream; entries [valid_from(), pushed) are kept.
@@ -386,11 +387,11 @@ class Monitor {
   void update_primary();
   void drain_primary();
   void drive(const HistoryEntry& entry);
-  void push_estimators(const Eigen::Vector3d& ground_m_s2);
+  void push_estimators(const Vector3r& ground_m_s2);
   void cross_check();
   void check_sensor(int sensor);
   [[nodiscard]] bool reference_at(const History& reference, std::int64_t time_ns,
-                                  Eigen::Vector3d& value) const;
+                                  Vector3r& value) const;
   [[nodiscard]] bool usable(int sensor) const;
   [[nodiscard]] bool quiet() const;
   void take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update);
@@ -420,7 +421,7 @@ class Monitor {
   bool restart_pending_ = false;  // the next entry starts the estimators at rest
   bool align_pending_ = false;    // the next entry continues after a failover: align by time
   std::int64_t last_fed_ns_ = 0;  // receive time of the estimators' newest sample
-  Eigen::Vector3d last_ground_ = Eigen::Vector3d::Zero();  // its value, m/s2
+  Vector3r last_ground_ = Vector3r::Zero();  // its value, m/s2
   std::array<std::span<const Scene>, kMaxAxes> scenes_{};
   std::array<std::array<PlanarEstimator, kMaxEnsembleMembers>, kMaxAxes> ensembles_{};
   std::array<Forecaster, kMaxAxes> forecasters_{};

@@ -18,13 +18,15 @@
 #include <cstddef>
 #include <span>
 
+#include "plinth/core/real.h"
+
 namespace plinth {
 
 inline constexpr int kMaxUncertainParameters = 15;
 // Members of the largest design: the centre and 16 corners.
 inline constexpr int kMaxDesignPoints = 17;
 
-using DesignPoint = std::array<double, kMaxUncertainParameters>;  // z_i in [-1, 1]; unused: 0
+using DesignPoint = std::array<Real, kMaxUncertainParameters>;  // z_i in [-1, 1]; unused: 0
 
 // The number of points the design of `dimensions` parameters has (0 when dimensions is
 // outside [0, kMaxUncertainParameters]).

@@ -19,7 +19,9 @@ struct Error {
   ErrorCode code = ErrorCode::kOk;
   const char* field = "";
   const char* reason = "";
-  double limit = 0.0;  // the bound that was passed, in the field's unit, where there is one
+  // the bound that was passed, in the field's unit, where there is one; reported, not computed
+  // with: double whatever Real is (real.h)
+  double limit = 0.0;
 
   [[nodiscard]] constexpr bool ok() const { return code == ErrorCode::kOk; }
 };

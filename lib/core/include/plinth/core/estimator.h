@@ -8,23 +8,22 @@
 
 #include "plinth/core/error.h"
 #include "plinth/core/excitation.h"
+#include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/simulator.h"
 
 namespace plinth {
 
 struct EstimatorSettings {
-  double sample_rate_hz = 200.0;  // Hz, the sensor rate: 100 to 1000
+  double sample_rate_hz = 200.0;  // Hz, the sensor rate: 100 to 1000 (the time base: Time's type)
   int steps_per_sample = 4;       // solver steps per sample period: 1 to 64
   // The solver's other settings; its step is 1 / (sample_rate_hz * steps_per_sample). Full
   // contact propagated exactly, as docs/accuracy.md recommends for the box: a quiet step costs
   // a fraction of an RK4 one and the base's motion is exact between samples.
   SolverSettings solver{.exact_full_contact = true};
 
-  [[nodiscard]] double sample_period() const { return 1.0 / sample_rate_hz; }
-  [[nodiscard]] double step() const {
-    return sample_period() / static_cast<double>(steps_per_sample);
-  }
+  [[nodiscard]] Time sample_period() const { return 1.0 / sample_rate_hz; }
+  [[nodiscard]] Time step() const { return sample_period() / static_cast<Time>(steps_per_sample); }
 };
 
 // Checks the settings and that the resulting step is stable for `scene`; the Error names the
@@ -48,7 +47,7 @@ class PlanarEstimator {
   void set_event_sink(EventSink* sink) { simulator_.set_event_sink(sink); }
 
   [[nodiscard]] bool started() const { return started_; }
-  [[nodiscard]] double time() const { return simulator_.time(); }
+  [[nodiscard]] Time time() const { return simulator_.time(); }
   [[nodiscard]] std::int64_t samples() const { return stream_.latest_index; }
   [[nodiscard]] const Mode& mode() const { return simulator_.mode(); }
   [[nodiscard]] const State& state() const { return simulator_.state(); }

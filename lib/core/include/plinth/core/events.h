@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "plinth/core/name_table.h"
+#include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 
@@ -26,12 +27,12 @@ enum class EventKind : std::uint8_t {
 };
 
 struct Event {
-  double t = 0.0;  // s
+  Time t = 0.0;  // s
   EventKind kind = EventKind::kRockingStart;
   Corner corner = Corner::kLeft;
   std::int8_t side = 0;
-  double before = 0.0;
-  double after = 0.0;
+  Real before = 0.0;
+  Real after = 0.0;
   Phase phase = Phase::kFullContact;  // the phase just after the event
   std::int8_t overhang = 0;           // Mode::overhang just after the event
   State state = State::Zero();        // just after the reset

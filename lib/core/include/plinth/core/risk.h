@@ -16,6 +16,7 @@
 #pragma once
 
 #include "plinth/core/error.h"
+#include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 
@@ -23,16 +24,16 @@ namespace plinth {
 
 struct RiskSettings {
   // Risk given to the base reaching its stops, dimensionless, in [0, 1].
-  double base_stop_weight = 0.5;
+  Real base_stop_weight = 0.5;
 };
 
 [[nodiscard]] Error validate(const RiskSettings& settings);
 
 struct Risk {
-  double overturning = 0.0;  // each in [0, 1]
-  double falling = 0.0;
-  double base_stops = 0.0;
-  double total = 0.0;  // the largest of the three
+  Real overturning = 0.0;  // each in [0, 1]
+  Real falling = 0.0;
+  Real base_stops = 0.0;
+  Real total = 0.0;  // the largest of the three
 };
 
 [[nodiscard]] Risk overturning_risk(const Scene& scene, const Mode& mode, const State& y,

@@ -5,45 +5,46 @@
 
 #include "plinth/core/error.h"
 #include "plinth/core/name_table.h"
+#include "plinth/core/real.h"
 
 namespace plinth {
 
-inline constexpr double kStandardGravity = 9.80665;  // m/s2
+inline constexpr Real kStandardGravity = Real(9.80665);  // m/s2
 
 struct BlockParams {
-  double half_width = 0.0;    // b, m
-  double com_height = 0.0;    // h, height of the centre of mass C above the base, m
-  double eccentricity = 0.0;  // e = b1 - b, m; positive when C lies right of the middle M
-  double mass = 0.0;          // m, kg
-  double inertia = 0.0;       // I_C, polar inertia about C, kg m2
+  Real half_width = 0.0;    // b, m
+  Real com_height = 0.0;    // h, height of the centre of mass C above the base, m
+  Real eccentricity = 0.0;  // e = b1 - b, m; positive when C lies right of the middle M
+  Real mass = 0.0;          // m, kg
+  Real inertia = 0.0;       // I_C, polar inertia about C, kg m2
 };
 
 struct BaseParams {
-  double mass = 0.0;           // m_b, kg
-  double period = 0.0;         // T, s (Eq 26)
-  double damping_ratio = 0.0;  // xi (Eq 26)
+  Real mass = 0.0;           // m_b, kg
+  Real period = 0.0;         // T, s (Eq 26)
+  Real damping_ratio = 0.0;  // xi (Eq 26)
 };
 
 struct FrictionParams {
-  double static_coefficient = 0.0;   // mu_s
-  double kinetic_coefficient = 0.0;  // mu_k
+  Real static_coefficient = 0.0;   // mu_s
+  Real kinetic_coefficient = 0.0;  // mu_k
 };
 
 struct BaseStopParams {
-  double max_displacement = 0.0;  // u_max, m (Eq 28)
-  double restitution = 0.0;       // eta_i (Eq 29)
+  Real max_displacement = 0.0;  // u_max, m (Eq 28)
+  Real restitution = 0.0;       // eta_i (Eq 29)
 };
 
 struct SupportParams {
-  double clearance = 0.0;  // x_hat, m: sliding before the block overhangs the support
+  Real clearance = 0.0;  // x_hat, m: sliding before the block overhangs the support
 };
 
 struct SlidingStopParams {
-  double restitution = 0.0;  // eta_s (Eq 32)
+  Real restitution = 0.0;  // eta_s (Eq 32)
 };
 
 struct SceneParams {
-  double gravity = kStandardGravity;  // g, m/s2
+  Real gravity = kStandardGravity;  // g, m/s2
   BlockParams block;
   bool has_base = false;  // false: the block stands on the ground (non-isolated system)
   BaseParams base;
@@ -72,28 +73,28 @@ inline constexpr NameTable<Corner, 2> kCornerNames{{{
 // (offset, h); offset = b1 for corner 1 and -b2 for corner 2, which turns Eqs 8-9 for corner 1
 // into the equations of either corner.
 struct CornerGeometry {
-  double offset = 0.0;          // horizontal distance corner -> C at theta = 0, signed, m
-  double radius = 0.0;          // r_i = sqrt(b_i^2 + h^2), m
-  double inertia = 0.0;         // I_i = I_C + m r_i^2, kg m2
-  double critical_angle = 0.0;  // alpha_i = atan(b_i / h), rad; |theta| past it overturns
-  double onset_ratio = 0.0;     // b_i / h: Eq 16 threshold over (g + vg'')
-  double sign = 0.0;            // +1 for corner 1 (theta > 0), -1 for corner 2
+  Real offset = 0.0;          // horizontal distance corner -> C at theta = 0, signed, m
+  Real radius = 0.0;          // r_i = sqrt(b_i^2 + h^2), m
+  Real inertia = 0.0;         // I_i = I_C + m r_i^2, kg m2
+  Real critical_angle = 0.0;  // alpha_i = atan(b_i / h), rad; |theta| past it overturns
+  Real onset_ratio = 0.0;     // b_i / h: Eq 16 threshold over (g + vg'')
+  Real sign = 0.0;            // +1 for corner 1 (theta > 0), -1 for corner 2
 };
 
 struct Scene {
   SceneParams params;
 
   // Derived once by make_scene.
-  double b = 0.0, h = 0.0, m = 0.0, inertia_c = 0.0, g = 0.0;
-  double b1 = 0.0, b2 = 0.0;  // distances from C's vertical to corners 1 and 2, m
+  Real b = Real(0), h = Real(0), m = Real(0), inertia_c = Real(0), g = 0.0;
+  Real b1 = Real(0), b2 = 0.0;  // distances from C's vertical to corners 1 and 2, m
   CornerGeometry corner1, corner2;
   // Rotational inertia about the new corner carried through a theta = 0 impact:
   // J = I_C + m h^2 - m b1 b2 (the same for either direction; see resets.h, Eq 21).
-  double impact_inertia = 0.0;
-  double total_mass = 0.0;  // m + m_b (m alone when there is no base), kg
-  double omega = 0.0;       // base circular frequency, rad/s (Eq 26)
-  double stiffness = 0.0;   // k, N/m
-  double damping = 0.0;     // c, N s/m
+  Real impact_inertia = 0.0;
+  Real total_mass = 0.0;  // m + m_b (m alone when there is no base), kg
+  Real omega = 0.0;       // base circular frequency, rad/s (Eq 26)
+  Real stiffness = 0.0;   // k, N/m
+  Real damping = 0.0;     // c, N s/m
 
   [[nodiscard]] const CornerGeometry& corner(Corner c) const {
     return c == Corner::kLeft ? corner1 : corner2;
@@ -121,16 +122,16 @@ struct Features {
 
 // Geometry of rocking about a pivot `distance` (b_i or b_hat_i, m) from C's vertical, on the
 // side `sign` (+1: corner 1, -1: corner 2).
-[[nodiscard]] CornerGeometry corner_geometry(const Scene& s, double distance, double sign);
+[[nodiscard]] CornerGeometry corner_geometry(const Scene& s, Real distance, Real sign);
 
 // Validates `params` and fills `out`. On error, `out` is left unchanged and the Error names the
 // first field at fault.
 [[nodiscard]] Error make_scene(const SceneParams& params, Scene& out);
 
 // Polar inertia about C of a homogeneous rectangle 2b wide and 2h tall: m (b^2 + h^2) / 3.
-[[nodiscard]] constexpr double homogeneous_rectangle_inertia(double mass, double half_width,
-                                                             double com_height) {
-  return mass * (half_width * half_width + com_height * com_height) / 3.0;
+[[nodiscard]] constexpr Real homogeneous_rectangle_inertia(Real mass, Real half_width,
+                                                           Real com_height) {
+  return mass * (half_width * half_width + com_height * com_height) / Real(3);
 }
 
 }  // namespace plinth

@@ -13,6 +13,7 @@
 #include "plinth/core/internal/flows.h"
 #include "plinth/core/internal/full_contact_propagator.h"
 #include "plinth/core/internal/guards.h"
+#include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 #include "plinth/core/stepper.h"
@@ -26,7 +27,7 @@ struct StepInterval;
 }  // namespace internal
 
 struct SolverSettings {
-  double step = 1e-4;  // s, the fixed time step
+  Time step = Real(1e-4);  // s, the fixed time step
   // The one-step method and how events are taken (stepper.h). docs/accuracy.md measures them.
   Stepper stepper = Stepper::kRk4Located;
   // Full contact (Eq 1, linear) propagated exactly over each step with the ground acceleration
@@ -35,19 +36,20 @@ struct SolverSettings {
   bool exact_full_contact = false;
   // Rest criterion: rocking ends at an impact that leaves less rocking energy than this
   // fraction of the energy needed to overturn, I theta'^2 / 2 < ratio m g (r_i - h).
-  double rest_energy_ratio = 1e-6;
+  Real rest_energy_ratio = Real(1e-6);
   // The base is held at a stop when it rebounds slower than this while the stop pushes, m/s.
   // (rk4_step_end: or slower than a few steps of its acceleration; event_logic.h, slowest_rebound.)
-  double base_rest_speed = 1e-5;
+  Real base_rest_speed = Real(1e-5);
   // The block sticks against a sliding stop instead of rebounding slower than this, m/s (the
   // same addition for rk4_step_end).
-  double slide_rest_speed = 1e-5;
+  Real slide_rest_speed = Real(1e-5);
   // Events located within one step before the remaining ones are treated as chatter (Zeno):
   // rocking is brought to rest, sliding stopped and the base held, and the step finishes
   // without further events.
   int max_events_per_step = 64;
-  // Events are located in time to within this fraction of the step.
-  double event_time_tolerance = 1e-10;
+  // Events are located in time to within this fraction of the step: 1e-10 in double, 64
+  // roundings in float (real.h, real_tolerance::kEventTime).
+  Real event_time_tolerance = real_tolerance::kEventTime;
 };
 
 // Checks the settings; the Error names the field at fault.
@@ -73,7 +75,7 @@ class Simulator {
   // Impulse I, the initial condition of Eq 34: the ground's velocity jumps by -I, m/s. On a
   // base, u'(0+) = I; on the ground, the block turns about the corner the jump throws it on,
   // with theta'(0+) = -m h I / I_i (angular momentum about that corner).
-  void start_with_impulse(double impulse);
+  void start_with_impulse(Real impulse);
   // Starts from an arbitrary mode and state at time 0 (tests and estimators).
   void start_from(const Mode& mode, const State& state);
 
@@ -82,7 +84,7 @@ class Simulator {
   void step() {
     if (mode_.phase == Phase::kFullContact && quiet_full_contact_step_fn_ != nullptr &&
         quiet_full_contact_step_fn_(*this, time(),
-                                    static_cast<double>(step_count_ + 1) * settings_.step)) {
+                                    static_cast<Time>(step_count_ + 1) * settings_.step)) {
       ++step_count_;
       return;
     }
@@ -91,13 +93,13 @@ class Simulator {
 
   void set_event_sink(EventSink* sink) { sink_ = sink; }
 
-  [[nodiscard]] double time() const { return static_cast<double>(step_count_) * settings_.step; }
+  [[nodiscard]] Time time() const { return static_cast<Time>(step_count_) * settings_.step; }
   [[nodiscard]] std::int64_t step_count() const { return step_count_; }
   [[nodiscard]] const State& state() const { return y_; }
   [[nodiscard]] const Mode& mode() const { return mode_; }
   [[nodiscard]] const Scene& scene() const { return *scene_; }
   [[nodiscard]] const SolverSettings& settings() const { return settings_; }
-  [[nodiscard]] GroundAcceleration ground(double t) const { return excitation_.at(t); }
+  [[nodiscard]] GroundAcceleration ground(Time t) const { return excitation_.at(t); }
   // Accelerations of the current mode at the current time and state.
   [[nodiscard]] Accelerations accelerations() const;
   // Number of steps whose events were cut short as chatter (see max_events_per_step).
@@ -118,14 +120,13 @@ class Simulator {
   // The guards of the current mode, after it changed.
   void refresh_guards() { active_guards_ = guards_fn_(mode_); }
   void step_intervals();
-  [[gnu::noinline]] void finish_step(double t0, double t_end);
+  [[gnu::noinline]] void finish_step(Time t0, Time t_end);
 
   // Advances in the current mode from t0 towards t_end (one interval of a step, StepInterval in
   // step_interval.h). On an event it applies the reset, sets t0 to the event's time and returns
   // true.
   // `full_step`: the interval is the whole step (no event before it in this step).
-  using IntervalFn = bool (*)(Simulator&, double& t0, double t_end, bool guards_live,
-                              bool full_step);
+  using IntervalFn = bool (*)(Simulator&, Time& t0, Time t_end, bool guards_live, bool full_step);
 
   const Scene* scene_ = nullptr;
   Excitation excitation_;
@@ -134,16 +135,16 @@ class Simulator {
   // Bound once by create: the stepper's interval for each non-terminal Phase, and the event
   // logic (guards, resets) compiled for the scene's features (EventLogic, event_logic.h).
   std::array<IntervalFn, 4> interval_fns_{};
-  void (*apply_reset_fn_)(Simulator&, internal::GuardId, double t) = nullptr;
-  void (*settle_chatter_fn_)(Simulator&, double t) = nullptr;
+  void (*apply_reset_fn_)(Simulator&, internal::GuardId, Time t) = nullptr;
+  void (*settle_chatter_fn_)(Simulator&, Time t) = nullptr;
   internal::ActiveGuards (*guards_fn_)(const Mode&) = nullptr;
-  void (*start_phases_fn_)(Simulator&, double t) = nullptr;  // whose onset already holds
-  Accelerations (*accelerations_fn_)(const Simulator&, double t, const State&) = nullptr;
+  void (*start_phases_fn_)(Simulator&, Time t) = nullptr;  // whose onset already holds
+  Accelerations (*accelerations_fn_)(const Simulator&, Time t, const State&) = nullptr;
   // exact_full_contact: a quiet whole step of full contact (false: take the interval).
-  bool (*quiet_full_contact_step_fn_)(Simulator&, double t0, double t_end) = nullptr;
+  bool (*quiet_full_contact_step_fn_)(Simulator&, Time t0, Time t_end) = nullptr;
   // u_G'' at the end of the last quiet full-contact step, the start of step number
   // quiet_ground_step_, m/s2.
-  double quiet_ground_horizontal_ = 0.0;
+  Real quiet_ground_horizontal_ = 0.0;
   std::int64_t quiet_ground_step_ = -1;
   internal::FullContactPropagator propagator_;  // for exact_full_contact, over one step
   bool events_at_step_ends_ = false;  // the stepper takes events at step ends (rest speeds)

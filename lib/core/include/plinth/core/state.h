@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "plinth/core/name_table.h"
+#include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 
 namespace plinth {
@@ -12,15 +13,15 @@ namespace plinth {
 // y = (u, x, theta, u', x', theta'): base displacement relative to the ground, sliding of the
 // body on the base (0 until sliding is modelled), rotation about the active corner (> 0 about
 // corner 1), and their rates. SI units: m, m, rad, m/s, m/s, rad/s.
-using State = Eigen::Matrix<double, 6, 1>;
+using State = Eigen::Matrix<Real, 6, 1>;
 
 enum StateIndex : Eigen::Index { kU = 0, kX = 1, kTheta = 2, kUDot = 3, kXDot = 4, kThetaDot = 5 };
 
 // Accelerations (u'', x'', theta'') of one phase's equations of motion.
 struct Accelerations {
-  double u = 0.0;      // m/s2, relative to the ground
-  double x = 0.0;      // m/s2
-  double theta = 0.0;  // rad/s2
+  Real u = 0.0;      // m/s2, relative to the ground
+  Real x = 0.0;      // m/s2
+  Real theta = 0.0;  // rad/s2
 };
 
 enum class Phase : std::uint8_t {

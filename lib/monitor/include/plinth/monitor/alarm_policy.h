@@ -58,32 +58,34 @@
 
 #include "plinth/core/error.h"
 #include "plinth/core/name_table.h"
+#include "plinth/core/real.h"
 #include "plinth/monitor/alarm_level.h"
 
 namespace plinth::monitor {
 
 struct RiskThresholds {
-  double on = 0.0;   // risk (dimensionless, 0..1) at or above which the condition starts
-  double off = 0.0;  // risk below which it ends; off < on
+  Real on = 0.0;   // risk (dimensionless, 0..1) at or above which the condition starts
+  Real off = 0.0;  // risk below which it ends; off < on
 };
 
 struct AlarmPolicySettings {
   // Calibrated with plinth-eval (docs/forecast.md): on the worst member's risk and the
   // forecast's probability together, the alarm rule that missed none of 1,078 collapses with
   // the fewest false alarms; warning and advisory below it.
-  RiskThresholds advisory{0.1, 0.05};  // also active while the block is out of full contact
-  RiskThresholds warning{0.5, 0.4};
-  RiskThresholds alarm{0.65, 0.55};
+  RiskThresholds advisory{Real(0.1),
+                          Real(0.05)};  // also active while the block is out of full contact
+  RiskThresholds warning{Real(0.5), Real(0.4)};
+  RiskThresholds alarm{Real(0.65), Real(0.55)};
   // On the forecast's probability of a collapse within its horizon (0 while no forecast has
   // completed).
-  RiskThresholds advisory_forecast{0.125, 0.0625};
-  RiskThresholds warning_forecast{0.25, 0.1875};
-  RiskThresholds alarm_forecast{0.375, 0.3125};
-  double raise_hold_s = 0.1;  // s, >= 0: a condition holds this long before its level rises
-  double lower_hold_s = 2.0;  // s, >= 0: a condition (or fault) is gone this long before it lowers
+  RiskThresholds advisory_forecast{Real(0.125), Real(0.0625)};
+  RiskThresholds warning_forecast{Real(0.25), Real(0.1875)};
+  RiskThresholds alarm_forecast{Real(0.375), Real(0.3125)};
+  Time raise_hold_s = Real(0.1);  // s, >= 0: a condition holds this long before its level rises
+  Time lower_hold_s = 2.0;    // s, >= 0: a condition (or fault) is gone this long before it lowers
   bool latch_warning = true;  // a raised warning holds until acknowledged
   bool latch_alarm = true;    // a raised alarm holds until acknowledged (a collapse always does)
-  double heartbeat_period_s = 1.0;  // s, > 0: longest time between two status messages
+  Time heartbeat_period_s = 1.0;  // s, > 0: longest time between two status messages
 };
 
 // Checks the settings; the Error names the field at fault ("alarm_policy.warning.off", ...).
@@ -99,8 +101,8 @@ struct Acknowledgement {
 
 struct AlarmInput {
   std::int64_t time_ns = 0;          // monitor time since start, ns
-  double risk = 0.0;                 // overturning risk, dimensionless, [0, 1]
-  double probability = 0.0;          // forecast probability of a collapse, [0, 1]
+  Real risk = 0.0;                   // overturning risk, dimensionless, [0, 1]
+  Real probability = 0.0;            // forecast probability of a collapse, [0, 1]
   bool out_of_full_contact = false;  // the block slides or rocks (motion started)
   bool collapse_detected = false;    // the block overturned or fell
   bool fault_active = false;         // sensor or bus trouble

@@ -39,6 +39,7 @@
 
 #include "plinth/core/error.h"
 #include "plinth/core/name_table.h"
+#include "plinth/core/real.h"
 
 namespace plinth::monitor {
 
@@ -56,16 +57,17 @@ struct ConditioningSettings {
   // Rotation from the sensor frame to the statue frame (statue = R * sensor). Must be
   // orthonormal (every element of R^T R - I within rotation_tolerance) with det R = +1
   // (within rotation_tolerance): a reflection means an axis is wired or declared backwards.
-  Eigen::Matrix3d sensor_to_statue = Eigen::Matrix3d::Identity();
-  double rotation_tolerance = 1e-3;  // dimensionless, in (0, 0.1]
-  double sample_period_s = 0.001;    // the stream's sample period, s
-  double startup_window_s = 10.0;    // s, at least 2 samples long
-  double startup_max_std_m_s2 = 0.05;     // m/s2, per axis, over the start-up window
-  double startup_max_offset_m_s2 = 1.0;   // m/s2, per axis of the estimated offset
-  double startup_max_drift_m_s2 = 0.02;   // m/s2, per axis: second half's mean - first half's
-  double startup_gravity_tolerance_m_s2 = 0.5;  // m/s2: | |window mean| - g0 | at most this
-  double tracking_time_constant_s = 600.0;  // s, of the offset's low-pass while quiet
-  double tracking_gate_m_s2 = 0.1;  // m/s2: a quiet sample beyond this on an axis is not tracked
+  Matrix3r sensor_to_statue = Matrix3r::Identity();
+  Real rotation_tolerance = Real(1e-3);       // dimensionless, in (0, 0.1]
+  Time sample_period_s = Real(0.001);         // the stream's sample period, s
+  Time startup_window_s = 10.0;               // s, at least 2 samples long
+  Real startup_max_std_m_s2 = Real(0.05);     // m/s2, per axis, over the start-up window
+  Real startup_max_offset_m_s2 = 1.0;         // m/s2, per axis of the estimated offset
+  Real startup_max_drift_m_s2 = Real(0.02);   // m/s2, per axis: second half's mean - first half's
+  Real startup_gravity_tolerance_m_s2 = 0.5;  // m/s2: | |window mean| - g0 | at most this
+  Time tracking_time_constant_s = 600.0;      // s, of the offset's low-pass while quiet
+  Real tracking_gate_m_s2 =
+      Real(0.1);  // m/s2: a quiet sample beyond this on an axis is not tracked
 };
 
 // Checks the settings; the Error names the field at fault ("conditioning.sensor_to_statue", ...).
@@ -113,7 +115,7 @@ inline constexpr NameTable<OffsetTracking, 5> kOffsetTrackingNames{{{
 
 struct ConditionedSample {
   bool ready = false;  // ground_m_s2 holds a conditioned sample (start-up done, input finite)
-  Eigen::Vector3d ground_m_s2 = Eigen::Vector3d::Zero();  // statue frame; z is v_G''
+  Vector3r ground_m_s2 = Vector3r::Zero();  // statue frame; z is v_G''
   OffsetTracking tracking = OffsetTracking::kStartup;
   bool window_passed = false;  // this sample completed a verification window that passed
 };
@@ -136,9 +138,9 @@ struct ConditioningStatus {
   std::uint64_t tracked = 0;          // samples that moved the offset
   std::uint64_t gated = 0;            // quiet samples the gate kept out
   std::uint64_t consecutive_gated = 0;  // quiet samples gated since the last tracked one
-  Eigen::Vector3d offset_m_s2 = Eigen::Vector3d::Zero();  // statue frame (valid when ready)
-  Eigen::Vector3d window_std_m_s2 = Eigen::Vector3d::Zero();  // of the last completed window
-  Eigen::Vector3d window_drift_m_s2 = Eigen::Vector3d::Zero();  // of the last completed window
+  Vector3r offset_m_s2 = Vector3r::Zero();        // statue frame (valid when ready)
+  Vector3r window_std_m_s2 = Vector3r::Zero();    // of the last completed window
+  Vector3r window_drift_m_s2 = Vector3r::Zero();  // of the last completed window
 };
 
 class Conditioner {
@@ -150,7 +152,7 @@ class Conditioner {
 
   // One sample in the sensor frame and the declared unit. `quiet`: the caller's estimate that
   // the block is at rest in full contact and the ground quiet (allows offset tracking).
-  [[nodiscard]] ConditionedSample condition(const Eigen::Vector3d& sensor_sample, bool quiet);
+  [[nodiscard]] ConditionedSample condition(const Vector3r& sensor_sample, bool quiet);
 
   // Forgets the offset and starts a new start-up window (for example after a sensor fault).
   void restart_startup();
@@ -158,25 +160,25 @@ class Conditioner {
   void begin_verification();
 
   // Unit and rotation alone, m/s2 in the statue frame (gravity and offset still in).
-  [[nodiscard]] Eigen::Vector3d to_statue_m_s2(const Eigen::Vector3d& sensor_sample) const;
+  [[nodiscard]] Vector3r to_statue_m_s2(const Vector3r& sensor_sample) const;
 
   [[nodiscard]] const ConditioningStatus& status() const { return status_; }
   [[nodiscard]] const ConditioningSettings& settings() const { return settings_; }
 
  private:
   // Adds a sample; true when it completed the window (status_.last_rejection says how).
-  [[nodiscard]] bool add_to_window(const Eigen::Vector3d& statue_m_s2);
-  [[nodiscard]] StartupRejection quietness(const Eigen::Vector3d& offset) const;
+  [[nodiscard]] bool add_to_window(const Vector3r& statue_m_s2);
+  [[nodiscard]] StartupRejection quietness(const Vector3r& offset) const;
   void clear_window();
 
   ConditioningSettings settings_;
-  double unit_scale_ = 1.0;     // sensor unit to m/s2
-  double tracking_gain_ = 0.0;  // the low-pass's per-sample gain, 1 - exp(-period / tau)
+  Real unit_scale_ = 1.0;     // sensor unit to m/s2
+  Real tracking_gain_ = 0.0;  // the low-pass's per-sample gain, 1 - exp(-period / tau)
   ConditioningStatus status_;
   // Running mean and sum of squared deviations of the window (Welford), statue frame, m/s2.
-  Eigen::Vector3d window_mean_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d window_m2_ = Eigen::Vector3d::Zero();
-  Eigen::Vector3d first_half_sum_ = Eigen::Vector3d::Zero();  // statue frame, m/s2
+  Vector3r window_mean_ = Vector3r::Zero();
+  Vector3r window_m2_ = Vector3r::Zero();
+  Vector3r first_half_sum_ = Vector3r::Zero();  // statue frame, m/s2
 };
 
 }  // namespace plinth::monitor

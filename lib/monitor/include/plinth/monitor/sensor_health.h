@@ -51,6 +51,7 @@
 
 #include "plinth/core/error.h"
 #include "plinth/core/name_table.h"
+#include "plinth/core/real.h"
 #include "plinth/monitor/alarm_level.h"
 
 namespace plinth::monitor {
@@ -60,18 +61,18 @@ inline constexpr int kMaxBridgeSamples = 15;
 inline constexpr std::size_t kMaxFedPerSample = static_cast<std::size_t>(kMaxBridgeSamples) + 1;
 
 struct SensorHealthSettings {
-  double sample_period_s = 0.001;  // the node's nominal sample period, s
+  Time sample_period_s = Real(0.001);  // the node's nominal sample period, s
   // No accepted sample for this long is a timeout fault, s. Must exceed the longest bridgeable
   // gap, (max_bridge_samples + 1) periods, and stay below 128 periods so that a silence cannot
   // hide behind the 8-bit sequence counter's wrap.
-  double timeout_s = 0.05;
+  Time timeout_s = Real(0.05);
   int max_bridge_samples = 3;  // samples, 0..kMaxBridgeSamples: longest gap bridged
   int recovery_samples = 10;   // samples, >= 1: consecutive clean samples that clear a condition
   // samples: this many consecutive bit-identical samples is a stuck sensor; 0 turns the check
   // off (for noise-free synthetic input), else >= 2.
   int stuck_samples = 50;
-  double full_scale_g = 8.0;   // g: |a| at or above this on an axis is saturated
-  double max_valid_g = 8.192;  // g, >= full_scale_g: |a| above this is impossible (rejected)
+  Real full_scale_g = 8.0;         // g: |a| at or above this on an axis is saturated
+  Real max_valid_g = Real(8.192);  // g, >= full_scale_g: |a| above this is impossible (rejected)
 };
 
 // Checks the settings; the Error names the field at fault ("sensor_health.timeout_s", ...).
@@ -162,14 +163,14 @@ struct SensorSample {
   std::int64_t receive_time_ns = 0;
   std::uint8_t sequence = 0;
   std::uint8_t status = 0;                                   // sensor_flags (alarm_level.h)
-  Eigen::Vector3d acceleration_g = Eigen::Vector3d::Zero();  // sensor frame, g
+  Vector3r acceleration_g = Vector3r::Zero();                // sensor frame, g
 };
 
 // A sample to feed, in order.
 struct FedSample {
   std::int64_t time_ns = 0;  // receive time; interpolated for a bridged sample
   std::uint8_t sequence = 0;  // the sensor's number (the missing one's for a bridged sample)
-  Eigen::Vector3d acceleration_g = Eigen::Vector3d::Zero();  // sensor frame, g
+  Vector3r acceleration_g = Vector3r::Zero();  // sensor frame, g
   bool bridged = false;    // interpolated across a gap
   bool restart = false;    // first sample after a fault: does not connect to the one before
   bool saturated = false;  // at full scale: the true |a| on some axis is at least this
@@ -227,7 +228,7 @@ class SensorHealthTracker {
   // The last accepted sample (valid values): the start of the next gap and of bridging.
   std::uint8_t last_accepted_sequence_ = 0;
   std::int64_t last_accepted_time_ns_ = 0;
-  Eigen::Vector3d last_accepted_g_ = Eigen::Vector3d::Zero();
+  Vector3r last_accepted_g_ = Vector3r::Zero();
 
   int rejected_in_gap_ = 0;     // rejected samples since the last accepted one
   HealthCause last_rejection_ = HealthCause::kNone;  // why the latest of them was rejected

@@ -9,6 +9,7 @@
 
 #include "plinth/core/excitation.h"
 #include "plinth/core/internal/flows.h"
+#include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 
@@ -36,7 +37,7 @@ enum class GuardId : std::uint8_t {
 
 inline constexpr int kMaxActiveGuards = 13;
 
-using GuardValues = std::array<double, kMaxActiveGuards>;
+using GuardValues = std::array<Real, kMaxActiveGuards>;
 
 struct ActiveGuards {
   std::array<GuardId, kMaxActiveGuards> ids{};
@@ -92,23 +93,23 @@ template <Features F>
 // Eqs 16-17: rocking about corner i starts when the block's absolute horizontal acceleration
 // u'' + u_G'' + x'' reaches (b_hat_i / h)(g + v_G'') towards that corner's side (corner 1:
 // positive). b_hat_i is the pivot's distance from C (b_i on the support).
-[[nodiscard]] inline double rocking_onset_guard(const Scene& s, double sign, double onset_ratio,
-                                                const Accelerations& acc, GroundAcceleration ag) {
-  const double block = acc.u + acc.x + ag.horizontal;
+[[nodiscard]] inline Real rocking_onset_guard(const Scene& s, Real sign, Real onset_ratio,
+                                              const Accelerations& acc, GroundAcceleration ag) {
+  const Real block = acc.u + acc.x + ag.horizontal;
   return sign * block - onset_ratio * (s.g + ag.vertical);
 }
 
-[[nodiscard]] inline double rocking_onset_guard(const Scene& s, const Pivot& pivot,
-                                                const Accelerations& acc, GroundAcceleration ag) {
+[[nodiscard]] inline Real rocking_onset_guard(const Scene& s, const Pivot& pivot,
+                                              const Accelerations& acc, GroundAcceleration ag) {
   return rocking_onset_guard(s, pivot.geometry.sign, pivot.geometry.onset_ratio, acc, ag);
 }
 
 // The same about `corner`, with the pivot's onset ratio b_hat_i / h computed as make_scene does.
-[[nodiscard]] inline double rocking_onset_guard(const Scene& s, Corner corner, const Mode& mode,
-                                                const State& y, const Accelerations& acc,
-                                                GroundAcceleration ag) {
+[[nodiscard]] inline Real rocking_onset_guard(const Scene& s, Corner corner, const Mode& mode,
+                                              const State& y, const Accelerations& acc,
+                                              GroundAcceleration ag) {
   const PivotDistance pivot = pivot_distance(s, corner, mode.overhang, y[kX]);
-  const double ratio = pivot.overhanging ? pivot.distance / s.h : s.corner(corner).onset_ratio;
+  const Real ratio = pivot.overhanging ? pivot.distance / s.h : s.corner(corner).onset_ratio;
   return rocking_onset_guard(s, pivot.sign, ratio, acc, ag);
 }
 
@@ -116,8 +117,8 @@ template <Features F>
 // corner alpha_i is fixed: sign theta - alpha_i. About the support's corner b_hat_i moves with x,
 // and the guard is h sin(sign theta) - b_hat_i cos(theta) = r_i sin(sign theta - alpha_i), which
 // has the same sign and the same root (C right above the pivot) without an atan2 per point.
-[[nodiscard]] inline double overturning_guard(const Scene& s, const Mode& mode, const State& y,
-                                              const SinCos& trig) {
+[[nodiscard]] inline Real overturning_guard(const Scene& s, const Mode& mode, const State& y,
+                                            const SinCos& trig) {
   const PivotDistance pivot = pivot_distance(s, mode.corner, mode.overhang, y[kX]);
   if (!pivot.overhanging) {
     const CornerGeometry& c = s.corner(mode.corner);
@@ -147,8 +148,8 @@ template <Features F>
 
 // det(with friction) / det(frictionless) of slide-rocking about the mode's pivot in `direction`
 // (flows.h, sliding_consistency).
-[[nodiscard]] inline double sliding_consistency(const Scene& s, const Mode& mode, int direction,
-                                                const State& y, const SinCos& trig) {
+[[nodiscard]] inline Real sliding_consistency(const Scene& s, const Mode& mode, int direction,
+                                              const State& y, const SinCos& trig) {
   const PivotDistance pivot = pivot_distance(s, mode.corner, mode.overhang, y[kX]);
   return slide_rocking_system(s, pivot.offset(), pivot.overhanging, direction, y, trig)
       .consistency();
@@ -159,33 +160,35 @@ template <Features F>
 // slide into it.
 // While rocking, a direction in which Painlevé's paradox holds (or nearly: kPainleveMargin)
 // cannot start sliding either: the contact sticks.
-[[nodiscard]] inline double sliding_onset_guard(const Scene& s, const Mode& mode, const State& y,
-                                                int direction, const ContactForce& f,
-                                                const SinCos& trig) {
+[[nodiscard]] inline Real sliding_onset_guard(const Scene& s, const Mode& mode, const State& y,
+                                              int direction, const ContactForce& f,
+                                              const SinCos& trig) {
   if (s.params.has_sliding_stops &&
-      direction * y[kX] >= s.params.support.clearance * (1.0 - 1e-12)) {
-    return -1.0;
+      static_cast<Real>(direction) * y[kX] >=
+          s.params.support.clearance * (Real(1) - real_tolerance::kAtEdge)) {
+    return -Real(1);
   }
-  const double onset = -direction * f.tangential - s.params.friction.static_coefficient * f.normal;
+  const Real onset = -static_cast<Real>(direction) * f.tangential -
+                     s.params.friction.static_coefficient * f.normal;
   // The 3x3 determinants only where the onset would otherwise fire, not every step.
-  if (onset >= 0.0 && mode.rocking() &&
+  if (onset >= Real(0) && mode.rocking() &&
       sliding_consistency(s, mode, direction, y, trig) <= kPainleveMargin) {
-    return -1.0;
+    return -Real(1);
   }
   return onset;
 }
 
-[[nodiscard]] inline double sliding_onset_guard(const Scene& s, const Mode& mode, const State& y,
-                                                int direction, const ContactForce& f) {
+[[nodiscard]] inline Real sliding_onset_guard(const Scene& s, const Mode& mode, const State& y,
+                                              int direction, const ContactForce& f) {
   return sliding_onset_guard(s, mode, y, direction, f, sin_cos(y[kTheta]));
 }
 
 // Value of guard `id` at (y, ag) with the mode's accelerations `acc`; trig holds sin and cos of
 // y[kTheta] (FlowPoint).
-[[nodiscard]] inline double guard_value(GuardId id, const Scene& s, const Mode& mode,
-                                        const State& y, GroundAcceleration ag,
-                                        const Accelerations& acc, const SinCos& trig) {
-  const double x_hat = s.params.support.clearance;
+[[nodiscard]] inline Real guard_value(GuardId id, const Scene& s, const Mode& mode, const State& y,
+                                      GroundAcceleration ag, const Accelerations& acc,
+                                      const SinCos& trig) {
+  const Real x_hat = s.params.support.clearance;
   switch (id) {
     case GuardId::kRockingOnsetLeft:
       return rocking_onset_guard(s, Corner::kLeft, mode, y, acc, ag);
@@ -218,23 +221,21 @@ template <Features F>
     case GuardId::kBaseStopLeft:
       return -y[kU] - s.params.base_stops.max_displacement;
     case GuardId::kBaseStopRelease:
-      return static_cast<double>(mode.held_stop) *
-             base_stop_reaction(s, mode, y, ag, acc, trig);
+      return static_cast<Real>(mode.held_stop) * base_stop_reaction(s, mode, y, ag, acc, trig);
   }
-  return -1.0;
+  return -Real(1);
 }
 
-[[nodiscard]] inline double guard_value(GuardId id, const Scene& s, const Mode& mode,
-                                        const State& y, GroundAcceleration ag,
-                                        const Accelerations& acc) {
+[[nodiscard]] inline Real guard_value(GuardId id, const Scene& s, const Mode& mode, const State& y,
+                                      GroundAcceleration ag, const Accelerations& acc) {
   return guard_value(id, s, mode, y, ag, acc, sin_cos(y[kTheta]));
 }
 
 // guard_value at a FlowPoint, with the guards every step evaluates written out here, small
 // enough to be inlined into the solver's loop; the costlier ones (Eqs 15/18, the stop's
 // reaction, the support's edge) go through guard_value. The same values.
-[[nodiscard]] inline double step_guard_value(GuardId id, const Scene& s, const Mode& mode,
-                                             const State& y, const FlowPoint& p) {
+[[nodiscard]] inline Real step_guard_value(GuardId id, const Scene& s, const Mode& mode,
+                                           const State& y, const FlowPoint& p) {
   const Accelerations& acc = p.acc;
   const GroundAcceleration ag = p.ground;
   switch (id) {

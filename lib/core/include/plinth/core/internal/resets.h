@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "plinth/core/internal/flows.h"
+#include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
 
@@ -27,24 +28,24 @@ namespace plinth::internal {
 // is u' - h'_1 theta'); with that sign Eq 24 changes sign, see rocking_impact_reset.
 // Without a moving base (no base, or base held at a stop) U+ = U- and the ratio is J / I_to;
 // for a symmetric homogeneous block it is Housner's 1 - 1.5 sin^2(alpha).
-[[nodiscard]] inline double impact_velocity_ratio(const Scene& s, const CornerGeometry& from,
-                                                   const CornerGeometry& to, bool base_moves) {
+[[nodiscard]] inline Real impact_velocity_ratio(const Scene& s, const CornerGeometry& from,
+                                                const CornerGeometry& to, bool base_moves) {
   // J = I_C + m (h^2 + p_from p_to), the pivots' signed offsets p (= I_C + m(h^2 - b1 b2)).
-  const double inertia_through = s.inertia_c + s.m * (s.h * s.h + from.offset * to.offset);
+  const Real inertia_through = s.inertia_c + s.m * (s.h * s.h + from.offset * to.offset);
   if (!base_moves) return inertia_through / to.inertia;
-  const double mh_squared = s.m * s.h * s.m * s.h;
+  const Real mh_squared = s.m * s.h * s.m * s.h;
   return (s.total_mass * inertia_through - mh_squared) / (s.total_mass * to.inertia - mh_squared);
 }
 
 // The same between the body's own corners.
-[[nodiscard]] inline double impact_velocity_ratio(const Scene& s, Corner to, bool base_moves) {
+[[nodiscard]] inline Real impact_velocity_ratio(const Scene& s, Corner to, bool base_moves) {
   return impact_velocity_ratio(s, s.corner(opposite(to)), s.corner(to), base_moves);
 }
 
 // Eq 22 solved for U+: the base picks up the horizontal momentum the block loses.
 // U+ = U- + (m h / (m + m_b)) (theta'+ - theta'-)   (Eq 24 with the sign of Eqs 6-8).
-inline void transfer_rocking_momentum(const Scene& s, double theta_dot_before,
-                                      double theta_dot_after, State& y) {
+inline void transfer_rocking_momentum(const Scene& s, Real theta_dot_before, Real theta_dot_after,
+                                      State& y) {
   y[kUDot] += s.m * s.h / s.total_mass * (theta_dot_after - theta_dot_before);
 }
 
@@ -53,11 +54,11 @@ inline void transfer_rocking_momentum(const Scene& s, double theta_dot_before,
 // friction holds the new corner.
 inline void rocking_impact_reset(const Scene& s, bool base_moves, Mode& mode, State& y) {
   const Corner to = opposite(mode.corner);
-  const double before = y[kThetaDot];
-  const double ratio = impact_velocity_ratio(s, pivot_of(s, mode.corner, mode.overhang, y[kX]).geometry,
-                                             pivot_of(s, to, mode.overhang, y[kX]).geometry,
-                                             base_moves);
-  const double after = ratio * before;
+  const Real before = y[kThetaDot];
+  const Real ratio =
+      impact_velocity_ratio(s, pivot_of(s, mode.corner, mode.overhang, y[kX]).geometry,
+                            pivot_of(s, to, mode.overhang, y[kX]).geometry, base_moves);
+  const Real after = ratio * before;
   if (base_moves) transfer_rocking_momentum(s, before, after, y);
   y[kTheta] = 0.0;
   y[kThetaDot] = after;
@@ -77,11 +78,11 @@ inline void rocking_impact_reset(const Scene& s, bool base_moves, Mode& mode, St
 
 // M with the coordinates the mode holds fixed replaced by identity rows and columns: u when the
 // base cannot move (no base, or held at a stop), x unless sliding, theta unless rocking.
-[[nodiscard]] inline Eigen::Matrix3d constrained_mass_matrix(const Scene& s, const Mode& mode,
-                                                             const State& y, bool base_moves) {
+[[nodiscard]] inline Matrix3r constrained_mass_matrix(const Scene& s, const Mode& mode,
+                                                      const State& y, bool base_moves) {
   const Pivot pivot = pivot_of(s, mode, y);
   const ContactKinematics k = contact_kinematics(s, pivot.geometry, pivot.overhanging, y);
-  Eigen::Matrix3d mass = slide_rocking_matrices(s, k, 0).frictionless;
+  Matrix3r mass = slide_rocking_matrices(s, k, 0).frictionless;
   const bool free[3] = {base_moves, mode.sliding(), mode.rocking()};
   for (Eigen::Index i = 0; i < 3; ++i) {
     if (free[i]) continue;
@@ -95,12 +96,12 @@ inline void rocking_impact_reset(const Scene& s, bool base_moves, Mode& mode, St
 // An impulse along coordinate `i` (kUDot, kXDot or kThetaDot) that sets its velocity to
 // `velocity_after`; the mode's other free coordinates respond through M.
 inline void coordinate_impulse_reset(const Scene& s, const Mode& mode, bool base_moves,
-                                     StateIndex i, double velocity_after, State& y) {
+                                     StateIndex i, Real velocity_after, State& y) {
   const Eigen::Index coordinate = i - kUDot;
-  const Eigen::Vector3d response = constrained_mass_matrix(s, mode, y, base_moves)
-                                       .partialPivLu()
-                                       .solve(Eigen::Vector3d::Unit(coordinate));
-  const double impulse = (velocity_after - y[i]) / response[coordinate];
+  const Vector3r response = constrained_mass_matrix(s, mode, y, base_moves)
+                                .partialPivLu()
+                                .solve(Vector3r::Unit(coordinate));
+  const Real impulse = (velocity_after - y[i]) / response[coordinate];
   y.tail<3>() += impulse * response;
   y[i] = velocity_after;  // exactly, whatever the rounding
 }
@@ -109,7 +110,7 @@ inline void coordinate_impulse_reset(const Scene& s, const Mode& mode, bool base
 // horizontal momentum kept (Eq 22; in pure rocking this is Eq 24 with theta'+ = 0).
 // Slide-rocking goes on sliding (Section 3.2.3).
 inline void rocking_stop_reset(const Scene& s, bool base_moves, Mode& mode, State& y) {
-  coordinate_impulse_reset(s, mode, base_moves, kThetaDot, 0.0, y);
+  coordinate_impulse_reset(s, mode, base_moves, kThetaDot, Real(0), y);
   y[kTheta] = 0.0;
   mode.phase = mode.phase == Phase::kSlideRocking ? Phase::kSliding : Phase::kFullContact;
 }
@@ -142,7 +143,7 @@ inline void sliding_stop_hit_reset(const Scene& s, int side, bool base_moves, Mo
                                    State& y) {
   coordinate_impulse_reset(s, mode, base_moves, kXDot,
                            -s.params.sliding_stops.restitution * y[kXDot], y);
-  y[kX] = side * s.params.support.clearance;
+  y[kX] = static_cast<Real>(side) * s.params.support.clearance;
   mode.slide_direction = static_cast<std::int8_t>(-side);
 }
 
@@ -158,7 +159,7 @@ inline void rocking_onset_reset(Corner corner, Mode& mode, State& y) {
 // Painlevé's paradox (flows.h, sliding_consistency): the sliding contact sticks at once, a
 // plastic impulse on x (a tangential impact: it never adds energy); the block goes on rocking.
 inline void tangential_impact_reset(const Scene& s, Mode& mode, State& y) {
-  coordinate_impulse_reset(s, mode, mode.held_stop == 0 && s.has_base(), kXDot, 0.0, y);
+  coordinate_impulse_reset(s, mode, mode.held_stop == 0 && s.has_base(), kXDot, Real(0), y);
   mode.phase = Phase::kRocking;
   mode.slide_direction = 0;
 }
@@ -172,14 +173,14 @@ inline void tangential_impact_reset(const Scene& s, Mode& mode, State& y) {
 // While sliding, the block's absolute velocity is kept (x' changes by -delta u').
 inline void base_stop_reset(const Scene& s, int side, const Mode& mode, State& y) {
   coordinate_impulse_reset(s, mode, true, kUDot, -s.params.base_stops.restitution * y[kUDot], y);
-  y[kU] = side * s.params.base_stops.max_displacement;
+  y[kU] = static_cast<Real>(side) * s.params.base_stops.max_displacement;
 }
 
 // The base's rebounds died out against stop `side`: it rests there (u' = 0) while the stop
 // pushes (guard kBaseStopRelease). The same impulse rule as base_stop_reset with eta_i = 0.
 inline void base_stop_hold_reset(const Scene& s, int side, Mode& mode, State& y) {
-  coordinate_impulse_reset(s, mode, true, kUDot, 0.0, y);
-  y[kU] = side * s.params.base_stops.max_displacement;
+  coordinate_impulse_reset(s, mode, true, kUDot, Real(0), y);
+  y[kU] = static_cast<Real>(side) * s.params.base_stops.max_displacement;
   mode.held_stop = static_cast<std::int8_t>(side);
 }
 
@@ -202,8 +203,8 @@ inline void base_stop_hold_reset(const Scene& s, int side, Mode& mode, State& y)
 // Energy never grows (plastic normal impact, friction opposing the slip; tested on random
 // states) and the horizontal momentum is kept when the base moves.
 struct CoulombImpact {
-  double normal_impulse = 0.0;      // Pn, N s
-  double tangential_impulse = 0.0;  // Pt along x, N s
+  Real normal_impulse = 0.0;      // Pn, N s
+  Real tangential_impulse = 0.0;  // Pt along x, N s
   bool sticks = true;
 };
 
@@ -217,49 +218,51 @@ inline CoulombImpact coulomb_impact_reset(const Scene& s, bool base_moves, Mode&
       contact_kinematics(s, old_pivot.geometry, old_pivot.overhanging, at_impact);
   const ContactKinematics after =
       contact_kinematics(s, new_pivot.geometry, new_pivot.overhanging, at_impact);
-  const Eigen::Vector3d q_dot_before = y.tail<3>();
-  const Eigen::Vector2d v_c_before(before.jx.dot(q_dot_before), before.jy.dot(q_dot_before));
+  const Vector3r q_dot_before = y.tail<3>();
+  const Vector2r v_c_before(before.jx.dot(q_dot_before), before.jy.dot(q_dot_before));
 
   // G_new^T M_free v-: the new coordinates' generalized momenta before the impact.
-  Eigen::Vector3d momentum = s.m * (after.jx * v_c_before.x() + after.jy * v_c_before.y());
+  Vector3r momentum = s.m * (after.jx * v_c_before.x() + after.jy * v_c_before.y());
   momentum[0] += (s.total_mass - s.m) * y[kUDot];
   momentum[2] += s.inertia_c * y[kThetaDot];
-  const Eigen::Matrix3d mass = slide_rocking_matrices(s, after, 0).frictionless;
-  const auto hold_base = [&](Eigen::Matrix3d& a, Eigen::Vector3d& b) {
+  const Matrix3r mass = slide_rocking_matrices(s, after, 0).frictionless;
+  const auto hold_base = [&](Matrix3r& a, Vector3r& b) {
     if (base_moves) return;
-    a.row(0) << 1.0, 0.0, 0.0;
+    a.row(0) << Real(1), Real(0), Real(0);
     b[0] = y[kUDot];
   };
-  const auto normal_impulse = [&](const Eigen::Vector3d& q_dot) {
-    const Eigen::Vector2d v_c(after.jx.dot(q_dot), after.jy.dot(q_dot));
+  const auto normal_impulse = [&](const Vector3r& q_dot) {
+    const Vector2r v_c(after.jx.dot(q_dot), after.jy.dot(q_dot));
     return s.m * after.normal.dot(v_c - v_c_before);
   };
 
   // Stick: unknowns (u'+, Pt, theta'+) with x'+ = 0.
-  Eigen::Matrix3d stick = mass;
-  stick.col(1) = -Eigen::Vector3d::UnitY();
-  Eigen::Vector3d stick_rhs = momentum;
+  Matrix3r stick = mass;
+  stick.col(1) = -Vector3r::UnitY();
+  Vector3r stick_rhs = momentum;
   hold_base(stick, stick_rhs);
-  const Eigen::Vector3d z = stick.partialPivLu().solve(stick_rhs);
-  const Eigen::Vector3d q_stick(z[0], 0.0, z[2]);
+  const Vector3r z = stick.partialPivLu().solve(stick_rhs);
+  const Vector3r q_stick(z[0], Real(0), z[2]);
   CoulombImpact result{normal_impulse(q_stick), z[1], true};
-  Eigen::Vector3d q_after = q_stick;
+  Vector3r q_after = q_stick;
 
   if (std::fabs(result.tangential_impulse) >
       s.params.friction.static_coefficient * result.normal_impulse) {
     // Slide against the impulse sticking would need: Pt = -d mu_k Pn (the with-friction matrix
     // carries Pn's dependence on q'+, like Eqs 10-12 carry Y's on q'').
-    const int direction = result.tangential_impulse > 0.0 ? -1 : 1;
-    Eigen::Matrix3d slide = slide_rocking_matrices(s, after, direction).with_friction;
-    const double mu = s.params.friction.kinetic_coefficient * direction;
-    Eigen::Vector3d slide_rhs = momentum;
+    const int direction = result.tangential_impulse > Real(0) ? -1 : 1;
+    Matrix3r slide = slide_rocking_matrices(s, after, direction).with_friction;
+    const Real mu = s.params.friction.kinetic_coefficient * static_cast<Real>(direction);
+    Vector3r slide_rhs = momentum;
     slide_rhs[1] += mu * s.m * after.normal.dot(v_c_before);
     hold_base(slide, slide_rhs);
-    const Eigen::Vector3d q_slide = slide.partialPivLu().solve(slide_rhs);
-    if (q_slide[1] * direction > 0.0) {  // otherwise the slip stops within the impact: stick
+    const Vector3r q_slide = slide.partialPivLu().solve(slide_rhs);
+    if (q_slide[1] * static_cast<Real>(direction) >
+        Real(0)) {  // otherwise the slip stops within the impact: stick
       q_after = q_slide;
-      result = {normal_impulse(q_slide), -direction * s.params.friction.kinetic_coefficient *
-                                             normal_impulse(q_slide),
+      result = {normal_impulse(q_slide),
+                -static_cast<Real>(direction) * s.params.friction.kinetic_coefficient *
+                    normal_impulse(q_slide),
                 false};
       mode.slide_direction = static_cast<std::int8_t>(direction);
     }

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "plinth/core/excitation.h"
+#include "plinth/core/real.h"
 #include "plinth/core/state.h"
 
 namespace plinth::internal {
@@ -18,14 +19,14 @@ struct Rk4 {
 
   // `end_ground`, when given, is the ground at t + h (shared with the step's end point).
   template <class Flow>
-  [[nodiscard]] static State advance(const Flow& f, double t, const State& y, const State& k1,
-                                     double h, const GroundAcceleration* end_ground = nullptr) {
-    const GroundAcceleration middle = f.ground(t + 0.5 * h);
-    const State k2 = f.derivative(middle, y + 0.5 * h * k1);
-    const State k3 = f.derivative(middle, y + 0.5 * h * k2);
-    const State k4 =
-        f.derivative(end_ground != nullptr ? *end_ground : f.ground(t + h), y + h * k3);
-    return y + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  [[nodiscard]] static State advance(const Flow& f, Time t, const State& y, const State& k1, Real h,
+                                     const GroundAcceleration* end_ground = nullptr) {
+    const GroundAcceleration middle = f.ground(t + static_cast<Time>(Real(0.5) * h));
+    const State k2 = f.derivative(middle, y + Real(0.5) * h * k1);
+    const State k3 = f.derivative(middle, y + Real(0.5) * h * k2);
+    const State k4 = f.derivative(
+        end_ground != nullptr ? *end_ground : f.ground(t + static_cast<Time>(h)), y + h * k3);
+    return y + (h / Real(6)) * (k1 + Real(2) * k2 + Real(2) * k3 + k4);
   }
 };
 
@@ -38,11 +39,11 @@ struct Heun {
   static constexpr int kStages = 2;
 
   template <class Flow>
-  [[nodiscard]] static State advance(const Flow& f, double t, const State& y, const State& k1,
-                                     double h, const GroundAcceleration* end_ground = nullptr) {
-    const State k2 =
-        f.derivative(end_ground != nullptr ? *end_ground : f.ground(t + h), y + h * k1);
-    return y + (0.5 * h) * (k1 + k2);
+  [[nodiscard]] static State advance(const Flow& f, Time t, const State& y, const State& k1, Real h,
+                                     const GroundAcceleration* end_ground = nullptr) {
+    const State k2 = f.derivative(
+        end_ground != nullptr ? *end_ground : f.ground(t + static_cast<Time>(h)), y + h * k1);
+    return y + (Real(0.5) * h) * (k1 + k2);
   }
 };
 
@@ -53,9 +54,8 @@ struct SemiImplicitEuler {
   static constexpr int kStages = 1;
 
   template <class Flow>
-  [[nodiscard]] static State advance(const Flow& /*f*/, double /*t*/, const State& y,
-                                     const State& k1, double h,
-                                     const GroundAcceleration* /*end_ground*/ = nullptr) {
+  [[nodiscard]] static State advance(const Flow& /*f*/, Time /*t*/, const State& y, const State& k1,
+                                     Real h, const GroundAcceleration* /*end_ground*/ = nullptr) {
     State next;
     next.tail<3>() = y.tail<3>() + h * k1.tail<3>();
     next.head<3>() = y.head<3>() + h * next.tail<3>();
