@@ -146,10 +146,14 @@ if [ "${1:-}" = "--guest" ]; then
   }
   # The monitor's estimator ran from start to end, or plinth-replay kept its deadlines so well
   # (45 ms) that no silence of the sensor can explain a restart: then the checks judge it.
-  estimated_throughout() {  # NAME
+  # The monitor's summary: the last line it wrote.
+  summary_of() {  # NAME
     local line last=""
     while IFS= read -r line; do last=$line; done <"$1.monitor.jsonl"
-    [[ $last =~ \"estimator_restarts\":\ 1, ]] && return 0
+    printf '%s' "$last"
+  }
+  estimated_throughout() {  # NAME
+    [[ $(summary_of "$1") =~ \"estimator_restarts\":\ 1, ]] && return 0
     echo "e2e-can (guest): $1, run $n: the estimator restarted" >&2
     replay_on_time "$1" 45000
   }
@@ -189,9 +193,7 @@ if [ "${1:-}" = "--guest" ]; then
     stop_capture
   }
   single_timeout() {  # NAME
-    local line last=""
-    while IFS= read -r line; do last=$line; done <"$1.monitor.jsonl"
-    [[ $last =~ \"timeouts\":\ 1[,}] ]] && return 0
+    [[ $(summary_of "$1") =~ \"timeouts\":\ 1[,}] ]] && return 0
     echo "e2e-can (guest): $1, run $n: the sensor timed out before it was killed" >&2
     return 1
   }

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "bundled_records.h"
 #include "plinth/core/closed_forms.h"
 #include "plinth/core/energy.h"
 #include "plinth/core/internal/resets.h"
@@ -124,9 +125,7 @@ TEST(Housner, FreeRockingConservesEnergyBetweenImpacts) {
 
 // The response to (epsilon, input) mirrored is the response mirrored.
 TEST(Housner, MirroredSceneAndInputGiveTheMirroredResponse) {
-  const host::Record record = host::read_at2(
-      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
-      kStandardGravity);
+  const host::Record record = testing::brienza();
   const double gamma = 1.0 * kStandardGravity / record.peak_horizontal();
   for (const bool isolated : {false, true}) {
     SceneParams p = isolated ? testing::paper_isolated(0.3, 1.0) : paper_block(0.3);

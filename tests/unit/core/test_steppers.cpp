@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "bundled_records.h"
 #include "plinth/core/internal/flows.h"
 #include "plinth/core/internal/full_contact_propagator.h"
 #include "plinth/core/internal/resets.h"
@@ -320,9 +321,7 @@ TEST(ExactFullContact, QuietStepsAreTheIntervalsToTheLastBit) {
   everything.has_sliding_stops = true;
   SceneParams edge = everything;
   edge.has_sliding_stops = false;
-  const host::Record record = host::read_at2(
-      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
-      kStandardGravity);
+  const host::Record record = testing::brienza();
   int returns = 0;  // back to full contact after leaving it, over all runs
   int events = 0;
   for (const double pga_g : {1.0, 2.0, 2.5}) {
@@ -513,9 +512,7 @@ double largest_difference(const RecordRun& a, const RecordRun& b) {
 }
 
 TEST(OnlyWhatTheSceneNeeds, UnusedFeaturesGiveTheSameRun) {
-  const host::Record record = host::read_at2(
-      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
-      kStandardGravity);
+  const host::Record record = testing::brienza();
   struct Base {
     SceneParams params;
     double pga_g;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bundled_records.h"
 #include "dbc_file.h"
 #include "monitor_input.h"
 #include "plinth/firmware/monitor.h"
@@ -304,9 +305,7 @@ ForecastFrames run_forecast_frames(bool enabled) {
   config.forecast.enabled = enabled;
   Monitor monitor;
   EXPECT_TRUE(monitor.start(config, {std::span<const Scene>(statues), {}}).ok());
-  const host::Record record = host::read_at2(
-      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
-      kStandardGravity);
+  const host::Record record = plinth::testing::brienza();
   plinth::testing::QuietThenQuake input(200.0, 12.0, record, 20.0);  // after the 10 s start-up
   ForecastFrames out;
   for (long n = 0; n < input.size() && out.overturn_t < 0.0; ++n) {

@@ -7,6 +7,7 @@
 #include <new>
 #include <string>
 
+#include "bundled_records.h"
 #include "monitor_input.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/record_io.h"
@@ -52,9 +53,7 @@ TEST(NoAllocation, CounterSeesAllocations) {
 }
 
 TEST(NoAllocation, LongRunsWithEventsAllocateNothing) {
-  const host::Record record = host::read_at2(
-      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
-      kStandardGravity);
+  const host::Record record = testing::brienza();
   SceneParams isolated = testing::paper_isolated(0.3, 1.0);
   isolated.has_base_stops = true;
   isolated.base_stops = {0.05, 0.7};
@@ -89,9 +88,7 @@ TEST(NoAllocation, LongRunsWithEventsAllocateNothing) {
 // quiet, the block at rest and the bias followed, the alarm in the earthquake.
 TEST(NoAllocation, MonitorRunsAnHourWithoutAllocating) {
   const Scene scene = testing::make(testing::paper_isolated(0.0));
-  const host::Record record = host::read_at2(
-      std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
-      kStandardGravity);
+  const host::Record record = testing::brienza();
   const double quiet_s = 3600.0;
   testing::QuietThenQuake input(200.0, quiet_s, record, 20.0);
   firmware::MonitorConfig config;

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "bundled_records.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/job_runner.h"
 #include "plinth/host/record_io.h"
@@ -14,9 +15,7 @@
 namespace plinth::host::testing {
 
 inline const Record& brienza() {
-  static const Record record =
-      read_at2(std::string(PLINTH_SOURCE_DIR) + "/sim/data/records/irpinia1980_brienza_000.AT2",
-               kStandardGravity);
+  static const Record record = ::plinth::testing::brienza();
   return record;
 }
 
