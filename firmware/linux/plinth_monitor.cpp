@@ -360,7 +360,10 @@ bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
     }
     outputs.carry_out_commands(monitor, restart);
     const std::int64_t now_ns = plinth::hal::monotonic_now_ns();
-    if (supervisor.stall_due(now_ns)) fw::Supervisor::stall(g_stop);  // test only
+    if (supervisor.stall_due(now_ns)) {  // test only: a hung loop pings no more, even at its end
+      fw::Supervisor::stall(g_stop);
+      continue;
+    }
     supervisor.on_progress(now_ns);
   }
   supervisor.stopping();
