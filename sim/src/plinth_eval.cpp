@@ -46,7 +46,8 @@ struct RunOptions {
   bool all_scales = false;
   double rate_hz = 200.0;
   int steps_per_sample = 4;
-  std::string forecast = "strongest_window";
+  // The box's own continuation unless told (plinth::ForecastSettings, docs/forecast.md).
+  std::string forecast = plinth::kContinuationNames.name(plinth::ForecastSettings{}.continuation);
   double horizon_s = 4.0;
   double truth_step_s = 5e-4;
   std::optional<int> jobs;
@@ -267,7 +268,8 @@ int main(int argc, char** argv) {
       ->check(kFinitePositive);
   run->add_option("--steps", opt.steps_per_sample, "the box's solver steps per sample (default 4)");
   run->add_option("--forecast", opt.forecast,
-                  "strongest_window, recent_window or off (default strongest_window)");
+                  "strongest_window, recent_window or off (default the box's, " + opt.forecast +
+                      ")");
   run->add_option("--horizon", opt.horizon_s, "forecast horizon, s (default 4)")
       ->check(kFinitePositive);
   run->add_option("--truth-step", opt.truth_step_s, "the truth's solver step, s (default 5e-4)")
