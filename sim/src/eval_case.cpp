@@ -103,7 +103,10 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
              const host::CrossingGrids& grids, double stop_s, EvalRun& run) {
   const fw::MonitorConfig config = box_config(box);
   auto monitor = std::make_unique<fw::Monitor>();  // an ensemble is too big for the stack
-  const Error e = monitor->start(config, {std::span<const Scene>(c.scene->members), {}});
+  const std::span<const Scene> members = box.knows_true_statue
+                                             ? std::span<const Scene>(c.true_statue, 1)
+                                             : std::span<const Scene>(c.scene->members);
+  const Error e = monitor->start(config, {members, {}});
   if (!e.ok()) {
     throw InputError(c.scene_name + ": the box refuses it: " + e.field + " " + e.reason);
   }

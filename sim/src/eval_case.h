@@ -21,6 +21,9 @@ struct BoxSettings {
   int steps_per_sample = 4;        // the estimator's solver steps per sample
   ForecastSettings forecast;       // forecast.enabled false: the reactive box alone
   double startup_window_s = 2.0;   // s: the quiet lead-in that estimates the sensor's offset
+  // A box given the true statue (one member, no uncertainty) instead of the scene file: what
+  // knowing the statue exactly would buy, against the same truth (docs/forecast.md).
+  bool knows_true_statue = false;
 };
 
 struct TruthSettings {

@@ -46,6 +46,7 @@ struct RunOptions {
   bool all_scales = false;
   double rate_hz = 200.0;
   int steps_per_sample = 4;
+  bool box_knows_statue = false;
   // The box's own continuation unless told (plinth::ForecastSettings, docs/forecast.md).
   std::string forecast = plinth::kContinuationNames.name(plinth::ForecastSettings{}.continuation);
   double horizon_s = 4.0;
@@ -91,6 +92,7 @@ plinth::eval::BoxSettings box_settings(const RunOptions& opt) {
   plinth::eval::BoxSettings box;
   box.rate_hz = opt.rate_hz;
   box.steps_per_sample = opt.steps_per_sample;
+  box.knows_true_statue = opt.box_knows_statue;
   if (opt.forecast == "off") {
     box.forecast.enabled = false;
   } else if (!plinth::kContinuationNames.parse(opt.forecast, box.forecast.continuation)) {
@@ -267,6 +269,8 @@ int main(int argc, char** argv) {
   run->add_option("--rate", opt.rate_hz, "the box's sample rate, Hz (default 200)")
       ->check(kFinitePositive);
   run->add_option("--steps", opt.steps_per_sample, "the box's solver steps per sample (default 4)");
+  run->add_flag("--box-knows-statue", opt.box_knows_statue,
+                "give the box the true statue, not the scene file: what knowing it would buy");
   run->add_option("--forecast", opt.forecast,
                   "strongest_window, recent_window or off (default the box's, " + opt.forecast +
                       ")");

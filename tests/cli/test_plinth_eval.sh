@@ -47,6 +47,22 @@ for key, rs in cases.items():
             assert float(r["collapse_time_s"]) > 0 and float(r["peak_ratio"]) >= 1
 PY
 
+# A box given the true statue: one member, so its worst member is its nominal statue in every
+# row, where the scene file's ensemble differs in some; the truth is the same run for run.
+expect_success "a box that knows the statue" run "${SMALL[@]}" --box-knows-statue --out knows.csv
+ok_if "the box that knows the statue runs it alone, on the same truth" \
+  python3 - all.csv knows.csv <<'PY'
+import csv, sys
+ensemble = list(csv.DictReader(open(sys.argv[1])))
+knows = list(csv.DictReader(open(sys.argv[2])))
+truth = ["record", "scene", "statue", "scale_g", "collapsed", "collapse_time_s", "peak_ratio"]
+assert [[r[c] for c in truth] for r in ensemble] == [[r[c] for c in truth] for r in knows]
+risk = [c for c in knows[0] if c.startswith("risk_ge_")]
+def alone(r): return all(r[c] == r["nominal_" + c] for c in risk)
+assert all(alone(r) for r in knows)
+assert not all(alone(r) for r in ensemble)
+PY
+
 expect_success "shard 1/2" run "${SMALL[@]}" --shard 1/2 --out s1.csv
 expect_success "shard 2/2" run "${SMALL[@]}" --shard 2/2 --out s2.csv
 expect_success "merge" merge --out merged.csv s1.csv s2.csv
