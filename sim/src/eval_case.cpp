@@ -70,6 +70,7 @@ fw::MonitorConfig box_config(const BoxSettings& box) {
   fw::MonitorConfig config = fw::box_defaults();
   config.estimator.steps_per_sample = box.steps_per_sample;
   config.forecast = box.forecast;
+  config.alarm.raise_hold_s = box.raise_hold_s;
   config.conditioning.startup_window_s = box.startup_window_s;
   fw::configure_record_replay(config, box.rate_hz);
   return config;

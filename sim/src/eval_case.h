@@ -13,6 +13,7 @@
 #include "plinth/host/eval_metrics.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
+#include "plinth/monitor/alarm_policy.h"
 
 namespace plinth::eval {
 
@@ -20,6 +21,7 @@ struct BoxSettings {
   double rate_hz = 200.0;          // the ground sensor's sample rate, Hz
   int steps_per_sample = 4;        // the estimator's solver steps per sample
   ForecastSettings forecast;       // forecast.enabled false: the reactive box alone
+  Time raise_hold_s = monitor::AlarmPolicySettings{}.raise_hold_s;  // s, the policy's hold
   double startup_window_s = 2.0;   // s: the quiet lead-in that estimates the sensor's offset
   // A box given the true statue (one member, no uncertainty) instead of the scene file: what
   // knowing the statue exactly would buy, against the same truth (docs/forecast.md).

@@ -50,6 +50,7 @@ struct RunOptions {
   // The box's own continuation unless told (plinth::ForecastSettings, docs/forecast.md).
   std::string forecast = plinth::kContinuationNames.name(plinth::ForecastSettings{}.continuation);
   double horizon_s = 4.0;
+  double raise_hold_s = plinth::monitor::AlarmPolicySettings{}.raise_hold_s;
   double truth_step_s = 5e-4;
   std::optional<int> jobs;
   std::string shard = "1/1";
@@ -68,6 +69,12 @@ struct MergeOptions {
 
 std::string file_name(const std::string& path) {
   return std::filesystem::path(path).filename().string();
+}
+
+std::string shortest(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
 }
 
 std::vector<double> pga_grid(const RunOptions& opt) {
@@ -100,6 +107,7 @@ plinth::eval::BoxSettings box_settings(const RunOptions& opt) {
                      opt.forecast + "'");
   }
   box.forecast.horizon_s = opt.horizon_s;
+  box.raise_hold_s = opt.raise_hold_s;
   box.forecast.rate_hz = std::min(box.forecast.rate_hz, opt.rate_hz);
   return box;
 }
@@ -276,6 +284,10 @@ int main(int argc, char** argv) {
                       ")");
   run->add_option("--horizon", opt.horizon_s, "forecast horizon, s (default 4)")
       ->check(kFinitePositive);
+  run->add_option("--raise-hold", opt.raise_hold_s,
+                  "the box's alarm_policy.raise_hold_s, s (default the box's, " +
+                      shortest(opt.raise_hold_s) + ")")
+      ->check(CLI::Range(0.0, 10.0));
   run->add_option("--truth-step", opt.truth_step_s, "the truth's solver step, s (default 5e-4)")
       ->check(kFinitePositive);
   run->add_option("--jobs", opt.jobs, "threads (default: the hardware's)");

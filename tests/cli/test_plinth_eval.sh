@@ -63,6 +63,26 @@ assert all(alone(r) for r in knows)
 assert not all(alone(r) for r in ensemble)
 PY
 
+# Without the policy's raise hold the box's alarm is a rule of the runs file's columns: one pair
+# of thresholds "risk >= a or probability >= b" gives every row's first alarm (up to a sample).
+expect_success "a box without a raise hold" run "${SMALL[@]}" --raise-hold 0 --out hold0.csv
+ok_if "without a hold the alarm is the first crossing of one rule" python3 - hold0.csv <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+risk = [c for c in rows[0] if c.startswith("risk_ge_")]
+probability = [c for c in rows[0] if c.startswith("probability_ge_")]
+def first(r, a, b):
+    ts = [float(r[c]) for c in (a, b) if float(r[c]) >= 0]
+    return min(ts) if ts else -1.0
+def fits(a, b):
+    return all(abs(first(r, a, b) - float(r["first_alarm_s"])) <= 0.006 for r in rows
+               if float(r["first_alarm_s"]) >= 0 or r["collapsed"] == "0")
+assert any(float(r["first_alarm_s"]) >= 0 for r in rows)
+assert any(fits(a, b) for a in risk for b in probability)
+PY
+expect_failure "a negative raise hold" "--raise-hold" -- run "${SMALL[@]}" --raise-hold -1 \
+  --out x.csv
+
 expect_success "shard 1/2" run "${SMALL[@]}" --shard 1/2 --out s1.csv
 expect_success "shard 2/2" run "${SMALL[@]}" --shard 2/2 --out s2.csv
 expect_success "merge" merge --out merged.csv s1.csv s2.csv
@@ -86,6 +106,27 @@ assert alarm["collapses"] == len(collapses), (alarm, len(collapses))
 assert alarm["hits"] == len(hits) and alarm["misses"] == len(collapses) - len(hits)
 assert alarm["quiet_runs"] == len(quiet) and alarm["false_alarms"] == len(false_alarms)
 PY
+# tools/eval-frontier.py scores the rules again, in Python: its best rule that misses nothing
+# raises no more false alarms than the report's choice, and as many when the report found no
+# rule within the alarm's target (its safety-first choice is that same rule).
+ok_if "eval-frontier agrees with the report" python3 - "$SRC/tools/eval-frontier.py" all.csv \
+  report.json <<'PY'
+import json, re, subprocess, sys
+out = subprocess.run([sys.executable, sys.argv[1], sys.argv[2]], capture_output=True, text=True,
+                     check=True).stdout
+line = [l for l in out.splitlines() if l.startswith("no miss  ")][0]
+frontier = float(re.search(r"false alarms +([0-9.]+) %", line).group(1))
+alarm = [l for l in json.load(open(sys.argv[3]))["levels"] if l["level"] == "alarm"][0]
+chosen = alarm["all_records"]
+reported = 100.0 * chosen["outcome"]["false_alarm_rate"]
+if chosen["outcome"]["misses"] == 0:
+    assert frontier <= reported + 0.05, (line, chosen)
+if not chosen["meets_target"]:
+    assert abs(frontier - reported) < 0.05, (line, chosen)
+PY
+sed '2s/,[^,]*$/,zz/' all.csv >all-bad.csv  # the first row's last column is no number
+ok_if "eval-frontier names a bad number" bash -c "! python3 '$SRC/tools/eval-frontier.py' \
+  all-bad.csv 2>err.txt && grep -q 'all-bad.csv:2: nominal_risk_ge_1: expected a number' err.txt"
 ok_if "the report names the two folds" grep -q "fold 2: chosen" report.txt
 
 if command -v gnuplot >/dev/null 2>&1; then
