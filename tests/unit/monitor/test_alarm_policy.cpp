@@ -266,8 +266,9 @@ TEST(AlarmPolicy, StaleWrongLevelAndNeedlessAcknowledgementsChangeNothing) {
 }
 
 TEST(AlarmPolicy, CollapseGoesStraightToAlarmAndLatches) {
-  AlarmPolicySettings s;  // holds of 0.1 s and 2 s: the collapse does not wait for them
-  s.latch_alarm = false;   // a collapse latches all the same
+  AlarmPolicySettings s;
+  s.raise_hold_s = 0.1;   // holds of 0.1 s and 2 s: the collapse does not wait for them
+  s.latch_alarm = false;  // a collapse latches all the same
   Policy p(s);
   p.base.collapse_detected = true;
   const AlarmOutput fell = p.at(0, 0.3);

@@ -81,7 +81,10 @@ struct AlarmPolicySettings {
   RiskThresholds advisory_forecast{Real(0.125), Real(0.0625)};
   RiskThresholds warning_forecast{Real(0.25), Real(0.1875)};
   RiskThresholds alarm_forecast{Real(0.375), Real(0.3125)};
-  Time raise_hold_s = Real(0.1);  // s, >= 0: a condition holds this long before its level rises
+  // s, >= 0: a condition holds this long before its level rises. 0: the sample it starts (a
+  // margin run out is news at once), so plinth-eval's rules are exactly what the box applies;
+  // 0.1 s missed a collapse they caught and cost 0.1-0.2 s of lead (docs/forecast.md).
+  Time raise_hold_s = 0.0;
   Time lower_hold_s = 2.0;    // s, >= 0: a condition (or fault) is gone this long before it lowers
   bool latch_warning = true;  // a raised warning holds until acknowledged
   bool latch_alarm = true;    // a raised alarm holds until acknowledged (a collapse always does)
