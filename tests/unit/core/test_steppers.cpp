@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <numbers>
@@ -361,6 +362,22 @@ TEST(ExactFullContact, QuietStepsAreTheIntervalsToTheLastBit) {
   }
   EXPECT_GE(returns, 2);
   EXPECT_GE(events, 20);
+}
+
+// A whole step goes from t0 = n step to t_end = (n + 1) step (Simulator::step); in double its
+// length t_end - t0 is exact (Sterbenz: t0 <= t_end <= 2 t0 from n = 1), so t0 + h is t_end: the
+// quiet step and a whole step's interval take the ground at t_end without checking it.
+TEST(ExactFullContact, WholeStepsEndAtTheirEndExactly) {
+  for (const double rate_hz : {100.0, 200.0, 344.8275862068966, 1000.0}) {
+    for (const int steps : {1, 3, 4, 7, 64}) {
+      const Time step = 1.0 / rate_hz / steps;
+      for (std::int64_t n = 0; n < 2000000; n += (n < 100000 ? 1 : 997)) {
+        const Time t0 = static_cast<Time>(n) * step;
+        const Time t_end = static_cast<Time>(n + 1) * step;
+        ASSERT_EQ(t0 + (t_end - t0), t_end) << rate_hz << " Hz, " << steps << " steps, n " << n;
+      }
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------------------------
