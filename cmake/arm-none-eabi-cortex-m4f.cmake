@@ -14,9 +14,12 @@ set(PLINTH_MCU_CPU_FLAGS "-mcpu=cortex-m4 -mthumb -mfloat-abi=hard -mfpu=fpv4-sp
 set(CMAKE_C_COMPILER arm-none-eabi-gcc)
 set(CMAKE_CXX_COMPILER arm-none-eabi-g++)
 set(CMAKE_ASM_COMPILER arm-none-eabi-gcc)
-set(CMAKE_AR arm-none-eabi-ar)
-set(CMAKE_RANLIB arm-none-eabi-ranlib)
+# The archivers with GCC's LTO plugin (PLINTH_MCU_LTO: the symbol index of LTO objects).
+set(CMAKE_AR arm-none-eabi-gcc-ar)
+set(CMAKE_RANLIB arm-none-eabi-gcc-ranlib)
 set(CMAKE_NM arm-none-eabi-nm)
+# The nm checks read the objects' ELF symbols, not the LTO plugin's (tools/check-freestanding.sh).
+set(PLINTH_NM_TARGET elf32-littlearm)
 set(CMAKE_OBJCOPY arm-none-eabi-objcopy)
 set(CMAKE_SIZE arm-none-eabi-size)
 

@@ -17,7 +17,7 @@ function(plinth_freestanding_library name alias)
   target_link_libraries(${name} PRIVATE plinth_freestanding plinth_warnings)
   if(PLINTH_BUILD_TESTS)
     add_test(NAME ${alias}_is_freestanding
-      COMMAND ${CMAKE_COMMAND} -E env NM=${CMAKE_NM}
+      COMMAND ${CMAKE_COMMAND} -E env NM=${CMAKE_NM} NM_TARGET=${PLINTH_NM_TARGET}
               bash ${PROJECT_SOURCE_DIR}/tools/check-freestanding.sh $<TARGET_FILE:${name}>)
   endif()
 endfunction()

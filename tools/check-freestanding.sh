@@ -6,8 +6,13 @@
 #   check-freestanding.sh --image IMAGE.elf [MAP]   every symbol of a linked image (defined or
 #                                                   not), and the archive members its link map
 #                                                   says were pulled in, and why
-# NM selects nm (NM=arm-none-eabi-nm for a cross build).
+# NM selects nm (NM=arm-none-eabi-nm for a cross build). NM_TARGET (e.g. elf32-littlearm) makes
+# nm read the objects' own symbol tables as that BFD target, past binutils' LTO plugin: on an LTO
+# object (even a fat one) the plugin lists the GIMPLE's symbols, which leave out calls to
+# builtins such as malloc and memcpy.
 set -euo pipefail
+nm_command=("${NM:-nm}")
+[ -z "${NM_TARGET:-}" ] || nm_command+=("--target=$NM_TARGET")
 forbidden='^(malloc|calloc|realloc|free|aligned_alloc|posix_memalign|_sbrk|_sbrk_r|_malloc_r|_calloc_r|_realloc_r|_free_r)$|operator new|operator delete|__cxa_throw|__cxa_allocate_exception|__cxa_begin_catch|__gxx_personality|_Unwind_|__aeabi_unwind_cpp_pr|typeinfo|std::ios_base|std::basic_ostream|std::cout|std::cerr|printf|(^|[^A-Za-z])f?puts|fwrite'
 
 report_bad() {  # WHAT BAD-SYMBOLS
@@ -21,7 +26,7 @@ if [ "${1:-}" = "--image" ]; then
   map=${3:-}
   [ -f "$image" ] || { echo "check-freestanding: no such image: $image" >&2; exit 2; }
   # "ADDRESS TYPE NAME" or, undefined, "TYPE NAME"; a demangled NAME may hold spaces.
-  symbols=$("${NM:-nm}" -C "$image" | sed -E 's/^ *([0-9a-fA-F]+ )?[A-Za-z?-] //' | sort -u)
+  symbols=$("${nm_command[@]}" -C "$image" | sed -E 's/^ *([0-9a-fA-F]+ )?[A-Za-z?-] //' | sort -u)
   bad=$(grep -E "$forbidden" <<<"$symbols" || true)
   [ -z "$bad" ] || report_bad "$image" "$bad"
   if [ -n "$map" ]; then
@@ -41,7 +46,7 @@ fi
 
 archive=${1:?usage: check-freestanding.sh ARCHIVE | --image IMAGE.elf [IMAGE.map]}
 [ -f "$archive" ] || { echo "check-freestanding: no such archive: $archive" >&2; exit 2; }
-undefined=$("${NM:-nm}" -C --undefined-only "$archive" | awk 'NF >= 2 && $1 == "U" { $1 = ""; print substr($0, 2) }' | sort -u)
+undefined=$("${nm_command[@]}" -C --undefined-only "$archive" | awk 'NF >= 2 && $1 == "U" { $1 = ""; print substr($0, 2) }' | sort -u)
 bad=$(grep -E "$forbidden" <<<"$undefined" || true)
 [ -z "$bad" ] || report_bad "$archive" "$bad"
 count=$(grep -c . <<<"$undefined" || true)

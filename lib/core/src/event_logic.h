@@ -416,23 +416,22 @@ struct EventLogic {
   // the end's horizontal ground acceleration is kept, as the next step's start. Otherwise (a
   // guard at or past 0, or not a number) returns false, nothing changed, and the step's interval
   // runs (ExactFullContact in phase_kernels.h).
-  static bool quiet_full_contact_step(Simulator& sim, Time t0, Time t_end) {
+  static bool quiet_full_contact_step(Simulator& sim, Time t_end) {
     if constexpr (!F.base) {
       return false;
     } else {
       const Mode& mode = sim.mode_;
-      const auto h = static_cast<Real>(t_end - t0);
       State& y = sim.y_;
       // x and theta at rest, as every reset into full contact leaves them (a state given to
       // start_from may not: the interval advances it).
       if (mode.held_stop != 0 || mode.overhang != 0 || y[kXDot] != Real(0) ||
-          y[kThetaDot] != Real(0) || t0 + static_cast<Time>(h) != t_end) {
+          y[kThetaDot] != Real(0)) {
         return false;
       }
       const Scene& s = *sim.scene_;
       const Real a0 = sim.quiet_ground_step_ == sim.step_count_
                           ? sim.quiet_ground_horizontal_
-                          : kernels::Base::ground(sim.excitation_, t0).horizontal;
+                          : kernels::Base::ground(sim.excitation_, sim.time()).horizontal;
       const GroundAcceleration a1 = kernels::Base::ground(sim.excitation_, t_end);
       Real u = y[kU];
       Real u_dot = y[kUDot];

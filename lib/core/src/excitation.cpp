@@ -3,13 +3,20 @@
 #include <cmath>
 #include <numbers>
 
+#include "plinth/core/internal/flows.h"
+
 namespace plinth {
 
 GroundAcceleration Excitation::pulse_at(Time t) const {
   if (t < 0.0 || t > period) return {};
   const auto phase = static_cast<Real>(2.0 * std::numbers::pi * t / period);
-  return {amplitude * (kind == ExcitationKind::kSinePulse ? std::sin(phase) : std::cos(phase)),
-          Real(0)};
+  const bool sine = kind == ExcitationKind::kSinePulse;
+  if constexpr (real_tolerance::kSingle) {  // phase in [0, 2 pi]: bounded_trig.h
+    const internal::SinCos trig = internal::real_sin_cos(phase);
+    return {amplitude * (sine ? trig.sin : trig.cos), Real(0)};
+  } else {
+    return {amplitude * (sine ? std::sin(phase) : std::cos(phase)), Real(0)};
+  }
 }
 
 Time Excitation::duration() const {

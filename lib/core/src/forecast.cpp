@@ -70,6 +70,12 @@ Error validate(const ForecastSettings& s, double input_rate_hz) {
 Error Forecaster::start(const ForecastSettings& settings, double input_rate_hz) {
   PLINTH_TRY(validate(settings, input_rate_hz));
   settings_ = settings;
+  if constexpr (!kForecastBuiltIn) {
+    // validate() let only a disabled forecast through: nothing of it is built or linked.
+    started_ = true;
+    reset();
+    return ok_error();
+  }
   decimation_ = decimation_for(settings.rate_hz, input_rate_hz);
   rate_hz_ = input_rate_hz / decimation_;
   window_length_ = static_cast<int>(std::lround(settings.window_s * rate_hz_));
@@ -114,7 +120,7 @@ double Forecaster::window_energy() const {
 
 void Forecaster::on_sample(GroundAcceleration sample, double time_s,
                            std::span<const PlanarEstimator> members) {
-  if (!started_ || !settings_.enabled) return;
+  if (!kForecastBuiltIn || !started_ || !settings_.enabled) return;
   sum_.horizontal += sample.horizontal;
   sum_.vertical += sample.vertical;
   if (++summed_ >= decimation_) {

@@ -177,9 +177,8 @@ void Simulator::start_with_impulse(Real impulse) {
 }
 
 // One step by intervals: the stepper in the current mode, then event after event.
-void Simulator::step_intervals() {
+void Simulator::step_intervals(Time t_end) {
   if (mode_.terminal()) return;
-  const Time t_end = static_cast<Time>(step_count_ + 1) * settings_.step;
   Time t0 = time();
   if (interval_fns_[static_cast<std::size_t>(mode_.phase)](*this, t0, t_end, true, true)) {
     finish_step(t0, t_end);

@@ -167,9 +167,13 @@ struct StepInterval {
       start = k.point(y0, k.ground(t0));
       evaluate_guards(s, mode, guards, y0, start, g_start);
     }
+    // A whole step ends at t_end: in double t0 + h is t_end exactly (t_end - t0 is exact, t0
+    // being n step and t_end (n + 1) step); in float h is that difference rounded, and the
+    // ground is still taken at t_end, as the quiet full-contact step takes it.
     const GroundAcceleration end_ground = k.ground(t_end);
-    const State y1 = advance_state(k, t0, y0, start, h,
-                                   t0 + static_cast<Time>(h) == t_end ? &end_ground : nullptr);
+    const State y1 =
+        advance_state(k, t0, y0, start, h,
+                      full_step || t0 + static_cast<Time>(h) == t_end ? &end_ground : nullptr);
     FlowPoint& end = sim.points_[next];
     GuardValues& g_end = sim.guard_values_[next];
     end = k.point(y1, end_ground);

@@ -77,8 +77,9 @@ Error Conditioner::create(const ConditioningSettings& settings, Conditioner& out
   out.settings_ = settings;
   out.unit_scale_ =
       settings.unit == AccelerationUnit::kStandardGravity ? kStandardGravity : Real(1);
+  // The ratio of the settings' doubles, its expm1 in Real (a float build: expm1f, not double's).
   out.tracking_gain_ =
-      static_cast<Real>(-std::expm1(-settings.sample_period_s / settings.tracking_time_constant_s));
+      -std::expm1(static_cast<Real>(-settings.sample_period_s / settings.tracking_time_constant_s));
   out.status_.window_length = window_length(settings);
   return ok_error();
 }

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 
 #include "plinth/core/excitation.h"
@@ -55,6 +56,39 @@ TEST(Excitation, NoneIsStill) {
   EXPECT_EQ(e.at(1.0).horizontal, 0.0);
   EXPECT_EQ(e.at(1.0).vertical, 0.0);
   EXPECT_EQ(e.duration(), 0.0);
+}
+
+TEST(GroundStream, InterpolatesBetweenTheTwoNewestSamplesHeldPastThem) {
+  GroundStream s;
+  s.reset(0.01, {1.0, -1.0});
+  EXPECT_EQ(s.at(0.0).horizontal, 1.0);  // sample 0 held until sample 1 arrives
+  s.push({3.0, 1.0});                    // sample 1, t = 0.01
+  EXPECT_DOUBLE_EQ(s.at(0.0025).horizontal, 1.5);
+  EXPECT_DOUBLE_EQ(s.at(0.0075).vertical, 0.5);
+  EXPECT_EQ(s.at(-0.5).horizontal, 1.0);  // before the interval: the older sample
+  EXPECT_EQ(s.at(0.5).horizontal, 3.0);   // past it: the newer one
+}
+
+// The weight is the old double expression, (t - start) / period clamped to [0, 1], to the last
+// bit in a double build (the host's decisions unchanged), hours into a run.
+TEST(GroundStream, WeightIsTheDoubleFractionBitForBit) {
+  for (const double rate_hz : {100.0, 200.0, 344.8275862068966, 1000.0}) {
+    GroundStream s;
+    s.reset(1.0 / rate_hz, {});
+    const int steps = 4;
+    const Time step = s.period / steps;
+    for (std::int64_t n = 0; n < 200000; ++n) {
+      if (n % steps == 0) s.push({static_cast<Real>(n % 7), 0.0});
+      for (std::int64_t i : {n, n + 1, n + 3600 * 1000}) {
+        const Time t = static_cast<Time>(i) * step;
+        const Time fraction = (t - s.start_time) / s.period;
+        const double w = fraction < 0.0 ? 0.0 : (fraction > 1.0 ? 1.0 : fraction);
+        ASSERT_EQ(s.at(t).horizontal,
+                  s.previous.horizontal + w * (s.latest.horizontal - s.previous.horizontal))
+            << "rate " << rate_hz << " step " << i;
+      }
+    }
+  }
 }
 
 }  // namespace

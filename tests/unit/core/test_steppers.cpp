@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <limits>
 #include <numbers>
@@ -22,10 +23,13 @@
 namespace plinth {
 namespace {
 
+namespace bounded_trig = internal::bounded_trig;
+using internal::bounded_sin_cos;
 using internal::contact_kinematics;
 using internal::ContactKinematics;
 using internal::coulomb_impact_reset;
 using internal::CoulombImpact;
+using internal::FloatSinCos;
 using internal::FullContactPropagator;
 using internal::kStageAngle;
 using internal::lever_arms;
@@ -363,6 +367,22 @@ TEST(ExactFullContact, QuietStepsAreTheIntervalsToTheLastBit) {
   EXPECT_GE(events, 20);
 }
 
+// A whole step goes from t0 = n step to t_end = (n + 1) step (Simulator::step); in double its
+// length t_end - t0 is exact (Sterbenz: t0 <= t_end <= 2 t0 from n = 1), so t0 + h is t_end: the
+// quiet step and a whole step's interval take the ground at t_end without checking it.
+TEST(ExactFullContact, WholeStepsEndAtTheirEndExactly) {
+  for (const double rate_hz : {100.0, 200.0, 344.8275862068966, 1000.0}) {
+    for (const int steps : {1, 3, 4, 7, 64}) {
+      const Time step = 1.0 / rate_hz / steps;
+      for (std::int64_t n = 0; n < 2000000; n += (n < 100000 ? 1 : 997)) {
+        const Time t0 = static_cast<Time>(n) * step;
+        const Time t_end = static_cast<Time>(n + 1) * step;
+        ASSERT_EQ(t0 + (t_end - t0), t_end) << rate_hz << " Hz, " << steps << " steps, n " << n;
+      }
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // The fast forms of the flows against straightforward Eigen ones
 
@@ -385,6 +405,54 @@ TEST(FastFlows, SinCosIsWithinTwoRoundingsOfLibm) {
   EXPECT_EQ(zero.cos, 1.0);
   EXPECT_EQ(sin_cos(1e-300).sin, 1e-300);
   EXPECT_TRUE(std::isnan(sin_cos(std::nan("")).sin));
+}
+
+// bounded_sin_cos (bounded_trig.h, the float build's sin and cos) against libm's double sin and
+// cos of the same float argument: the block's angles and a pulse's phase to two roundings of the
+// result (float's epsilon is 1.2e-7), and the whole range, near every multiple of pi / 2
+// included, to that or 3e-11 absolute (the reduction's error grows with the quadrant).
+TEST(FastFlows, BoundedSinCosIsWithinTwoRoundingsOfLibm) {
+  constexpr double kTwoRoundings = 2.0 * double{std::numeric_limits<float>::epsilon()};
+  // |error| of sin and cos at x, less two roundings of the exact value, in units of `absolute`.
+  const auto excess = [&](float x, double absolute) {
+    const FloatSinCos t = bounded_sin_cos(x);
+    const double s = std::sin(static_cast<double>(x));
+    const double c = std::cos(static_cast<double>(x));
+    return std::max((std::fabs(static_cast<double>(t.sin) - s) - kTwoRoundings * std::fabs(s)),
+                    (std::fabs(static_cast<double>(t.cos) - c) - kTwoRoundings * std::fabs(c))) /
+           absolute;
+  };
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  // The block's angles and a pulse's phase: two roundings of the result (1e-30: nothing more).
+  for (const double range : {1e-3, 0.8, 1.7, 2.0 * std::numbers::pi}) {
+    double worst = -1.0;
+    for (int i = 0; i < 200000; ++i) {
+      worst = std::max(worst, excess(static_cast<float>(range * unit(rng)), 1e-30));
+    }
+    EXPECT_LE(worst, 0.0) << "range " << range;
+  }
+  // The whole range, and next to each multiple of pi / 2 (the smallest reduced arguments): two
+  // roundings or 3e-11.
+  double worst = -1.0;
+  for (int i = 0; i < 400000; ++i) {
+    const double range = bounded_trig::kRange;
+    worst = std::max(worst, excess(static_cast<float>(range * unit(rng)), 3e-11));
+  }
+  for (int k = -5215; k <= 5215; ++k) {
+    const auto x = static_cast<float>(k * std::numbers::pi / 2);
+    for (const float y : {std::nextafter(x, -1e9F), x, std::nextafter(x, 1e9F)}) {
+      if (std::fabs(y) <= bounded_trig::kRange) worst = std::max(worst, excess(y, 3e-11));
+    }
+  }
+  EXPECT_LE(worst, 1.0);
+  EXPECT_EQ(bounded_sin_cos(0.0F).sin, 0.0F);
+  EXPECT_EQ(bounded_sin_cos(0.0F).cos, 1.0F);
+  EXPECT_EQ(bounded_sin_cos(1e-30F).sin, 1e-30F);
+  EXPECT_TRUE(std::isnan(bounded_sin_cos(std::nanf("")).sin));
+  EXPECT_TRUE(std::isnan(bounded_sin_cos(std::numeric_limits<float>::infinity()).cos));
+  EXPECT_TRUE(std::isnan(bounded_sin_cos(std::nextafter(bounded_trig::kRange, 1e9F)).sin));
+  EXPECT_FALSE(std::isnan(bounded_sin_cos(-bounded_trig::kRange).sin));
 }
 
 // lever_arms_turned (the rocking kernel's stages) against Eq 9 with libm's sin and cos, over

@@ -33,8 +33,10 @@ struct SampledSignal {
     if (position >= last) return position == last ? static_cast<Real>(values[count - 1]) : 0;
     // position >= 0: truncation is the floor (std::floor is a libm call without SSE4.1)
     const auto i = static_cast<std::size_t>(position);
-    const double w = position - static_cast<double>(i);
-    return static_cast<Real>(values[i] + w * (values[i + 1] - values[i]));
+    // The weight and the samples in Real (in a double build the same expression as in double).
+    const auto w = static_cast<Real>(position - static_cast<double>(i));
+    const auto v0 = static_cast<Real>(values[i]);
+    return v0 + w * (static_cast<Real>(values[i + 1]) - v0);
   }
   [[nodiscard]] Time duration() const {
     return count == 0 ? 0.0 : static_cast<Time>(count - 1) * dt;
@@ -47,17 +49,22 @@ struct SampledSignal {
 struct GroundStream {
   Time start_time = 0.0;  // s, time of `previous`
   Time period = 1.0;      // s, between the two samples
+  Real period_real = 1.0;  // s, `period` in Real (set with it by reset)
   GroundAcceleration previous;
   GroundAcceleration latest;
   std::int64_t latest_index = 0;  // `latest` is sample n, at t = n period
 
   [[nodiscard]] GroundAcceleration at(Time t) const {
-    // The fraction of the interval in Time, then Real: t is far from 0 after hours.
-    const Time fraction = (t - start_time) / period;
-    const Real w =
-        fraction < 0.0 ? Real(0) : (fraction > 1.0 ? Real(1) : static_cast<Real>(fraction));
+    // The offset into the interval in Time (t is far from 0 after hours), then the fraction in
+    // Real: the offset is under a few periods, which Real resolves (in a double build the same
+    // expression as in double).
+    const Real w = weight(static_cast<Real>(t - start_time) / period_real);
     return {previous.horizontal + w * (latest.horizontal - previous.horizontal),
             previous.vertical + w * (latest.vertical - previous.vertical)};
+  }
+  // The interpolation weight of a fraction of the interval, held at the samples beyond it.
+  [[nodiscard]] static Real weight(Real fraction) {
+    return fraction < Real(0) ? Real(0) : (fraction > Real(1) ? Real(1) : fraction);
   }
   // The next sample arrives: the interval moves on by one period.
   void push(GroundAcceleration sample) {
@@ -69,6 +76,7 @@ struct GroundStream {
   // Sample 0 at t = 0: held until the next one arrives.
   void reset(Time sample_period, GroundAcceleration first) {
     period = sample_period;
+    period_real = static_cast<Real>(sample_period);
     start_time = -sample_period;
     latest_index = 0;
     previous = first;

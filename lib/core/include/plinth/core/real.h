@@ -7,6 +7,9 @@
 // 2048 * 2^-23 = 0.24 ms, a whole 0.25 ms step; the solver's time is step_count * step, which a
 // double keeps to a nanosecond for centuries. The offsets inside one step (stage times, located
 // events) are Real, added to the step's start explicitly; a double add per stage is the cost.
+// A quiet step takes no other double arithmetic than its end time: the ground's interpolation
+// weight is the offset into the sample interval (a double difference) divided in Real, and a
+// whole step is known to end at its end time (no double check of t0 + h).
 #pragma once
 
 #include <Eigen/Core>

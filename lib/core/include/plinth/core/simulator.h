@@ -82,13 +82,13 @@ class Simulator {
   // Advances one step (no-op once a terminal phase is reached). A quiet step of exactly
   // propagated full contact is taken here, without a call to the step's intervals.
   void step() {
+    const Time t_end = static_cast<Time>(step_count_ + 1) * settings_.step;
     if (mode_.phase == Phase::kFullContact && quiet_full_contact_step_fn_ != nullptr &&
-        quiet_full_contact_step_fn_(*this, time(),
-                                    static_cast<Time>(step_count_ + 1) * settings_.step)) {
+        quiet_full_contact_step_fn_(*this, t_end)) {
       ++step_count_;
       return;
     }
-    step_intervals();
+    step_intervals(t_end);
   }
 
   void set_event_sink(EventSink* sink) { sink_ = sink; }
@@ -119,7 +119,7 @@ class Simulator {
   }
   // The guards of the current mode, after it changed.
   void refresh_guards() { active_guards_ = guards_fn_(mode_); }
-  void step_intervals();
+  void step_intervals(Time t_end);
   [[gnu::noinline]] void finish_step(Time t0, Time t_end);
 
   // Advances in the current mode from t0 towards t_end (one interval of a step, StepInterval in
@@ -140,8 +140,9 @@ class Simulator {
   internal::ActiveGuards (*guards_fn_)(const Mode&) = nullptr;
   void (*start_phases_fn_)(Simulator&, Time t) = nullptr;  // whose onset already holds
   Accelerations (*accelerations_fn_)(const Simulator&, Time t, const State&) = nullptr;
-  // exact_full_contact: a quiet whole step of full contact (false: take the interval).
-  bool (*quiet_full_contact_step_fn_)(Simulator&, Time t0, Time t_end) = nullptr;
+  // exact_full_contact: a quiet whole step of full contact, from time() to t_end (false: take
+  // the interval).
+  bool (*quiet_full_contact_step_fn_)(Simulator&, Time t_end) = nullptr;
   // u_G'' at the end of the last quiet full-contact step, the start of step number
   // quiet_ground_step_, m/s2.
   Real quiet_ground_horizontal_ = 0.0;

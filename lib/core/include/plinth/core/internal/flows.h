@@ -7,6 +7,7 @@
 #include <cstddef>
 
 #include "plinth/core/excitation.h"
+#include "plinth/core/internal/bounded_trig.h"
 #include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/state.h"
@@ -38,6 +39,17 @@ struct SinCos {
   Real sin = 0.0;
   Real cos = 1.0;
 };
+
+// sin and cos from libm in a double build; in a float build from bounded_sin_cos
+// (bounded_trig.h: |x| <= 8192 rad, without newlib's reduction of arbitrary arguments).
+[[nodiscard]] inline SinCos real_sin_cos(Real x) {
+  if constexpr (real_tolerance::kSingle) {
+    const FloatSinCos t = bounded_sin_cos(static_cast<float>(x));
+    return {static_cast<Real>(t.sin), static_cast<Real>(t.cos)};
+  } else {
+    return {std::sin(x), std::cos(x)};
+  }
+}
 
 namespace trig_table {
 
@@ -117,7 +129,7 @@ inline constexpr Real kNearAngle = 0.0625;
 // and subtracting 1.5 2^52 (no conversion to an integer on the way to d: this is on the
 // critical path of every step).
 [[nodiscard]] inline SinCos sin_cos_of_turned(Real theta) {
-  if (!(std::fabs(theta) <= trig_table::kRange)) return {std::sin(theta), std::cos(theta)};
+  if (!(std::fabs(theta) <= trig_table::kRange)) return real_sin_cos(theta);
   constexpr Real kRoundingShift = 6755399441055744.0;  // 1.5 2^52
   const Real shifted = theta * trig_table::kSteps + kRoundingShift;
   const Real k = shifted - kRoundingShift;
@@ -170,7 +182,7 @@ inline constexpr Real kNearAngle = 0.0625;
 }
 
 [[nodiscard]] inline LeverArms lever_arms(const Scene& s, const CornerGeometry& c, Real theta) {
-  return lever_arms(s, c.offset, SinCos{std::sin(theta), std::cos(theta)});
+  return lever_arms(s, c.offset, real_sin_cos(theta));
 }
 
 // The pivot of rocking about `corner`: the body's own corner, or, when the block overhangs the
@@ -300,8 +312,7 @@ struct ContactKinematics {
 
 [[nodiscard]] inline ContactKinematics contact_kinematics(const Scene& s, const CornerGeometry& c,
                                                           bool overhanging, const State& y) {
-  return contact_kinematics(s, c.offset, overhanging, y, SinCos{std::sin(y[kTheta]),
-                                                                std::cos(y[kTheta])});
+  return contact_kinematics(s, c.offset, overhanging, y, real_sin_cos(y[kTheta]));
 }
 
 // Contact force of the base (or the support's corner) on the block, in the contact's frame.
