@@ -18,6 +18,7 @@
 #include "plinth/host/cli.h"
 #include "plinth/host/eval_metrics.h"
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 #include "plinth/host/job_runner.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/run_progress.h"
@@ -69,12 +70,6 @@ struct MergeOptions {
 
 std::string file_name(const std::string& path) {
   return std::filesystem::path(path).filename().string();
-}
-
-std::string shortest(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
 }
 
 std::vector<double> pga_grid(const RunOptions& opt) {
@@ -286,7 +281,7 @@ int main(int argc, char** argv) {
       ->check(kFinitePositive);
   run->add_option("--raise-hold", opt.raise_hold_s,
                   "the box's alarm_policy.raise_hold_s, s (default the box's, " +
-                      shortest(opt.raise_hold_s) + ")")
+                      plinth::host::number_text(opt.raise_hold_s) + ")")
       ->check(CLI::Range(0.0, 10.0));
   run->add_option("--truth-step", opt.truth_step_s, "the truth's solver step, s (default 5e-4)")
       ->check(kFinitePositive);
