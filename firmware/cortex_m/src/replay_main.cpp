@@ -3,6 +3,7 @@
 // monitor hands over go out through the CAN stand-in, a candump log on the semihosting console;
 // phase events, the cost per sample and the stack's high-water mark follow as '#' comment lines
 // (docs/microcontroller.md). Exit status 0 when the replay ran to its end and every frame went out.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -143,8 +144,8 @@ extern "C" int plinth_board_main() {
     // This build holds one sensor: no cross-check runs, and their windows, never filled, are
     // set within the build's window capacity.
     const double longest_s = fw::kMaxCheckWindowSamples / record.sample_rate_hz;
-    config.redundancy.window_s = std::fmin(config.redundancy.window_s, longest_s);
-    config.plate.window_s = std::fmin(config.plate.window_s, longest_s);
+    config.redundancy.window_s = std::min(config.redundancy.window_s, longest_s);
+    config.plate.window_s = std::min(config.plate.window_s, longest_s);
   }
   if (Error e =
           g_monitor.start(config, {&g_scenes[0], replay.has_scene_y ? &g_scenes[1] : nullptr});

@@ -140,7 +140,7 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
   return validate_sensors(c, sensor_index);
 }
 
-void Monitor::RmsWindow::add(double square) {
+void Monitor::RmsWindow::add(Real square) {
   const auto slot = static_cast<std::size_t>(next);
   if (count >= length) {
     sum -= squares[slot];
@@ -151,15 +151,15 @@ void Monitor::RmsWindow::add(double square) {
   sum += square;
   next = next + 1 >= length ? 0 : next + 1;
   if (next == 0) {  // once per window: the sum afresh, no drift of the running sum over hours
-    sum = 0.0;
+    sum = 0;
     for (int i = 0; i < count; ++i) sum += squares[static_cast<std::size_t>(i)];
   }
 }
 
-double Monitor::RmsWindow::rms() const {
-  if (count == 0) return 0.0;
-  const double mean = sum / static_cast<double>(count);
-  return mean > 0.0 ? std::sqrt(mean) : 0.0;
+Real Monitor::RmsWindow::rms() const {
+  if (count == 0) return 0;
+  const Real mean = sum / static_cast<Real>(count);
+  return mean > 0 ? std::sqrt(mean) : 0;
 }
 
 Error Monitor::start(const MonitorConfig& config,
@@ -492,15 +492,15 @@ void Monitor::check_sensor(int sensor) {
       continue;
     }
     ++st.pairs;
-    double square = 0.0;
+    Real square = 0;
     for (int c = 0; c < components; ++c) {
-      const auto d = static_cast<double>(e.value[c] - r[c]);
+      const Real d = e.value[c] - r[c];
       square += d * d;
     }
     s.window.add(square);
   }
   st.window_full = s.window.full();
-  st.rms_m_s2 = s.window.rms();
+  st.rms_m_s2 = static_cast<double>(s.window.rms());
   const double limit = plate ? config_.plate.threshold_m_s2 : config_.redundancy.tolerance_m_s2;
   const bool beyond = st.window_full && st.rms_m_s2 > limit;
   if (st.window_full) st.max_rms_m_s2 = st.rms_m_s2 > st.max_rms_m_s2 ? st.rms_m_s2 : st.max_rms_m_s2;
@@ -594,7 +594,7 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
     collapse = collapse || axis.mode.terminal();
     const ForecastOutcome& f = axis.forecast;
     axis.collapse_forecast_s = -1.0;
-    if (!f.valid) continue;
+    if (!kForecastBuiltIn || !f.valid) continue;
     if (status_.forecast_axis < 0 || f.probability > status_.probability) {
       status_.probability = f.probability;
       status_.forecast_axis = i;
@@ -678,7 +678,8 @@ void Monitor::report(MonitorUpdate& update) {
   for (int i = 0; i < status_.axis_count; ++i) {
     add_frame(update, status_message(status_, i, status_sequence_));
   }
-  for (int i = 0; config_.forecast.enabled && i < status_.axis_count; ++i) {
+  // A build without the forecast (PLINTH_FORECAST=OFF) never has one to send.
+  for (int i = 0; kForecastBuiltIn && config_.forecast.enabled && i < status_.axis_count; ++i) {
     if (!status_.axes[static_cast<std::size_t>(i)].forecast.valid) continue;
     add_frame(update, forecast_message(status_, i, config_.forecast.horizon_s, status_sequence_));
   }

@@ -13,6 +13,10 @@ namespace {
 // What a sensor at rest reads in the statue frame, m/s2 (the support pushes up).
 Vector3r gravity_up() { return {Real(0), Real(0), kStandardGravity}; }
 
+// A sample count as Real, through double (exact below 2^53): a float build then needs no
+// int64-to-float routine (libgcc's comes with its software float addition, about 700 bytes).
+Real count_as_real(std::int64_t n) { return static_cast<Real>(static_cast<double>(n)); }
+
 // Samples in the start-up window; validate() checks it is at least 2.
 std::int64_t window_length(const ConditioningSettings& s) {
   return static_cast<std::int64_t>(std::llround(s.startup_window_s / s.sample_period_s));
@@ -131,14 +135,14 @@ bool Conditioner::add_to_window(const Vector3r& statue_m_s2) {
   const std::int64_t half = status_.window_length / 2;
   if (n <= half) first_half_sum_ += statue_m_s2;
   const Vector3r before = statue_m_s2 - window_mean_;
-  window_mean_ += before / static_cast<Real>(n);
+  window_mean_ += before / count_as_real(n);
   window_m2_ += before.cwiseProduct(statue_m_s2 - window_mean_);
   if (n < status_.window_length) return false;
 
-  status_.window_std_m_s2 = (window_m2_ / static_cast<Real>(n - 1)).cwiseSqrt();
-  const Vector3r second_half_sum = window_mean_ * static_cast<Real>(n) - first_half_sum_;
+  status_.window_std_m_s2 = (window_m2_ / count_as_real(n - 1)).cwiseSqrt();
+  const Vector3r second_half_sum = window_mean_ * count_as_real(n) - first_half_sum_;
   status_.window_drift_m_s2 =
-      second_half_sum / static_cast<Real>(n - half) - first_half_sum_ / static_cast<Real>(half);
+      second_half_sum / count_as_real(n - half) - first_half_sum_ / count_as_real(half);
   const Vector3r offset = window_mean_ - gravity_up();
   status_.last_rejection = quietness(offset);
   switch (status_.last_rejection) {

@@ -363,17 +363,18 @@ class Monitor {
     void push(const HistoryEntry& e) { entries[static_cast<std::size_t>(pushed++ % kSensorHistory)] = e; }
     void clear() { first_kept = pushed; }
   };
-  // The RMS of a sliding window of squared differences.
+  // The RMS of a sliding window of squared differences, m/s2, in Real (the sum is taken afresh
+  // once per window, so a float build does not drift).
   struct RmsWindow {
-    std::array<double, kMaxCheckWindowSamples> squares{};
+    std::array<Real, kMaxCheckWindowSamples> squares{};
     int length = 2;   // samples
     int count = 0;    // samples held, up to length
     int next = 0;     // slot of the next one
-    double sum = 0.0;
-    void reset() { count = 0; next = 0; sum = 0.0; }
-    void add(double square);
+    Real sum = 0;
+    void reset() { count = 0; next = 0; sum = 0; }
+    void add(Real square);
     [[nodiscard]] bool full() const { return count >= length; }
-    [[nodiscard]] double rms() const;
+    [[nodiscard]] Real rms() const;
   };
   struct Sensor {
     monitor::SensorHealthTracker health;

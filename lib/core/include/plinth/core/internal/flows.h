@@ -127,8 +127,11 @@ inline constexpr Real kNearAngle = 0.0625;
 // sin and cos of theta to about one rounding, without libm for |theta| <= trig_table::kRange:
 // theta = k / 64 + d with |d| <= 1/128, the table's entry turned by d. k is rounded by adding
 // and subtracting 1.5 2^52 (no conversion to an integer on the way to d: this is on the
-// critical path of every step).
+// critical path of every step). A float build takes bounded_sin_cos (real_sin_cos): its own
+// reduction is as short, and the table, whose rounding would need 1.5 2^23 in float, is 1.7 KB
+// of a microcontroller's flash.
 [[nodiscard]] inline SinCos sin_cos_of_turned(Real theta) {
+  if constexpr (real_tolerance::kSingle) return real_sin_cos(theta);
   if (!(std::fabs(theta) <= trig_table::kRange)) return real_sin_cos(theta);
   constexpr Real kRoundingShift = 6755399441055744.0;  // 1.5 2^52
   const Real shifted = theta * trig_table::kSteps + kRoundingShift;
