@@ -1,5 +1,6 @@
 // The simulator's set-up and the step's frame: the event logic (event_logic.h) and the steppers'
-// intervals (step_interval.h) compiled for the scene's features are bound here, once.
+// intervals (step_interval.h) compiled for the scene's features are bound here, once, by
+// feature_sets.cpp.
 #include "plinth/core/simulator.h"
 
 #include <cmath>
@@ -7,6 +8,7 @@
 
 #include "build_options.h"
 #include "event_logic.h"
+#include "feature_sets.h"
 #include "plinth/core/stability.h"
 
 namespace plinth {
@@ -43,68 +45,6 @@ Error validate(const SolverSettings& st) {
   return ok_error();
 }
 
-namespace {
-
-// The feature sets (scene.h, Features) as the build names them: the base (ground, base,
-// base_stops) times the contact (no_sliding, sliding, support_edge, sliding_stops).
-constexpr std::size_t kFeatureSetCount = 12;
-constexpr std::size_t feature_set_index(const Features& f) {
-  const std::size_t base = !f.base ? 0 : (!f.base_stops ? 1 : 2);
-  const std::size_t contact = !f.sliding ? 0 : (f.support_edge ? 2 : (f.sliding_stops ? 3 : 1));
-  return 4 * base + contact;
-}
-constexpr const char* kFeatureSetLeftOut[kFeatureSetCount] = {
-    "is ground+no_sliding, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is ground+sliding, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is ground+support_edge, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is ground+sliding_stops, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is base+no_sliding, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is base+sliding, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is base+support_edge, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is base+sliding_stops, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is base_stops+no_sliding, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is base_stops+sliding, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is base_stops+support_edge, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-    "is base_stops+sliding_stops, a feature set this build leaves out (PLINTH_CORE_FEATURE_SETS)",
-};
-
-constexpr bool compiled_in(const Features& f) {
-  return ((PLINTH_CORE_FEATURE_MASK >> feature_set_index(f)) & 1) != 0;
-}
-
-// Binds the event logic and intervals compiled for exactly the features `F`, when the build has
-// them (validate_feature_set refused the scene otherwise).
-template <Features F>
-void bind_features(Simulator& sim, const SolverSettings& settings) {
-  if constexpr (compiled_in(F)) {
-    internal::EventLogic<F>::bind_to(sim, settings);
-  } else {
-    (void)sim;
-    (void)settings;
-  }
-}
-
-template <bool kBase, bool kBaseStops>
-void bind_for_friction(Simulator& sim, const Features& f, const SolverSettings& settings) {
-  if (!f.sliding) {
-    bind_features<Features{kBase, kBaseStops, false, false, false}>(sim, settings);
-  } else if (f.support_edge) {
-    bind_features<Features{kBase, kBaseStops, true, true, false}>(sim, settings);
-  } else if (f.sliding_stops) {
-    bind_features<Features{kBase, kBaseStops, true, false, true}>(sim, settings);
-  } else {
-    bind_features<Features{kBase, kBaseStops, true, false, false}>(sim, settings);
-  }
-}
-
-}  // namespace
-
-Error validate_feature_set(const Scene& scene) {
-  const Features f = features_of(scene);
-  if (compiled_in(f)) return ok_error();
-  return {ErrorCode::kInconsistent, "scene", kFeatureSetLeftOut[feature_set_index(f)]};
-}
-
 Error Simulator::create(const Scene& scene, const Excitation& excitation,
                         const SolverSettings& settings, Simulator& out) {
   PLINTH_TRY(validate(settings));
@@ -123,15 +63,8 @@ Error Simulator::create(const Scene& scene, const Excitation& excitation,
     sim.propagator_ =
         internal::FullContactPropagator::make(scene, static_cast<Real>(settings.step));
   }
-  const Features f = features_of(scene);
   PLINTH_TRY(validate_feature_set(scene));
-  if (!f.base) {
-    bind_for_friction<false, false>(sim, f, settings);
-  } else if (!f.base_stops) {
-    bind_for_friction<true, false>(sim, f, settings);
-  } else {
-    bind_for_friction<true, true>(sim, f, settings);
-  }
+  internal::bind_event_logic(sim, features_of(scene), settings);
   out = sim;
   return ok_error();
 }
