@@ -278,6 +278,45 @@ TEST(ExactFullContact, PhiIsTheDampedOscillatorsTransition) {
   }
 }
 
+// The series stops early for short steps (full_contact_propagator.cpp) yet every coefficient
+// keeps its relative accuracy, the small ones too (Gamma1's displacement is about -h^2 / 6): the
+// same augmented exponential summed to 40 terms in long double is the reference.
+TEST(ExactFullContact, ShortStepsKeepEveryCoefficientToRoundings) {
+  const Scene s = make(testing::paper_isolated(0.0, 2.0, 0.2));
+  for (const double h : {1e-7, 1e-6, 2.5e-4, 1e-3, 1e-2, 0.5}) {
+    long double a[4][4] = {};
+    a[0][1] = 1.0L;
+    a[1][0] = -static_cast<long double>(s.stiffness / s.total_mass);
+    a[1][1] = -static_cast<long double>(s.damping / s.total_mass);
+    a[1][2] = -1.0L;
+    a[2][3] = 1.0L;
+    long double sum[4][4] = {}, term[4][4] = {};
+    for (int i = 0; i < 4; ++i) sum[i][i] = term[i][i] = 1.0L;
+    for (int n = 1; n <= 40; ++n) {
+      long double next[4][4] = {};
+      for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) {
+          for (int k = 0; k < 4; ++k) next[i][j] += term[i][k] * a[k][j] * h / n;
+        }
+      }
+      for (int i = 0; i < 4; ++i) {
+        for (int j = 0; j < 4; ++j) sum[i][j] += (term[i][j] = next[i][j]);
+      }
+    }
+    const FullContactPropagator p = FullContactPropagator::make(s, h);
+    // 4 roundings; 16 where scaling and squaring (|a h| > 1/2) compounds them.
+    const double rel = (h < 0.1 ? 4.0 : 16.0) * std::numeric_limits<double>::epsilon();
+    for (int i = 0; i < 2; ++i) {
+      const double gamma1 = static_cast<double>(sum[i][3] / h);
+      const double gamma0 = static_cast<double>(sum[i][2]) - gamma1;
+      EXPECT_NEAR(p.phi[i][0], static_cast<double>(sum[i][0]), rel * std::fabs(p.phi[i][0]));
+      EXPECT_NEAR(p.phi[i][1], static_cast<double>(sum[i][1]), rel * std::fabs(p.phi[i][1]));
+      EXPECT_NEAR(p.gamma1[i], gamma1, rel * std::fabs(gamma1)) << h << " row " << i;
+      EXPECT_NEAR(p.gamma0[i], gamma0, rel * std::fabs(gamma0)) << h << " row " << i;
+    }
+  }
+}
+
 // Onset located on the exact solution: with a piecewise-linear input the rocking onset time at
 // a step of 5 ms is the fine reference's.
 TEST(ExactFullContact, OnsetIsLocatedOnTheExactSolution) {
