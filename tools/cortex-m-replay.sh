@@ -7,18 +7,24 @@
 # mark. See docs/microcontroller.md.
 #
 # Usage: tools/cortex-m-replay.sh --monitor PLINTH_MONITOR --embed PLINTH_EMBED_RECORD
-#                                 --work DIR [--cmake CMAKE] [--launcher CCACHE]
+#                                 --work DIR [--cmake CMAKE] [--launcher CCACHE] [--preset NAME]
 #   --monitor, --embed   the host build's plinth-monitor and plinth-embed-record
 #   --work DIR           the cross build tree and every file of the run (kept)
 #   --launcher PROG      compiler launcher for the cross build (e.g. ccache)
+#   --preset NAME        cortex-m4f (default) or cortex-m4f-ensemble (9 members, the forecast)
+#   --cases REGEX        only the cases whose names match (grep -E), and only their images built
 # Exit status: 0 every case agrees, 1 a case differs or a build or run failed, 2 usage, 77 the
 # cross compiler or QEMU is missing (ctest's SKIP_RETURN_CODE; tools/install-deps.sh installs
 # them).
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 src=$(dirname "$here")
-monitor="" embed="" work="" cmake=cmake launcher=""
-usage() { echo "usage: $0 --monitor FILE --embed FILE --work DIR [--cmake CMAKE] [--launcher PROG]" >&2; exit 2; }
+monitor="" embed="" work="" cmake=cmake launcher="" preset=cortex-m4f cases_regex=""
+usage() {
+  echo "usage: $0 --monitor FILE --embed FILE --work DIR [--cmake CMAKE] [--launcher PROG]" \
+       "[--preset NAME] [--cases REGEX]" >&2
+  exit 2
+}
 while [ $# -gt 0 ]; do
   case "$1" in
     --monitor) monitor=${2:-}; shift 2 ;;
@@ -26,6 +32,8 @@ while [ $# -gt 0 ]; do
     --work) work=${2:-}; shift 2 ;;
     --cmake) cmake=${2:-}; shift 2 ;;
     --launcher) launcher=${2:-}; shift 2 ;;
+    --preset) preset=${2:-}; shift 2 ;;
+    --cases) cases_regex=${2:-}; shift 2 ;;
     *) usage ;;
   esac
 done
@@ -41,18 +49,25 @@ done
 
 mkdir -p "$work"
 build=$work/build
-configure=("$cmake" --preset cortex-m4f -S "$src" -B "$build" "-DPLINTH_EMBED_RECORD=$embed")
+configure=("$cmake" --preset "$preset" -S "$src" -B "$build" "-DPLINTH_EMBED_RECORD=$embed")
 if [ -n "$launcher" ]; then
   configure+=("-DCMAKE_CXX_COMPILER_LAUNCHER=$launcher" "-DCMAKE_C_COMPILER_LAUNCHER=$launcher")
 fi
 echo "cortex-m-replay: cross build in $build"
 (cd "$src" && "${configure[@]}") >"$work/configure.log" 2>&1 ||
   { tail -n 30 "$work/configure.log"; echo "cortex-m-replay: configure failed ($work/configure.log)"; exit 1; }
-"$cmake" --build "$build" >"$work/build.log" 2>&1 ||
+# The cases (written at configure time), those matching --cases; only their images are built then.
+cases=$work/cases.txt
+awk -F '\t' -v re="$cases_regex" '$1 ~ re' "$build/firmware/cortex_m/replay_cases.txt" >"$cases"
+[ -s "$cases" ] || { echo "cortex-m-replay: no cases${cases_regex:+ matching '$cases_regex'} in $build"; exit 1; }
+targets=()
+if [ -n "$cases_regex" ]; then targets=(--target $(cut -f 1 "$cases")); fi
+"$cmake" --build "$build" "${targets[@]}" >"$work/build.log" 2>&1 ||
   { grep -E "error|FAILED" -A5 "$work/build.log" | head -n 40; echo "cortex-m-replay: build failed ($work/build.log)"; exit 1; }
 
-cases=$build/firmware/cortex_m/replay_cases.txt
-[ -s "$cases" ] || { echo "cortex-m-replay: no cases in $cases"; exit 1; }
+# plinth-monitor runs the forecast when the images have it (the preset's PLINTH_FORECAST).
+forecast_option=(--no-forecast)
+if grep -q '^PLINTH_FORECAST:BOOL=ON$' "$build/CMakeCache.txt"; then forecast_option=(); fi
 qemu=(qemu-system-arm -M mps2-an386 -nographic -monitor none -serial none
       -semihosting-config enable=on,target=native -icount shift=0)
 failed=0
@@ -63,8 +78,8 @@ while IFS=$'\t' read -r name image options; do
     failed=1
     continue
   fi
-  # The image is built without the forecast (preset cortex-m4f: PLINTH_FORECAST=OFF).
-  if ! (cd "$src" && "$monitor" "${opts[@]}" --no-forecast --frames-out "$work/$name.host.log") \
+  if ! (cd "$src" && "$monitor" "${opts[@]}" "${forecast_option[@]}" \
+      --frames-out "$work/$name.host.log") \
       >"$work/$name.host.jsonl" 2>"$work/$name.host.err"; then
     echo "not ok - $name: plinth-monitor failed: $(head -n 1 "$work/$name.host.err")"
     failed=1

@@ -21,13 +21,21 @@ PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "
 CORNERS = ["none", "left", "right"]
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
-          "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault"]
+          "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
+          "collapse_forecast", "not_calibrated"]
 STATUS_ID, ALARM_ID = 0x320, 0x330
 
 
 def bits(data, start, length):
     """An Intel (little-endian) unsigned signal."""
     return (int.from_bytes(data, "little") >> start) & ((1 << length) - 1)
+
+
+def named(names, value, signal):
+    """The value table's name of `value` (plinth.dbc); a value outside it is an error."""
+    if value >= len(names):
+        raise ValueError("%s %d is not in plinth.dbc's value table" % (signal, value))
+    return names[value]
 
 
 def decode(text):
@@ -42,13 +50,16 @@ def decode(text):
     if len(data) != 8:
         raise ValueError("not 8 bytes: %r" % text)
     if frame_id in (STATUS_ID, STATUS_ID + 1):
-        fields = {"axis": frame_id - STATUS_ID, "phase": PHASES[bits(data, 0, 4)],
-                  "corner": CORNERS[bits(data, 4, 4)], "alarm": LEVELS[bits(data, 8, 4)],
+        fields = {"axis": frame_id - STATUS_ID, "phase": named(PHASES, bits(data, 0, 4), "Phase"),
+                  "corner": named(CORNERS, bits(data, 4, 4), "Corner"),
+                  "alarm": named(LEVELS, bits(data, 8, 4), "AlarmLevel"),
                   "risk": bits(data, 16, 16) * 1e-4, "sequence": bits(data, 32, 8),
                   "sample_age_ms": bits(data, 40, 16)}
     elif frame_id == ALARM_ID:
-        fields = {"level": LEVELS[bits(data, 0, 4)], "previous": LEVELS[bits(data, 4, 4)],
-                  "cause": CAUSES[bits(data, 8, 8)], "latched": bool(bits(data, 16, 1)),
+        fields = {"level": named(LEVELS, bits(data, 0, 4), "Level"),
+                  "previous": named(LEVELS, bits(data, 4, 4), "PreviousLevel"),
+                  "cause": named(CAUSES, bits(data, 8, 8), "Cause"),
+                  "latched": bool(bits(data, 16, 1)),
                   "time_ms": bits(data, 24, 32), "sequence": bits(data, 56, 8)}
     else:
         fields = {}

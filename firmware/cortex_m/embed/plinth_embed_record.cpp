@@ -8,6 +8,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <span>
 #include <sstream>
 #include <string>
 #include <type_traits>
@@ -33,6 +34,7 @@ struct Options {
   std::string scene_y_path;
   fw::RecordReplayOptions input;
   std::optional<int> steps;
+  bool no_forecast = false;
   std::string out_path;
 };
 
@@ -86,6 +88,13 @@ std::string scene_source(const plinth::SceneParams& p) {
   return out.str();
 }
 
+// The statues of one axis as an array of SceneParams, the nominal one first.
+void write_members(std::ostream& out, const char* name, const std::vector<plinth::Scene>& members) {
+  out << "const SceneParams " << name << "[" << members.size() << "] = {";
+  for (const plinth::Scene& member : members) out << "\n    " << scene_source(member.params) << ",";
+  out << "\n};\n";
+}
+
 // `values` as an array in the RECORD region (the linker script), 4 to a line.
 void write_array(std::ostream& out, const char* name, const std::vector<double>& values) {
   out << "__attribute__((section(\".record\"))) const double " << name << "[" << values.size()
@@ -115,13 +124,18 @@ std::string monitor_command(const Options& opt) {
   if (opt.input.scale) out << " --scale " << exact(*opt.input.scale);
   if (opt.input.rate_hz) out << " --rate " << exact(*opt.input.rate_hz);
   if (opt.steps) out << " --steps " << *opt.steps;
+  if (opt.no_forecast) out << " --no-forecast";
   return out.str();
 }
 
 int run(const Options& opt) {
-  const plinth::Scene scene_x = plinth::host::load_scene_file(opt.scene_path);
-  std::optional<plinth::Scene> scene_y;
-  if (!opt.scene_y_path.empty()) scene_y = plinth::host::load_scene_file(opt.scene_y_path);
+  // Each axis's ensemble as plinth-monitor builds it: the scene file's [uncertainty] design.
+  const plinth::host::UncertainScene scene_x =
+      plinth::host::load_uncertain_scene_file(opt.scene_path);
+  std::optional<plinth::host::UncertainScene> scene_y;
+  if (!opt.scene_y_path.empty()) {
+    scene_y = plinth::host::load_uncertain_scene_file(opt.scene_y_path);
+  }
   if (!opt.input.y_path.empty() && !scene_y) {
     throw InputError("--replay-y needs a second axis: --scene-y");
   }
@@ -131,9 +145,13 @@ int run(const Options& opt) {
   fw::MonitorConfig config = fw::box_defaults();
   config.axis_count = scene_y ? 2 : 1;
   if (opt.steps) config.estimator.steps_per_sample = *opt.steps;
+  if (opt.no_forecast) config.forecast.enabled = false;
   fw::configure_record_replay(config, record.rate_hz);
   const auto monitor = std::make_unique<fw::Monitor>();
-  if (const plinth::Error e = monitor->start(config, {&scene_x, scene_y ? &*scene_y : nullptr});
+  if (const plinth::Error e = monitor->start(
+          config, {std::span<const plinth::Scene>(scene_x.members),
+                   scene_y ? std::span<const plinth::Scene>(scene_y->members)
+                           : std::span<const plinth::Scene>()});
       !e.ok()) {
     throw InputError(std::string("monitor settings: ") + e.field + " " + e.reason);
   }
@@ -152,6 +170,8 @@ int run(const Options& opt) {
          << "// plinth-monitor " << monitor_command(opt) << "\n"
          << "#include \"plinth/firmware/replay_case.h\"\n\n"
          << "namespace plinth::firmware {\nnamespace {\n\n";
+  write_members(source, "kMembersX", scene_x.members);
+  if (scene_y) write_members(source, "kMembersY", scene_y->members);
   write_array(source, "kX", x);
   if (any_y) write_array(source, "kY", y);
   if (any_vertical) write_array(source, "kZ", z);
@@ -159,11 +179,10 @@ int run(const Options& opt) {
          << "const ReplayCase kReplayCase{\n"
          << "    .name = " << literal(opt.name) << ",\n"
          << "    .command = " << literal(monitor_command(opt)) << ",\n"
-         << "    .scene_x = " << scene_source(scene_x.params) << ",\n"
-         << "    .has_scene_y = " << (scene_y ? "true" : "false") << ",\n"
-         << "    .scene_y = " << (scene_y ? scene_source(scene_y->params) : "SceneParams{}")
-         << ",\n"
+         << "    .x = kMembersX,\n"
+         << "    .y = " << (scene_y ? "kMembersY" : "{}") << ",\n"
          << "    .steps_per_sample = " << (opt.steps ? *opt.steps : 0) << ",\n"
+         << "    .forecast = " << boolean(!opt.no_forecast) << ",\n"
          << "    .record = {.description = " << literal(opt.input.path) << ",\n"
          << "               .sample_rate_hz = " << hex_double(record.rate_hz) << ",\n"
          << "               .count = " << record.samples.size() << ",\n"
@@ -198,6 +217,8 @@ int main(int argc, char** argv) {
       ->check(plinth::host::kFinitePositive);
   app.add_option("--steps", opt.steps, "solver steps per sample (default 4)")
       ->check(CLI::Range(1, 64));
+  app.add_flag("--no-forecast", opt.no_forecast,
+               "the box without the forecast (in a build that has it), as plinth-monitor's");
   app.add_option("--out", opt.out_path, "the C++ source to write")->required();
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
     return *exit_code;

@@ -139,7 +139,7 @@ Scene g_scene;
 
 extern "C" int plinth_board_main() {
   const firmware::ReplayCase& replay = firmware::kReplayCase;
-  if (!make_scene(replay.scene_x, g_scene).ok() || !g_scene.has_base()) {
+  if (!make_scene(replay.x[0], g_scene).ok() || !g_scene.has_base()) {
     hal::semihosting::write("# end: FAILED: the case's first scene has no base\n");
     return 1;
   }

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <span>
 
 #include "plinth/core/events.h"
 #include "plinth/core/scene.h"
@@ -115,8 +116,22 @@ int fail(const char* what, const Error& e) {
   return 1;
 }
 
-Scene g_scenes[fw::kMaxAxes];
+// Each axis's statues, the ensemble's members (replay_case.h).
+std::array<std::array<Scene, kMaxEnsembleMembers>, fw::kMaxAxes> g_scenes;
 fw::Monitor g_monitor;
+
+// Makes the scenes of one axis; an empty span for an axis the case does not have.
+Error make_axis(std::span<const SceneParams> members, std::array<Scene, kMaxEnsembleMembers>& out,
+                std::span<const Scene>& scenes) {
+  if (members.size() > out.size()) {
+    return {ErrorCode::kOutOfRange, "ensemble",
+            "has more members than this build holds (PLINTH_MAX_ENSEMBLE_MEMBERS)",
+            static_cast<double>(out.size())};
+  }
+  for (std::size_t i = 0; i < members.size(); ++i) PLINTH_TRY(make_scene(members[i], out[i]));
+  scenes = std::span<const Scene>(out.data(), members.size());
+  return ok_error();
+}
 
 }  // namespace
 
@@ -132,13 +147,14 @@ extern "C" int plinth_board_main() {
     // (tests/cli/mcu_replay_check.py) follows it.
     hal::semihosting::write(sizeof(Real) == sizeof(double) ? "# real=double\n" : "# real=float\n");
   }
-  if (Error e = make_scene(replay.scene_x, g_scenes[0]); !e.ok()) return fail("scene x", e);
-  if (replay.has_scene_y) {
-    if (Error e = make_scene(replay.scene_y, g_scenes[1]); !e.ok()) return fail("scene y", e);
-  }
+  const bool two_axes = !replay.y.empty();
+  std::array<std::span<const Scene>, fw::kMaxAxes> scenes{};
+  if (Error e = make_axis(replay.x, g_scenes[0], scenes[0]); !e.ok()) return fail("scene x", e);
+  if (Error e = make_axis(replay.y, g_scenes[1], scenes[1]); !e.ok()) return fail("scene y", e);
   fw::MonitorConfig config = fw::box_defaults();
-  config.axis_count = replay.has_scene_y ? 2 : 1;
+  config.axis_count = two_axes ? 2 : 1;
   if (replay.steps_per_sample > 0) config.estimator.steps_per_sample = replay.steps_per_sample;
+  if (!replay.forecast) config.forecast.enabled = false;
   fw::configure_record_replay(config, record.sample_rate_hz);
   if constexpr (fw::kMaxSensors == 1) {
     // This build holds one sensor: no cross-check runs, and their windows, never filled, are
@@ -147,9 +163,7 @@ extern "C" int plinth_board_main() {
     config.redundancy.window_s = std::min(config.redundancy.window_s, longest_s);
     config.plate.window_s = std::min(config.plate.window_s, longest_s);
   }
-  if (Error e =
-          g_monitor.start(config, {&g_scenes[0], replay.has_scene_y ? &g_scenes[1] : nullptr});
-      !e.ok()) {
+  if (Error e = g_monitor.start(config, scenes); !e.ok()) {
     return fail("monitor settings", e);
   }
   const std::int64_t lead_in = fw::record_replay_lead_in(config);
@@ -157,7 +171,7 @@ extern "C" int plinth_board_main() {
   EventPrinter events_x("x", g_monitor, origin_ns);
   EventPrinter events_y("y", g_monitor, origin_ns);
   g_monitor.set_event_sink(0, &events_x);
-  if (replay.has_scene_y) g_monitor.set_event_sink(1, &events_y);
+  if (two_axes) g_monitor.set_event_sink(1, &events_y);
 
   std::int64_t now_ns = 0;  // the CAN stand-in's clock: the receive time of the latest sample
   hal::SemihostingCanPort can("can0", &now_ns);

@@ -57,7 +57,7 @@ extern "C" int plinth_board_main() {
   const hal::CompiledRecord& record = replay.record;
   const Excitation ground = Excitation::record(
       SampledSignal{record.x, static_cast<std::size_t>(record.count), 1.0 / record.sample_rate_hz});
-  if (!make_scene(replay.scene_x, g_scene).ok() ||
+  if (!make_scene(replay.x[0], g_scene).ok() ||
       !Simulator::create(g_scene, ground, settings, g_simulator).ok()) {
     hal::semihosting::write("# end: FAILED: scene or solver settings\n");
     return 1;

@@ -4,6 +4,8 @@
 // the image and plinth-monitor can be compared (docs/microcontroller.md).
 #pragma once
 
+#include <span>
+
 #include "plinth/core/scene.h"
 #include "plinth/hal/compiled_record.h"
 
@@ -12,10 +14,12 @@ namespace plinth::firmware {
 struct ReplayCase {
   const char* name = "";
   const char* command = "";  // the plinth-monitor options it reproduces
-  SceneParams scene_x;       // the statue's axis 1
-  bool has_scene_y = false;  // two axes
-  SceneParams scene_y;
+  // The statues of each axis, the scene file's first, then the other members of the ensemble its
+  // [uncertainty] table declares (plinth/core/ensemble_design.h), as plinth-monitor builds them.
+  std::span<const SceneParams> x;
+  std::span<const SceneParams> y;  // empty: one axis
   int steps_per_sample = 0;  // 0: the estimator's default
+  bool forecast = true;      // false: off (plinth-monitor --no-forecast) in a build that has it
   hal::CompiledRecord record;
 };
 
