@@ -46,9 +46,8 @@ int grid_index(const std::vector<double>& grid, double value) {
 }
 
 WarningOutcome nominal_risk_outcome(const std::vector<EvalRun>& runs, int index) {
-  return host::outcome_of(runs, [index](const EvalRun& r) {
-    return index < 0 ? -1.0 : r.nominal_risk_crossing_s[static_cast<std::size_t>(index)];
-  });
+  const Rule rule{index, -1, host::RiskSignal::kNominal};
+  return host::outcome_of(runs, [&rule](const EvalRun& r) { return host::first_time(r, rule); });
 }
 
 std::vector<EvalRun> runs_of(const std::vector<EvalRun>& runs,
@@ -98,7 +97,8 @@ std::string names_json(const std::vector<std::string>& names) {
 std::string describe_rule(const Rule& rule, const CrossingGrids& grids) {
   std::string out;
   if (rule.risk_index >= 0) {
-    out += "risk >= " + number(grids.risk[static_cast<std::size_t>(rule.risk_index)], 2);
+    out += rule.risk_signal == host::RiskSignal::kNominal ? "nominal_risk >= " : "risk >= ";
+    out += number(grids.risk[static_cast<std::size_t>(rule.risk_index)], 2);
   }
   if (rule.probability_index >= 0) {
     if (!out.empty()) out += " or ";
@@ -108,7 +108,7 @@ std::string describe_rule(const Rule& rule, const CrossingGrids& grids) {
   return out.empty() ? "never" : out;
 }
 
-Report make_report(const EvalTable& table, const CalibrationTargets& targets) {
+Report make_report(const EvalTable& table, const CalibrationTargets& targets, bool with_frontier) {
   Report report;
   report.runs = table.runs.size();
   std::set<std::string> names;
@@ -140,6 +140,12 @@ Report make_report(const EvalTable& table, const CalibrationTargets& targets) {
     l.all_records = host::choose_rule(all_points, target);
     report.levels.push_back(l);
   }
+  if (with_frontier) {
+    report.frontiers.push_back({"risk", host::frontier(all_points)});
+    report.frontiers.push_back(
+        {"nominal_risk",
+         host::frontier(host::roc(table.runs, table.grids, host::RiskSignal::kNominal))});
+  }
   return report;
 }
 
@@ -160,6 +166,16 @@ std::string report_text(const Report& report, const CrossingGrids& grids) {
     out += "  chosen on all records:     " + describe_rule(l.all_records.point.rule, grids) +
            (l.all_records.meets_target ? "" : " (target not met)") + "\n";
     out += "                             " + outcome_text(l.all_records.point.outcome) + "\n";
+  }
+  for (const FrontierReport& f : report.frontiers) {
+    out += "frontier: the fewest false alarms of the rules on " + f.signal +
+           " and probability, every record\n";
+    for (const host::FrontierRow& row : f.rows) {
+      out += "  " + std::string(row.constraint) + ": ";
+      out += row.found ? describe_rule(row.point.rule, grids) + "\n    " +
+                             outcome_text(row.point.outcome) + "\n"
+                       : "none\n";
+    }
   }
   return out;
 }
@@ -186,7 +202,24 @@ std::string report_json(const Report& report, const CrossingGrids& grids) {
            ", \"meets_target\": " + (l.all_records.meets_target ? "true" : "false") +
            ", \"outcome\": " + outcome_json(l.all_records.point.outcome) + "}}";
   }
-  return out + "]}\n";
+  out += "]";
+  if (!report.frontiers.empty()) {
+    out += ", \"frontier\": {";
+    for (std::size_t i = 0; i < report.frontiers.size(); ++i) {
+      const FrontierReport& f = report.frontiers[i];
+      out += (i ? ", " : "") + host::json_quoted(f.signal) + ": [";
+      for (std::size_t k = 0; k < f.rows.size(); ++k) {
+        const host::FrontierRow& row = f.rows[k];
+        out += (k ? ", " : "");
+        out += "{\"constraint\": " + host::json_quoted(row.constraint) + ", \"rule\": " +
+               (row.found ? host::json_quoted(describe_rule(row.point.rule, grids)) : "null") +
+               ", \"outcome\": " + (row.found ? outcome_json(row.point.outcome) : "null") + "}";
+      }
+      out += "]";
+    }
+    out += "}";
+  }
+  return out + "}\n";
 }
 
 namespace {

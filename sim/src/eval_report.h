@@ -33,13 +33,22 @@ struct LevelReport {
   host::Choice all_records;       // the rule chosen on every record (the shipped defaults)
 };
 
+// The frontier (host::frontier) of the rules on one reactive risk and the forecast probability.
+struct FrontierReport {
+  std::string signal;  // "risk" (the worst member's) or "nominal_risk"
+  std::vector<host::FrontierRow> rows;
+};
+
 struct Report {
   std::size_t runs = 0;
   std::vector<LevelReport> levels;  // advisory, warning, alarm
+  std::vector<FrontierReport> frontiers;  // with_frontier: risk, then nominal_risk
 };
 
-// The records split in two halves by name (alternately, sorted), the runs of each.
-[[nodiscard]] Report make_report(const host::EvalTable& table, const CalibrationTargets& targets);
+// The records split in two halves by name (alternately, sorted), the runs of each. With
+// `with_frontier`, also the best rule each of the alarm's constraints allows on every record.
+[[nodiscard]] Report make_report(const host::EvalTable& table, const CalibrationTargets& targets,
+                                 bool with_frontier = false);
 
 // The report as text (stdout) and as JSON.
 [[nodiscard]] std::string report_text(const Report& report, const host::CrossingGrids& grids);

@@ -61,6 +61,7 @@ struct ReportOptions {
   std::string runs_path;
   std::string json_path;
   std::string plot_path;
+  bool frontier = false;  // also the frontier of the rules (make_report)
 };
 
 struct MergeOptions {
@@ -216,7 +217,7 @@ int run_eval(const RunOptions& opt) {
 int run_report(const ReportOptions& opt) {
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
-  const plinth::eval::Report report = plinth::eval::make_report(table, {});
+  const plinth::eval::Report report = plinth::eval::make_report(table, {}, opt.frontier);
   std::fputs(plinth::eval::report_text(report, table.grids).c_str(), stdout);
   if (!opt.json_path.empty()) {
     const std::string temporary = opt.json_path + ".tmp";
@@ -292,6 +293,9 @@ int main(int argc, char** argv) {
   report_command->add_option("runs", report.runs_path, "a plinth-eval runs CSV")->required();
   report_command->add_option("--json", report.json_path, "also write the report as JSON");
   report_command->add_option("--plot", report.plot_path, "also draw the ROC as a PNG");
+  report_command->add_flag("--frontier", report.frontier,
+                           "also the rule with the fewest false alarms under each of the alarm's "
+                           "targets, on the worst member's and on the nominal statue's risk");
   MergeOptions merge;
   CLI::App* merge_command = app.add_subcommand("merge", "join the runs CSVs of shards");
   merge_command->add_option("--out", merge.out_path, "merged CSV")->required();

@@ -137,9 +137,11 @@ double first_time(const EvalRun& run, const Rule& rule) {
   const auto earlier = [&t](double candidate) {
     if (candidate >= 0.0 && (t < 0.0 || candidate < t)) t = candidate;
   };
-  if (rule.risk_index >= 0 &&
-      static_cast<std::size_t>(rule.risk_index) < run.risk_crossing_s.size()) {
-    earlier(run.risk_crossing_s[static_cast<std::size_t>(rule.risk_index)]);
+  const std::vector<double>& risk = rule.risk_signal == RiskSignal::kNominal
+                                        ? run.nominal_risk_crossing_s
+                                        : run.risk_crossing_s;
+  if (rule.risk_index >= 0 && static_cast<std::size_t>(rule.risk_index) < risk.size()) {
+    earlier(risk[static_cast<std::size_t>(rule.risk_index)]);
   }
   if (rule.probability_index >= 0 &&
       static_cast<std::size_t>(rule.probability_index) < run.probability_crossing_s.size()) {
@@ -148,14 +150,15 @@ double first_time(const EvalRun& run, const Rule& rule) {
   return t;
 }
 
-std::vector<RocPoint> roc(const std::vector<EvalRun>& runs, const CrossingGrids& grids) {
+std::vector<RocPoint> roc(const std::vector<EvalRun>& runs, const CrossingGrids& grids,
+                          RiskSignal risk_signal) {
   std::vector<RocPoint> points;
   const int nr = static_cast<int>(grids.risk.size());
   const int np = static_cast<int>(grids.probability.size());
   for (int r = -1; r < nr; ++r) {
     for (int p = -1; p < np; ++p) {
       if (r < 0 && p < 0) continue;
-      const Rule rule{r, p};
+      const Rule rule{r, p, risk_signal};
       points.push_back({rule, outcome_of(runs, [&](const EvalRun& run) {
                           return first_time(run, rule);
                         })});
@@ -201,6 +204,53 @@ Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& targe
     if (better) best = {true, ra == 0, p};
   }
   return best;
+}
+
+std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points) {
+  using Allowed = bool (*)(const WarningOutcome&);
+  struct Constraint {
+    const char* name;
+    Allowed allowed;
+    bool fewest_misses_first;
+  };
+  static constexpr Constraint kConstraints[] = {
+      {"no miss", [](const WarningOutcome& o) { return o.misses == 0; }, false},
+      {"no miss, median lead >= 1.5 s",
+       [](const WarningOutcome& o) { return o.misses == 0 && o.lead_quantile(0.5) >= 1.5; },
+       false},
+      {"no miss, 10th pct lead >= 0.5 s",
+       [](const WarningOutcome& o) { return o.misses == 0 && o.lead_quantile(0.1) >= 0.5; },
+       false},
+      {"no miss, median lead >= 3 s",
+       [](const WarningOutcome& o) { return o.misses == 0 && o.lead_quantile(0.5) >= 3.0; },
+       false},
+      {"false alarms <= 5 %", [](const WarningOutcome& o) { return o.false_alarm_rate() <= 0.05; },
+       true},
+      {"fewest false alarms", [](const WarningOutcome&) { return true; }, false},
+  };
+  // Lexicographic: (false alarms, misses, -median lead), or (misses, false alarms, -median).
+  const auto better = [](const WarningOutcome& a, const WarningOutcome& b, bool misses_first) {
+    const double fa = a.false_alarm_rate();
+    const double fb = b.false_alarm_rate();
+    if (misses_first && a.misses != b.misses) return a.misses < b.misses;
+    if (fa != fb) return fa < fb;
+    if (a.misses != b.misses) return a.misses < b.misses;
+    return a.lead_quantile(0.5) > b.lead_quantile(0.5);
+  };
+  std::vector<FrontierRow> rows;
+  for (const Constraint& c : kConstraints) {
+    FrontierRow row;
+    row.constraint = c.name;
+    for (const RocPoint& p : points) {
+      if (!c.allowed(p.outcome)) continue;
+      if (!row.found || better(p.outcome, row.point.outcome, c.fewest_misses_first)) {
+        row.found = true;
+        row.point = p;
+      }
+    }
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids) {

@@ -130,6 +130,49 @@ TEST(EvalMetrics, ChoosesTheLongestLeadWithinTheTarget) {
   EXPECT_FALSE(choose_rule({}, {}).found);
 }
 
+// The frontier on the same runs: every rule that misses nothing raises one false alarm in two, and
+// "probability 0.5" leads longest (6 and 7 s); the rules without a false alarm all miss one,
+// "probability 1.0" the longest lead of those (3 s and a miss: median 1.5).
+TEST(EvalMetrics, FrontierIsTheFewestFalseAlarmsEachConstraintAllows) {
+  const CrossingGrids grids{{0.2, 0.5, 0.8}, {0.5, 1.0}};
+  const std::vector<FrontierRow> rows = frontier(roc(roc_runs(), grids));
+  ASSERT_EQ(rows.size(), 6U);
+  for (std::size_t i = 0; i < 4; ++i) {  // the "no miss" constraints: all met by one rule
+    SCOPED_TRACE(rows[i].constraint);
+    ASSERT_TRUE(rows[i].found);
+    EXPECT_EQ(rows[i].point.rule.risk_index, -1);
+    EXPECT_EQ(rows[i].point.rule.probability_index, 0);
+    EXPECT_DOUBLE_EQ(rows[i].point.outcome.false_alarm_rate(), 0.5);
+  }
+  for (std::size_t i = 4; i < 6; ++i) {  // within 5 %, and the fewest false alarms
+    SCOPED_TRACE(rows[i].constraint);
+    ASSERT_TRUE(rows[i].found);
+    EXPECT_EQ(rows[i].point.outcome.false_alarms, 0);
+    EXPECT_EQ(rows[i].point.outcome.misses, 1);
+    EXPECT_DOUBLE_EQ(rows[i].point.outcome.lead_quantile(0.5), 1.5);
+  }
+  // The risk alone at 0.2 and 0.5: nothing within 5 %, nothing with a 3 s median but 0.2's.
+  const std::vector<FrontierRow> risk_only = frontier(roc(roc_runs(), {{0.2, 0.5}, {}}));
+  EXPECT_FALSE(risk_only[4].found);
+  ASSERT_TRUE(risk_only[3].found);
+  EXPECT_EQ(risk_only[3].point.rule.risk_index, 0);
+  EXPECT_TRUE(frontier({})[0].constraint[0] != '\0');
+  EXPECT_FALSE(frontier({})[0].found);
+}
+
+TEST(EvalMetrics, TheNominalSignalReadsTheNominalStatuesCrossings) {
+  std::vector<EvalRun> runs = roc_runs();
+  for (EvalRun& r : runs) r.nominal_risk_crossing_s = {-1.0, -1.0, -1.0};  // never reached
+  runs[0].nominal_risk_crossing_s[0] = 9.0;
+  EXPECT_EQ(first_time(runs[0], {0, -1, RiskSignal::kNominal}), 9.0);
+  EXPECT_EQ(first_time(runs[0], {0, -1}), 5.0);
+  const std::vector<RocPoint> nominal = roc(runs, {{0.2, 0.5, 0.8}, {}}, RiskSignal::kNominal);
+  ASSERT_EQ(nominal.size(), 3U);
+  EXPECT_EQ(nominal[0].rule.risk_signal, RiskSignal::kNominal);
+  EXPECT_EQ(nominal[0].outcome.misses, 1);        // run 1 never crosses
+  EXPECT_EQ(nominal[0].outcome.false_alarms, 0);
+}
+
 std::string temp_path(const std::string& name) {
   return (std::filesystem::temp_directory_path() / ("plinth_eval_" + name)).string();
 }

@@ -96,11 +96,16 @@ template <class FirstTime>
 
 [[nodiscard]] WarningOutcome level_outcome(const std::vector<EvalRun>& runs, EvalLevel level);
 
-// A rule of the alarm policy's form: shown once the worst member's risk reaches `risk` or the
-// forecast probability reaches `probability` (index into the grids; -1: that signal unused).
+// Which reactive risk a rule reads: the worst member's (the box's) or the nominal statue's alone
+// (today's box, EvalRun::nominal_risk_crossing_s).
+enum class RiskSignal { kWorstMember, kNominal };
+
+// A rule of the alarm policy's form: shown once the risk reaches `risk` or the forecast
+// probability reaches `probability` (index into the grids; -1: that signal unused).
 struct Rule {
   int risk_index = -1;
   int probability_index = -1;
+  RiskSignal risk_signal = RiskSignal::kWorstMember;
 };
 [[nodiscard]] double first_time(const EvalRun& run, const Rule& rule);
 
@@ -110,7 +115,8 @@ struct RocPoint {
 };
 // Every rule of the grids (each signal alone, and every pair), with its outcome.
 [[nodiscard]] std::vector<RocPoint> roc(const std::vector<EvalRun>& runs,
-                                        const CrossingGrids& grids);
+                                        const CrossingGrids& grids,
+                                        RiskSignal risk_signal = RiskSignal::kWorstMember);
 
 // Calibration targets of one level.
 struct LevelTarget {
@@ -127,6 +133,17 @@ struct Choice {
   RocPoint point;
 };
 [[nodiscard]] Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& target);
+
+// The frontier of a set of rules: for each of the alarm's constraints (docs/forecast.md), the rule
+// that meets it with the fewest false alarms (then the fewest misses, the longest median lead),
+// or for "false alarms <= 5 %" the fewest misses (then the fewest false alarms): what the signals
+// of a runs file allow at best, whatever thresholds the box ships.
+struct FrontierRow {
+  const char* constraint = "";
+  bool found = false;  // some rule meets the constraint
+  RocPoint point;
+};
+[[nodiscard]] std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points);
 
 // CSV: one run per row (header first); the grids are written in the header's column names
 // (risk_ge_0.3, probability_ge_0.5625, nominal_risk_ge_0.3). read_eval_csv checks the header and every field and
