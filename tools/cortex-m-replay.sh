@@ -4,7 +4,7 @@
 # mps2-an386, runs plinth-monitor --replay on the same scene, record and scale, and checks that
 # the image sent the same status and alarm frames and found the same phase events
 # (tests/cli/mcu_replay_check.py). Prints each image's cost per sample and stack high-water
-# mark. See docs/microcontroller.md.
+# mark; without --cases, also runs the cross tree's own tests. See docs/microcontroller.md.
 #
 # Usage: tools/cortex-m-replay.sh --monitor PLINTH_MONITOR --embed PLINTH_EMBED_RECORD
 #                                 --work DIR [--cmake CMAKE] [--launcher CCACHE] [--preset NAME]
@@ -95,6 +95,20 @@ while IFS=$'\t' read -r name image options; do
   grep -E '^# (cost per_sample|stack)' "$work/$name.mcu.log" | sed 's/^/    /'
   last=$name
 done <"$cases"
+
+# A whole tree built (no --cases): its own tests too, the nm and heap checks of every library and
+# image, the images in QEMU and the refusals (docs/microcontroller.md, "Build and run").
+if [ -z "$cases_regex" ]; then
+  ctest_command=ctest  # the one beside --cmake when there is one
+  if [ -x "$(dirname "$cmake")/ctest" ]; then ctest_command=$(dirname "$cmake")/ctest; fi
+  if "$ctest_command" --test-dir "$build" -j 2 --output-on-failure >"$work/ctest.log" 2>&1; then
+    echo "ok - the cross tree's tests: $(grep -E 'tests passed' "$work/ctest.log")"
+  else
+    echo "not ok - the cross tree's tests ($work/ctest.log):"
+    grep -E '^\s+[0-9]+ - ' "$work/ctest.log" | sed 's/^/    /'
+    failed=1
+  fi
+fi
 
 # The comparison can fail: the last case's log with the cause of its last alarm change altered
 # (internal_fault), which both rules refuse (tests/cli/test_mcu_replay_check.py tests each rule).
