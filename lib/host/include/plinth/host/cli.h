@@ -13,7 +13,8 @@ namespace plinth::host {
 extern const CLI::Validator kFinite;
 extern const CLI::Validator kFinitePositive;
 
-// Parses the command line. Empty: go on. Otherwise CLI11 has printed the help or the usage
+// Parses the command line, after adding --version (the program's name from argv[0] and
+// plinth/version/version.h's kVersionText). Empty: go on. Otherwise CLI11 has printed the help or the usage
 // error, and the tool exits with this code: 0 after --help (or --version), 2 on a usage error.
 [[nodiscard]] std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv);
 
