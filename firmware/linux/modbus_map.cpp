@@ -289,8 +289,9 @@ std::string map_csv() {
   for (const Point& p : kPoints) {
     out += std::string(kTableNames.name(p.table)) + "," + kTableFunctions.name(p.table) + "," +
            std::to_string(p.address) + "," + std::to_string(p.words) + "," + p.name + "," +
-           kTypeNames.name(p.type) + "," + p.scale + "," + p.unit + "," + (p.none ? "65535" : "") + "," +
-           field(codes_text(p)) + "," + p.json + "," + field(p.meaning) + "\n";
+           kTypeNames.name(p.type) + "," + p.scale + "," + p.unit + "," +
+           (p.none ? "65535" : "") + "," + field(codes_text(p)) + "," + p.json + "," +
+           field(p.meaning) + "\n";
   }
   return out;
 }

@@ -91,9 +91,9 @@ extern "C" void publish_callback(mosquitto*, void* self, int mid) {
 }
 extern "C" void message_callback(mosquitto*, void* self, const mosquitto_message* message) {
   if (message == nullptr || message->topic == nullptr) return;
-  const std::string payload(static_cast<const char*>(message->payload),
-                            message->payload == nullptr ? 0U
-                                                        : static_cast<std::size_t>(message->payloadlen));
+  const std::size_t length =
+      message->payload == nullptr ? 0U : static_cast<std::size_t>(message->payloadlen);
+  const std::string payload(static_cast<const char*>(message->payload), length);
   static_cast<MqttPublisher*>(self)->on_message(message->topic, payload);
 }
 extern "C" void log_callback(mosquitto*, void* self, int level, const char* text) {
@@ -420,7 +420,9 @@ void MqttPublisher::publish_discovery() {
                                  .text("sw_version", kVersionText)
                                  .close();
   std::vector<std::string> levels;
-  for (const auto& level : monitor::kAlarmLevelNames) levels.push_back(host::json_quoted(level.name));
+  for (const auto& level : monitor::kAlarmLevelNames) {
+    levels.push_back(host::json_quoted(level.name));
+  }
   const auto config = [&](const char* component, const char* object, JsonObject entity) {
     const std::string topic =
         settings_.discovery_prefix + "/" + component + "/" + node + "/" + object + "/config";

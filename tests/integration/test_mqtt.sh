@@ -271,7 +271,7 @@ assert mqtt["commands_refused"] == 3 and mqtt["discovery_configs"] >= 6, mqtt
 PY
 )
 if ((rc == 0)) && [[ -z "$problem" ]]; then
-  pass "mqtt: the operator's acknowledgement accepted, bad ones refused with the reason, the watcher's refused by the ACL"
+  pass "mqtt: operator's acknowledgement accepted, bad ones refused with reasons, ACL keeps others out"
 else
   fail "mqtt: commands" "exit $rc; $problem; replies: $(head -c 600 "$TMP/replies.out")"
 fi
@@ -311,7 +311,7 @@ assert "%s (%s)" % (state["version"]["project"], state["version"]["git"]) == ver
 PY
 )
 if [[ -z "$problem" ]]; then
-  pass "mqtt: Home Assistant discovery configs retained; the state carries the forecast, counters and version"
+  pass "mqtt: discovery configs retained; the state carries the forecast, counters and version"
 else
   fail "mqtt: discovery and state" "$problem"
 fi
@@ -334,7 +334,8 @@ discovered=$(mosquitto_sub "${WATCH[@]}" -W 2 -v -t 'homeassistant/+/plinth_b7/#
 kill -INT "$BOX" 2>/dev/null
 wait "$BOX" 2>/dev/null
 BOX=
-reply='"id": 7, "command": "acknowledge", "result": "refused", "reason": "commands are off (mqtt.commands = false)"'
+reply='"id": 7, "command": "acknowledge", "result": "refused", '
+reply+='"reason": "commands are off (mqtt.commands = false)"'
 if grep -qF "$reply" "$TMP/replies.out" && ((discovered == 0)) &&
   ! grep -q '"type": "command"' "$TMP/box.out"; then
   pass "mqtt: with commands off the reply says so; discovery off publishes no config"
