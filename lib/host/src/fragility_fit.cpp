@@ -13,6 +13,8 @@ constexpr double kInverseSqrt2 = 0.70710678118654752440;
 constexpr double kInverseSqrt2Pi = 0.39894228040143267794;
 constexpr double kZ95 = 1.959963984540054;  // the normal's 97.5th percentile
 constexpr int kMaxIterations = 200;
+// Of ln(median) and ln(beta): a millionth of the median and of beta, far below any sampling error.
+constexpr double kStepTolerance = 1e-6;
 // Beyond these the likelihood has no finite maximum (the checks before the fit should catch it).
 constexpr double kMaxBeta = 50.0;
 constexpr double kMinBeta = 1e-6;
@@ -116,24 +118,29 @@ std::string refusal(std::span<const CollapseIntensity> cases) {
     return "all " + n + " cases collapsed at or below " + g_text(lowest) +
            " g, the lowest intensity tried: the median is below it";
   }
-  // A point inside every case's range: the likelihood tends to 1 as beta tends to 0 there.
-  double common = std::numeric_limits<double>::infinity();
+  // A point in every case's closed range, [highest lower, lowest upper]: with the median there and
+  // beta tending to 0 the likelihood grows to its supremum (each range taking all, or a fixed part
+  // of, the probability), so no beta > 0 is the maximum. On a grid: every collapse within two
+  // neighbouring steps.
+  double lowest_upper = std::numeric_limits<double>::infinity();
   double highest_lower = 0.0;
+  double lowest = std::numeric_limits<double>::infinity();
+  double highest = 0.0;
   for (const CollapseIntensity& c : cases) {
-    common = std::min(common, c.upper_g);
+    lowest_upper = std::min(lowest_upper, c.upper_g);
     highest_lower = std::max(highest_lower, c.lower_g);
+    lowest = std::min(lowest, c.lower_g);
+    highest = std::max(highest, c.collapsed() ? c.upper_g : c.lower_g);
   }
-  const bool shared = std::all_of(cases.begin(), cases.end(), [common](const CollapseIntensity& c) {
-    return c.lower_g == c.upper_g ? c.lower_g == common : c.lower_g < common;
-  });
-  if (shared && cases.size() == 1) {
+  if (highest_lower <= lowest_upper && cases.size() == 1) {
     return "one case: a median and a dispersion need at least two cases whose collapse "
            "intensities differ";
   }
-  if (shared) {
-    return "all " + n + " cases share a collapse intensity (every one between " +
-           g_text(highest_lower) + " and " + g_text(common) +
-           " g): the dispersion beta cannot be estimated (it tends to 0)";
+  if (highest_lower <= lowest_upper) {
+    return "the collapse intensities of all " + n + " cases meet at " + g_text(highest_lower) +
+           " g (every one between " + g_text(lowest) + " and " + g_text(highest) +
+           " g): the dispersion beta cannot be estimated (it tends to 0; a finer grid could "
+           "tell them apart)";
   }
   const bool bounded = std::any_of(cases.begin(), cases.end(), [](const CollapseIntensity& c) {
     return c.lower_g > 0.0 && c.collapsed();
@@ -178,19 +185,28 @@ FragilityFit fit_lognormal_fragility(std::span<const CollapseIntensity> cases) {
   if (!fit.fitted()) return fit;
   Parameters p = start(cases);
   Evaluation e = evaluate(cases, p);
-  const double gradient_tolerance = 1e-9 * static_cast<double>(cases.size());
   bool converged = false;
-  for (fit.iterations = 0; fit.iterations < kMaxIterations && !converged; ++fit.iterations) {
+  for (fit.iterations = 0; fit.iterations < kMaxIterations; ++fit.iterations) {
     const auto h = hessian(cases, p);
     const double det = h[0][0] * h[1][1] - h[0][1] * h[1][0];
+    const bool concave = h[0][0] < 0.0 && det > 0.0;
     std::array<double, 2> d{};
-    if (h[0][0] < 0.0 && det > 0.0) {  // concave here: Newton's step, -H^-1 g
+    if (concave) {  // Newton's step, -H^-1 g
       d[0] = -(h[1][1] * e.gradient[0] - h[0][1] * e.gradient[1]) / det;
       d[1] = -(-h[1][0] * e.gradient[0] + h[0][0] * e.gradient[1]) / det;
     } else {  // otherwise uphill
       d = e.gradient;
     }
     const double length = std::hypot(d[0], d[1]);
+    // Done when Newton's step would move ln(median) and ln(beta) by less than kStepTolerance: the
+    // likelihood's rounding stops a line search short of 0 gradient (about 1e-9 from it), so that
+    // step is taken whole, without one.
+    if (concave && length < kStepTolerance) {  // the last step, whole: quadratic convergence
+      p = {p.log_median + d[0], p.log_beta + d[1]};
+      e = evaluate(cases, p);
+      converged = true;
+      break;
+    }
     if (length > 1.0) {  // at most one unit of ln(PGA) or ln(beta) a step
       d[0] /= length;
       d[1] /= length;
@@ -204,15 +220,12 @@ FragilityFit fit_lognormal_fragility(std::span<const CollapseIntensity> cases) {
       if (en.log_likelihood >= e.log_likelihood || t < 1e-12) break;
       t *= 0.5;
     }
-    if (!(en.log_likelihood >= e.log_likelihood)) {
-      converged = std::max(std::abs(e.gradient[0]), std::abs(e.gradient[1])) < 1e-6;
+    if (!(en.log_likelihood >= e.log_likelihood)) {  // nothing uphill: at the maximum's rounding
+      converged = concave && length < 100.0 * kStepTolerance;
       break;
     }
-    const double moved = t * std::hypot(d[0], d[1]);
     p = next;
     e = en;
-    converged = std::max(std::abs(e.gradient[0]), std::abs(e.gradient[1])) < gradient_tolerance ||
-                moved < 1e-13;
     if (std::exp(p.log_beta) > kMaxBeta || std::exp(p.log_beta) < kMinBeta ||
         std::abs(p.log_median) > kMaxAbsLogMedian) {
       break;
@@ -229,8 +242,13 @@ FragilityFit fit_lognormal_fragility(std::span<const CollapseIntensity> cases) {
   // Standard errors: the inverse of the observed information -H at the maximum.
   const auto h = hessian(cases, p);
   const double det = h[0][0] * h[1][1] - h[0][1] * h[1][0];
-  const double var_mu = det > 0.0 ? -h[1][1] / det : 0.0;
-  const double var_s = det > 0.0 ? -h[0][0] / det : 0.0;
+  if (!(h[0][0] < 0.0 && det > 0.0)) {
+    fit.no_fit = "the likelihood is flat or not a maximum at median " +
+                 g_text(std::exp(p.log_median)) + " g, beta " + g_text(beta);
+    return fit;
+  }
+  const double var_mu = -h[1][1] / det;
+  const double var_s = -h[0][0] / det;
   fit.curve.median_g = std::exp(p.log_median);
   fit.curve.beta = beta;
   fit.log_likelihood = e.log_likelihood;

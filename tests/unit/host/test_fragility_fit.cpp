@@ -178,11 +178,19 @@ TEST(FragilityFit, DataWithoutAFiniteMaximumAreRefusedWithTheReason) {
             "one case: a median and a dispersion need at least two cases whose collapse "
             "intensities differ");
   EXPECT_EQ(no_fit({{0.4, 0.6}, {0.4, 0.6}, {0.5, kInfinity}}),
-            "all 3 cases share a collapse intensity (every one between 0.5 and 0.6 g): the "
-            "dispersion beta cannot be estimated (it tends to 0)");
-  EXPECT_EQ(no_fit({exactly(0.7), exactly(0.7)}),
-            "all 2 cases share a collapse intensity (every one between 0.7 and 0.7 g): the "
-            "dispersion beta cannot be estimated (it tends to 0)");
+            "the collapse intensities of all 3 cases meet at 0.5 g (every one between 0.4 and 0.6 "
+            "g): the dispersion beta cannot be estimated (it tends to 0; a finer grid could tell "
+            "them apart)");
+  EXPECT_NE(no_fit({exactly(0.7), exactly(0.7)}).find("meet at 0.7 g"), std::string::npos);
+  // Two neighbouring grid steps: the ranges touch at 0.4 g, where a step of beta -> 0 puts 7/8 of
+  // the probability below and 1/8 above, the likelihood's supremum.
+  std::vector<CollapseIntensity> neighbours(7, CollapseIntensity{0.2, 0.4});
+  neighbours.push_back({0.4, 0.6});
+  EXPECT_NE(no_fit(neighbours).find("meet at 0.4 g (every one between 0.2 and 0.6 g)"),
+            std::string::npos);
+  // Stood at the top 0.6 g, or collapsed in the step below it: the same.
+  EXPECT_NE(no_fit({{0.4, 0.6}, {0.6, kInfinity}}).find("meet at 0.6 g"), std::string::npos);
+  EXPECT_NE(no_fit({exactly(0.5), {0.5, 0.7}}).find("meet at 0.5 g"), std::string::npos);
   EXPECT_NE(no_fit({{0.0, 0.2}, {2.5, kInfinity}}).find("bounded on both sides"),
             std::string::npos);
   EXPECT_EQ(no_fit({{0.6, 0.4}, exactly(1.0)}), "case 1: not an intensity range: (0.6, 0.4] g");

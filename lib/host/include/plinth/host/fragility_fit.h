@@ -44,9 +44,9 @@ struct FragilityFit {
 };
 
 // The fit (see above). Refuses, in no_fit, what has no finite maximum: no case, no collapse, every
-// case collapsing below the lowest intensity tried, intensities that all share a point (one case,
-// or every collapse in one grid step: beta -> 0), or no case whose intensity is bounded on both
-// sides (only "below the lowest" and "above the top": beta -> infinity).
+// case collapsing below the lowest intensity tried, ranges that all reach one point (one case,
+// or every collapse within two neighbouring grid steps: beta -> 0), or no case whose intensity is
+// bounded on both sides (only "below the lowest" and "above the top": beta -> infinity).
 [[nodiscard]] FragilityFit fit_lognormal_fragility(std::span<const CollapseIntensity> cases);
 
 }  // namespace plinth::host
