@@ -58,6 +58,13 @@ std::vector<EvalRun> runs_of(const std::vector<EvalRun>& runs,
   return out;
 }
 
+// The records' names, sorted, each once.
+std::vector<std::string> record_names(const std::vector<EvalRun>& runs) {
+  std::set<std::string> names;
+  for (const EvalRun& r : runs) names.insert(r.record);
+  return {names.begin(), names.end()};
+}
+
 const host::LevelTarget& target_of(const CalibrationTargets& t, std::size_t level) {
   return level == 0 ? t.advisory : level == 1 ? t.warning : t.alarm;
 }
@@ -173,22 +180,34 @@ std::string describe_rule(const Rule& rule, const CrossingGrids& grids) {
   return out.empty() ? "never" : out;
 }
 
-Report make_report(const EvalTable& table, const CalibrationTargets& targets, bool with_frontier) {
+void require_margins(const EvalTable& table, const CalibrationTargets& targets,
+                     const std::string& name) {
   if (targets.false_alarm == host::FalseAlarm::kMargin && !table.has_grid) {
-    throw InputError(
-        "the runs file has no seed and pga grid columns (written by a plinth-eval before the "
-        "collapse margin): the margin needs each case's grid; run plinth-eval run again, or "
-        "report this file with --false-alarm peak");
+    throw InputError(name +
+                     ": no seed and pga grid columns (written by a plinth-eval before the "
+                     "collapse margin): the margin needs each case's grid; run plinth-eval run "
+                     "again, or report with --false-alarm peak");
+  }
+}
+
+Report make_report(const EvalTable& table, const CalibrationTargets& targets, bool with_frontier,
+                   const EvalTable* calibration) {
+  require_margins(table, targets, "the runs file");
+  if (calibration != nullptr) {
+    require_margins(*calibration, targets, "--calibrate-on's file");
+    if (calibration->grids.risk != table.grids.risk ||
+        calibration->grids.probability != table.grids.probability) {
+      throw InputError("--calibrate-on: its threshold columns differ from the report's file's "
+                       "(another plinth-eval version)");
+    }
   }
   Report report;
   report.runs = table.runs.size();
   report.false_alarm = targets.false_alarm;
   report.margins_known = table.has_grid;
-  std::set<std::string> names;
-  for (const EvalRun& r : table.runs) names.insert(r.record);
   std::vector<std::string> halves[2];
   std::size_t k = 0;
-  for (const std::string& name : names) halves[k++ % 2].push_back(name);
+  for (const std::string& name : record_names(table.runs)) halves[k++ % 2].push_back(name);
   const std::vector<host::RocPoint> all_points = host::roc(table.runs, table.grids);
   for (std::size_t level = 0; level < host::kEvalLevels; ++level) {
     LevelReport l;
@@ -201,9 +220,9 @@ Report make_report(const EvalTable& table, const CalibrationTargets& targets, bo
       FoldResult f;
       f.calibration_records = halves[fold];
       f.report_records = halves[1 - fold];
-      const std::vector<EvalRun> calibration = runs_of(table.runs, f.calibration_records);
+      const std::vector<EvalRun> on_half = runs_of(table.runs, f.calibration_records);
       const std::vector<EvalRun> held_out = runs_of(table.runs, f.report_records);
-      f.chosen = host::choose_rule(host::roc(calibration, table.grids), target);
+      f.chosen = host::choose_rule(host::roc(on_half, table.grids), target);
       if (f.chosen.found) {
         const Rule rule = f.chosen.point.rule;
         f.held_out = host::outcome_of(held_out,
@@ -212,6 +231,18 @@ Report make_report(const EvalTable& table, const CalibrationTargets& targets, bo
       l.folds.push_back(f);
     }
     l.all_records = host::choose_rule(all_points, target);
+    if (calibration != nullptr) {
+      FoldResult f;
+      f.calibration_records = record_names(calibration->runs);
+      f.report_records = record_names(table.runs);
+      f.chosen = host::choose_rule(host::roc(calibration->runs, calibration->grids), target);
+      if (f.chosen.found) {
+        const Rule rule = f.chosen.point.rule;
+        f.held_out = host::outcome_of(table.runs,
+                                      [&rule](const EvalRun& r) { return host::first_time(r, rule); });
+      }
+      l.calibrated_elsewhere.push_back(f);
+    }
     report.levels.push_back(l);
   }
   if (with_frontier) {
@@ -253,6 +284,14 @@ std::string report_text(const Report& report, const CrossingGrids& grids) {
     out += "  chosen on all records:     " + describe_rule(l.all_records.point.rule, grids) +
            (l.all_records.meets_target ? "" : " (target not met)") + "\n";
     out += "                             " + outcome_text(l.all_records.point.outcome, m) + "\n";
+    for (const FoldResult& f : l.calibrated_elsewhere) {
+      out += "  calibrated on --calibrate-on's " + std::to_string(f.calibration_records.size()) +
+             " records: chosen " + describe_rule(f.chosen.point.rule, grids) +
+             (f.chosen.meets_target ? "" : " (target not met there)") + "\n";
+      out += "    there:                   " + outcome_text(f.chosen.point.outcome, m) + "\n";
+      out += "    here:                    " + outcome_text(f.held_out, m) + "\n";
+      if (m) out += bands_text(f.held_out);
+    }
   }
   for (const FrontierReport& f : report.frontiers) {
     out += "frontier: the fewest false alarms of the rules on " + f.signal +
@@ -278,20 +317,27 @@ std::string report_json(const Report& report, const CrossingGrids& grids) {
     out += "{\"level\": " + host::json_quoted(l.level) + ", \"shown\": " +
            outcome_json(l.shown, m) + ", \"shown_by_margin\": " + (m ? bands_json(l.shown) : "null") +
            ", \"reactive\": " + outcome_json(l.reactive, m) + ", \"folds\": [";
-    for (std::size_t f = 0; f < l.folds.size(); ++f) {
-      const FoldResult& fold = l.folds[f];
-      out += f ? ", " : "";
-      out += "{\"calibration_records\": " + names_json(fold.calibration_records) +
+    const auto fold_json = [&](const FoldResult& fold) {
+      return "{\"calibration_records\": " + names_json(fold.calibration_records) +
              ", \"report_records\": " + names_json(fold.report_records) +
              ", \"rule\": " + host::json_quoted(describe_rule(fold.chosen.point.rule, grids)) +
              ", \"meets_target\": " + (fold.chosen.meets_target ? "true" : "false") +
              ", \"calibration\": " + outcome_json(fold.chosen.point.outcome, m) +
              ", \"held_out\": " + outcome_json(fold.held_out, m) + "}";
-    }
+    };
+    for (std::size_t f = 0; f < l.folds.size(); ++f) out += (f ? ", " : "") + fold_json(l.folds[f]);
     out += "], \"all_records\": {\"rule\": " +
            host::json_quoted(describe_rule(l.all_records.point.rule, grids)) +
            ", \"meets_target\": " + (l.all_records.meets_target ? "true" : "false") +
-           ", \"outcome\": " + outcome_json(l.all_records.point.outcome, m) + "}}";
+           ", \"outcome\": " + outcome_json(l.all_records.point.outcome, m) +
+           "}, \"calibrated_elsewhere\": ";
+    if (l.calibrated_elsewhere.empty()) {
+      out += "null}";
+    } else {
+      const FoldResult& f = l.calibrated_elsewhere.front();
+      out += fold_json(f).substr(0, fold_json(f).size() - 1) + ", \"held_out_by_margin\": " +
+             (m ? bands_json(f.held_out) : "null") + "}}";
+    }
   }
   out += "]";
   if (!report.frontiers.empty()) {

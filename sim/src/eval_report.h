@@ -34,6 +34,9 @@ struct LevelReport {
   host::WarningOutcome reactive;  // today's box: the nominal statue's risk at the default threshold
   std::vector<FoldResult> folds;  // two: calibrated on one half, reported on the other
   host::Choice all_records;       // the rule chosen on every record (the shipped defaults)
+  // With another runs file to calibrate on (report --calibrate-on): the rule chosen on all of
+  // it, and that rule on this file's runs.
+  std::vector<FoldResult> calibrated_elsewhere;  // none or one
 };
 
 // The frontier (host::frontier) of the rules on one reactive risk and the forecast probability.
@@ -50,11 +53,19 @@ struct Report {
   std::vector<FrontierReport> frontiers;  // with_frontier: risk, then nominal_risk
 };
 
+// Throws InputError, naming the file as `name`, when the targets count margins and the table has
+// no grid (a file of an earlier plinth-eval).
+void require_margins(const host::EvalTable& table, const CalibrationTargets& targets,
+                     const std::string& name);
+
 // The records split in two halves by name (alternately, sorted), the runs of each. With
 // `with_frontier`, also the best rule each of the alarm's constraints allows on every record.
-// Throws InputError when the targets count margins and the table has no grid.
+// With `calibration`, also each level's rule chosen on that other file's runs (of the same
+// threshold grids) and reported on these. Throws InputError when the targets count margins and
+// a table has no grid, or the two files' thresholds differ.
 [[nodiscard]] Report make_report(const host::EvalTable& table, const CalibrationTargets& targets,
-                                 bool with_frontier = false);
+                                 bool with_frontier = false,
+                                 const host::EvalTable* calibration = nullptr);
 
 // The report as text (stdout) and as JSON.
 [[nodiscard]] std::string report_text(const Report& report, const host::CrossingGrids& grids);

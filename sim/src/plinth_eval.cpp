@@ -65,6 +65,7 @@ struct ReportOptions {
   std::string json_path;
   std::string plot_path;
   bool frontier = false;  // also the frontier of the rules (make_report)
+  std::string calibration_path;  // choose the rules on this other runs file
   std::string false_alarm = plinth::host::false_alarm_name(plinth::eval::CalibrationTargets{}.false_alarm);
 };
 
@@ -259,12 +260,15 @@ int run_report(const ReportOptions& opt) {
   }
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
-  plinth::eval::Report report;
-  try {
-    report = plinth::eval::make_report(table, targets, opt.frontier);
-  } catch (const InputError& e) {
-    throw InputError(opt.runs_path + ": " + e.what());
+  plinth::eval::require_margins(table, targets, opt.runs_path);
+  EvalTable calibration;
+  if (!opt.calibration_path.empty()) {
+    calibration = plinth::host::read_eval_csv(opt.calibration_path);
+    if (calibration.runs.empty()) throw InputError(opt.calibration_path + ": no runs");
+    plinth::eval::require_margins(calibration, targets, opt.calibration_path + " (--calibrate-on)");
   }
+  const plinth::eval::Report report = plinth::eval::make_report(
+      table, targets, opt.frontier, opt.calibration_path.empty() ? nullptr : &calibration);
   std::fputs(plinth::eval::report_text(report, table.grids).c_str(), stdout);
   if (!opt.json_path.empty()) write_text(opt.json_path, plinth::eval::report_json(report, table.grids));
   if (!opt.plot_path.empty()) plinth::eval::plot_roc(table, opt.plot_path);
@@ -358,6 +362,9 @@ int main(int argc, char** argv) {
   report_command->add_flag("--frontier", report.frontier,
                            "also the rule with the fewest false alarms under each of the alarm's "
                            "targets, on the worst member's and on the nominal statue's risk");
+  report_command->add_option("--calibrate-on", report.calibration_path,
+                             "also choose each level's rule on this other runs CSV and report it "
+                             "on these runs");
   report_command->add_option("--false-alarm", report.false_alarm,
                              "what calibration and frontier count as false: margin (alarms in runs "
                              "whose collapse margin is >= 2) or peak (in runs below half the "

@@ -199,6 +199,36 @@ assert r["false_alarm"] == "peak" and r["margins_known"], r["false_alarm"]'
 expect_failure "an unknown false alarm" "--false-alarm: expected margin or peak" -- report \
   all.csv --false-alarm loud
 
+# report --calibrate-on: each level's rule chosen on another file (here shard 1, as its own report
+# chooses it on all its records), and that rule on this file's rows (shard 2, recounted here).
+expect_success "report on shard 1" report s1.csv --json s1.json
+expect_success "report on shard 2 calibrated on shard 1" report s2.csv --calibrate-on s1.csv \
+  --json s2-cal.json
+ok_if "the rule chosen on one file is scored on the other" python3 - s1.json s2-cal.json s2.csv <<'PY'
+import csv, json, sys
+own = json.load(open(sys.argv[1]))
+report = json.load(open(sys.argv[2]))
+rows = list(csv.DictReader(open(sys.argv[3])))
+for mine, theirs in zip(own["levels"], report["levels"]):
+    elsewhere = theirs["calibrated_elsewhere"]
+    assert elsewhere["rule"] == mine["all_records"]["rule"], (elsewhere, mine["all_records"])
+    assert elsewhere["calibration"] == mine["all_records"]["outcome"]
+columns = []
+for part in report["levels"][2]["calibrated_elsewhere"]["rule"].split(" or "):
+    signal, value = part.split(" >= ")
+    columns += [c for c in rows[0] if c.startswith(signal + "_ge_")
+                and abs(float(c.split("_ge_")[1]) - float(value)) < 1e-3]
+def first(r):
+    ts = [float(r[c]) for c in columns if float(r[c]) >= 0]
+    return min(ts) if ts else -1.0
+held_out = report["levels"][2]["calibrated_elsewhere"]["held_out"]
+collapses = [r for r in rows if r["collapsed"] == "1"]
+assert held_out["misses"] == sum(1 for r in collapses
+                                 if not 0 <= first(r) < float(r["collapse_time_s"]))
+quiet = [r for r in rows if r["collapsed"] == "0" and float(r["peak_ratio"]) < 0.5]
+assert held_out["false_alarms"] == sum(1 for r in quiet if first(r) >= 0)
+PY
+
 # A runs file of a plinth-eval before the margin (no seed and grid columns): reported with the
 # peak alone, refused for the margin and the fragility with what to do.
 python3 - all.csv old.csv <<'PY'
@@ -215,6 +245,8 @@ expect_failure "an earlier file has no fragility" "old.csv" "no seed and pga gri
   fragility old.csv
 expect_failure "merging an earlier file with a new one" "pga grid columns" -- merge --out m.csv \
   all.csv old.csv
+expect_failure "calibrating on an earlier file" "old.csv \\(--calibrate-on\\): no seed and pga grid" -- \
+  report all.csv --calibrate-on old.csv
 # A case with a row missing: its rows must run up the grid from its first point.
 python3 - all.csv short.csv <<'PY'
 import csv, sys
