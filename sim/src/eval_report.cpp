@@ -90,9 +90,9 @@ std::string outcome_text(const WarningOutcome& o, bool margins) {
                     std::to_string(o.false_alarms) + "/" + std::to_string(o.quiet_runs) + " (" +
                     number(100.0 * o.false_alarm_rate(), 1) + " %), ";
   if (margins) {
+    const host::BandCount unknown = o.margin_unknown();
     out += "unneeded (margin >= 2) " + count_text(o.unneeded()) + ", margin unknown " +
-           std::to_string(o.margin_unknown().alarms) + "/" + std::to_string(o.margin_unknown().runs) +
-           ", ";
+           std::to_string(unknown.alarms) + "/" + std::to_string(unknown.runs) + ", ";
   }
   return out + "near misses raised " + std::to_string(o.raised_on_near_misses) + "/" +
          std::to_string(o.near_miss_runs) + ", lead median " + number(o.lead_quantile(0.5), 2) +
@@ -106,9 +106,10 @@ std::string bands_text(const WarningOutcome& o) {
   for (std::size_t b = 0; b < host::kMarginBands; ++b) {
     out += (b ? "; " : " ") + band_name(b) + ": " + count_text(m.known[b]);
   }
-  out += "\n    margin bounded below only (the case stood up to its grid's top; >= 3 counted above):";
+  out += "\n    margin bounded below only (the case stood up to its grid's top; >= 3 counted "
+         "above):";
   for (std::size_t b = 0; b < m.lower_bound.size(); ++b) {
-    out += (b ? "; " : " ") + std::string(">= ") + band_name(b) + ": " + count_text(m.lower_bound[b]);
+    out += (b ? "; >= " : " >= ") + band_name(b) + ": " + count_text(m.lower_bound[b]);
   }
   if (m.below_one.runs > 0) {
     out += "\n    stood above the case's lowest collapse (margin < 1): " + count_text(m.below_one);
@@ -315,7 +316,8 @@ std::string report_json(const Report& report, const CrossingGrids& grids) {
     const LevelReport& l = report.levels[i];
     out += i ? ", " : "";
     out += "{\"level\": " + host::json_quoted(l.level) + ", \"shown\": " +
-           outcome_json(l.shown, m) + ", \"shown_by_margin\": " + (m ? bands_json(l.shown) : "null") +
+           outcome_json(l.shown, m) +
+           ", \"shown_by_margin\": " + (m ? bands_json(l.shown) : "null") +
            ", \"reactive\": " + outcome_json(l.reactive, m) + ", \"folds\": [";
     const auto fold_json = [&](const FoldResult& fold) {
       return "{\"calibration_records\": " + names_json(fold.calibration_records) +

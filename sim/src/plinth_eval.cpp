@@ -66,7 +66,8 @@ struct ReportOptions {
   std::string plot_path;
   bool frontier = false;  // also the frontier of the rules (make_report)
   std::string calibration_path;  // choose the rules on this other runs file
-  std::string false_alarm = plinth::host::false_alarm_name(plinth::eval::CalibrationTargets{}.false_alarm);
+  std::string false_alarm =
+      plinth::host::false_alarm_name(plinth::eval::CalibrationTargets{}.false_alarm);
 };
 
 struct FragilityOptions {
@@ -270,7 +271,9 @@ int run_report(const ReportOptions& opt) {
   const plinth::eval::Report report = plinth::eval::make_report(
       table, targets, opt.frontier, opt.calibration_path.empty() ? nullptr : &calibration);
   std::fputs(plinth::eval::report_text(report, table.grids).c_str(), stdout);
-  if (!opt.json_path.empty()) write_text(opt.json_path, plinth::eval::report_json(report, table.grids));
+  if (!opt.json_path.empty()) {
+    write_text(opt.json_path, plinth::eval::report_json(report, table.grids));
+  }
   if (!opt.plot_path.empty()) plinth::eval::plot_roc(table, opt.plot_path);
   return 0;
 }

@@ -146,7 +146,8 @@ double PgaGrid::at(int i) const {
 int PgaGrid::index_of(double pga_g) const {
   if (!known()) return -1;
   const double span = to_g - from_g;
-  const long i = steps == 1 || !(span > 0.0) ? 0 : std::lround((pga_g - from_g) / span * (steps - 1));
+  const long i =
+      steps == 1 || !(span > 0.0) ? 0 : std::lround((pga_g - from_g) / span * (steps - 1));
   if (i < 0 || i >= steps) return -1;
   const double point = at(static_cast<int>(i));
   return std::abs(point - pga_g) <= kGridMatch * std::max(std::abs(point), std::abs(pga_g))
@@ -164,14 +165,14 @@ double BandCount::rate() const { return runs > 0 ? static_cast<double>(alarms) /
 void count_margin(const EvalRun& run, bool raised, MarginBands& bands) {
   if (!run.grid.known() || run.collapsed) return;
   const double margin = run.collapse_margin();
-  int band = -1;
-  for (int i = static_cast<int>(kMarginBands) - 1; i >= 0 && band < 0; --i) {
-    if (margin >= kMarginBandFloors[static_cast<std::size_t>(i)] * (1.0 - kMarginRounding)) band = i;
+  std::size_t band = kMarginBands;  // none: below 1
+  for (std::size_t i = kMarginBands; i-- > 0 && band == kMarginBands;) {
+    if (margin >= kMarginBandFloors[i] * (1.0 - kMarginRounding)) band = i;
   }
-  const bool top = band == static_cast<int>(kMarginBands) - 1;
-  BandCount& count = band < 0                                  ? bands.below_one
-                     : run.margin_is_lower_bound() && !top     ? bands.lower_bound[static_cast<std::size_t>(band)]
-                                                               : bands.known[static_cast<std::size_t>(band)];
+  const bool top = band == kMarginBands - 1;
+  BandCount& count = band == kMarginBands                  ? bands.below_one
+                     : run.margin_is_lower_bound() && !top ? bands.lower_bound[band]
+                                                           : bands.known[band];
   ++count.runs;
   count.alarms += raised ? 1 : 0;
 }
@@ -558,7 +559,8 @@ EvalTable read_eval_csv(const std::string& path) {
     if (table.has_grid) {
       const double seed = parse_number(f[c], where, "seed");
       if (seed < 0.0 || seed != std::floor(seed) || seed > 4294967295.0) {
-        throw InputError(where + ": seed: expected a whole number from 0 to 4294967295, got " + f[c]);
+        throw InputError(where + ": seed: expected a whole number from 0 to 4294967295, got " +
+                         f[c]);
       }
       r.seed = static_cast<std::uint32_t>(seed);
       r.grid.from_g = parse_number(f[c + 1], where, "pga_from_g");

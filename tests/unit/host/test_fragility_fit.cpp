@@ -28,7 +28,8 @@ TEST(FragilityFit, ExactIntensitiesGiveTheLogMeanAndSpread) {
   EXPECT_NEAR(f.curve.beta, std::log(2.0) * std::sqrt(2.0 / 3.0), 1e-8);
   EXPECT_EQ(f.cases, 3);
   EXPECT_EQ(f.collapsed, 3);
-  // The observed information of a normal sample: se(mu) = beta / sqrt(n), se(beta) = beta / sqrt(2n).
+  // The observed information of a normal sample: se(mu) = beta / sqrt(n), se(beta) =
+  // beta / sqrt(2n).
   EXPECT_NEAR(f.log_median_se, f.curve.beta / std::sqrt(3.0), 1e-5);
   EXPECT_NEAR(f.beta_se, f.curve.beta / std::sqrt(6.0), 1e-5);
   EXPECT_LT(f.median_ci95_low_g, 1.0);
@@ -45,8 +46,10 @@ TEST(FragilityFit, SymmetricIntervalsHaveAClosedForm) {
   ASSERT_TRUE(f.fitted()) << f.no_fit;
   EXPECT_NEAR(f.curve.median_g, 1.0, 1e-8);
   EXPECT_NEAR(f.curve.beta, 1.0 / std::sqrt(2.0 / 3.0 * std::log(2.0)), 1e-7);
-  EXPECT_NEAR(f.log_likelihood, 2.0 * std::log(0.5 * std::erfc(-2.0 / std::sqrt(2.0) / f.curve.beta) -
-                                               0.5 * std::erfc(-1.0 / std::sqrt(2.0) / f.curve.beta)),
+  const double a = 1.0 / f.curve.beta;
+  EXPECT_NEAR(f.log_likelihood,
+              2.0 * std::log(0.5 * std::erfc(-2.0 * a / std::sqrt(2.0)) -
+                             0.5 * std::erfc(-a / std::sqrt(2.0))),
               1e-10);
 }
 
@@ -63,7 +66,8 @@ TEST(FragilityFit, ACensoredCaseSatisfiesTheScoreEquations) {
   const double z1 = (std::log(0.5) - mu) / beta;
   const double z2 = (std::log(1.0) - mu) / beta;
   const double zc = (std::log(2.0) - mu) / beta;
-  const double h = std::exp(-0.5 * zc * zc) / std::sqrt(2.0 * M_PI) / (0.5 * std::erfc(zc / std::sqrt(2.0)));
+  const double density = std::exp(-0.5 * zc * zc) / std::sqrt(2.0 * M_PI);
+  const double h = density / (0.5 * std::erfc(zc / std::sqrt(2.0)));
   EXPECT_NEAR(z1 + z2 + h, 0.0, 1e-7);
   EXPECT_NEAR(z1 * z1 - 1.0 + z2 * z2 - 1.0 + zc * h, 0.0, 1e-7);
   EXPECT_GT(f.curve.median_g, std::sqrt(0.5));  // above the two collapses' own median

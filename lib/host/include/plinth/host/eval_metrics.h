@@ -40,8 +40,8 @@ enum class FalseAlarm { kMargin, kPeak };
 // "margin" or "peak" into `definition`; false otherwise.
 [[nodiscard]] bool parse_false_alarm(const std::string& text, FalseAlarm& definition);
 
-// plinth-eval run's PGA grid: `steps` points from from_g to to_g, evenly spaced (steps 0: not known,
-// a runs file written before the grid was recorded).
+// plinth-eval run's PGA grid: `steps` points from from_g to to_g, evenly spaced (steps 0: not
+// known, a runs file written before the grid was recorded).
 struct PgaGrid {
   double from_g = 0.0;
   double to_g = 0.0;
@@ -243,7 +243,7 @@ void assign_case_collapses(std::vector<EvalRun>& runs, const std::string& where)
 // pga_to_g and pga_steps (the case's draw and grid, after first_alarm_s) are read when present:
 // a file of an earlier plinth-eval has none, and its runs have no known grid (has_grid false).
 void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with_grid);
-// The row has the seed and grid columns when run.grid is known (the header must say so). the seed and grid columns when run.grid is known (as the header must say).
+// with_grid: the seed and grid columns. A row has them when run.grid is known (as the header must).
 void write_eval_csv_row(std::FILE* out, const EvalRun& run);
 struct EvalTable {
   CrossingGrids grids;

@@ -3,7 +3,7 @@
 // (incremental dynamic analysis, Vamvatsikos & Cornell 2002): a case that first collapses at a
 // grid point collapses somewhere above the grid point below it; a case that never collapses up
 // to the grid's top is right-censored there. With x = ln(PGA), mu = ln(median), each case adds
-//   exact x:           ln(phi((x - mu) / beta) / beta)            (the density; x's own -ln PGA left out)
+//   exact x:           ln(phi((x - mu) / beta) / beta)   (the density, without x's own -ln PGA)
 //   in (lower, upper]: ln(Phi((x_upper - mu) / beta) - Phi((x_lower - mu) / beta))
 // (lower 0: Phi(-inf) = 0; upper infinite: Phi(+inf) = 1) to the log-likelihood, maximised over
 // (mu, ln beta) by Newton's method. The standard errors are the observed information's.
