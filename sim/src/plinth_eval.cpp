@@ -314,7 +314,9 @@ int run_merge(const MergeOptions& opt) {
     for (EvalRun& r : part.runs) merged.runs.push_back(std::move(r));
   }
   // A case in two inputs (shards of one run never share one) would not be one case.
-  if (merged.has_grid) (void)plinth::host::eval_cases(merged.runs, "merge");
+  if (merged.has_grid) {
+    (void)plinth::host::eval_cases(merged.runs, "merge (a case in two inputs?)");
+  }
   write_runs(opt.out_path, merged.grids, {merged.runs}, merged.has_grid);
   std::printf("plinth-eval merge: %zu runs from %zu files -> %s\n", merged.runs.size(),
               opt.inputs.size(), opt.out_path.c_str());

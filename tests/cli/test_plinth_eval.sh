@@ -152,8 +152,8 @@ ok_if "the report names the two folds" grep -q "fold 2: chosen" report.txt
 ok_if "each row names its case's seed and grid" python3 - all.csv <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
-assert all((r["seed"], r["pga_from_g"], r["pga_to_g"], r["pga_steps"]) == ("2026", "0.3", "1.5", "4")
-           for r in rows), rows[0]
+columns = ("seed", "pga_from_g", "pga_to_g", "pga_steps")
+assert all(tuple(r[c] for c in columns) == ("2026", "0.3", "1.5", "4") for r in rows), rows[0]
 PY
 ok_if "the report's margins are the rows'" python3 - all.csv report.json <<'PY'
 import csv, json, sys
@@ -204,7 +204,8 @@ expect_failure "an unknown false alarm" "--false-alarm: expected margin or peak"
 expect_success "report on shard 1" report s1.csv --json s1.json
 expect_success "report on shard 2 calibrated on shard 1" report s2.csv --calibrate-on s1.csv \
   --json s2-cal.json
-ok_if "the rule chosen on one file is scored on the other" python3 - s1.json s2-cal.json s2.csv <<'PY'
+ok_if "the rule chosen on one file is scored on the other" \
+  python3 - s1.json s2-cal.json s2.csv <<'PY'
 import csv, json, sys
 own = json.load(open(sys.argv[1]))
 report = json.load(open(sys.argv[2]))
@@ -245,7 +246,8 @@ expect_failure "an earlier file has no fragility" "old.csv" "no seed and pga gri
   fragility old.csv
 expect_failure "merging an earlier file with a new one" "pga grid columns" -- merge --out m.csv \
   all.csv old.csv
-expect_failure "calibrating on an earlier file" "old.csv \\(--calibrate-on\\): no seed and pga grid" -- \
+expect_failure "calibrating on an earlier file" \
+  "old.csv \\(--calibrate-on\\): no seed and pga grid" -- \
   report all.csv --calibrate-on old.csv
 # A case with a row missing: its rows must run up the grid from its first point.
 python3 - all.csv short.csv <<'PY'
@@ -267,7 +269,8 @@ expect_failure "two records of one name" "--record: two files named r.AT2" -- ru
 # plinth-eval fragility: per scene its cases and collapses, as the rows count them, and each
 # fitted curve a maximum of the likelihood (recomputed here, interval-censored on the grid).
 expect_success "fragility" fragility all.csv --json fragility.json
-ok_if "the fragility's counts are the rows', its fits maxima" python3 - all.csv fragility.json <<'PY'
+ok_if "the fragility's counts are the rows', its fits maxima" \
+  python3 - all.csv fragility.json <<'PY'
 import csv, json, math, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 fits = json.load(open(sys.argv[2]))
@@ -343,6 +346,10 @@ expect_failure "a PGA grid upside down" "--pga-to.*below --pga-from" -- run "${C
   --statues 2 --pga-from 1g --pga-to 0.5g --out x.csv
 expect_failure "a PGA of zero" "--pga-from: must be above 0" -- run "${CASES[@]}" \
   --statues 2 --pga-from 0g --out x.csv
+expect_failure "a grid of one point in steps" "--pga-steps: a grid from 1g to 1g has one point" \
+  -- run "${CASES[@]}" --statues 2 --pga-from 1g --pga-to 1g --out x.csv
+expect_failure "merging a file with itself" "merge \\(a case in two inputs\\?\\): case .*two rows" \
+  -- merge --out m.csv all.csv all.csv
 expect_failure "a PGA without a unit" "--pga-from" -- run "${CASES[@]}" --statues 2 \
   --pga-from 0.3 --out x.csv
 expect_failure "too many statues" "--statues: expected 1 to 1000" -- run "${CASES[@]}" \
