@@ -99,12 +99,17 @@ std::string outcome_text(const WarningOutcome& o, bool margins) {
          " s, 10th pct " + number(o.lead_quantile(0.1), 2) + " s";
 }
 
-// The alarm rate by margin band, and the runs bounded below only.
+// The alarm rate by margin band (and how many of the band's runs the peak calls quiet), and the
+// runs bounded below only.
 std::string bands_text(const WarningOutcome& o) {
   const host::MarginBands& m = o.margins;
   std::string out = "    by collapse margin (runs that stood):";
   for (std::size_t b = 0; b < host::kMarginBands; ++b) {
     out += (b ? "; " : " ") + band_name(b) + ": " + count_text(m.known[b]);
+  }
+  out += "\n    of those, quiet by the peak:";
+  for (std::size_t b = 0; b < host::kMarginBands; ++b) {
+    out += (b ? "; " : " ") + band_name(b) + ": " + std::to_string(m.known[b].quiet);
   }
   out += "\n    margin bounded below only (the case stood up to its grid's top; >= 3 counted "
          "above):";
@@ -119,7 +124,8 @@ std::string bands_text(const WarningOutcome& o) {
 
 std::string count_json(const host::BandCount& c) {
   return "{\"runs\": " + std::to_string(c.runs) + ", \"alarms\": " + std::to_string(c.alarms) +
-         ", \"rate\": " + (c.runs > 0 ? number(c.rate(), 4) : "null") + "}";
+         ", \"rate\": " + (c.runs > 0 ? number(c.rate(), 4) : "null") +
+         ", \"quiet\": " + std::to_string(c.quiet) + "}";
 }
 
 std::string outcome_json(const WarningOutcome& o, bool margins) {

@@ -175,6 +175,7 @@ void count_margin(const EvalRun& run, bool raised, MarginBands& bands) {
                                                            : bands.known[band];
   ++count.runs;
   count.alarms += raised ? 1 : 0;
+  count.quiet += run.quiet() ? 1 : 0;
 }
 
 BandCount WarningOutcome::unneeded() const {
@@ -182,6 +183,7 @@ BandCount WarningOutcome::unneeded() const {
   const auto add = [&c](const BandCount& b) {
     c.runs += b.runs;
     c.alarms += b.alarms;
+    c.quiet += b.quiet;
   };
   for (std::size_t i = 0; i < kMarginBands; ++i) {
     if (kMarginBandFloors[i] >= kUnneededMargin) add(margins.known[i]);
@@ -198,6 +200,7 @@ BandCount WarningOutcome::margin_unknown() const {
     if (kMarginBandFloors[i] < kUnneededMargin) {
       c.runs += margins.lower_bound[i].runs;
       c.alarms += margins.lower_bound[i].alarms;
+      c.quiet += margins.lower_bound[i].quiet;
     }
   }
   return c;

@@ -220,6 +220,7 @@ TEST(EvalMetrics, TheCollapseMarginIsTheCasesLowestCollapseOverTheRunsPga) {
   EXPECT_EQ(m.known[3].alarms, 1);
   EXPECT_EQ(m.known[4].runs, 2);
   EXPECT_EQ(m.known[4].alarms, 1);
+  EXPECT_EQ(m.known[4].quiet, 2);  // both stood with a peak of 0.1
   // Bounded below only: >= 1 (raised), >= 1.25 (not), >= 1.67 (raised), >= 2.5 (raised).
   EXPECT_EQ(m.lower_bound[0].runs, 1);
   EXPECT_EQ(m.lower_bound[0].alarms, 1);
@@ -257,6 +258,9 @@ TEST(EvalMetrics, TheCalibrationCountsTheFalseAlarmsItIsTold) {
   runs[0].probability_crossing_s = {1.0};
   runs[0].peak_ratio = 0.6;
   assign_case_collapses(runs, "test");
+  const WarningOutcome never = outcome_of(runs, [](const EvalRun&) { return -1.0; });
+  EXPECT_EQ(never.margins.known[4].quiet, 0);  // the run at 0.5 g rocked past half the angle
+  EXPECT_EQ(never.margins.known[1].quiet, 1);
   const std::vector<RocPoint> points = roc(runs, {{0.5}, {0.5}});
   const Choice by_margin = choose_rule(points, {0.0, 0, FalseAlarm::kMargin});
   const Choice by_peak = choose_rule(points, {0.0, 0, FalseAlarm::kPeak});

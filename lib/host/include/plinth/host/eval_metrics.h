@@ -103,6 +103,7 @@ inline constexpr std::size_t kMarginBands = kMarginBandFloors.size();
 struct BandCount {
   int runs = 0;
   int alarms = 0;  // runs in which the rule or level was raised
+  int quiet = 0;   // runs whose peak stayed below half the angle: false alarms by the peak
   [[nodiscard]] double rate() const;  // alarms / runs (0 if none)
 };
 struct MarginBands {
