@@ -4,8 +4,8 @@
 #                               example scenes and box file, the bundled records
 #   lib/systemd/system/         the units (plinth-monitor@.service, plinth-monitor@.socket)
 #   lib/sysusers.d/, lib/udev/rules.d/   the service's user, the GPIO chips' group
-#   etc/plinth/                 the box's configuration (a package installs it in /etc: the
-#                               package presets set CMAKE_INSTALL_SYSCONFDIR=/etc)
+#   etc/plinth/                 the box's configuration (/etc/plinth for the prefix /usr, as
+#                               in the Debian packages: GNUInstallDirs' rule, at install time)
 #   include/, lib/.../cmake/plinth/   the freestanding core for find_package(plinth)
 # Three components, one Debian package each (cmake/packaging.cmake): monitor (plinth-monitor),
 # tools (plinth-tools), dev (libplinth-dev). Installed programs find their data from their own
@@ -38,8 +38,13 @@ install(CODE "
   file(INSTALL DESTINATION \"\${CMAKE_INSTALL_PREFIX}/lib/systemd/system\" TYPE FILE
        FILES \"${CMAKE_BINARY_DIR}/plinth-units/plinth-monitor@.service\"
              \"${CMAKE_BINARY_DIR}/plinth-units/plinth-monitor@.socket\")
-  file(INSTALL DESTINATION \"\${plinth_sysconfdir}/plinth\" TYPE FILE
-       FILES \"${PROJECT_SOURCE_DIR}/firmware/linux/systemd/box.toml\")
+  # An existing box.toml is the site's: kept, as dpkg keeps a conffile.
+  if(EXISTS \"\$ENV{DESTDIR}\${plinth_sysconfdir}/plinth/box.toml\")
+    message(STATUS \"Kept: \$ENV{DESTDIR}\${plinth_sysconfdir}/plinth/box.toml (the site's)\")
+  else()
+    file(INSTALL DESTINATION \"\${plinth_sysconfdir}/plinth\" TYPE FILE
+         FILES \"${PROJECT_SOURCE_DIR}/firmware/linux/systemd/box.toml\")
+  endif()
 " COMPONENT monitor)
 install(FILES firmware/linux/systemd/plinth-monitor.sysusers
         DESTINATION lib/sysusers.d RENAME plinth-monitor.conf COMPONENT monitor)

@@ -40,10 +40,11 @@ build=(
   libeigen3-dev libcli11-dev libtomlplusplus-dev
   libgpiod-dev libsystemd-dev  # relays (libgpiod 1.6), sd_notify, sd_listen_fds, the journal
   libmodbus-dev libmosquitto-dev  # plinth-monitor's Modbus TCP server and MQTT publisher
+  libsocketcan-dev  # the CAN controller's state (hal/socketcan)
 )
 tests=(
   libgtest-dev libgmock-dev libbenchmark-dev
-  libsocketcan-dev kmod iproute2 can-utils  # SocketCAN, tested on a real bus (tools/vcan-bus.sh):
+  kmod iproute2 can-utils  # SocketCAN, tested on a real bus (tools/vcan-bus.sh):
   user-mode-linux                           #   route uml
   qemu-system-x86 linux-image-amd64 busybox-static xz-utils  # route qemu
   linux-headers-amd64 linux-source-6.1 gpiod  # gpio-sim in the qemu route
@@ -59,7 +60,7 @@ tests=(
   # (multiarch), and qemu-user, which runs the arm64 plinth-monitor on this machine.
   g++-aarch64-linux-gnu qemu-user
   libtomlplusplus-dev:arm64 libgpiod-dev:arm64 libsystemd-dev:arm64 libmodbus-dev:arm64
-  libmosquitto-dev:arm64
+  libmosquitto-dev:arm64 libsocketcan-dev:arm64
 )
 case "$set_name" in
   runtime) packages=("${runtime[@]}") ;;

@@ -359,7 +359,7 @@ std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings)
 template <typename Restart>
 bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
               fw::EventRecorder* recorder, fw::Supervisor& supervisor, fw::LatencyLog* latency,
-              Restart restart) {
+              fw::LatencyLog* due_latency, Restart restart) {
   supervisor.ready("monitoring " + input.source());
   fw::InputItem item;
   bool estimated = false;
@@ -369,7 +369,9 @@ bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
     estimated = estimated || monitor.status().estimating;
     if (latency != nullptr && item.kind != fw::InputItem::Kind::kTick &&
         item.kind != fw::InputItem::Kind::kBusFault) {
-      latency->add(fw::monotonic_ns() - arrival_ns);
+      const std::int64_t ready_ns = fw::monotonic_ns();
+      latency->add(ready_ns - arrival_ns);
+      if (item.due_ns > 0) due_latency->add(ready_ns - item.due_ns);
     }
     outputs.carry_out_commands(monitor, restart);
     const std::int64_t now_ns = plinth::hal::monotonic_now_ns();
@@ -517,7 +519,11 @@ int run(const Options& opt, const CLI::App& app) {
     outputs.trace = &trace.emplace(opt.trace_path, config.axis_count, input->t_origin());
   }
   std::optional<fw::LatencyLog> latency;
-  if (opt.latency) latency.emplace(kLatencyCapacity);
+  std::optional<fw::LatencyLog> due_latency;  // a paced replay: from each sample's deadline
+  if (opt.latency) {
+    latency.emplace(kLatencyCapacity);
+    due_latency.emplace(kLatencyCapacity);
+  }
   fw::Supervisor supervisor(file.watchdog);
   outputs.supervisor = &supervisor;
   outputs.identity = identity;
@@ -525,7 +531,8 @@ int run(const Options& opt, const CLI::App& app) {
     start_monitor(monitor, config, scene_x, scene_y, app, opt.config.config_path);
   };
   const bool estimated = run_loop(*input, monitor, outputs, recorder.get(), supervisor,
-                                  latency ? &*latency : nullptr, restart);
+                                  latency ? &*latency : nullptr,
+                                  due_latency ? &*due_latency : nullptr, restart);
   if (trace) trace->close();
   if (recorder) recorder->close();  // every capture is on disk before the summary
   if (frames_log && !frames_log->flush()) throw InputError("--frames-out: " + frames_log->error());
@@ -536,6 +543,9 @@ int run(const Options& opt, const CLI::App& app) {
     totals.outputs.emplace_back(o->name(), o->summary_json());
   }
   if (latency) totals.outputs.emplace_back("latency", latency->summary_json());
+  if (due_latency && input_settings.speed > 0.0) {
+    totals.outputs.emplace_back("latency_from_due", due_latency->summary_json());
+  }
   totals.input_fault = input_fault(*input, estimated);
   print_line(fw::summary_json(monitor, totals, input->t_origin()));
   std::fflush(stdout);

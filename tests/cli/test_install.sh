@@ -27,6 +27,10 @@ prefix=$tmp/prefix
 
 "$cmake" --install "$build" --prefix "$prefix" >"$tmp/install.log" 2>&1
 check "cmake --install into $prefix" $? "$(tail -3 "$tmp/install.log")"
+echo "# edited on site" >>"$prefix/etc/plinth/box.toml"
+"$cmake" --install "$build" --prefix "$prefix" >"$tmp/install2.log" 2>&1 &&
+  tail -1 "$prefix/etc/plinth/box.toml" | grep -q "edited on site"
+check "a second cmake --install keeps the edited etc/plinth/box.toml" $? "$(grep -i box.toml "$tmp/install2.log")"
 expected=$("$build/firmware/linux/plinth-monitor" --version)
 expected=${expected#plinth-monitor }
 

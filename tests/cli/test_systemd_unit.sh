@@ -49,6 +49,7 @@ for want in 'Type=notify' 'NotifyAccess=main' 'WatchdogSec=[0-9]+s' 'Restart=(al
   'User=plinth' 'NoNewPrivileges=yes' 'ProtectSystem=strict' \
   'ReadWritePaths=/var/lib/plinth-monitor/%i' 'CapabilityBoundingSet=' 'AmbientCapabilities=' \
   'DevicePolicy=closed' 'RestrictAddressFamilies=AF_CAN AF_UNIX AF_NETLINK AF_INET AF_INET6' \
+  'CPUSchedulingPolicy=fifo' 'CPUSchedulingResetOnFork=yes' 'RestrictRealtime=yes' \
   'WantedBy=multi-user.target sys-subsystem-net-devices-%i.device'; do
   setting "$want" "$unit"
   check "service: $want" $?
