@@ -78,14 +78,21 @@ if ! unshare -n true 2>/dev/null || ! command -v systemd-socket-activate >/dev/n
   finish
   exit
 fi
-printf '[modbus]\nlisten = "127.0.0.1:502"\n' >"$tmp/box.toml"
-chmod 755 "$tmp"
-chmod 644 "$tmp/box.toml"
+# nobody reads and runs copies in a folder of its own (the trees may lie under a private folder).
+box_dir=$(mktemp -d /tmp/plinth-socket-test.XXXXXX)
+trap 'rm -rf "$tmp" "$box_dir"' EXIT
+printf '[modbus]\nlisten = "127.0.0.1:502"\n' >"$box_dir/box.toml"
+cp "$monitor" "$box_dir/plinth-monitor"
+cp "$src/sim/scenes/paper-eccentric.toml" "$src/sim/data/records/friuli1976-09-15_buia_000.AT2" \
+  "$box_dir/"
+chmod 755 "$box_dir" "$box_dir/plinth-monitor"
+chmod 644 "$box_dir/box.toml" "$box_dir/paper-eccentric.toml" \
+  "$box_dir/friuli1976-09-15_buia_000.AT2"
 unprivileged=(setpriv --reuid=65534 --regid=65534 --clear-groups --inh-caps=-all
               --bounding-set=-all --)
-run_box=("$monitor" --scene "$src/sim/scenes/paper-eccentric.toml"
-         --replay "$src/sim/data/records/friuli1976-09-15_buia_000.AT2" --scale 6.5 --speed 1
-         --no-events --config "$tmp/box.toml")
+run_box=("$box_dir/plinth-monitor" --scene "$box_dir/paper-eccentric.toml"
+         --replay "$box_dir/friuli1976-09-15_buia_000.AT2" --scale 6.5 --speed 1
+         --no-events --config "$box_dir/box.toml")
 cat >"$tmp/activate.sh" <<'EOF'
 tmp=$1 port=$2
 shift 2
