@@ -4,7 +4,8 @@
 # (qemu-user) on the quick start's replay (paper-eccentric.toml, Buia 1976 x6.5), runs this
 # machine's plinth-monitor on the same, and checks the same alarm timeline (every alarm line:
 # time, level, previous level, cause, latch, sequence) and the same phase events (names, axes,
-# times within 1 µs), and that the arm64 build reports the same version. See docs/install.md.
+# times within 1 µs), and that the arm64 build reports the same version (its git description is
+# the reference's, given to its configure step). See docs/install.md.
 #
 # Usage: tools/arm64-replay.sh --monitor PLINTH_MONITOR --work DIR [--cmake CMAKE] [--launcher PROG]
 #   --monitor   this machine's plinth-monitor (the reference)
@@ -43,7 +44,13 @@ fi
 
 mkdir -p "$work"
 build=$work/build
-configure=("$cmake" --preset package-arm64 -S "$src" -B "$build")
+# The cross build describes itself as the reference does (a commit made since the reference was
+# built must not make them differ): the description in its --version's parentheses.
+native_version=$("$monitor" --version)
+description=${native_version##*(}
+description=${description%)}
+configure=("$cmake" --preset package-arm64 -S "$src" -B "$build"
+           "-DPLINTH_GIT_DESCRIPTION=$description")
 [ -z "$launcher" ] || configure+=("-DCMAKE_CXX_COMPILER_LAUNCHER=$launcher")
 start=$SECONDS
 (cd "$src" && "${configure[@]}") >"$work/configure.log" 2>&1 ||
@@ -64,7 +71,6 @@ start=$SECONDS
 qemu-aarch64 -L /usr/aarch64-linux-gnu "$arm64" "${replay[@]}" >"$work/arm64.jsonl" \
   2>"$work/arm64.err" || { cat "$work/arm64.err"; echo "arm64-replay: the arm64 run failed"; exit 1; }
 echo "arm64-replay: qemu-aarch64 ran the replay in $((SECONDS - start)) s"
-native_version=$("$monitor" --version)
 arm_version=$(qemu-aarch64 -L /usr/aarch64-linux-gnu "$arm64" --version)
 
 python3 - "$work/amd64.jsonl" "$work/arm64.jsonl" "$native_version" "$arm_version" <<'PY'

@@ -2,6 +2,9 @@
 
 #include <syslog.h>
 #include <systemd/sd-daemon.h>
+// No CODE_FILE/CODE_LINE in the entries: they would name the build's source path, of no use on a
+// box (and no installed file names the source tree: tests/cli/test_install.sh).
+#define SD_JOURNAL_SUPPRESS_LOCATION
 #include <systemd/sd-journal.h>
 
 #include <cerrno>
