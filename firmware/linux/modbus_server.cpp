@@ -14,6 +14,7 @@
 
 #include "modbus_map.h"
 #include "plinth/host/input_error.h"
+#include "socket_activation.h"
 #include "status_json.h"
 
 namespace plinth::firmware {
@@ -66,7 +67,9 @@ ModbusServer::ModbusServer(const ModbusSettings& settings) : settings_(settings)
     throw host::InputError(settings.listen_where + ": cannot listen at " + endpoint.text() + ": " +
                            modbus_strerror(errno));
   }
-  listen_socket_ = modbus_tcp_pi_listen(context_, settings.max_clients);
+  // Under systemd, the socket unit's listening socket (port 502 without privileges); else ours.
+  listen_socket_ = inherited_listening_socket("modbus", endpoint.port, settings.listen_where);
+  if (listen_socket_ < 0) listen_socket_ = modbus_tcp_pi_listen(context_, settings.max_clients);
   if (listen_socket_ < 0) {
     const int error = errno;
     modbus_free(context_);
