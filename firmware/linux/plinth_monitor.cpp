@@ -434,13 +434,16 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
 // Samples whose latency --latency keeps (4 bytes each); later ones are counted only.
 constexpr std::size_t kLatencyCapacity = std::size_t{1} << 22;
 
-// The outputs off the loop that the configuration enables.
-std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFile& file) {
+// The outputs off the loop that the configuration enables, each given the run's identity once.
+std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFile& file,
+                                                             const fw::RunIdentity& identity) {
   std::vector<std::unique_ptr<fw::StatusOutput>> outputs;
   if (!file.modbus.listen.empty()) {
-    outputs.push_back(std::make_unique<fw::ModbusServer>(file.modbus));
+    outputs.push_back(std::make_unique<fw::ModbusServer>(file.modbus, identity));
   }
-  if (!file.mqtt.broker.empty()) outputs.push_back(std::make_unique<fw::MqttPublisher>(file.mqtt));
+  if (!file.mqtt.broker.empty()) {
+    outputs.push_back(std::make_unique<fw::MqttPublisher>(file.mqtt, identity));
+  }
   return outputs;
 }
 
@@ -493,8 +496,9 @@ int run(const Options& opt, const CLI::App& app) {
     sinks.emplace_back(i, monitor, input->t_origin(), !opt.quiet_events);
     monitor.set_event_sink(i, &sinks.back());
   }
-  const std::string identity = fw::identity_members(
-      fw::run_identity(opt.scene_path, file.second_scene_path, opt.config.config_path));
+  const fw::RunIdentity run_identity =
+      fw::run_identity(opt.scene_path, file.second_scene_path, opt.config.config_path);
+  const std::string identity = fw::identity_members(run_identity);
   const std::unique_ptr<fw::EventRecorder> recorder = make_recorder(opt, file, identity);
   // --frames-out: the frames a replay sends, stamped with the receive time of the input that
   // caused them (what candump on the bus would show).
@@ -512,7 +516,7 @@ int run(const Options& opt, const CLI::App& app) {
     std::setvbuf(stdout, nullptr, _IOLBF, 0);
   }
   const std::unique_ptr<fw::RelayOutputs> relays = make_relays(file.relays);
-  const std::vector<std::unique_ptr<fw::StatusOutput>> network = start_outputs(file);
+  const std::vector<std::unique_ptr<fw::StatusOutput>> network = start_outputs(file, run_identity);
   std::vector<fw::StatusOutput*> output_list;
   for (const auto& o : network) output_list.push_back(o.get());
   Outputs outputs(monitor, input->t_origin(), recorder.get(), bus, relays.get(), output_list);

@@ -121,20 +121,26 @@ RunIdentity run_identity(const std::string& scene_path, const std::string& scene
   RunIdentity id;
   id.version = kVersionText;
   const auto digest = [](const std::string& path) {
-    return path.empty() ? std::string() : hex(file_sha256(path));
+    return path.empty() ? std::nullopt : std::optional<Sha256Digest>(file_sha256(path));
   };
-  id.scene_sha256 = digest(scene_path);
-  id.scene_y_sha256 = digest(scene_y_path);
-  id.config_sha256 = digest(config_path);
+  id.scene = digest(scene_path);
+  id.scene_y = digest(scene_y_path);
+  id.config = digest(config_path);
   return id;
+}
+
+std::array<NamedDigest, 3> named_digests(const RunIdentity& identity) {
+  return {{{"scene_sha256", "Scene", &identity.scene},
+           {"scene_y_sha256", "Scene y", &identity.scene_y},
+           {"config_sha256", "Box file", &identity.config}}};
 }
 
 std::string identity_members(const RunIdentity& identity) {
   JsonObject o;
   o.text("version", identity.version);
-  if (!identity.scene_sha256.empty()) o.text("scene_sha256", identity.scene_sha256);
-  if (!identity.scene_y_sha256.empty()) o.text("scene_y_sha256", identity.scene_y_sha256);
-  if (!identity.config_sha256.empty()) o.text("config_sha256", identity.config_sha256);
+  for (const NamedDigest& d : named_digests(identity)) {
+    if (d.digest->has_value()) o.text(d.member, hex(**d.digest));
+  }
   const std::string object = o.close();
   return object.substr(1, object.size() - 2);  // without the braces
 }

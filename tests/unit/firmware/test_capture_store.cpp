@@ -140,8 +140,15 @@ TEST(Sha256, FipsExamples) {
 TEST(RunIdentity, MembersAndInsertion) {
   RunIdentity id;
   id.version = "0.1.0 (abc)";
-  id.scene_sha256 = "00";
-  EXPECT_EQ(identity_members(id), "\"version\": \"0.1.0 (abc)\", \"scene_sha256\": \"00\"");
+  id.scene = sha256("");
+  id.config = sha256("abc");
+  EXPECT_EQ(identity_members(id),
+            "\"version\": \"0.1.0 (abc)\", "
+            "\"scene_sha256\": "
+            "\"e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855\", "
+            "\"config_sha256\": "
+            "\"ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad\"")
+      << "no scene_y_sha256: that file was not given";
   EXPECT_EQ(with_members("{\"a\": 1}", "\"b\": 2"), "{\"a\": 1, \"b\": 2}");
   EXPECT_EQ(with_members("{}", "\"b\": 2"), "{\"b\": 2}");
 }
