@@ -128,7 +128,7 @@ class Outputs {
   }
 
   void handle(const fw::MonitorUpdate& u) {
-    const fw::MonitorStatus& s = monitor_.status();
+    const fw::BoxStatus& s = monitor_.status();
     if (relays_ != nullptr) {  // first: the alarm panel's contacts
       relays_->update(s.alarm, s.latched,
                       s.sensors_state == mon::HealthState::kFault || s.disagreement);
@@ -202,7 +202,7 @@ class Outputs {
  private:
   void trigger(const mon::AlarmEventRecord& e) {
     if (recorder_ == nullptr) return;
-    const fw::MonitorStatus& s = monitor_.status();
+    const fw::BoxStatus& s = monitor_.status();
     fw::TriggerInfo info;
     info.t = static_cast<double>(e.time_ns) * 1e-9 - t_origin_;
     info.level = mon::alarm_level_name(e.level);

@@ -32,7 +32,7 @@ SampleTrace::SampleTrace(const std::string& path, int axis_count, double t_origi
 }
 
 void SampleTrace::after_update(const Monitor& monitor) {
-  const MonitorStatus& s = monitor.status();
+  const BoxStatus& s = monitor.status();
   if (s.newest_sample_time_ns == last_sample_ns_) return;
   last_sample_ns_ = s.newest_sample_time_ns;
   std::FILE* f = file_.get();

@@ -31,7 +31,7 @@ std::string formatted(double value, int digits, bool fixed) {
 
 // One axis's value, or {"x": .., "y": ..} with two axes.
 template <typename ValueOf>
-std::string per_axis(const MonitorStatus& s, ValueOf value_of) {
+std::string per_axis(const BoxStatus& s, ValueOf value_of) {
   if (s.axis_count == 1) return value_of(s.axes[0]);
   JsonObject axes;
   for (int i = 0; i < s.axis_count; ++i) {
@@ -64,7 +64,7 @@ std::string rms_value(const SensorStatus& sensor) {
 }
 
 // The sensors of a status line, each with its health and cross-check.
-std::string status_sensors(const MonitorStatus& s) {
+std::string status_sensors(const BoxStatus& s) {
   std::vector<std::string> sensors;
   for (int i = 0; i < s.sensor_count; ++i) {
     const SensorStatus& sensor = s.sensors[static_cast<std::size_t>(i)];
@@ -125,7 +125,7 @@ std::string sensor_counters(const monitor::SensorHealth& h) {
 }
 
 // Every sensor's totals.
-std::string summary_sensors(const MonitorStatus& s) {
+std::string summary_sensors(const BoxStatus& s) {
   std::vector<std::string> sensors;
   for (int i = 0; i < s.sensor_count; ++i) {
     const SensorStatus& sensor = s.sensors[static_cast<std::size_t>(i)];
@@ -198,7 +198,7 @@ std::string json_array(const std::vector<std::string>& values) {
   return out + "]";
 }
 
-std::string status_json(const MonitorStatus& s, double t_origin) {
+std::string status_json(const BoxStatus& s, double t_origin) {
   JsonObject line;
   line.text("type", "status").fixed("t", seconds(s.time_ns, t_origin), 6);
   line.raw("phase",
@@ -248,7 +248,7 @@ std::string event_json(int axis, const Event& event) {
 }
 
 std::string summary_json(const Monitor& monitor, const RunTotals& totals, double t_origin) {
-  const MonitorStatus& s = monitor.status();
+  const BoxStatus& s = monitor.status();
   JsonObject line;
   line.text("type", "summary")
       .text("source", totals.source)

@@ -37,7 +37,7 @@ class JsonObject {
 
 // {"type": "status", "t": .., "phase": .., "risk": .., "alarm": .., ...}: the monitor's status;
 // t in s of monitor time less `t_origin` (a record replay's lead-in).
-[[nodiscard]] std::string status_json(const MonitorStatus& status, double t_origin);
+[[nodiscard]] std::string status_json(const BoxStatus& status, double t_origin);
 
 // {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
 [[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);

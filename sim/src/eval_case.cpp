@@ -131,7 +131,7 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
     if (n < lead_in) continue;
     const double t = static_cast<double>(k) / rate;
     if (stop_s >= 0.0 && t >= stop_s) break;
-    const fw::MonitorStatus& status = monitor->status();
+    const fw::BoxStatus& status = monitor->status();
     note_level(status.alarm, t, run.first_shown_s);
     if (!status.estimating) continue;
     note_crossings(grids.risk, status.risk, t, run.risk_crossing_s);

@@ -203,7 +203,7 @@ class Harness {
 
   // The check function, after every call.
   void after(const fw::MonitorUpdate& u) {
-    const fw::MonitorStatus& s = box_->status();
+    const fw::BoxStatus& s = box_->status();
     check(s.time_ns >= last_time_ns_, "monitor time never goes back");
     last_time_ns_ = s.time_ns;
     check_estimator(s);
@@ -228,7 +228,7 @@ class Harness {
     rejected_ = c.rejected;
   }
 
-  void check_estimator(const fw::MonitorStatus& s) {
+  void check_estimator(const fw::BoxStatus& s) {
     check(std::isfinite(s.risk) && s.risk >= 0.0 && s.risk <= 1.0, "risk in [0, 1]");
     check(std::isfinite(s.probability) && s.probability >= 0.0 && s.probability <= 1.0,
           "probability in [0, 1]");
@@ -250,7 +250,7 @@ class Harness {
   }
 
   // A fault event reports what was rejected: the cause the monitor's inputs give now.
-  void check_event(const fw::MonitorStatus& s, const mon::AlarmEventRecord& e) {
+  void check_event(const fw::BoxStatus& s, const mon::AlarmEventRecord& e) {
     if (e.level != mon::AlarmLevel::kFault || e.cause == mon::AlarmCause::kAcknowledged) return;
     // From alarm the fault may be one held beneath it; fault to fault is a latch change.
     if (e.previous_level != mon::AlarmLevel::kAlarm &&

@@ -96,7 +96,7 @@ struct Cost {
 // Which cost a sample counts to: every axis in full contact, some axis moving on the base, or
 // none moving and some overturned or fallen (the estimator no longer steps).
 enum class SampleKind { kQuiet, kMoving, kOver };
-SampleKind kind_of(const fw::MonitorStatus& s) {
+SampleKind kind_of(const fw::BoxStatus& s) {
   bool moving = false;
   bool over = false;
   for (int i = 0; i < s.axis_count; ++i) {
@@ -198,7 +198,7 @@ extern "C" int plinth_board_main() {
     }
   }
 
-  const fw::MonitorStatus& s = g_monitor.status();
+  const fw::BoxStatus& s = g_monitor.status();
   char text[200];
   hal::TextLine line(text, sizeof text);
   line.put("# summary samples=").decimal(static_cast<std::uint64_t>(lead_in + record.count));

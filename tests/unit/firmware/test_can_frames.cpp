@@ -59,7 +59,7 @@ std::string domain_name(const std::string& signal, unsigned raw) {
   } else if (signal == "Latched") {
     return raw == 0 ? "not_latched" : "latched";  // a flag: the DBC names its two values
   } else if (signal == "WorstMember" || signal == "CollapseIn") {
-    MonitorStatus s;  // a forecast in which no member collapses
+    BoxStatus s;  // a forecast in which no member collapses
     s.axes[0].forecast.valid = true;
     s.axes[0].forecast.members = 5;
     const can::CollapseForecast m = forecast_message(s, 0, 4.0, 0);
@@ -113,7 +113,7 @@ TEST(CanFrames, AlarmEventsKeepTheirFieldsAndWrapTheirMilliseconds) {
 }
 
 TEST(CanFrames, StatusCarriesPhaseCornerLevelRiskAndSampleAge) {
-  MonitorStatus s;
+  BoxStatus s;
   s.axis_count = 2;
   s.axes[1].mode = rocking_about(Corner::kRight);
   s.axes[1].risk.total = 0.4321;
@@ -142,7 +142,7 @@ TEST(CanFrames, StatusCarriesPhaseCornerLevelRiskAndSampleAge) {
 }
 
 TEST(CanFrames, ForecastCarriesProbabilityWorstMemberAndTimeToCollapse) {
-  MonitorStatus s;
+  BoxStatus s;
   s.axis_count = 2;
   s.time_ns = 12'000 * kMs;
   ForecastOutcome& f = s.axes[1].forecast;
@@ -310,7 +310,7 @@ ForecastFrames run_forecast_frames(bool enabled) {
   ForecastFrames out;
   for (long n = 0; n < input.size() && out.overturn_t < 0.0; ++n) {
     const MonitorUpdate u = monitor.on_sample(input.sample(n));
-    const MonitorStatus& st = monitor.status();
+    const BoxStatus& st = monitor.status();
     if (st.axes[0].mode.terminal()) out.overturn_t = static_cast<double>(st.time_ns) * 1e-9;
     if (!u.status_due) continue;
     ++out.statuses;

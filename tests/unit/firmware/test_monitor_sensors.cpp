@@ -104,7 +104,7 @@ TEST(MonitorSensors, TwoAgreeingGroundSensorsGiveTheSingleSensorResults) {
     (void)dual.on_sensor_sample(1, sample(n, a, delay));
     ASSERT_FALSE(dual.status().disagreement) << n;
   }
-  const fw::MonitorStatus& s = dual.status();
+  const fw::BoxStatus& s = dual.status();
   EXPECT_EQ(s.primary, 0);
   EXPECT_EQ(s.failovers, 0U);
   EXPECT_EQ(s.sensors_state, monitor::HealthState::kOk);
@@ -147,7 +147,7 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   ASSERT_GT(reported, drift_from);
   EXPECT_LT(reported - drift_from, std::lround(0.5 * kRate));
   EXPECT_TRUE(fault_event);
-  const fw::MonitorStatus& s = monitor.status();
+  const fw::BoxStatus& s = monitor.status();
   EXPECT_EQ(s.alarm, monitor::AlarmLevel::kFault);
   EXPECT_TRUE(s.sensors[1].disagreeing);
   EXPECT_EQ(s.sensors[1].disagreements, 1U);
@@ -196,7 +196,7 @@ TEST(MonitorSensors, PrimarySilentFailsOverAndTheEstimatorContinues) {
   // The estimate went on through the failover: the single sensor's (the second sensor's
   // conditioner tracked its offset on its own: 1e-9).
   expect_same_estimate(single, monitor, 1000, 1e-9);
-  fw::MonitorStatus s = monitor.status();
+  fw::BoxStatus s = monitor.status();
   EXPECT_FALSE(fault_after_start);
   EXPECT_EQ(s.primary, 1);
   EXPECT_EQ(s.failovers, 1U);
@@ -236,7 +236,7 @@ TEST(MonitorSensors, PrimarySilentFailsOverAndTheEstimatorContinues) {
 // drive the estimators (the estimate is the ground sensor's alone). Mounted backwards (x
 // reversed) or with a wrong horizontal gain: the residual passes its threshold, reported; with
 // plate.raises_fault also the fault level, cause kSensorDisagreement.
-double run_plate(double gain, bool raises_fault, fw::MonitorStatus& out, bool& fault_seen) {
+double run_plate(double gain, bool raises_fault, fw::BoxStatus& out, bool& fault_seen) {
   fw::Monitor single;
   EXPECT_TRUE(started(single, single_config()));
   fw::MonitorConfig config = sensors_config({fw::SensorRole::kGround, fw::SensorRole::kPlate});
@@ -271,7 +271,7 @@ double run_plate(double gain, bool raises_fault, fw::MonitorStatus& out, bool& f
 }
 
 TEST(MonitorSensors, PlateSensorMatchingTheModelHasASmallResidual) {
-  fw::MonitorStatus s;
+  fw::BoxStatus s;
   bool fault = false;
   const double residual = run_plate(1.0, true, s, fault);
   EXPECT_LT(residual, 1e-3);
@@ -287,7 +287,7 @@ TEST(MonitorSensors, PlateSensorMatchingTheModelHasASmallResidual) {
 
 TEST(MonitorSensors, PlateSensorMountedBackwardsOrScaledIsAMismatch) {
   for (const double gain : {-1.0, 2.5}) {
-    fw::MonitorStatus s;
+    fw::BoxStatus s;
     bool fault = false;
     const double residual = run_plate(gain, false, s, fault);
     EXPECT_GT(residual, 0.5) << gain;

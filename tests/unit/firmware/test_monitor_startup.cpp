@@ -109,7 +109,7 @@ struct BoxRun {
 };
 
 void check_update(const Case& c, std::size_t n, const fw::Monitor& box, BoxRun& run) {
-  const fw::MonitorStatus& st = box.status();
+  const fw::BoxStatus& st = box.status();
   const double t = static_cast<double>(n) / kRateHz;
   const bool before_collapse = c.collapse_s < 0.0 || t < c.collapse_s;
   if (st.alarm == AlarmLevel::kAlarm && before_collapse) run.alarm_before_collapse = true;

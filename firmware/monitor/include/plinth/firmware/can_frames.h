@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "plinth/core/state.h"
-#include "plinth/firmware/monitor.h"
+#include "plinth/firmware/box_status.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
@@ -28,13 +28,13 @@ namespace plinth::firmware {
 
 // The MonitorStatus of axis `axis` of `status`: phase, corner, alarm level, risk, and the age of
 // the newest sample the estimate used (65535 ms, the most the frame says, before estimating).
-[[nodiscard]] can::MonitorStatus status_message(const MonitorStatus& status, int axis,
+[[nodiscard]] can::MonitorStatus status_message(const BoxStatus& status, int axis,
                                                 std::uint8_t sequence);
 // The CollapseForecast of axis `axis` of `status`, whose forecast must be valid: probability,
 // worst member (none: kNoWorstMember), members, the time from status.time_ns to the worst
 // member's collapse (whole ms, 0 when that time has passed, capped at 65534 ms), the horizon
 // `horizon_s` and the `sequence` of the MonitorStatus it goes out with.
-[[nodiscard]] can::CollapseForecast forecast_message(const MonitorStatus& status, int axis,
+[[nodiscard]] can::CollapseForecast forecast_message(const BoxStatus& status, int axis,
                                                      double horizon_s, std::uint8_t sequence);
 // The AlarmEvent of an alarm policy event: its time in whole ms since start, wrapping after
 // 2^32 ms as the frame's counter does.

@@ -61,7 +61,6 @@
 // (an alarm still shows above it).
 #pragma once
 
-#include <Eigen/Core>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -71,10 +70,10 @@
 #include "plinth/core/estimator.h"
 #include "plinth/core/events.h"
 #include "plinth/core/forecast.h"
-#include "plinth/core/name_table.h"
 #include "plinth/core/real.h"
-#include "plinth/core/risk.h"
 #include "plinth/core/scene.h"
+#include "plinth/firmware/box_status.h"
+#include "plinth/firmware/config.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/hal/frame_io.h"
 #include "plinth/monitor/alarm_level.h"
@@ -83,114 +82,6 @@
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
-
-// Capacities, fixed at build time: CMake cache variables of the same names (firmware/monitor);
-// the defaults are the host's. A microcontroller build with one ground sensor chooses 1 sensor,
-// a short history and 2-sample windows to fit its RAM (docs/microcontroller.md).
-#ifndef PLINTH_MONITOR_MAX_SENSORS
-#define PLINTH_MONITOR_MAX_SENSORS 4
-#endif
-#ifndef PLINTH_MONITOR_SENSOR_HISTORY
-#define PLINTH_MONITOR_SENSOR_HISTORY 128
-#endif
-#ifndef PLINTH_MONITOR_MAX_CHECK_WINDOW_SAMPLES
-#define PLINTH_MONITOR_MAX_CHECK_WINDOW_SAMPLES 1000
-#endif
-
-inline constexpr int kMaxAxes = 2;
-// Accelerometers, ground and plate together.
-inline constexpr int kMaxSensors = PLINTH_MONITOR_MAX_SENSORS;
-// Samples kept per sensor (conditioned, with receive times): the cross-checks' pairing and a
-// failover's catch-up. A timeout is below 128 sample periods, so with 128 a silent primary's
-// failover still finds the new primary's samples since the last one the estimators took.
-inline constexpr int kSensorHistory = PLINTH_MONITOR_SENSOR_HISTORY;
-// Longest cross-check window, samples (window_s times the sample rate).
-inline constexpr int kMaxCheckWindowSamples = PLINTH_MONITOR_MAX_CHECK_WINDOW_SAMPLES;
-static_assert(kMaxSensors >= 1, "at least the one ground sensor");
-static_assert(kSensorHistory >= static_cast<int>(monitor::kMaxFedPerSample),
-              "the history holds every sample one input can feed");
-static_assert(kMaxCheckWindowSamples >= 2, "a window spans at least 2 samples");
-
-enum class SensorRole : std::uint8_t {
-  kGround = 0,  // on the ground (the foundation): may drive the estimators
-  kPlate = 1,   // on the isolation plate: checks the model, never drives it
-};
-// The roles' names in the configuration file and the status lines.
-inline constexpr NameTable<SensorRole, 2> kSensorRoleNames{{{
-    {SensorRole::kGround, "ground"},
-    {SensorRole::kPlate, "plate"},
-}}};
-[[nodiscard]] constexpr const char* sensor_role_name(SensorRole role) {
-  return kSensorRoleNames.name(role);
-}
-
-struct SensorConfig {
-  std::uint8_t node = 1;  // CAN node id, 1..15, one per sensor
-  SensorRole role = SensorRole::kGround;
-  monitor::ConditioningSettings conditioning;   // its sample period is the estimator's
-  monitor::SensorHealthSettings sensor_health;  // its sample period is the estimator's
-};
-
-// Ground sensors against the primary.
-struct RedundancySettings {
-  // s: sliding window of the RMS difference, 2 to kMaxCheckWindowSamples samples
-  double window_s = 0.5;
-  double tolerance_m_s2 = 0.3;   // m/s2, > 0: an RMS difference beyond this is a disagreement
-};
-
-// The plate sensor against the model.
-struct PlateCheckSettings {
-  // s: sliding window of the RMS residual, 2 to kMaxCheckWindowSamples samples
-  double window_s = 1.0;
-  double threshold_m_s2 = 0.5;   // m/s2, > 0: an RMS residual beyond this is a mismatch
-  bool raises_fault = false;     // a mismatch also raises the fault level (kSensorDisagreement)
-};
-
-struct MonitorConfig {
-  int axis_count = 1;  // 1: the statue's first principal axis; 2: both
-  // The single-sensor form, used when sensor_count = 0: one ground accelerometer.
-  std::uint8_t ground_node = 1;  // CAN node id of the ground accelerometer, 1..15
-  EstimatorSettings estimator;   // sample rate (= the sensor's) and solver steps per sample
-  RiskSettings risk;
-  ForecastSettings forecast;     // the ensemble's look ahead (forecast.h)
-  monitor::ConditioningSettings conditioning;  // its sample period is the estimator's
-  monitor::SensorHealthSettings sensor_health;  // its sample period is the estimator's
-  monitor::AlarmPolicySettings alarm;
-  // Quiet (offset tracking allowed): every axis at rest in full contact with risk below this.
-  double quiet_risk = 1e-3;
-  // s, > 0: a status (its frames, and the application's status line) goes out at least this
-  // often, besides at every alarm change and at the alarm policy's heartbeat.
-  double status_interval_s = 0.1;
-  // The sensor list, sensors[0 .. sensor_count): replaces ground_node, conditioning and
-  // sensor_health when sensor_count > 0. At least one ground sensor, at most one plate sensor,
-  // distinct nodes; the configured order is the order of preference for the primary.
-  int sensor_count = 0;
-  std::array<SensorConfig, kMaxSensors> sensors{};
-  RedundancySettings redundancy;
-  PlateCheckSettings plate;
-};
-
-// Checks every part; the Error names the field ("monitor.axis_count", "estimator....", ...).
-// A sensor's fields are "sensor.node", "sensor.role", "conditioning....", "sensor_health....";
-// `sensor_index`, when given, receives the index of the sensor at fault (-1: none).
-[[nodiscard]] Error validate(const MonitorConfig& config, int* sensor_index = nullptr);
-
-// The sensors of `config`: its list, or the single-sensor form as one ground sensor. Returns
-// the count.
-[[nodiscard]] int resolved_sensors(const MonitorConfig& config,
-                                   std::array<SensorConfig, kMaxSensors>& out);
-
-struct AxisStatus {
-  Mode mode;  // the nominal statue's (member 0)
-  State state = State::Zero();
-  Risk risk;             // the worst member's (the highest total)
-  Risk nominal_risk;     // member 0's: the scene file's statue alone, as a box without ensemble
-  int members = 1;       // the ensemble's size
-  int worst_member = 0;  // whose risk that is
-  ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
-  // Monitor time, s, of that forecast's first collapse (its worst member's); -1: none forecast.
-  double collapse_forecast_s = -1.0;
-};
 
 // Frames that were not sensor samples of a configured node, or could not be decoded.
 struct FrameCounters {
@@ -205,61 +96,6 @@ struct FrameCounters {
   can::CodecError last_error = can::CodecError::kOk;  // of the latest rejected frame
   const char* last_error_signal = "";
   std::uint64_t not_encoded = 0;  // frames to send that the codec refused (left out)
-};
-
-// One sensor's part of the status.
-struct SensorStatus {
-  std::uint8_t node = 1;
-  SensorRole role = SensorRole::kGround;
-  bool primary = false;  // drives the estimators
-  bool ready = false;    // conditioning ready (offset estimated)
-  monitor::SensorHealth health;
-  // Cross-check (ground sensors but the primary: the RMS difference to the primary; the plate:
-  // the model-mismatch residual), m/s2, over the sliding window; valid once the window is full.
-  double rms_m_s2 = 0.0;
-  bool window_full = false;
-  bool disagreeing = false;   // rms_m_s2 beyond the tolerance (plate: the threshold)
-  double max_rms_m_s2 = 0.0;  // the largest full-window RMS so far
-  std::uint64_t pairs = 0;         // samples compared
-  std::uint64_t unpaired = 0;      // samples with no reference sample within one period
-  std::uint64_t disagreements = 0;  // entries into the disagreeing state
-};
-
-struct MonitorStatus {
-  std::int64_t time_ns = 0;  // monitor time of the newest sample (or tick)
-  bool estimating = false;   // conditioning ready and the estimators running
-  // Their offset and initial state are trusted (the start-up rule, above); else the level is
-  // fault, cause kNotCalibrated.
-  bool calibrated = false;
-  int axis_count = 1;
-  std::array<AxisStatus, kMaxAxes> axes{};
-  double risk = 0.0;  // the worst axis's total
-  // The forecast: the highest probability of a collapse within the horizon over the axes, the
-  // axis it is on (-1: no forecast yet), and the monitor time, s, at which the first member of
-  // any axis is forecast to collapse (-1: none is).
-  double probability = 0.0;
-  int forecast_axis = -1;
-  double collapse_forecast_s = -1.0;
-  monitor::AlarmLevel alarm = monitor::AlarmLevel::kNormal;
-  monitor::AlarmLevel latched = monitor::AlarmLevel::kNormal;
-  monitor::SensorHealth sensor;
-  std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
-  std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
-  std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
-  // The sensors, in configured order; `sensor` above is the primary's health (before the
-  // first primary: the first ground sensor's).
-  int sensor_count = 1;
-  std::array<SensorStatus, kMaxSensors> sensors{};
-  int primary = -1;  // index of the sensor driving the estimators; -1 before the first
-  std::uint64_t failovers = 0;            // switches of the primary after the first choice
-  std::uint64_t failovers_continued = 0;  // of which the estimators continued from their state
-  // ok; degraded: a sensor but the primary not ok (a redundant or the plate sensor lost), a
-  // disagreement or a plate mismatch; fault: no usable ground sensor (the primary's fault).
-  monitor::HealthState sensors_state = monitor::HealthState::kFault;
-  bool disagreement = false;     // a ground sensor disagrees with the primary (fault input)
-  bool plate_mismatch = false;   // the plate's residual is beyond its threshold
-  int plate = -1;                // index of the plate sensor; -1: none
-  double plate_residual_m_s2 = 0.0;  // the plate's RMS residual (valid when its window is full)
 };
 
 // An update's alarm events: each update evaluates the alarm policy once.
@@ -313,7 +149,7 @@ class Monitor {
   // until `active` is cleared.
   void set_bus_fault(bool active) { bus_fault_ = active; }
 
-  [[nodiscard]] const MonitorStatus& status() const { return status_; }
+  [[nodiscard]] const BoxStatus& status() const { return status_; }
   [[nodiscard]] const FrameCounters& frames() const { return frames_; }
   // The primary's conditioning (before the first primary: the first sensor's).
   [[nodiscard]] const monitor::ConditioningStatus& conditioning() const {
@@ -428,7 +264,7 @@ class Monitor {
   std::array<Forecaster, kMaxAxes> forecasters_{};
   std::array<EventSink*, kMaxAxes> sinks_{};
   monitor::AlarmPolicy alarm_;
-  MonitorStatus status_;
+  BoxStatus status_;
   FrameCounters frames_;
   bool have_epoch_ = false;
   std::int64_t epoch_ns_ = 0;  // receive time of the first sample
