@@ -44,7 +44,7 @@ void SampleTrace::after_update(const Monitor& monitor) {
       continue;
     }
     const AxisStatus& a = s.axes[static_cast<std::size_t>(axis)];
-    std::fprintf(f, "\t%.5f\t%.6f\t%d", monitor.estimator(axis).ground().horizontal,
+    std::fprintf(f, "\t%.5f\t%.6f\t%d", monitor.ensemble(axis).nominal().ground().horizontal,
                  a.state[kTheta], static_cast<int>(a.mode.phase));
   }
   std::fputc('\n', f);

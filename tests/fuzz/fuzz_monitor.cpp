@@ -245,7 +245,7 @@ class Harness {
       check(std::abs(a.mode.overhang) <= 1 && std::abs(a.mode.held_stop) <= 1,
             "overhang and held stop are -1, 0 or +1");
       check(a.risk.total >= 0.0 && a.risk.total <= 1.0, "axis risk in [0, 1]");
-      check(!s.estimating || box_->estimator(i).time() >= 0.0, "estimator time >= 0");
+      check(!s.estimating || box_->ensemble(i).nominal().time() >= 0.0, "estimator time >= 0");
     }
   }
 

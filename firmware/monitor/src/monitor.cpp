@@ -54,14 +54,8 @@ Error Monitor::start(const MonitorConfig& config,
     if (members.empty()) {
       return {ErrorCode::kInconsistent, "monitor.axis_count", "names an axis without a scene"};
     }
-    if (members.size() > static_cast<std::size_t>(kMaxEnsembleMembers)) {
-      return {ErrorCode::kOutOfRange, "uncertainty",
-              "gives more ensemble members than this build holds (kMaxEnsembleMembers)",
-              static_cast<double>(kMaxEnsembleMembers)};
-    }
-    for (const Scene& scene : members) PLINTH_TRY(validate(config.estimator, scene));
-    PLINTH_TRY(forecasters_[static_cast<std::size_t>(i)].start(config.forecast,
-                                                               config.estimator.sample_rate_hz));
+    PLINTH_TRY(ensembles_[static_cast<std::size_t>(i)].start(members, config.estimator,
+                                                             config.forecast, config.risk));
   }
   config_ = config;
   config_.conditioning.sample_period_s = config.estimator.sample_period();
@@ -93,9 +87,8 @@ Error Monitor::start(const MonitorConfig& config,
     if (sc.role == SensorRole::kPlate) status_.plate = i;
   }
   PLINTH_TRY(monitor::AlarmPolicy::create(config_.alarm, alarm_));
-  scenes_ = ensembles;
   for (int i = 0; i < config.axis_count; ++i) {
-    status_.axes[static_cast<std::size_t>(i)].members = members(i);
+    status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
   status_.sensor = sensors_[0].health.health();
   estimate_ = History{};
@@ -118,9 +111,7 @@ Error Monitor::start(const MonitorConfig& config,
 
 void Monitor::set_event_sink(int axis, EventSink* sink) {
   if (axis < 0 || axis >= kMaxAxes) return;
-  const auto i = static_cast<std::size_t>(axis);
-  sinks_[i] = sink;
-  ensembles_[i][0].set_event_sink(sink);  // the nominal statue's phases and impacts
+  ensembles_[static_cast<std::size_t>(axis)].set_event_sink(sink);
 }
 
 std::int64_t Monitor::monitor_time(std::int64_t receive_time_ns) {
@@ -136,12 +127,7 @@ std::int64_t Monitor::monitor_time(std::int64_t receive_time_ns) {
 // tracked only then; the same for every member, whatever their order).
 bool Monitor::quiet() const {
   bool quiet = status_.estimating && status_.calibrated && status_.risk < config_.quiet_risk;
-  for (int i = 0; i < status_.axis_count && quiet; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
-      quiet = quiet && ensembles_[k][m].mode().phase == Phase::kFullContact;
-    }
-  }
+  for (int i = 0; i < status_.axis_count && quiet; ++i) quiet = ensemble(i).in_full_contact();
   return quiet;
 }
 
@@ -246,13 +232,9 @@ void Monitor::drain_primary() {
   while (consumed_ < h.pushed) drive(h.at(consumed_++));
 }
 
-void Monitor::push_estimators(const Vector3r& g) {
+void Monitor::push_ensembles(const Vector3r& g) {
   for (int i = 0; i < status_.axis_count; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    const GroundAcceleration ground{g[i], g.z()};
-    const std::span<PlanarEstimator> members(ensembles_[k].data(), scenes_[k].size());
-    for (PlanarEstimator& e : members) e.push(ground);
-    forecasters_[k].on_sample(ground, members[0].time(), members);
+    ensembles_[static_cast<std::size_t>(i)].push({g[i], g.z()});
   }
 }
 
@@ -261,15 +243,7 @@ void Monitor::drive(const HistoryEntry& entry) {
   const bool restart = !status_.estimating || entry.restart || restart_pending_;
   if (restart) {
     for (int i = 0; i < status_.axis_count; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      const GroundAcceleration ground{entry.value[i], entry.value.z()};
-      // validate() in start() checked what start() can refuse but a non-finite sample, which
-      // conditioning does not pass on.
-      for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
-        (void)ensembles_[k][m].start(scenes_[k][m], config_.estimator, ground);
-      }
-      ensembles_[k][0].set_event_sink(sinks_[k]);
-      forecasters_[k].reset();
+      ensembles_[static_cast<std::size_t>(i)].restart({entry.value[i], entry.value.z()});
     }
     ++status_.estimator_restarts;
     status_.estimator_start_ns = entry.time_ns - epoch_ns_;
@@ -291,11 +265,11 @@ void Monitor::drive(const HistoryEntry& entry) {
     if (n < 1) return;  // at or before the estimators' newest sample: taken already
     for (long j = 1; j < n; ++j) {
       const auto w = static_cast<Real>(static_cast<double>(j) / static_cast<double>(n));
-      push_estimators(last_ground_ + w * (entry.value - last_ground_));
+      push_ensembles(last_ground_ + w * (entry.value - last_ground_));
     }
-    push_estimators(entry.value);
+    push_ensembles(entry.value);
   } else {
-    push_estimators(entry.value);
+    push_ensembles(entry.value);
   }
   status_.estimating = true;
   status_.newest_sample_time_ns = entry.time_ns - epoch_ns_;
@@ -305,10 +279,7 @@ void Monitor::drive(const HistoryEntry& entry) {
     // The model's absolute base acceleration u'' + u_G'' per axis: the plate's reference.
     HistoryEntry e;
     e.time_ns = entry.time_ns;
-    for (int i = 0; i < status_.axis_count; ++i) {
-      const PlanarEstimator& est = estimator(i);
-      e.value[i] = est.simulator().accelerations().u + est.ground().horizontal;
-    }
+    for (int i = 0; i < status_.axis_count; ++i) e.value[i] = ensemble(i).base_acceleration();
     estimate_.push(e);
   }
 }
@@ -434,22 +405,14 @@ void Monitor::update_sensors_status() {
 
 // One axis: the nominal statue's mode and state, the worst member's risk, the forecast.
 void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
-  const auto k = static_cast<std::size_t>(axis_index);
-  const PlanarEstimator& nominal = ensembles_[k][0];
-  axis.mode = nominal.mode();
-  axis.state = nominal.state();
-  axis.risk = Risk{};
-  axis.worst_member = 0;
-  for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
-    const PlanarEstimator& e = ensembles_[k][m];
-    const Risk r = overturning_risk(scenes_[k][m], e.mode(), e.state(), config_.risk);
-    if (m == 0) axis.nominal_risk = r;
-    if (m == 0 || r.total > axis.risk.total) {
-      axis.risk = r;
-      axis.worst_member = static_cast<int>(m);
-    }
-  }
-  axis.forecast = forecasters_[k].latest();
+  const Ensemble& statues = ensemble(axis_index);
+  axis.mode = statues.nominal().mode();
+  axis.state = statues.nominal().state();
+  const EnsembleRisk risk = statues.risk();
+  axis.risk = risk.worst;
+  axis.nominal_risk = risk.nominal;
+  axis.worst_member = risk.worst_member;
+  axis.forecast = statues.forecaster().latest();
 }
 
 // The axes' part of the status (mode, state, risk), and the alarm policy's input from them.

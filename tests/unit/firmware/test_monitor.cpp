@@ -253,7 +253,7 @@ TEST(Monitor, EnsembleMembersFollowTheirOwnStatues) {
   fw::Monitor second;
   ASSERT_TRUE(first.start(config, {std::span<const Scene>(statues), {}}).ok());
   ASSERT_TRUE(second.start(config, {std::span<const Scene>(rotated), {}}).ok());
-  ASSERT_EQ(first.members(0), 3);
+  ASSERT_EQ(first.ensemble(0).size(), 3);
   testing::QuietThenQuake input(200.0, 10.0, brienza(), 12.0);
   testing::QuietThenQuake same(200.0, 10.0, brienza(), 12.0);  // the same samples again
   bool worst_not_nominal = false;
@@ -263,8 +263,8 @@ TEST(Monitor, EnsembleMembersFollowTheirOwnStatues) {
     double worst = 0.0;
     double nominal = 0.0;
     for (int m = 0; m < 3; ++m) {
-      const PlanarEstimator& e = first.member(0, m);
-      ASSERT_EQ(e.state(), second.member(0, (m + 2) % 3).state()) << n << " " << m;
+      const PlanarEstimator& e = first.ensemble(0).member(m);
+      ASSERT_EQ(e.state(), second.ensemble(0).member((m + 2) % 3).state()) << n << " " << m;
       const double r = overturning_risk(statues[static_cast<std::size_t>(m)], e.mode(),
                                         e.state(), config.risk).total;
       worst = std::fmax(worst, r);
@@ -272,7 +272,7 @@ TEST(Monitor, EnsembleMembersFollowTheirOwnStatues) {
     }
     const fw::AxisStatus& axis = first.status().axes[0];
     if (!first.status().estimating) continue;
-    ASSERT_EQ(axis.state, first.member(0, 0).state());
+    ASSERT_EQ(axis.state, first.ensemble(0).nominal().state());
     ASSERT_EQ(axis.risk.total, worst);
     ASSERT_EQ(axis.nominal_risk.total, nominal);
     ASSERT_EQ(axis.risk.total, second.status().axes[0].risk.total);

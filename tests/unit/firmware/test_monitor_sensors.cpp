@@ -251,7 +251,7 @@ double run_plate(double gain, bool raises_fault, fw::BoxStatus& out, bool& fault
     expect_same_estimate(single, monitor, n);
     double plate_g = ground_g(n);
     if (monitor.status().estimating) {
-      const PlanarEstimator& e = monitor.estimator(0);
+      const PlanarEstimator& e = monitor.ensemble(0).nominal();
       plate_g = (e.simulator().accelerations().u + e.ground().horizontal) / kStandardGravity;
     }
     const fw::MonitorUpdate u = monitor.on_sensor_sample(1, sample(n, gain * plate_g));

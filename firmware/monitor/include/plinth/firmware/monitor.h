@@ -66,6 +66,7 @@
 #include <cstdint>
 #include <span>
 
+#include "plinth/core/ensemble.h"
 #include "plinth/core/error.h"
 #include "plinth/core/estimator.h"
 #include "plinth/core/events.h"
@@ -158,16 +159,9 @@ class Monitor {
   [[nodiscard]] const monitor::ConditioningStatus& conditioning(int sensor) const {
     return sensors_[static_cast<std::size_t>(sensor)].conditioner.status();
   }
-  // The nominal statue's estimator of `axis`.
-  [[nodiscard]] const PlanarEstimator& estimator(int axis) const { return member(axis, 0); }
-  [[nodiscard]] const PlanarEstimator& member(int axis, int m) const {
-    return ensembles_[static_cast<std::size_t>(axis)][static_cast<std::size_t>(m)];
-  }
-  [[nodiscard]] int members(int axis) const {
-    return static_cast<int>(scenes_[static_cast<std::size_t>(axis)].size());
-  }
-  [[nodiscard]] const Forecaster& forecaster(int axis) const {
-    return forecasters_[static_cast<std::size_t>(axis)];
+  // The statues of `axis`: their estimators, forecaster and risk.
+  [[nodiscard]] const Ensemble& ensemble(int axis) const {
+    return ensembles_[static_cast<std::size_t>(axis)];
   }
   // The sensors as started (the single-sensor form resolved).
   [[nodiscard]] const SensorConfig& sensor_config(int sensor) const {
@@ -224,7 +218,7 @@ class Monitor {
   void update_primary();
   void drain_primary();
   void drive(const HistoryEntry& entry);
-  void push_estimators(const Vector3r& ground_m_s2);
+  void push_ensembles(const Vector3r& ground_m_s2);
   void cross_check();
   void check_sensor(int sensor);
   [[nodiscard]] bool reference_at(const History& reference, std::int64_t time_ns,
@@ -259,10 +253,7 @@ class Monitor {
   bool align_pending_ = false;    // the next entry continues after a failover: align by time
   std::int64_t last_fed_ns_ = 0;  // receive time of the estimators' newest sample
   Vector3r last_ground_ = Vector3r::Zero();  // its value, m/s2
-  std::array<std::span<const Scene>, kMaxAxes> scenes_{};
-  std::array<std::array<PlanarEstimator, kMaxEnsembleMembers>, kMaxAxes> ensembles_{};
-  std::array<Forecaster, kMaxAxes> forecasters_{};
-  std::array<EventSink*, kMaxAxes> sinks_{};
+  std::array<Ensemble, kMaxAxes> ensembles_{};
   monitor::AlarmPolicy alarm_;
   BoxStatus status_;
   FrameCounters frames_;
