@@ -6,37 +6,6 @@
 
 namespace plinth::firmware {
 
-namespace {
-
-int window_length(double window_s, double rate_hz) {
-  const long n = std::lround(window_s * rate_hz);
-  return n < 2 ? 2 : (n > kMaxCheckWindowSamples ? kMaxCheckWindowSamples : static_cast<int>(n));
-}
-
-}  // namespace
-
-void Monitor::RmsWindow::add(Real square) {
-  const auto slot = static_cast<std::size_t>(next);
-  if (count >= length) {
-    sum -= squares[slot];
-  } else {
-    ++count;
-  }
-  squares[slot] = square;
-  sum += square;
-  next = next + 1 >= length ? 0 : next + 1;
-  if (next == 0) {  // once per window: the sum afresh, no drift of the running sum over hours
-    sum = 0;
-    for (int i = 0; i < count; ++i) sum += squares[static_cast<std::size_t>(i)];
-  }
-}
-
-Real Monitor::RmsWindow::rms() const {
-  if (count == 0) return 0;
-  const Real mean = sum / static_cast<Real>(count);
-  return mean > 0 ? std::sqrt(mean) : 0;
-}
-
 Error Monitor::start(const MonitorConfig& config,
                      const std::array<const Scene*, kMaxAxes>& scenes) {
   std::array<std::span<const Scene>, kMaxAxes> ensembles{};
@@ -60,43 +29,13 @@ Error Monitor::start(const MonitorConfig& config,
   config_ = config;
   config_.conditioning.sample_period_s = config.estimator.sample_period();
   config_.sensor_health.sample_period_s = config.estimator.sample_period();
-  sensor_count_ = resolved_sensors(config_, sensor_configs_);
   status_ = BoxStatus{};
   status_.axis_count = config.axis_count;
-  status_.sensor_count = sensor_count_;
-  for (int i = 0; i < sensor_count_; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    SensorConfig& sc = sensor_configs_[k];
-    sc.conditioning.sample_period_s = config.estimator.sample_period();
-    sc.sensor_health.sample_period_s = config.estimator.sample_period();
-    Sensor& s = sensors_[k];
-    PLINTH_TRY(monitor::SensorHealthTracker::create(sc.sensor_health, s.health));
-    PLINTH_TRY(monitor::Conditioner::create(sc.conditioning, s.conditioner));
-    s.history = History{};
-    s.window.reset();
-    s.window.length = sc.role == SensorRole::kPlate
-                          ? window_length(config.plate.window_s, config.estimator.sample_rate_hz)
-                          : window_length(config.redundancy.window_s,
-                                          config.estimator.sample_rate_hz);
-    s.checked = 0;
-    SensorStatus& st = status_.sensors[k];
-    st = SensorStatus{};
-    st.node = sc.node;
-    st.role = sc.role;
-    st.health = s.health.health();
-    if (sc.role == SensorRole::kPlate) status_.plate = i;
-  }
+  PLINTH_TRY(sensors_.start(config_, status_));
   PLINTH_TRY(monitor::AlarmPolicy::create(config_.alarm, alarm_));
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
-  status_.sensor = sensors_[0].health.health();
-  estimate_ = History{};
-  period_ns_ = std::llround(config.estimator.sample_period() * 1e9);
-  consumed_ = 0;
-  restart_pending_ = false;
-  align_pending_ = false;
-  last_fed_ns_ = 0;
   last_ground_.setZero();
   frames_ = FrameCounters{};
   have_epoch_ = false;
@@ -131,13 +70,6 @@ bool Monitor::quiet() const {
   return quiet;
 }
 
-bool Monitor::usable(int sensor) const {
-  const Sensor& s = sensors_[static_cast<std::size_t>(sensor)];
-  return sensor_configs_[static_cast<std::size_t>(sensor)].role == SensorRole::kGround &&
-         s.health.health().state != monitor::HealthState::kFault && s.conditioner.status().ready &&
-         !s.history.empty();
-}
-
 MonitorUpdate Monitor::on_sensor_sample(int sensor, const monitor::SensorSample& sample) {
   MonitorUpdate update;
   take_sample(sensor, sample, update);
@@ -145,91 +77,23 @@ MonitorUpdate Monitor::on_sensor_sample(int sensor, const monitor::SensorSample&
 }
 
 void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update) {
-  if (sensor < 0 || sensor >= sensor_count_) {
+  if (sensor < 0 || sensor >= sensors_.count()) {
     report_state(update);
     return;
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
-  // The other sensors' silence shows on this one's clock (a silent primary fails over without
-  // waiting for a tick).
-  for (int j = 0; j < sensor_count_; ++j) {
-    if (j != sensor) (void)sensors_[static_cast<std::size_t>(j)].health.tick(sample.receive_time_ns);
+  sensors_.tick(sample.receive_time_ns, sensor);
+  const monitor::SensorUpdate fed = sensors_.receive(sensor, sample);
+  // Each fed sample in turn: the primary's goes on to the estimators at once (the next one's
+  // conditioning is told whether they are quiet).
+  for (std::size_t i = 0; i < fed.fed_count; ++i) {
+    if (sensors_.condition(sensor, fed.fed[i], quiet())) status_.calibrated = true;
+    feed_estimators();
   }
-  const monitor::SensorUpdate fed = sensors_[static_cast<std::size_t>(sensor)].health.on_sample(sample);
-  for (std::size_t i = 0; i < fed.fed_count; ++i) process(sensor, fed.fed[i]);
-  update_primary();
-  drain_primary();
-  cross_check();
+  sensors_.update_primary();
+  feed_estimators();
+  sensors_.cross_check();
   evaluate(update);
-}
-
-// One fed sample of `sensor`: conditioned, kept in its history; the primary's goes on to the
-// estimators at once.
-void Monitor::process(int sensor, const monitor::FedSample& sample) {
-  Sensor& s = sensors_[static_cast<std::size_t>(sensor)];
-  const monitor::ConditionedSample c = s.conditioner.condition(sample.acceleration_g, quiet());
-  if (!c.ready) return;  // start-up window, or refused input (counted by the conditioner)
-  // A verification window passed on the primary: the running estimators are trusted again.
-  if (c.window_passed && sensor == status_.primary && status_.estimating) {
-    status_.calibrated = true;
-  }
-  if (sample.restart) {  // a seam: nothing before it connects, nor compares, to what follows
-    s.history.clear();
-    s.window.reset();
-    s.checked = s.history.pushed;
-  }
-  s.history.push({sample.time_ns, c.ground_m_s2, sample.restart});
-  update_primary();
-  drain_primary();
-}
-
-// Keeps the primary while it is usable; else the first usable ground sensor in configured
-// order takes over (a failover once the estimators have run).
-void Monitor::update_primary() {
-  if (status_.primary >= 0 && usable(status_.primary)) return;
-  int candidate = -1;
-  for (int i = 0; i < sensor_count_ && candidate < 0; ++i) {
-    if (usable(i)) candidate = i;
-  }
-  if (candidate < 0 || candidate == status_.primary) return;
-  const History& h = sensors_[static_cast<std::size_t>(candidate)].history;
-  if (status_.primary >= 0) ++status_.failovers;
-  status_.primary = candidate;
-  // The reference changed: every cross-check starts afresh.
-  for (int i = 0; i < sensor_count_; ++i) {
-    Sensor& s = sensors_[static_cast<std::size_t>(i)];
-    s.window.reset();
-    s.checked = s.history.pushed;
-    SensorStatus& st = status_.sensors[static_cast<std::size_t>(i)];
-    st.window_full = false;
-    st.disagreeing = false;
-    st.rms_m_s2 = 0.0;
-  }
-  // Continue from the estimators' state when the new primary's history holds the stream on
-  // from their newest sample within the bridge limit; else start again at rest on its newest.
-  const int bridge = sensor_configs_[static_cast<std::size_t>(candidate)].sensor_health.max_bridge_samples;
-  std::uint64_t next = h.valid_from();
-  while (next < h.pushed && h.at(next).time_ns <= last_fed_ns_ + period_ns_ / 2) ++next;
-  const bool continues = status_.estimating && next < h.pushed && !h.at(next).restart &&
-                         h.at(next).time_ns - last_fed_ns_ <=
-                             static_cast<std::int64_t>(bridge + 1) * period_ns_ + period_ns_ / 2;
-  if (continues) {
-    consumed_ = next;
-    align_pending_ = true;
-    restart_pending_ = false;
-    if (status_.failovers > 0) ++status_.failovers_continued;
-  } else {
-    consumed_ = h.pushed - 1;
-    restart_pending_ = true;
-    align_pending_ = false;
-  }
-}
-
-void Monitor::drain_primary() {
-  if (status_.primary < 0) return;
-  const History& h = sensors_[static_cast<std::size_t>(status_.primary)].history;
-  if (consumed_ < h.valid_from()) consumed_ = h.valid_from();
-  while (consumed_ < h.pushed) drive(h.at(consumed_++));
 }
 
 void Monitor::push_ensembles(const Vector3r& g) {
@@ -238,168 +102,34 @@ void Monitor::push_ensembles(const Vector3r& g) {
   }
 }
 
-// One sample of the primary into the estimators.
-void Monitor::drive(const HistoryEntry& entry) {
-  const bool restart = !status_.estimating || entry.restart || restart_pending_;
-  if (restart) {
-    for (int i = 0; i < status_.axis_count; ++i) {
-      ensembles_[static_cast<std::size_t>(i)].restart({entry.value[i], entry.value.z()});
+void Monitor::feed_estimators() {
+  EstimatorInput in;
+  while (sensors_.next_input(in)) {
+    const Vector3r& g = in.ground_m_s2;
+    if (in.start) {
+      for (int i = 0; i < status_.axis_count; ++i) {
+        ensembles_[static_cast<std::size_t>(i)].restart({g[i], g.z()});
+      }
+      ++status_.estimator_restarts;
+      status_.estimator_start_ns = in.time_ns - epoch_ns_;
+      status_.calibrated = in.calibrated;
+    } else {
+      // A failover's seam: the samples missed, linearly between the newest taken and this one.
+      const long n = in.bridged + 1;
+      for (long j = 1; j < n; ++j) {
+        const auto w = static_cast<Real>(static_cast<double>(j) / static_cast<double>(n));
+        push_ensembles(last_ground_ + w * (g - last_ground_));
+      }
+      push_ensembles(g);
     }
-    ++status_.estimator_restarts;
-    status_.estimator_start_ns = entry.time_ns - epoch_ns_;
-    // Calibrated only on the sample right after a passing window; else verify a new one.
-    monitor::Conditioner& conditioner =
-        sensors_[static_cast<std::size_t>(status_.primary)].conditioner;
-    status_.calibrated = conditioner.status().samples_since_window <= 1;
-    if (!status_.calibrated) conditioner.begin_verification();
-    restart_pending_ = false;
-    align_pending_ = false;
-    estimate_.clear();
-  } else if (align_pending_) {
-    // The first sample after a failover: as many sample periods as its time says (the new
-    // primary's clock), the ones between bridged linearly.
-    align_pending_ = false;
-    const double periods =
-        static_cast<double>(entry.time_ns - last_fed_ns_) / static_cast<double>(period_ns_);
-    const long n = std::lround(periods);
-    if (n < 1) return;  // at or before the estimators' newest sample: taken already
-    for (long j = 1; j < n; ++j) {
-      const auto w = static_cast<Real>(static_cast<double>(j) / static_cast<double>(n));
-      push_ensembles(last_ground_ + w * (entry.value - last_ground_));
+    status_.estimating = true;
+    status_.newest_sample_time_ns = in.time_ns - epoch_ns_;
+    last_ground_ = g;
+    if (sensors_.has_plate()) {
+      Vector3r base = Vector3r::Zero();
+      for (int i = 0; i < status_.axis_count; ++i) base[i] = ensemble(i).base_acceleration();
+      sensors_.add_model_sample(in.time_ns, base);
     }
-    push_ensembles(entry.value);
-  } else {
-    push_ensembles(entry.value);
-  }
-  status_.estimating = true;
-  status_.newest_sample_time_ns = entry.time_ns - epoch_ns_;
-  last_fed_ns_ = entry.time_ns;
-  last_ground_ = entry.value;
-  if (status_.plate >= 0) {
-    // The model's absolute base acceleration u'' + u_G'' per axis: the plate's reference.
-    HistoryEntry e;
-    e.time_ns = entry.time_ns;
-    for (int i = 0; i < status_.axis_count; ++i) e.value[i] = ensemble(i).base_acceleration();
-    estimate_.push(e);
-  }
-}
-
-// The reference's value at `time_ns`: interpolated between its samples around it (at most two
-// periods apart), else its nearest within one period. False: none.
-bool Monitor::reference_at(const History& reference, std::int64_t time_ns, Vector3r& value) const {
-  const std::uint64_t from = reference.valid_from();
-  if (from >= reference.pushed) return false;
-  std::uint64_t after = reference.pushed;  // the first entry later than time_ns
-  while (after > from && reference.at(after - 1).time_ns > time_ns) --after;
-  const bool have_before = after > from;
-  const bool have_after = after < reference.pushed;
-  if (have_before && have_after) {
-    const HistoryEntry& a = reference.at(after - 1);
-    const HistoryEntry& b = reference.at(after);
-    if (b.time_ns - a.time_ns <= 2 * period_ns_ && !b.restart) {
-      const auto w = static_cast<Real>(static_cast<double>(time_ns - a.time_ns) /
-                                       static_cast<double>(b.time_ns - a.time_ns));
-      value = a.value + w * (b.value - a.value);
-      return true;
-    }
-  }
-  std::int64_t best = period_ns_ + 1;
-  if (have_before && time_ns - reference.at(after - 1).time_ns < best) {
-    best = time_ns - reference.at(after - 1).time_ns;
-    value = reference.at(after - 1).value;
-  }
-  if (have_after && reference.at(after).time_ns - time_ns < best) {
-    best = reference.at(after).time_ns - time_ns;
-    value = reference.at(after).value;
-  }
-  return best <= period_ns_;
-}
-
-void Monitor::check_sensor(int sensor) {
-  const auto k = static_cast<std::size_t>(sensor);
-  Sensor& s = sensors_[k];
-  SensorStatus& st = status_.sensors[k];
-  const bool plate = sensor_configs_[k].role == SensorRole::kPlate;
-  const History& reference = plate ? estimate_ : sensors_[static_cast<std::size_t>(status_.primary)].history;
-  const int components = plate ? status_.axis_count : 3;
-  if (s.checked < s.history.valid_from()) {  // pushed out before a reference came: not compared
-    st.unpaired += s.history.valid_from() - s.checked;
-    s.checked = s.history.valid_from();
-  }
-  while (s.checked < s.history.pushed) {
-    const HistoryEntry& e = s.history.at(s.checked);
-    // Wait until the reference has a sample at or after this one (or nothing will come: the
-    // entry is then pushed out of the history and counted unpaired).
-    if (reference.empty() || reference.newest().time_ns < e.time_ns) break;
-    ++s.checked;
-    Vector3r r = Vector3r::Zero();
-    if (!reference_at(reference, e.time_ns, r)) {
-      ++st.unpaired;
-      continue;
-    }
-    ++st.pairs;
-    Real square = 0;
-    for (int c = 0; c < components; ++c) {
-      const Real d = e.value[c] - r[c];
-      square += d * d;
-    }
-    s.window.add(square);
-  }
-  st.window_full = s.window.full();
-  st.rms_m_s2 = static_cast<double>(s.window.rms());
-  const double limit = plate ? config_.plate.threshold_m_s2 : config_.redundancy.tolerance_m_s2;
-  const bool beyond = st.window_full && st.rms_m_s2 > limit;
-  if (st.window_full) st.max_rms_m_s2 = st.rms_m_s2 > st.max_rms_m_s2 ? st.rms_m_s2 : st.max_rms_m_s2;
-  if (beyond && !st.disagreeing) ++st.disagreements;
-  st.disagreeing = beyond;
-}
-
-void Monitor::cross_check() {
-  if (sensor_count_ < 2 || status_.primary < 0) return;
-  for (int i = 0; i < sensor_count_; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    if (i == status_.primary) continue;
-    if (sensors_[k].health.health().state == monitor::HealthState::kFault) {
-      // Not compared while in fault: what it said before no longer counts.
-      sensors_[k].window.reset();
-      sensors_[k].checked = sensors_[k].history.pushed;
-      status_.sensors[k].window_full = false;
-      status_.sensors[k].disagreeing = false;
-      continue;
-    }
-    check_sensor(i);
-  }
-}
-
-// The sensors' part of the status: each sensor's health, the primary's, the sensors' state.
-void Monitor::update_sensors_status() {
-  const int reported = status_.primary >= 0 ? status_.primary : 0;
-  status_.sensor = sensors_[static_cast<std::size_t>(reported)].health.health();
-  bool others_degraded = false;
-  bool disagreement = false;
-  for (int i = 0; i < sensor_count_; ++i) {
-    const auto k = static_cast<std::size_t>(i);
-    SensorStatus& st = status_.sensors[k];
-    st.health = sensors_[k].health.health();
-    st.ready = sensors_[k].conditioner.status().ready;
-    st.primary = i == status_.primary;
-    if (i == reported) continue;
-    others_degraded = others_degraded || st.health.state != monitor::HealthState::kOk;
-    disagreement = disagreement || (st.role == SensorRole::kGround && st.disagreeing);
-  }
-  status_.disagreement = disagreement;
-  if (status_.plate >= 0) {
-    const SensorStatus& plate = status_.sensors[static_cast<std::size_t>(status_.plate)];
-    status_.plate_residual_m_s2 = plate.rms_m_s2;
-    status_.plate_mismatch = plate.disagreeing;
-  }
-  if (status_.sensor.state == monitor::HealthState::kFault) {
-    status_.sensors_state = monitor::HealthState::kFault;
-  } else if (status_.sensor.state != monitor::HealthState::kOk || others_degraded || disagreement ||
-             status_.plate_mismatch) {
-    status_.sensors_state = monitor::HealthState::kDegraded;
-  } else {
-    status_.sensors_state = monitor::HealthState::kOk;
   }
 }
 
@@ -454,7 +184,7 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
 }
 
 void Monitor::evaluate(MonitorUpdate& update) {
-  update_sensors_status();
+  sensors_.update_status();
   monitor::AlarmInput input;
   input.time_ns = status_.time_ns;
   update_axes_status(input);
@@ -532,13 +262,11 @@ void Monitor::report(MonitorUpdate& update) {
 MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
   MonitorUpdate update;
   if (have_epoch_) {
-    for (int i = 0; i < sensor_count_; ++i) {
-      (void)sensors_[static_cast<std::size_t>(i)].health.tick(receive_time_ns);
-    }
+    sensors_.tick(receive_time_ns);
     status_.time_ns = monitor_time(receive_time_ns);
-    update_primary();
-    drain_primary();
-    cross_check();
+    sensors_.update_primary();
+    feed_estimators();
+    sensors_.cross_check();
   }
   evaluate(update);
   return update;
@@ -555,8 +283,8 @@ bool Monitor::decoded(const can::CanFrame& frame, Message& message) {
 }
 
 int Monitor::sensor_of_node(std::uint8_t node) const {
-  for (int i = 0; i < sensor_count_; ++i) {
-    if (sensor_configs_[static_cast<std::size_t>(i)].node == node) return i;
+  for (int i = 0; i < sensors_.count(); ++i) {
+    if (sensors_.config(i).node == node) return i;
   }
   return -1;
 }

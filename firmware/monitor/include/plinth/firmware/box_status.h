@@ -46,29 +46,11 @@ struct SensorStatus {
   std::uint64_t disagreements = 0;  // entries into the disagreeing state
 };
 
-struct BoxStatus {
-  std::int64_t time_ns = 0;  // monitor time of the newest sample (or tick)
-  bool estimating = false;   // conditioning ready and the estimators running
-  // Their offset and initial state are trusted (the start-up rule, above); else the level is
-  // fault, cause kNotCalibrated.
-  bool calibrated = false;
-  int axis_count = 1;
-  std::array<AxisStatus, kMaxAxes> axes{};
-  double risk = 0.0;  // the worst axis's total
-  // The forecast: the highest probability of a collapse within the horizon over the axes, the
-  // axis it is on (-1: no forecast yet), and the monitor time, s, at which the first member of
-  // any axis is forecast to collapse (-1: none is).
-  double probability = 0.0;
-  int forecast_axis = -1;
-  double collapse_forecast_s = -1.0;
-  monitor::AlarmLevel alarm = monitor::AlarmLevel::kNormal;
-  monitor::AlarmLevel latched = monitor::AlarmLevel::kNormal;
+// The sensors' part of the box's status, which the SensorSet keeps (sensor_set.h).
+struct SensorSetStatus {
+  // The primary's health (before the first primary: the first sensor's).
   monitor::SensorHealth sensor;
-  std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
-  std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
-  std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
-  // The sensors, in configured order; `sensor` above is the primary's health (before the
-  // first primary: the first ground sensor's).
+  // The sensors, in configured order.
   int sensor_count = 1;
   std::array<SensorStatus, kMaxSensors> sensors{};
   int primary = -1;  // index of the sensor driving the estimators; -1 before the first
@@ -81,6 +63,29 @@ struct BoxStatus {
   bool plate_mismatch = false;   // the plate's residual is beyond its threshold
   int plate = -1;                // index of the plate sensor; -1: none
   double plate_residual_m_s2 = 0.0;  // the plate's RMS residual (valid when its window is full)
+};
+
+// The box: its sensors' part, the estimators' and the alarm policy's.
+struct BoxStatus : SensorSetStatus {
+  std::int64_t time_ns = 0;  // monitor time of the newest sample (or tick)
+  bool estimating = false;   // conditioning ready and the estimators running
+  // Their offset and initial state are trusted (the start-up rule, docs/monitor.md); else the
+  // level is fault, cause kNotCalibrated.
+  bool calibrated = false;
+  int axis_count = 1;
+  std::array<AxisStatus, kMaxAxes> axes{};
+  double risk = 0.0;  // the worst axis's total
+  // The forecast: the highest probability of a collapse within the horizon over the axes, the
+  // axis it is on (-1: no forecast yet), and the monitor time, s, at which the first member of
+  // any axis is forecast to collapse (-1: none is).
+  double probability = 0.0;
+  int forecast_axis = -1;
+  double collapse_forecast_s = -1.0;
+  monitor::AlarmLevel alarm = monitor::AlarmLevel::kNormal;
+  monitor::AlarmLevel latched = monitor::AlarmLevel::kNormal;
+  std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
+  std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
+  std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
 };
 
 }  // namespace plinth::firmware

@@ -75,6 +75,7 @@
 #include "plinth/core/scene.h"
 #include "plinth/firmware/box_status.h"
 #include "plinth/firmware/config.h"
+#include "plinth/firmware/sensor_set.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/hal/frame_io.h"
 #include "plinth/monitor/alarm_level.h"
@@ -157,7 +158,7 @@ class Monitor {
     return conditioning(status_.primary < 0 ? 0 : status_.primary);
   }
   [[nodiscard]] const monitor::ConditioningStatus& conditioning(int sensor) const {
-    return sensors_[static_cast<std::size_t>(sensor)].conditioner.status();
+    return sensors_.conditioning(sensor);
   }
   // The statues of `axis`: their estimators, forecaster and risk.
   [[nodiscard]] const Ensemble& ensemble(int axis) const {
@@ -165,65 +166,14 @@ class Monitor {
   }
   // The sensors as started (the single-sensor form resolved).
   [[nodiscard]] const SensorConfig& sensor_config(int sensor) const {
-    return sensor_configs_[static_cast<std::size_t>(sensor)];
+    return sensors_.config(sensor);
   }
   [[nodiscard]] const MonitorConfig& config() const { return config_; }
 
  private:
-  // A conditioned sample, statue frame, m/s2, at its receive time.
-  struct HistoryEntry {
-    std::int64_t time_ns = 0;  // receive clock
-    Vector3r value = Vector3r::Zero();
-    bool restart = false;  // the health tracker's restart mark
-  };
-  // The last kSensorHistory entries of a stream; entries [valid_from(), pushed) are kept.
-  struct History {
-    std::array<HistoryEntry, kSensorHistory> entries{};
-    std::uint64_t pushed = 0;      // entries ever pushed; the newest is pushed - 1
-    std::uint64_t first_kept = 0;  // entries before this were cleared (a seam in the stream)
-    [[nodiscard]] std::uint64_t valid_from() const {
-      const std::uint64_t held = pushed < kSensorHistory ? 0 : pushed - kSensorHistory;
-      return first_kept > held ? first_kept : held;
-    }
-    [[nodiscard]] bool empty() const { return valid_from() >= pushed; }
-    [[nodiscard]] const HistoryEntry& at(std::uint64_t n) const {
-      return entries[static_cast<std::size_t>(n % kSensorHistory)];
-    }
-    [[nodiscard]] const HistoryEntry& newest() const { return at(pushed - 1); }
-    void push(const HistoryEntry& e) { entries[static_cast<std::size_t>(pushed++ % kSensorHistory)] = e; }
-    void clear() { first_kept = pushed; }
-  };
-  // The RMS of a sliding window of squared differences, m/s2, in Real (the sum is taken afresh
-  // once per window, so a float build does not drift).
-  struct RmsWindow {
-    std::array<Real, kMaxCheckWindowSamples> squares{};
-    int length = 2;   // samples
-    int count = 0;    // samples held, up to length
-    int next = 0;     // slot of the next one
-    Real sum = 0;
-    void reset() { count = 0; next = 0; sum = 0; }
-    void add(Real square);
-    [[nodiscard]] bool full() const { return count >= length; }
-    [[nodiscard]] Real rms() const;
-  };
-  struct Sensor {
-    monitor::SensorHealthTracker health;
-    monitor::Conditioner conditioner;
-    History history;
-    RmsWindow window;
-    std::uint64_t checked = 0;  // history entries cross-checked (or found unpairable)
-  };
-
-  void process(int sensor, const monitor::FedSample& sample);
-  void update_primary();
-  void drain_primary();
-  void drive(const HistoryEntry& entry);
+  // The estimators take the inputs the sensors have for them (SensorSet::next_input).
+  void feed_estimators();
   void push_ensembles(const Vector3r& ground_m_s2);
-  void cross_check();
-  void check_sensor(int sensor);
-  [[nodiscard]] bool reference_at(const History& reference, std::int64_t time_ns,
-                                  Vector3r& value) const;
-  [[nodiscard]] bool usable(int sensor) const;
   [[nodiscard]] bool quiet() const;
   void take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update);
   // Decodes one frame and acts on it; true when that evaluated the state (and reported).
@@ -232,7 +182,6 @@ class Monitor {
   template <typename Message>
   [[nodiscard]] bool decoded(const can::CanFrame& frame, Message& message);
   [[nodiscard]] int sensor_of_node(std::uint8_t node) const;  // -1: not configured
-  void update_sensors_status();
   void update_axis(int axis_index, AxisStatus& axis) const;
   void update_axes_status(monitor::AlarmInput& input);
   void evaluate(MonitorUpdate& update);
@@ -243,16 +192,8 @@ class Monitor {
   [[nodiscard]] std::int64_t monitor_time(std::int64_t receive_time_ns);
 
   MonitorConfig config_;
-  std::array<SensorConfig, kMaxSensors> sensor_configs_{};
-  int sensor_count_ = 1;
-  std::array<Sensor, kMaxSensors> sensors_{};
-  History estimate_;  // the model's base acceleration u'' + u_G'' per axis (the plate's reference)
-  std::int64_t period_ns_ = 5'000'000;
-  std::uint64_t consumed_ = 0;  // the primary's history entries the estimators took
-  bool restart_pending_ = false;  // the next entry starts the estimators at rest
-  bool align_pending_ = false;    // the next entry continues after a failover: align by time
-  std::int64_t last_fed_ns_ = 0;  // receive time of the estimators' newest sample
-  Vector3r last_ground_ = Vector3r::Zero();  // its value, m/s2
+  SensorSet sensors_;
+  Vector3r last_ground_ = Vector3r::Zero();  // the estimators' newest input, m/s2
   std::array<Ensemble, kMaxAxes> ensembles_{};
   monitor::AlarmPolicy alarm_;
   BoxStatus status_;
