@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "plinth/firmware/alarm_inputs.h"
 #include "plinth/firmware/can_frames.h"
 
 namespace plinth::firmware {
@@ -145,11 +146,9 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   axis.forecast = statues.forecaster().latest();
 }
 
-// The axes' part of the status (mode, state, risk), and the alarm policy's input from them.
-void Monitor::update_axes_status(monitor::AlarmInput& input) {
+// The axes' part of the status: mode, state, risk, the forecast.
+void Monitor::update_axes_status() {
   Real risk = 0;
-  bool moving = false;
-  bool collapse = false;
   status_.probability = 0.0;
   status_.forecast_axis = -1;
   status_.collapse_forecast_s = -1.0;
@@ -158,8 +157,6 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
     AxisStatus& axis = status_.axes[k];
     if (status_.estimating) update_axis(i, axis);
     risk = axis.risk.total > risk ? axis.risk.total : risk;
-    moving = moving || axis.mode.phase != Phase::kFullContact;
-    collapse = collapse || axis.mode.terminal();
     const ForecastOutcome& f = axis.forecast;
     axis.collapse_forecast_s = -1.0;
     if (!kForecastBuiltIn || !f.valid) continue;
@@ -177,26 +174,12 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
     }
   }
   status_.risk = static_cast<double>(risk);
-  input.risk = risk;
-  input.probability = static_cast<Real>(status_.probability);
-  input.out_of_full_contact = moving;
-  input.collapse_detected = collapse;
 }
 
 void Monitor::evaluate(MonitorUpdate& update) {
   sensors_.update_status();
-  monitor::AlarmInput input;
-  input.time_ns = status_.time_ns;
-  update_axes_status(input);
-  const bool sensor_fault = status_.sensor.state == monitor::HealthState::kFault;
-  const bool disagreement = status_.disagreement;
-  const bool mismatch_fault = status_.plate_mismatch && config_.plate.raises_fault;
-  input.fault_active = sensor_fault || disagreement || mismatch_fault || bus_fault_;
-  input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status_.sensor.cause)
-                      : (disagreement || mismatch_fault) ? monitor::AlarmCause::kSensorDisagreement
-                                                         : monitor::AlarmCause::kBusError;
-  // Never normal while no estimator runs, or runs on an untrusted start (the start-up rule).
-  input.not_calibrated = !status_.estimating || !status_.calibrated;
+  update_axes_status();
+  monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
   pending_ack_ = false;

@@ -183,7 +183,7 @@ class Monitor {
   [[nodiscard]] bool decoded(const can::CanFrame& frame, Message& message);
   [[nodiscard]] int sensor_of_node(std::uint8_t node) const;  // -1: not configured
   void update_axis(int axis_index, AxisStatus& axis) const;
-  void update_axes_status(monitor::AlarmInput& input);
+  void update_axes_status();
   void evaluate(MonitorUpdate& update);
   void report(MonitorUpdate& update);
   void report_state(MonitorUpdate& update);
