@@ -94,7 +94,8 @@ JsonObject& stream_counts(JsonObject& object, const monitor::SensorCounters& c) 
       .count("long_gaps", c.long_gaps);
 }
 
-std::string frame_counters(const FrameCounters& f) {
+// The frame decoder's counters and the frames the monitor could not encode.
+std::string frame_counters(const FrameCounters& f, std::uint64_t not_encoded) {
   return JsonObject()
       .count("received", f.received)
       .count("sensor_samples", f.sensor_samples)
@@ -105,7 +106,7 @@ std::string frame_counters(const FrameCounters& f) {
       .count("rejected", f.rejected)
       .count("unknown_identifiers", f.unknown_identifiers)
       .text("last_error", can::codec_error_text(f.last_error))
-      .count("not_encoded", f.not_encoded)
+      .count("not_encoded", not_encoded)
       .close();
 }
 
@@ -264,7 +265,7 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
   line.count("alarm_events", totals.alarm_events)
       .count("fault_events", totals.fault_events)
       .count("phase_events", totals.phase_events)
-      .raw("frames", frame_counters(monitor.frames()))
+      .raw("frames", frame_counters(totals.frames, monitor.frames_not_encoded()))
       .raw("sensor", sensor_counters(s.sensor))
       .count("estimator_restarts", s.estimator_restarts)
       .count("bus_send_errors", totals.bus_send_errors)

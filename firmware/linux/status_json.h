@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "plinth/core/events.h"
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
@@ -49,6 +50,7 @@ class JsonObject {
 // What a run did besides the monitor's own counters: the summary's other fields.
 struct RunTotals {
   std::string source;  // the record, the log or the interface
+  FrameCounters frames;  // the frame decoder's (a log or a bus)
   std::uint64_t samples = 0;
   double max_risk = 0.0;
   monitor::AlarmLevel max_level = monitor::AlarmLevel::kNormal;  // the highest but fault

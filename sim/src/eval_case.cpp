@@ -127,11 +127,11 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
                                  kStandardGravity + (v.empty() ? 0.0 : gamma * v[k]));
     const monitor::SensorSample s =
         fw::record_replay_sample(config, static_cast<std::int64_t>(n), ground, kStandardGravity);
-    (void)monitor->on_sample(s);
+    const fw::MonitorUpdate update = monitor->on_sample(s);
     if (n < lead_in) continue;
     const double t = static_cast<double>(k) / rate;
     if (stop_s >= 0.0 && t >= stop_s) break;
-    const fw::BoxStatus& status = monitor->status();
+    const fw::BoxStatus& status = *update.status;
     note_level(status.alarm, t, run.first_shown_s);
     if (!status.estimating) continue;
     note_crossings(grids.risk, status.risk, t, run.risk_crossing_s);

@@ -191,7 +191,7 @@ extern "C" int plinth_board_main() {
     if (n >= lead_in) {
       const std::int64_t record_ns = sample.receive_time_ns - origin_ns;
       all.add(ticks, record_ns);
-      costs[static_cast<std::size_t>(kind_of(g_monitor.status()))].add(ticks, record_ns);
+      costs[static_cast<std::size_t>(kind_of(*update.status))].add(ticks, record_ns);
     }
     for (std::size_t i = 0; i < update.frame_count; ++i) {
       if (can.send(update.frames[i]) != hal::IoStatus::kOk) ++send_errors;
@@ -211,7 +211,7 @@ extern "C" int plinth_board_main() {
   line.put(" frames=")
       .decimal(can.frames_sent())
       .put(" send_errors=")
-      .decimal(send_errors + g_monitor.frames().not_encoded);
+      .decimal(send_errors + g_monitor.frames_not_encoded());
   print(line);
   all.print_as("per_sample");
   costs[0].print_as("per_sample_quiet");
@@ -220,7 +220,7 @@ extern "C" int plinth_board_main() {
   hal::TextLine stack(text, sizeof text);
   stack.put("# stack used_bytes=").decimal(static_cast<std::uint64_t>(board::stack_used_bytes()));
   print(stack.put(" size_bytes=").decimal(static_cast<std::uint64_t>(board::stack_size_bytes())));
-  const bool ok = send_errors + g_monitor.frames().not_encoded == 0;
+  const bool ok = send_errors + g_monitor.frames_not_encoded() == 0;
   hal::semihosting::write(ok ? "# end: ok\n" : "# end: FAILED: frames not sent\n");
   return ok ? 0 : 1;
 }

@@ -38,7 +38,7 @@ Error Monitor::start(const MonitorConfig& config,
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
   last_ground_.setZero();
-  frames_ = FrameCounters{};
+  frames_not_encoded_ = 0;
   have_epoch_ = false;
   bus_fault_ = false;
   pending_ack_ = false;
@@ -71,8 +71,14 @@ bool Monitor::quiet() const {
   return quiet;
 }
 
-MonitorUpdate Monitor::on_sensor_sample(int sensor, const monitor::SensorSample& sample) {
+MonitorUpdate Monitor::new_update() const {
   MonitorUpdate update;
+  update.status = &status_;
+  return update;
+}
+
+MonitorUpdate Monitor::on_sensor_sample(int sensor, const monitor::SensorSample& sample) {
+  MonitorUpdate update = new_update();
   take_sample(sensor, sample, update);
   return update;
 }
@@ -210,7 +216,7 @@ template <typename Message>
 void Monitor::add_frame(MonitorUpdate& update, const Message& message) {
   if (update.frame_count >= update.frames.size()) return;  // sized for the most an update has
   if (!can::encode(message, update.frames[update.frame_count]).ok()) {
-    ++frames_.not_encoded;
+    ++frames_not_encoded_;
     return;
   }
   ++update.frame_count;
@@ -243,7 +249,7 @@ void Monitor::report(MonitorUpdate& update) {
 }
 
 MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
-  MonitorUpdate update;
+  MonitorUpdate update = new_update();
   if (have_epoch_) {
     sensors_.tick(receive_time_ns);
     status_.time_ns = monitor_time(receive_time_ns);
@@ -255,79 +261,18 @@ MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
   return update;
 }
 
-template <typename Message>
-bool Monitor::decoded(const can::CanFrame& frame, Message& message) {
-  const can::DecodeResult r = can::decode(frame, message);
-  if (r.ok()) return true;
-  ++frames_.rejected;
-  frames_.last_error = r.error;
-  frames_.last_error_signal = r.signal;
-  return false;
-}
-
-int Monitor::sensor_of_node(std::uint8_t node) const {
-  for (int i = 0; i < sensors_.count(); ++i) {
-    if (sensors_.config(i).node == node) return i;
-  }
-  return -1;
-}
-
-MonitorUpdate Monitor::on_frame(const hal::TimedFrame& timed) {
-  ++frames_.received;
-  MonitorUpdate update;
-  if (!take_frame(timed, update)) report_state(update);  // nothing evaluated: a status may be due
+MonitorUpdate Monitor::acknowledge(const monitor::Acknowledgement& acknowledgement) {
+  MonitorUpdate update = new_update();
+  pending_ack_ = true;
+  ack_ = acknowledgement;
+  evaluate(update);
   return update;
 }
 
-bool Monitor::take_frame(const hal::TimedFrame& timed, MonitorUpdate& update) {
-  const can::CanFrame& frame = timed.frame;
-  switch (can::classify(frame.id)) {
-    case can::MessageKind::kSensorAcceleration: {
-      can::SensorAcceleration message;
-      if (!decoded(frame, message)) return false;
-      const int sensor = sensor_of_node(message.node);
-      if (sensor < 0) {
-        ++frames_.other_nodes;
-        return false;
-      }
-      ++frames_.sensor_samples;
-      take_sample(sensor, sample_of(message, timed.timestamp_ns), update);
-      return true;
-    }
-    case can::MessageKind::kSensorHeartbeat: {
-      can::SensorHeartbeat message;
-      if (decoded(frame, message)) ++frames_.heartbeats;
-      return false;
-    }
-    case can::MessageKind::kAcknowledge: {
-      can::Acknowledge message;
-      if (!decoded(frame, message)) return false;
-      ++frames_.acknowledgements;
-      pending_ack_ = true;
-      ack_ = acknowledgement_of(message);
-      evaluate(update);  // at once, at the current monitor time
-      return true;
-    }
-    case can::MessageKind::kMonitorStatus: {
-      can::MonitorStatus message;
-      if (decoded(frame, message)) ++frames_.monitor_frames;
-      return false;
-    }
-    case can::MessageKind::kAlarmEvent: {
-      can::AlarmEvent message;
-      if (decoded(frame, message)) ++frames_.monitor_frames;
-      return false;
-    }
-    case can::MessageKind::kCollapseForecast: {
-      can::CollapseForecast message;
-      if (decoded(frame, message)) ++frames_.monitor_frames;
-      return false;
-    }
-    case can::MessageKind::kUnknown:
-      ++frames_.unknown_identifiers;
-      return false;
-  }
-  return false;
+MonitorUpdate Monitor::poll() {
+  MonitorUpdate update = new_update();
+  report_state(update);
+  return update;
 }
 
 }  // namespace plinth::firmware

@@ -13,6 +13,7 @@
 #include "bundled_records.h"
 #include "dbc_file.h"
 #include "monitor_input.h"
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/record_io.h"
 #include "test_support.h"
@@ -261,16 +262,18 @@ TEST(CanFrames, UpdatesCarryTheFramesToSend) {
   EXPECT_GE(statuses, 25);
   EXPECT_LE(statuses, 27);
   EXPECT_EQ(alarm_frames, 2);
-  EXPECT_EQ(monitor.frames().not_encoded, 0U);
+  EXPECT_EQ(monitor.frames_not_encoded(), 0U);
 }
 
 TEST(CanFrames, AStatusIsDueBeforeTheFirstSample) {
   const Scene scene = plinth::testing::make(plinth::testing::paper_isolated(0.0));
   Monitor monitor;
   ASSERT_TRUE(monitor.start(MonitorConfig{}, {&scene, nullptr}).ok());
+  FrameDecoder decoder;
+  decoder.start(MonitorConfig{});
   can::CanFrame heartbeat;
   ASSERT_TRUE(can::encode(can::SensorHeartbeat{1, 1, 0, 1, 0, 0, 0}, heartbeat).ok());
-  const MonitorUpdate first = monitor.on_frame({heartbeat, 1000});
+  const MonitorUpdate first = on_frame(monitor, decoder, {heartbeat, 1000});
   EXPECT_TRUE(first.status_due);
   // The first evaluation's AlarmEvent (fault: no data yet), then the status: never the alarm
   // policy's initial normal (found by fuzz_monitor).
@@ -278,7 +281,7 @@ TEST(CanFrames, AStatusIsDueBeforeTheFirstSample) {
   EXPECT_EQ(first.events[0].level, monitor::AlarmLevel::kFault);
   EXPECT_EQ(first.frame_count, 2U);
   EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kFault);
-  EXPECT_FALSE(monitor.on_frame({heartbeat, 2000}).status_due);  // the time did not move
+  EXPECT_FALSE(on_frame(monitor, decoder, {heartbeat, 2000}).status_due);  // the time did not move
 }
 
 // An ensemble in an earthquake that overturns it: with each status a CollapseForecast (one axis)
@@ -341,7 +344,7 @@ ForecastFrames run_forecast_frames(bool enabled) {
       out.first_collapse_forecast_t = static_cast<double>(st.time_ns) * 1e-9;
     }
   }
-  EXPECT_EQ(monitor.frames().not_encoded, 0U);
+  EXPECT_EQ(monitor.frames_not_encoded(), 0U);
   return out;
 }
 

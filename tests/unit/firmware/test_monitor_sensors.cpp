@@ -9,6 +9,7 @@
 
 #include "box_file_error.h"
 #include "monitor_config.h"
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/input_error.h"
 #include "test_support.h"
@@ -310,16 +311,18 @@ TEST(MonitorSensors, FramesGoToTheirSensor) {
   config.sensors[1].node = 9;
   fw::Monitor monitor;
   ASSERT_TRUE(started(monitor, config));
+  fw::FrameDecoder decoder;
+  decoder.start(config);
   for (const int node : {4, 9, 9, 2}) {
     can::SensorAcceleration m;
     m.node = static_cast<std::uint8_t>(node);
     m.az_g = 1.0;
     can::CanFrame f;
     ASSERT_TRUE(can::encode(m, f).ok());
-    (void)monitor.on_frame({f, 1000});
+    (void)fw::on_frame(monitor, decoder, {f, 1000});
   }
-  EXPECT_EQ(monitor.frames().sensor_samples, 3U);
-  EXPECT_EQ(monitor.frames().other_nodes, 1U);
+  EXPECT_EQ(decoder.counters().sensor_samples, 3U);
+  EXPECT_EQ(decoder.counters().other_nodes, 1U);
   EXPECT_EQ(monitor.status().sensors[0].health.counters.received, 1U);
   EXPECT_EQ(monitor.status().sensors[1].health.counters.received, 2U);
 }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/record_io.h"
 #include "test_paths.h"
@@ -214,7 +215,9 @@ TEST(MonitorStartup, AFrameBeforeAnySampleReportsFault) {
   ASSERT_TRUE(box->start(box_config(), {&scene, nullptr}).ok());
   can::CanFrame heartbeat;
   ASSERT_TRUE(can::encode(can::SensorHeartbeat{1, 16, 0, 0, 0, 0, 0}, heartbeat).ok());
-  const fw::MonitorUpdate u = box->on_frame({heartbeat, 0});
+  fw::FrameDecoder decoder;
+  decoder.start(box_config());
+  const fw::MonitorUpdate u = fw::on_frame(*box, decoder, {heartbeat, 0});
   ASSERT_TRUE(u.status_due);
   EXPECT_EQ(box->status().alarm, AlarmLevel::kFault);
   ASSERT_EQ(u.event_count, 1U);

@@ -85,34 +85,23 @@
 
 namespace plinth::firmware {
 
-// Frames that were not sensor samples of a configured node, or could not be decoded.
-struct FrameCounters {
-  std::uint64_t received = 0;
-  std::uint64_t sensor_samples = 0;       // SensorAcceleration of a configured node, decoded
-  std::uint64_t other_nodes = 0;          // SensorAcceleration of other nodes (not used)
-  std::uint64_t heartbeats = 0;           // SensorHeartbeat of any node
-  std::uint64_t acknowledgements = 0;     // Acknowledge frames, decoded
-  std::uint64_t monitor_frames = 0;  // MonitorStatus / AlarmEvent / CollapseForecast (any box's)
-  std::uint64_t rejected = 0;             // failed to decode (length, range, reserved bits)
-  std::uint64_t unknown_identifiers = 0;  // not a plinth identifier
-  can::CodecError last_error = can::CodecError::kOk;  // of the latest rejected frame
-  const char* last_error_signal = "";
-  std::uint64_t not_encoded = 0;  // frames to send that the codec refused (left out)
-};
-
 // An update's alarm events: each update evaluates the alarm policy once.
 inline constexpr std::size_t kMaxUpdateEvents = monitor::kMaxEventsPerUpdate;
 // An AlarmEvent per event, then a MonitorStatus per axis, then a CollapseForecast per axis.
 inline constexpr std::size_t kMaxFramesPerUpdate =
     kMaxUpdateEvents + 2 * static_cast<std::size_t>(kMaxAxes);
 
-// What one input did, and the frames to send for it, in order.
+// What one input did: the status after it, its alarm events, and the frames to send for it, in
+// order. The outputs read it alone.
 struct MonitorUpdate {
+  // The monitor's status after the input (Monitor::status(): valid until its next input).
+  const BoxStatus* status = nullptr;
   std::array<monitor::AlarmEventRecord, kMaxUpdateEvents> events{};
   std::size_t event_count = 0;
   // A status is due (status_interval_s, an alarm change or the alarm policy's heartbeat): its
-  // frames are in `frames`, and status() is what it reports.
+  // frames are in `frames`.
   bool status_due = false;
+  // What came of an acknowledgement (Monitor::acknowledge); kNone for other inputs.
   monitor::AckOutcome acknowledgement = monitor::AckOutcome::kNone;
   std::array<can::CanFrame, kMaxFramesPerUpdate> frames{};  // frames[0 .. frame_count)
   std::size_t frame_count = 0;
@@ -136,8 +125,6 @@ class Monitor {
   // Phase changes and impacts of axis `axis` go to `sink` (nullptr: nowhere).
   void set_event_sink(int axis, EventSink* sink);
 
-  // One frame from the bus (or a candump log).
-  [[nodiscard]] MonitorUpdate on_frame(const hal::TimedFrame& frame);
   // One decoded sample of the first sensor (the ground node of the single-sensor form; file
   // replay feeds these directly).
   [[nodiscard]] MonitorUpdate on_sample(const monitor::SensorSample& sample) {
@@ -147,12 +134,21 @@ class Monitor {
   [[nodiscard]] MonitorUpdate on_sensor_sample(int sensor, const monitor::SensorSample& sample);
   // Call periodically with the receive clock's time: sensor timeouts, heartbeats.
   [[nodiscard]] MonitorUpdate on_tick(std::int64_t receive_time_ns);
+  // An operator acknowledges the latched level, quoting the latest alarm event (from the bus,
+  // Modbus or MQTT): evaluated at once, at the current monitor time; the update says what came
+  // of it (MonitorUpdate::acknowledgement).
+  [[nodiscard]] MonitorUpdate acknowledge(const monitor::Acknowledgement& acknowledgement);
+  // No input (a frame that is none of the monitor's): the status, if one is due; the alarm
+  // policy's first evaluation if none happened since start() (so that no status says the
+  // policy's initial `normal`).
+  [[nodiscard]] MonitorUpdate poll();
   // Bus trouble reported by the frame source (bus-off, dropped frames): raises the fault level
   // until `active` is cleared.
   void set_bus_fault(bool active) { bus_fault_ = active; }
 
   [[nodiscard]] const BoxStatus& status() const { return status_; }
-  [[nodiscard]] const FrameCounters& frames() const { return frames_; }
+  // Frames to send that the codec refused (left out of their update) since start().
+  [[nodiscard]] std::uint64_t frames_not_encoded() const { return frames_not_encoded_; }
   // The primary's conditioning (before the first primary: the first sensor's).
   [[nodiscard]] const monitor::ConditioningStatus& conditioning() const {
     return conditioning(status_.primary < 0 ? 0 : status_.primary);
@@ -175,13 +171,8 @@ class Monitor {
   void feed_estimators();
   void push_ensembles(const Vector3r& ground_m_s2);
   [[nodiscard]] bool quiet() const;
+  [[nodiscard]] MonitorUpdate new_update() const;
   void take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update);
-  // Decodes one frame and acts on it; true when that evaluated the state (and reported).
-  [[nodiscard]] bool take_frame(const hal::TimedFrame& timed, MonitorUpdate& update);
-  // Decodes `frame`; a refusal is counted (rejected, last_error).
-  template <typename Message>
-  [[nodiscard]] bool decoded(const can::CanFrame& frame, Message& message);
-  [[nodiscard]] int sensor_of_node(std::uint8_t node) const;  // -1: not configured
   void update_axis(int axis_index, AxisStatus& axis) const;
   void update_axes_status();
   void evaluate(MonitorUpdate& update);
@@ -197,7 +188,7 @@ class Monitor {
   std::array<Ensemble, kMaxAxes> ensembles_{};
   monitor::AlarmPolicy alarm_;
   BoxStatus status_;
-  FrameCounters frames_;
+  std::uint64_t frames_not_encoded_ = 0;
   bool have_epoch_ = false;
   std::int64_t epoch_ns_ = 0;  // receive time of the first sample
   bool bus_fault_ = false;
