@@ -84,17 +84,12 @@ void note_crossings(const std::vector<double>& grid, double value, double t,
   }
 }
 
-void note_level(monitor::AlarmLevel shown, double t, std::array<double, host::kEvalLevels>& first) {
-  int rank = 0;
-  switch (shown) {
-    case monitor::AlarmLevel::kAdvisory: rank = 1; break;
-    case monitor::AlarmLevel::kWarning: rank = 2; break;
-    case monitor::AlarmLevel::kAlarm: rank = 3; break;
-    case monitor::AlarmLevel::kNormal:
-    case monitor::AlarmLevel::kFault: rank = 0; break;
-  }
-  for (int level = 0; level < rank; ++level) {
-    if (first[static_cast<std::size_t>(level)] < 0.0) first[static_cast<std::size_t>(level)] = t;
+void note_level(monitor::AlarmLevel shown, double t,
+                std::array<double, monitor::kRiskLevels.size()>& first) {
+  if (shown == monitor::AlarmLevel::kFault) return;
+  for (const monitor::AlarmLevel level : monitor::kRiskLevels) {
+    double& first_shown = first[monitor::risk_level_index(level)];
+    if (shown >= level && first_shown < 0.0) first_shown = t;
   }
 }
 

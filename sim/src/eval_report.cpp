@@ -18,7 +18,6 @@ namespace {
 
 using host::Choice;
 using host::CrossingGrids;
-using host::EvalLevel;
 using host::EvalRun;
 using host::EvalTable;
 using host::InputError;
@@ -26,8 +25,8 @@ using host::Rule;
 using host::WarningOutcome;
 
 // The alarm policy's default risk thresholds (alarm_policy.h): today's reactive box.
-constexpr double kDefaultRiskOn[host::kEvalLevels] = {0.1, 0.5, 0.8};
-constexpr const char* kLevelNames[host::kEvalLevels] = {"advisory", "warning", "alarm"};
+// Per risk level (monitor::kRiskLevels).
+constexpr double kDefaultRiskOn[monitor::kRiskLevels.size()] = {0.1, 0.5, 0.8};
 
 std::string number(double v, int digits = 3) {
   char buffer[32];
@@ -117,10 +116,10 @@ Report make_report(const EvalTable& table, const CalibrationTargets& targets, bo
   std::size_t k = 0;
   for (const std::string& name : names) halves[k++ % 2].push_back(name);
   const std::vector<host::RocPoint> all_points = host::roc(table.runs, table.grids);
-  for (std::size_t level = 0; level < host::kEvalLevels; ++level) {
+  for (std::size_t level = 0; level < monitor::kRiskLevels.size(); ++level) {
     LevelReport l;
-    l.level = kLevelNames[level];
-    l.shown = host::level_outcome(table.runs, static_cast<EvalLevel>(level));
+    l.level = monitor::alarm_level_name(monitor::kRiskLevels[level]);
+    l.shown = host::level_outcome(table.runs, monitor::kRiskLevels[level]);
     l.reactive = nominal_risk_outcome(table.runs, grid_index(table.grids.risk, kDefaultRiskOn[level]));
     const host::LevelTarget& target = target_of(targets, level);
     for (int fold = 0; fold < 2; ++fold) {

@@ -40,7 +40,7 @@ TEST(EvalMetrics, ClassifiesHitsMissesFalseAlarmsAndNearMisses) {
       standing(0.5, 2.0),       // past half the angle: a near miss, raised
       standing(0.9, -1.0),      // near miss, not raised
   };
-  const WarningOutcome o = level_outcome(runs, EvalLevel::kAlarm);
+  const WarningOutcome o = level_outcome(runs, monitor::AlarmLevel::kAlarm);
   EXPECT_EQ(o.collapses, 4);
   EXPECT_EQ(o.hits, 2);
   EXPECT_EQ(o.misses, 2);
@@ -53,7 +53,7 @@ TEST(EvalMetrics, ClassifiesHitsMissesFalseAlarmsAndNearMisses) {
   EXPECT_DOUBLE_EQ(o.lead_quantile(0.5), 0.25);
   EXPECT_DOUBLE_EQ(o.lead_quantile(0.0), 0.0);
   EXPECT_DOUBLE_EQ(o.lead_quantile(1.0), 2.0);
-  EXPECT_DOUBLE_EQ(level_outcome(runs, EvalLevel::kWarning).lead_quantile(0.5), 0.0);
+  EXPECT_DOUBLE_EQ(level_outcome(runs, monitor::AlarmLevel::kWarning).lead_quantile(0.5), 0.0);
   EXPECT_EQ(WarningOutcome{}.lead_quantile(0.5), -1.0);
   EXPECT_EQ(WarningOutcome{}.false_alarm_rate(), 0.0);
 }
