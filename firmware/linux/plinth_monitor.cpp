@@ -333,8 +333,8 @@ std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings)
 // point.
 template <typename Restart>
 bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, fw::FrameDecoder& decoder,
-              Outputs& outputs, fw::EventRecorder* recorder, fw::Supervisor& supervisor, fw::LatencyLog* latency,
-              Restart restart) {
+              Outputs& outputs, fw::EventRecorder* recorder, fw::Supervisor& supervisor,
+              fw::LatencyLog* latency, Restart restart) {
   supervisor.ready("monitoring " + input.source());
   fw::InputItem item;
   bool estimated = false;

@@ -8,6 +8,9 @@
 #include "plinth/host/run_output.h"
 
 namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
 namespace {
 
 constexpr const char* kAxisNames[] = {"x", "y"};

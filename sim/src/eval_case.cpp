@@ -13,7 +13,7 @@
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_sampling.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 namespace {
 
 namespace fw = firmware;
@@ -155,4 +155,4 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   return run;
 }
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

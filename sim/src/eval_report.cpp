@@ -13,7 +13,7 @@
 #include "plinth/host/input_error.h"
 #include "plinth/host/json_text.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 namespace {
 
 using host::Choice;
@@ -265,7 +265,7 @@ void plot_roc(const EvalTable& table, const std::string& png_path) {
        << "'" << dir << "/probability.dat' using 1:2 with linespoints title 'forecast probability'\n";
     if (!gp) throw InputError("--plot: cannot write the gnuplot script");
   }
-  cli::run_gnuplot((folder / "roc.gp").string(), {});
+  run_gnuplot((folder / "roc.gp").string(), {});
   const std::string temporary = png_path + ".tmp";
   std::error_code ec;
   std::filesystem::copy_file(folder / "roc.png", temporary,
@@ -275,4 +275,4 @@ void plot_roc(const EvalTable& table, const std::string& png_path) {
   if (ec) throw InputError(png_path + ": cannot write the plot: " + ec.message());
 }
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

@@ -15,7 +15,7 @@
 
 extern char** environ;
 
-namespace plinth::cli {
+namespace plinth::sim {
 namespace {
 
 using plinth::host::InputError;
@@ -79,4 +79,4 @@ std::string comment_text(std::string text) {
   return text;
 }
 
-}  // namespace plinth::cli
+}  // namespace plinth::sim

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace plinth::cli {
+namespace plinth::sim {
 
 // The gnuplot executable on PATH. Throws InputError with the Debian package to install.
 [[nodiscard]] std::string find_gnuplot();
@@ -19,4 +19,4 @@ void run_gnuplot(const std::string& script_path, const std::vector<std::string>&
 // comment) become '?'.
 [[nodiscard]] std::string comment_text(std::string text);
 
-}  // namespace plinth::cli
+}  // namespace plinth::sim

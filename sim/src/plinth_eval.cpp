@@ -91,8 +91,8 @@ std::vector<double> pga_grid(const RunOptions& opt) {
   return grid;
 }
 
-plinth::eval::BoxSettings box_settings(const RunOptions& opt) {
-  plinth::eval::BoxSettings box;
+plinth::sim::BoxSettings box_settings(const RunOptions& opt) {
+  plinth::sim::BoxSettings box;
   box.rate_hz = opt.rate_hz;
   box.steps_per_sample = opt.steps_per_sample;
   box.knows_true_statue = opt.box_knows_statue;
@@ -148,8 +148,8 @@ int run_eval(const RunOptions& opt) {
     throw InputError("--statues: expected 1 to " + std::to_string(kMaxStatues) + ", got " +
                      std::to_string(opt.statues));
   }
-  const plinth::eval::BoxSettings box = box_settings(opt);
-  plinth::eval::TruthSettings truth;
+  const plinth::sim::BoxSettings box = box_settings(opt);
+  plinth::sim::TruthSettings truth;
   truth.step_s = opt.truth_step_s;
   std::vector<plinth::host::UncertainScene> scenes;
   std::vector<std::vector<plinth::Scene>> statues;
@@ -175,7 +175,7 @@ int run_eval(const RunOptions& opt) {
     const std::size_t r = index / per_record;
     const std::size_t s = index % per_record / static_cast<std::size_t>(opt.statues);
     const auto j = static_cast<int>(index % static_cast<std::size_t>(opt.statues));
-    return plinth::eval::EvalCase{&records[r], file_name(opt.record_paths[r]), &scenes[s],
+    return plinth::sim::EvalCase{&records[r], file_name(opt.record_paths[r]), &scenes[s],
                                   file_name(opt.scene_paths[s]), j,
                                   &statues[s][static_cast<std::size_t>(j)], pga};
   };
@@ -190,13 +190,13 @@ int run_eval(const RunOptions& opt) {
         std::vector<EvalRun> job;
         for (const double pga : pgas) {
           if (run.stop->load()) throw plinth::host::JobCancelled();
-          job.push_back(plinth::eval::run_case(case_of(index, pga), box, truth, grids));
+          job.push_back(plinth::sim::run_case(case_of(index, pga), box, truth, grids));
           if (job.back().collapsed && !opt.all_scales) break;
         }
         results[index] = std::move(job);
       },
       [&](std::size_t index) {
-        const plinth::eval::EvalCase c = case_of(index, 0.0);
+        const plinth::sim::EvalCase c = case_of(index, 0.0);
         return c.record_name + ", " + c.scene_name + ", statue " + std::to_string(c.statue);
       });
   progress.finish();
@@ -217,19 +217,19 @@ int run_eval(const RunOptions& opt) {
 int run_report(const ReportOptions& opt) {
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
-  const plinth::eval::Report report = plinth::eval::make_report(table, {}, opt.frontier);
-  std::fputs(plinth::eval::report_text(report, table.grids).c_str(), stdout);
+  const plinth::sim::Report report = plinth::sim::make_report(table, {}, opt.frontier);
+  std::fputs(plinth::sim::report_text(report, table.grids).c_str(), stdout);
   if (!opt.json_path.empty()) {
     const std::string temporary = opt.json_path + ".tmp";
     std::FILE* out = std::fopen(temporary.c_str(), "w");
     if (out == nullptr) throw InputError(opt.json_path + ": cannot write (does its folder exist?)");
-    std::fputs(plinth::eval::report_json(report, table.grids).c_str(), out);
+    std::fputs(plinth::sim::report_json(report, table.grids).c_str(), out);
     const bool ok = std::fclose(out) == 0;
     std::error_code ec;
     if (ok) std::filesystem::rename(temporary, opt.json_path, ec);
     if (!ok || ec) throw InputError(opt.json_path + ": cannot write");
   }
-  if (!opt.plot_path.empty()) plinth::eval::plot_roc(table, opt.plot_path);
+  if (!opt.plot_path.empty()) plinth::sim::plot_roc(table, opt.plot_path);
   return 0;
 }
 

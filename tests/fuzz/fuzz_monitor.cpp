@@ -33,7 +33,7 @@ namespace {
 
 namespace fw = plinth::firmware;
 namespace mon = plinth::monitor;
-namespace can = plinth::can;
+namespace can = plinth::hal::can;
 using plinth::fuzz::check;
 
 constexpr double kRateHz = 200.0;

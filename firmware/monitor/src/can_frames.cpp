@@ -3,6 +3,9 @@
 #include <cmath>
 
 namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
 namespace {
 
 template <typename Domain, typename Wire>

@@ -6,6 +6,9 @@
 
 namespace plinth::firmware {
 
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
+
 namespace {
 
 #define PLINTH_TEXT_OF(x) #x

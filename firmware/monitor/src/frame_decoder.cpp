@@ -4,6 +4,9 @@
 
 namespace plinth::firmware {
 
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
+
 void FrameDecoder::start(const MonitorConfig& config) {
   std::array<SensorConfig, kMaxSensors> sensors{};
   count_ = resolved_sensors(config, sensors);

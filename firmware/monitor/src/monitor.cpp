@@ -7,6 +7,9 @@
 
 namespace plinth::firmware {
 
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
+
 Error Monitor::start(const MonitorConfig& config,
                      const std::array<const Scene*, kMaxAxes>& scenes) {
   std::array<std::span<const Scene>, kMaxAxes> ensembles{};

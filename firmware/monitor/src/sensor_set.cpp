@@ -258,7 +258,7 @@ void SensorSet::check_sensor(int sensor) {
   st.rms_m_s2 = static_cast<double>(s.window.rms());
   const double limit = plate ? plate_.threshold_m_s2 : redundancy_.tolerance_m_s2;
   const bool beyond = st.window_full && st.rms_m_s2 > limit;
-  if (st.window_full) st.max_rms_m_s2 = st.rms_m_s2 > st.max_rms_m_s2 ? st.rms_m_s2 : st.max_rms_m_s2;
+  if (st.window_full && st.rms_m_s2 > st.max_rms_m_s2) st.max_rms_m_s2 = st.rms_m_s2;
   if (beyond && !st.disagreeing) ++st.disagreements;
   st.disagreeing = beyond;
 }

@@ -19,6 +19,9 @@
 #include "test_support.h"
 
 namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
 namespace {
 
 using monitor::AlarmCause;

@@ -5,6 +5,9 @@
 #include "plinth/firmware/frame_decoder.h"
 
 namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
 namespace {
 
 MonitorConfig two_sensors() {

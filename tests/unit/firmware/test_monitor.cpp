@@ -18,6 +18,7 @@ namespace plinth {
 namespace {
 
 namespace fw = firmware;
+namespace can = hal::can;
 using testing::RecordingSink;
 
 using ::plinth::testing::kSource;
@@ -248,7 +249,8 @@ TEST(Monitor, AcknowledgeIsACallAsTheFrameIs) {
   can::CanFrame ack;
   ASSERT_TRUE(can::encode(can::Acknowledge{can::AlarmLevel::kAlarm, 7, last_event}, ack).ok());
   const fw::MonitorUpdate from_frame = fw::on_frame(by_frame, decoder, {ack, t});
-  const fw::MonitorUpdate from_call = by_call.acknowledge({monitor::AlarmLevel::kAlarm, last_event});
+  const fw::MonitorUpdate from_call =
+      by_call.acknowledge({monitor::AlarmLevel::kAlarm, last_event});
   EXPECT_EQ(from_call.acknowledgement, monitor::AckOutcome::kReleasedConditionHolds);
   EXPECT_EQ(from_call.acknowledgement, from_frame.acknowledgement);
   ASSERT_EQ(from_call.event_count, from_frame.event_count);

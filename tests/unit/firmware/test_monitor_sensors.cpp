@@ -18,6 +18,7 @@ namespace plinth {
 namespace {
 
 namespace fw = firmware;
+namespace can = hal::can;
 
 constexpr double kRate = 200.0;                 // Hz
 constexpr std::int64_t kPeriodNs = 5'000'000;  // ns

@@ -23,7 +23,7 @@ namespace {
 namespace fw = firmware;
 using monitor::AlarmCause;
 using monitor::AlarmLevel;
-namespace can = plinth::can;
+namespace can = plinth::hal::can;
 
 using ::plinth::testing::kSource;
 constexpr double kRateHz = 200.0;  // the sensor rate of the candump log

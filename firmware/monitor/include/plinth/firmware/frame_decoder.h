@@ -25,7 +25,7 @@ struct FrameCounters {
   std::uint64_t monitor_frames = 0;  // MonitorStatus / AlarmEvent / CollapseForecast (any box's)
   std::uint64_t rejected = 0;             // failed to decode (length, range, reserved bits)
   std::uint64_t unknown_identifiers = 0;  // not a plinth identifier
-  can::CodecError last_error = can::CodecError::kOk;  // of the latest rejected frame
+  hal::can::CodecError last_error = hal::can::CodecError::kOk;  // of the latest rejected frame
   const char* last_error_signal = "";
 };
 
@@ -53,7 +53,7 @@ class FrameDecoder {
  private:
   // Decodes `frame`; a refusal is counted (rejected, last_error).
   template <typename Message>
-  [[nodiscard]] bool decoded(const can::CanFrame& frame, Message& message);
+  [[nodiscard]] bool decoded(const hal::can::CanFrame& frame, Message& message);
   [[nodiscard]] int sensor_of_node(std::uint8_t node) const;  // -1: not configured
 
   std::array<std::uint8_t, kMaxSensors> nodes_{};

@@ -103,7 +103,7 @@ struct MonitorUpdate {
   bool status_due = false;
   // What came of an acknowledgement (Monitor::acknowledge); kNone for other inputs.
   monitor::AckOutcome acknowledgement = monitor::AckOutcome::kNone;
-  std::array<can::CanFrame, kMaxFramesPerUpdate> frames{};  // frames[0 .. frame_count)
+  std::array<hal::can::CanFrame, kMaxFramesPerUpdate> frames{};  // frames[0 .. frame_count)
   std::size_t frame_count = 0;
 };
 

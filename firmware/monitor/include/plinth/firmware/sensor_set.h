@@ -106,7 +106,9 @@ class SensorSet {
       return entries[static_cast<std::size_t>(n % kSensorHistory)];
     }
     [[nodiscard]] const HistoryEntry& newest() const { return at(pushed - 1); }
-    void push(const HistoryEntry& e) { entries[static_cast<std::size_t>(pushed++ % kSensorHistory)] = e; }
+    void push(const HistoryEntry& e) {
+      entries[static_cast<std::size_t>(pushed++ % kSensorHistory)] = e;
+    }
     void clear() { first_kept = pushed; }
   };
   // The RMS of a sliding window of squared differences, m/s2, in Real (the sum is taken afresh
