@@ -19,6 +19,7 @@ packages=(
   libgpiod-dev libsystemd-dev systemd  # relays (libgpiod), sd_notify; systemd-analyze tests the unit
   libmodbus-dev mbpoll  # plinth-monitor's Modbus TCP server, tested with mbpoll (docs/integration.md)
   libmosquitto-dev mosquitto mosquitto-clients openssl  # its MQTT publisher, tested on a broker
+  nlohmann-json3-dev  # the MQTT command payloads (JSON; header-only, build time only)
   clang-14 libclang-rt-14-dev  # the sanitize preset: ASan + UBSan and libFuzzer (docs/fuzzing.md)
 )
 

@@ -176,6 +176,10 @@ void output_bindings(std::vector<Binding>& b, ModbusSettings& modbus, MqttSettin
   b.push_back({"mqtt.state_interval_s", number_into(mqtt.state_interval_s), "a number"});
   b.push_back({"mqtt.reconnect_min_s", number_into(mqtt.reconnect_min_s), "a number"});
   b.push_back({"mqtt.reconnect_max_s", number_into(mqtt.reconnect_max_s), "a number"});
+  b.push_back({"mqtt.commands", flag_into(mqtt.commands), "true or false"});
+  b.push_back({"mqtt.discovery", flag_into(mqtt.discovery), "true or false"});
+  b.push_back({"mqtt.discovery_prefix", string_into(mqtt.discovery_prefix),
+               "a string (topic levels)"});
 }
 
 std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
@@ -462,6 +466,10 @@ void check_outputs(MonitorFile& file, const KeyLines& lines, const std::string& 
   if (!topic_part(mqtt.topic_prefix, true)) {
     lines.fail("mqtt.topic_prefix",
                "mqtt.topic_prefix: expected topic levels (no '+' or '#', no empty level)");
+  }
+  if (!topic_part(mqtt.discovery_prefix, true)) {
+    lines.fail("mqtt.discovery_prefix",
+               "mqtt.discovery_prefix: expected topic levels (no '+' or '#', no empty level)");
   }
   const auto range = [&](const char* key, double value, double low, double high) {
     if (!(value >= low && value <= high)) {

@@ -20,6 +20,7 @@
 #include "event_recorder.h"
 #include "inputs.h"
 #include "latency_log.h"
+#include "modbus_map.h"
 #include "modbus_server.h"
 #include "monitor_config.h"
 #include "mqtt_publisher.h"
@@ -178,6 +179,7 @@ class Outputs {
                          .text("source", output->name())
                          .close());
           post_snapshot(monitor.status());
+          output->mailbox().post_result({c.id, mon::AckOutcome::kNone});
           continue;
         }
         const fw::MonitorUpdate u = monitor.acknowledge({c.level, c.event_sequence});
@@ -191,6 +193,7 @@ class Outputs {
                        .text("outcome", mon::ack_outcome_name(u.acknowledgement))
                        .close());
         handle(u);
+        output->mailbox().post_result({c.id, u.acknowledgement});
       }
     }
   }
@@ -559,6 +562,13 @@ void add_options(CLI::App& app, Options& opt) {
                  "Modbus TCP server at HOST:PORT (modbus.listen; docs/integration.md)");
   app.add_flag("--modbus-writes", c.modbus_writes,
                "the acknowledge and reset coils may be written (modbus.writes)");
+  app.add_flag_callback(
+      "--modbus-map",
+      [] {
+        std::fputs(fw::modbus::map_csv().c_str(), stdout);
+        throw CLI::Success();
+      },
+      "print the Modbus map this program serves (CSV, as share/plinth/modbus-map.csv) and exit");
   app.add_option("--mqtt", c.mqtt_broker, "publish to the MQTT broker at HOST:PORT (mqtt.broker)");
   app.add_option("--mqtt-box-id", c.mqtt_box_id, "the box's id in the topics (mqtt.box_id)");
   app.add_option("--mqtt-username", c.mqtt_username, "MQTT user name (mqtt.username)");
