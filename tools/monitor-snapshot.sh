@@ -160,11 +160,15 @@ if [ "$network" = 1 ]; then
     echo "monitor-snapshot: no '$2' in $1 within $3 s" >&2
     return 1
   }
-  # The 32 input registers but those that count with the wall clock (1 heartbeat, 12-13 uptime,
-  # 14-15 samples fed: the replay goes on), "address value".
+  # The input registers 0-38 but those that count with the wall clock (1 heartbeat, 12-13
+  # uptime, 14-15 samples fed: the replay goes on), then the discrete inputs (one per level),
+  # "input|discrete address value" (the git description, registers 39-70, is the build's).
   registers() {
-    mbpoll -m tcp -t 3 -0 -r 0 -c 32 -1 -o 2 -p "$1" 127.0.0.1 2>/dev/null |
-      sed -n 's/^\[\([0-9]*\)\]:[[:space:]]*\([0-9]*\).*/\1 \2/p' | grep -vE '^(1|12|13|14|15) '
+    local t
+    for t in 3:input:39 1:discrete:5; do
+      mbpoll -m tcp -t "${t%%:*}" -0 -r 0 -c "${t##*:}" -1 -o 2 -p "$1" 127.0.0.1 2>/dev/null |
+        sed -n "s/^\\[\\([0-9]*\\)\\]:[[:space:]]*\\([0-9]*\\).*/$(echo "$t" | cut -d: -f2) \\1 \\2/p"
+    done | grep -vE '^input (1|12|13|14|15) '
   }
   # test_modbus.sh: after the overturn (a steady state), then the acknowledge coil; the lines
   # but the acknowledgement's times (the command comes at a wall-clock moment).
@@ -222,7 +226,8 @@ for line in sys.stdin:
     topic, payload = line.rstrip("\n").split(" ", 1)
     if topic.endswith("/state"):
         d = json.loads(payload)
-        d.pop("time"); d.pop("t"); d.pop("heartbeat")
+        for key in ("time", "t", "heartbeat", "version"):
+            d.pop(key, None)
         payload = json.dumps(d)
     print(topic, payload)' >"$out/mqtt/retained.txt"
   kill "$broker"
