@@ -94,10 +94,10 @@ TEST(ModbusMap, ASnapshotsRegisters) {
     EXPECT_EQ(image.discrete_inputs[static_cast<std::size_t>(level)], level == 2 ? 1 : 0) << level;
   }
   // The version: the numbers of kProjectVersion, the description two characters a register.
-  const std::string version = std::to_string(at(reg::kVersionMajor)) + "." +
+  const std::string numbers = std::to_string(at(reg::kVersionMajor)) + "." +
                               std::to_string(at(reg::kVersionMinor)) + "." +
                               std::to_string(at(reg::kVersionPatch));
-  EXPECT_EQ(version, kProjectVersion);
+  EXPECT_EQ(numbers, version::kProjectVersion);
   std::string description;
   for (int i = 0; i < reg::kGitDescriptionWords; ++i) {
     for (const int shift : {8, 0}) {
@@ -105,7 +105,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
       if (c != '\0') description += c;
     }
   }
-  EXPECT_EQ(description, std::string(kGitDescription).substr(0, 64));
+  EXPECT_EQ(description, std::string(version::kGitDescription).substr(0, 64));
 }
 
 TEST(ModbusMap, NoValueReads65535) {
