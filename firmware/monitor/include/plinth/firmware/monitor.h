@@ -1,64 +1,10 @@
-// The box's loop, without the operating system: CAN frames (or decoded sensor samples) in;
-// sensor health, conditioning, one planar estimator per modelled axis, the overturning risk
-// and the alarm policy; a status and alarm events out. Freestanding like lib/core: no heap, no
-// exceptions; everything is sized at compile time and set up once by start().
-//
-//   frame --codec--> SensorSample --SensorHealthTracker (one per sensor)--> fed samples
-//     --Conditioner (one per sensor)--> acceleration in the statue frame (m/s2), kept in the
-//     sensor's history (its last kSensorHistory samples)
-//   the primary ground sensor's samples --an ensemble of PlanarEstimators per axis (x: statue
-//     axis 1, y: axis 2; z feeds g + v_G''; member 0 the nominal statue, the others the corners
-//     of the scene's declared uncertainty)--> phase, state per member --overturning_risk--> the
-//     worst member's risk; --Forecaster per axis (forecast.h)--> the probability of a collapse
-//     within the horizon, its worst member and time --AlarmPolicy--> level, events
-//   events, and the status at status_interval_s --can_frames.h--> frames ready to send (with
-//     each status, while forecasting, a CollapseForecast per axis that has a forecast)
-//   the other ground sensors' samples --cross-check against the primary--> disagreement
-//   the plate sensor's samples --compared with the model's base acceleration--> residual
-//
-// Sensors. Up to kMaxSensors accelerometers, each with its own node, role, health tracker and
-// conditioner (unit, mounting rotation, offset). The single-sensor form (sensor_count = 0) is
-// one ground sensor: ground_node, conditioning, sensor_health.
-//  - Ground sensors (at least one): the primary drives the estimators. It is the first usable
-//    ground sensor in configured order (usable: health not fault, conditioning ready) when the
-//    estimators start; afterwards it stays primary until it faults (no switching back when an
-//    earlier sensor recovers: every switch is a seam in the estimators' input). Then the first
-//    usable ground sensor in configured order takes over (a failover): when the new primary's
-//    history continues the stream within the bridge limit ((max_bridge_samples + 1) sample
-//    periods after the last sample the estimators took), the estimators continue from their
-//    state on its samples (a short seam is bridged by linear interpolation); otherwise they
-//    start again at rest on its newest sample, as after a fault. With no usable ground sensor
-//    left, the primary's fault is the fault level, as with one sensor.
-//  - Cross-check: each other usable ground sensor's samples are paired with the primary's at
-//    the same receive time (linear interpolation between the primary's two samples around it,
-//    or its nearest sample within one period; samples of different nodes are not synchronous)
-//    and the RMS of the difference (all three axes, m/s2) over redundancy.window_s is compared
-//    with redundancy.tolerance_m_s2. Beyond it the sensors disagree: counted, reported, and the
-//    alarm policy's fault input is raised with cause kSensorDisagreement (the estimators' input
-//    is not trusted while two sensors of the same ground disagree; the alarm policy never hides
-//    an alarm behind a fault). Which of the two is wrong is not decided.
-//  - Plate sensor (at most one, on the isolation plate): its horizontal acceleration measures
-//    the base's absolute acceleration u'' + u_G''. It never drives the estimators; it is paired
-//    with the estimators' own u'' + u_G'' (Simulator::accelerations() of the current mode, plus
-//    the ground's) and the RMS of the difference over plate.window_s is the model-mismatch
-//    residual, beyond plate.threshold_m_s2 a mismatch: counted and reported (degraded), and
-//    raising the fault level with kSensorDisagreement only when plate.raises_fault (impacts at
-//    the stops and on the block make the residual jump while the model is right).
-//  - A sensor other than the one driving the estimators in fault (a lost redundant or plate
-//    sensor), a disagreement or a mismatch make the sensors' state degraded (status, summary).
-//
-// Time: monitor time is ns since the first sensor sample's receive time. The estimator starts
-// (at rest, full contact) with the first sample that conditioning marks ready, and starts again
-// at rest on a sample the health tracker marks `restart` (after a fault nothing is known of
-// what happened meanwhile; the fault level shows it).
-//
-// Start-up rule (docs/monitor.md): the estimators' offset and initial state (at rest) are
-// trusted only when a window that passed conditioning's quietness test ends at the sample they
-// start on (`calibrated`). Any other start (after a sensor fault, a failover without
-// continuity) leaves them uncalibrated: they run, but the primary's conditioner verifies a new
-// window and they are calibrated when one passes. The level is never normal while the
-// estimators do not run or are not calibrated: the alarm policy's fault, cause kNotCalibrated
-// (an alarm still shows above it).
+// The box's loop, without the operating system: the monitor's inputs (a sensor's sample, a
+// tick, an operator's acknowledgement) in; one update out for each, which the outputs read
+// alone. Its rooms (docs/monitor-components.md, The monitor's rooms): the sensors (sensor_set.h),
+// the statues of each axis (lib/core ensemble.h), the alarm inputs (alarm_inputs.h) and the
+// alarm policy (lib/monitor), the frames to send (can_frames.h); the bus's frames come in
+// through frame_decoder.h. Freestanding like lib/core: no heap, no exceptions; everything is
+// sized at compile time and set up once by start().
 #pragma once
 
 #include <array>
@@ -68,17 +14,13 @@
 
 #include "plinth/core/ensemble.h"
 #include "plinth/core/error.h"
-#include "plinth/core/estimator.h"
 #include "plinth/core/events.h"
-#include "plinth/core/forecast.h"
 #include "plinth/core/real.h"
 #include "plinth/core/scene.h"
 #include "plinth/firmware/box_status.h"
 #include "plinth/firmware/config.h"
 #include "plinth/firmware/sensor_set.h"
 #include "plinth/hal/can_codec.h"
-#include "plinth/hal/frame_io.h"
-#include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/conditioning.h"
 #include "plinth/monitor/sensor_health.h"
@@ -107,6 +49,17 @@ struct MonitorUpdate {
   std::size_t frame_count = 0;
 };
 
+// Each input: the sensors take it (health, conditioning, failover, cross-checks), the
+// estimators take what the primary sensor has for them, the axes' status is read from the
+// ensembles, the alarm policy is told (alarm_inputs.h), and the update gets the alarm events
+// and, when a status is due, the status frames.
+//
+// Time: monitor time is ns since the first sensor sample's receive time, never going back.
+// The estimators start (at rest, full contact) on the primary's first conditioned sample, and
+// again on a seam (a sensor fault ended, a failover that cannot continue the stream). They are
+// calibrated only when they start right after a window that passed conditioning's quietness
+// test; else the primary's conditioner verifies a new window, and until then the level is
+// fault, cause not_calibrated (docs/monitor.md, Start-up and restart).
 class Monitor {
  public:
   Monitor() = default;
