@@ -100,8 +100,8 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
     if (sensors_.condition(sensor, fed.fed[i], quiet())) status_.calibrated = true;
     feed_estimators();
   }
-  sensors_.update_primary();
-  feed_estimators();
+  // The estimators took every input the primary had; a new primary may have more.
+  if (sensors_.update_primary()) feed_estimators();
   sensors_.cross_check();
   evaluate(update);
 }
@@ -148,10 +148,7 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   const Ensemble& statues = ensemble(axis_index);
   axis.mode = statues.nominal().mode();
   axis.state = statues.nominal().state();
-  const EnsembleRisk risk = statues.risk();
-  axis.risk = risk.worst;
-  axis.nominal_risk = risk.nominal;
-  axis.worst_member = risk.worst_member;
+  statues.risk(axis);
   axis.forecast = statues.forecaster().latest();
 }
 
@@ -256,8 +253,7 @@ MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
   if (have_epoch_) {
     sensors_.tick(receive_time_ns);
     status_.time_ns = monitor_time(receive_time_ns);
-    sensors_.update_primary();
-    feed_estimators();
+    if (sensors_.update_primary()) feed_estimators();
     sensors_.cross_check();
   }
   evaluate(update);

@@ -108,18 +108,18 @@ bool SensorSet::condition(int sensor, const monitor::FedSample& sample, bool qui
     restart_check(sensor);
   }
   s.history.push({sample.time_ns, c.ground_m_s2, sample.restart});
-  update_primary();
+  (void)update_primary();
   return trusted_again;
 }
 
-void SensorSet::update_primary() {
+bool SensorSet::update_primary() {
   SensorSetStatus& status = *status_;
-  if (status.primary >= 0 && usable(status.primary)) return;
+  if (status.primary >= 0 && usable(status.primary)) return false;
   int candidate = -1;
   for (int i = 0; i < count_ && candidate < 0; ++i) {
     if (usable(i)) candidate = i;
   }
-  if (candidate < 0 || candidate == status.primary) return;
+  if (candidate < 0 || candidate == status.primary) return false;
   const History& h = sensors_[static_cast<std::size_t>(candidate)].history;
   if (status.primary >= 0) ++status.failovers;
   status.primary = candidate;
@@ -149,6 +149,7 @@ void SensorSet::update_primary() {
     restart_pending_ = true;
     align_pending_ = false;
   }
+  return true;
 }
 
 bool SensorSet::next_input(EstimatorInput& input) {

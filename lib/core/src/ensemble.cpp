@@ -47,18 +47,18 @@ bool Ensemble::in_full_contact() const {
   return contact;
 }
 
-EnsembleRisk Ensemble::risk() const {
-  EnsembleRisk r;
+void Ensemble::risk(EnsembleRisk& out) const {
+  out.risk = Risk{};
+  out.worst_member = 0;
   for (std::size_t m = 0; m < scenes_.size(); ++m) {
     const PlanarEstimator& e = members_[m];
     const Risk member = overturning_risk(scenes_[m], e.mode(), e.state(), risk_);
-    if (m == 0) r.nominal = member;
-    if (m == 0 || member.total > r.worst.total) {
-      r.worst = member;
-      r.worst_member = static_cast<int>(m);
+    if (m == 0) out.nominal_risk = member;
+    if (m == 0 || member.total > out.risk.total) {
+      out.risk = member;
+      out.worst_member = static_cast<int>(m);
     }
   }
-  return r;
 }
 
 Real Ensemble::base_acceleration() const {

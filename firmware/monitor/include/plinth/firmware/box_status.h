@@ -7,6 +7,7 @@
 #include <array>
 #include <cstdint>
 
+#include "plinth/core/ensemble.h"
 #include "plinth/core/forecast.h"
 #include "plinth/core/risk.h"
 #include "plinth/core/state.h"
@@ -16,13 +17,12 @@
 
 namespace plinth::firmware {
 
-struct AxisStatus {
+// One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box
+// without ensemble) and the rest.
+struct AxisStatus : EnsembleRisk {
   Mode mode;  // the nominal statue's (member 0)
   State state = State::Zero();
-  Risk risk;             // the worst member's (the highest total)
-  Risk nominal_risk;     // member 0's: the scene file's statue alone, as a box without ensemble
   int members = 1;       // the ensemble's size
-  int worst_member = 0;  // whose risk that is
   ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
   // Monitor time, s, of that forecast's first collapse (its worst member's); -1: none forecast.
   double collapse_forecast_s = -1.0;

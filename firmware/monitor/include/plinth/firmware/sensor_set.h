@@ -68,8 +68,9 @@ class SensorSet {
   // else the first usable ground sensor in configured order takes over. After the estimators
   // ran (a failover) they continue on its history when it holds the stream on from their
   // newest sample within the bridge limit ((max_bridge_samples + 1) periods); else they start
-  // again at rest on its newest sample.
-  void update_primary();
+  // again at rest on its newest sample. True when the primary changed (the estimators have
+  // inputs from the new one).
+  bool update_primary();
   // The estimators' next input from the primary's history; false when they have taken all.
   [[nodiscard]] bool next_input(EstimatorInput& input);
   // The model's absolute base acceleration u'' + u_G'' (m/s2, per modelled axis in x, y) at

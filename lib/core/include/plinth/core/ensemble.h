@@ -23,9 +23,9 @@ namespace plinth {
 
 // The members' risks combined.
 struct EnsembleRisk {
-  Risk worst;            // the member with the highest total (the first of equals)
-  Risk nominal;          // member 0's: the scene file's statue alone
-  int worst_member = 0;  // whose risk `worst` is
+  Risk risk;             // the worst member's: the highest total (the first of equals)
+  Risk nominal_risk;     // member 0's: the scene file's statue alone
+  int worst_member = 0;  // whose `risk` that is
 };
 
 class Ensemble {
@@ -51,7 +51,8 @@ class Ensemble {
 
   // Every member in full contact.
   [[nodiscard]] bool in_full_contact() const;
-  [[nodiscard]] EnsembleRisk risk() const;
+  // The members' risks (the status keeps them in place: AxisStatus is an EnsembleRisk).
+  void risk(EnsembleRisk& out) const;
   // The nominal statue's absolute base acceleration u'' + u_G'' (Simulator::accelerations() of
   // its mode, plus the ground's), m/s2.
   [[nodiscard]] Real base_acceleration() const;
