@@ -156,7 +156,7 @@ class Outputs {
       print_line(fw::status_json(s, t_origin_));
       ++snapshot_.statuses;
     }
-    if (trace != nullptr) trace->after_update(monitor_);
+    if (trace != nullptr) trace->after_update(u, monitor_);
     post_snapshot(s);
   }
 

@@ -31,8 +31,8 @@ SampleTrace::SampleTrace(const std::string& path, int axis_count, double t_origi
   std::fputc('\n', file_.get());
 }
 
-void SampleTrace::after_update(const Monitor& monitor) {
-  const BoxStatus& s = monitor.status();
+void SampleTrace::after_update(const MonitorUpdate& update, const Monitor& monitor) {
+  const BoxStatus& s = *update.status;
   if (s.newest_sample_time_ns == last_sample_ns_) return;
   last_sample_ns_ = s.newest_sample_time_ns;
   std::FILE* f = file_.get();
