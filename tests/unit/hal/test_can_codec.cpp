@@ -17,7 +17,7 @@
 
 #include "dbc_file.h"
 
-namespace plinth::can {
+namespace plinth::hal::can {
 namespace {
 
 using testing::Dbc;
@@ -1096,4 +1096,4 @@ TEST(CanDbc, EveryMessageAndSignalIsDocumented) {
 }
 
 }  // namespace
-}  // namespace plinth::can
+}  // namespace plinth::hal::can

@@ -3,6 +3,8 @@
 // its static_asserts: firmware/monitor/src/can_frames.cpp). Freestanding.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include "plinth/core/name_table.h"
@@ -56,6 +58,15 @@ inline constexpr NameTable<AlarmCause, 12> kAlarmCauseNames{{{
     {AlarmCause::kCollapseForecast, "collapse_forecast"},
     {AlarmCause::kNotCalibrated, "not_calibrated"},
 }}};
+
+// The levels the risk raises, lowest first (neither normal nor fault): the ones plinth-eval
+// scores (lib/host eval_metrics.h).
+inline constexpr std::array<AlarmLevel, 3> kRiskLevels{AlarmLevel::kAdvisory, AlarmLevel::kWarning,
+                                                       AlarmLevel::kAlarm};
+// The position of a risk level in kRiskLevels.
+[[nodiscard]] constexpr std::size_t risk_level_index(AlarmLevel level) {
+  return static_cast<std::size_t>(level) - static_cast<std::size_t>(AlarmLevel::kAdvisory);
+}
 
 [[nodiscard]] constexpr const char* alarm_level_name(AlarmLevel level) {
   return kAlarmLevelNames.name(level);
