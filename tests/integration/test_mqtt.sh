@@ -97,45 +97,46 @@ if ! start_broker; then
 fi
 
 # restart_replay BOX_ID [KEY = VALUE lines]: Brienza x20 at --speed 2 through a box on the TLS
-# listener with a password; the broker stops once the level is back to normal and starts again
-# after the alarm, so the advisory, warning and alarm events happen while it is away. A
-# persistent subscriber takes the events topic. Sets rc; leaves $TMP/box.out, box.err and
-# events.out.
+# listener with a password; the broker stops once the normal event reached the subscriber and
+# starts again after the alarm, so the advisory, warning and alarm events happen while it is
+# away. On a loaded machine the subscriber can run seconds behind the box (whose replay keeps
+# to the wall clock), and the advisory may reach the broker before it stops: the scenario did
+# not happen, and is run again (up to 3 times) rather than judged. A persistent subscriber
+# takes the events topic. Sets rc; leaves $TMP/box.out, box.err and events.out.
 restart_replay() {
-  local box=$1
+  local box=$1 attempt
   shift
   printf '[mqtt]\nbroker = "127.0.0.1:%s"\nbox_id = "%s"\nusername = "box"\n' "$TLS" "$box" \
     >"$TMP/box.toml"
   printf '%s\n' 'password_file = "box.pw"' 'tls_ca_file = "ca.crt"' 'reconnect_min_s = 0.1' \
     'reconnect_max_s = 0.5' 'state_interval_s = 0.2' "$@" >>"$TMP/box.toml"
-  mosquitto_sub "${WATCH[@]}" -c -i "watcher-$box" -q 1 -v -t "plinth/$box/events" \
-    >"$TMP/events.out" 2>"$TMP/events.err" &
-  local watcher=$!
-  sleep 1
-  "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
-    --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
-  BOX=$!
-  # The box is held (SIGSTOP) as soon as it writes its normal event, until that event reached
-  # the subscriber and the broker stopped: on a loaded machine the subscriber runs seconds behind
-  # the box, and the advisory would otherwise reach the broker before it stops.
-  if wait_for "$TMP/box.out" '"level": "normal"' 30 && kill -STOP "$BOX" &&
-    wait_for "$TMP/events.out" '"level": "normal"' 30; then
-    sleep 0.5
-    stop_broker
-    kill -CONT "$BOX"
-    wait_for "$TMP/box.out" '"level": "alarm", "previous"' 30
+  for attempt in 1 2 3; do
+    mosquitto_sub "${WATCH[@]}" -c -i "watcher-$box-$attempt" -q 1 -v -t "plinth/$box/events" \
+      >"$TMP/events.out" 2>"$TMP/events.err" &
+    local watcher=$!
     sleep 1
-    start_broker || fail "mqtt: the broker starts again" "$(tail -n 3 "$TMP/broker.log")"
-  else
-    kill -CONT "$BOX" 2>/dev/null
-    fail "mqtt: replay" "no normal level within 30 s"
-  fi
-  wait "$BOX"
-  rc=$?
-  BOX=
-  sleep 2
-  kill "$watcher" 2>/dev/null
-  wait "$watcher" 2>/dev/null
+    "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
+      --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
+    BOX=$!
+    local happened=1
+    if wait_for "$TMP/events.out" '"level": "normal"' 30; then
+      stop_broker
+      grep -qE '"level": "(advisory|warning|alarm)"' "$TMP/events.out" && happened=0
+      wait_for "$TMP/box.out" '"level": "alarm", "previous"' 30
+      sleep 1
+      start_broker || fail "mqtt: the broker starts again" "$(tail -n 3 "$TMP/broker.log")"
+    else
+      fail "mqtt: replay" "no normal level within 30 s"
+    fi
+    wait "$BOX"
+    rc=$?
+    BOX=
+    sleep 2
+    kill "$watcher" 2>/dev/null
+    wait "$watcher" 2>/dev/null
+    ((happened)) && return
+    echo "# mqtt: $box: the advisory reached the broker before it stopped (attempt $attempt)"
+  done
 }
 
 # check_events PYTHON: the alarm lines of box.out (alarms), the payloads received (received,
