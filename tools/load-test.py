@@ -302,20 +302,30 @@ def free_port():
         return s.getsockname()[1]
 
 
+def write_input(path, seconds, quake_at, record, scale):
+    """The sensor's input at RATE_HZ: quiet (a 1 LSB dither, as a real sensor's noise: the
+    stuck-sensor check stays quiet) but for the record scaled from quake_at on, CSV in g with
+    few digits (an hour at 1000 Hz is 51 MB, under the 64 MiB a record may have)."""
+    dt, values_g = e2e_can.read_at2(record)
+    n_total = round(seconds * RATE_HZ)
+    first = round(quake_at * RATE_HZ)
+    last = min(n_total, first + round(len(values_g) * dt * RATE_HZ))
+    quiet = ["0", f"{e2e_can.RESOLUTION_G:g}", "0", f"{-e2e_can.RESOLUTION_G:g}"]
+    with open(path, "w") as out:
+        out.write(f"t,{Path(record).stem} [g]\n")
+        for k in range(n_total):
+            if first <= k < last:
+                a = f"{scale * e2e_can.value_at(dt, values_g, (k - first) / RATE_HZ):.6g}"
+            else:
+                a = quiet[k % 4]
+            out.write(f"{k / RATE_HZ:.3f},{a}\n")
+    return n_total
+
+
 def prepare(args, work):
-    dt, values_g = e2e_can.read_at2(args.record)
     quake_at = args.lead + min(5.0, args.stall / 2)  # while the broker is stalled
     input_s = args.lead + args.stall + args.drop + args.tail
-    record_s = min(len(values_g) * dt, input_s - quake_at)
-    n_quiet = round(quake_at * RATE_HZ)
-    n_record = round(record_s * RATE_HZ)
-    n_tail = round(input_s * RATE_HZ) - n_quiet - n_record
-    quiet = [d * e2e_can.RESOLUTION_G * e2e_can.G0 for d in e2e_can.DITHER]
-    samples = [quiet[k % 4] for k in range(n_quiet)]
-    samples += [args.scale * e2e_can.value_at(dt, values_g, k / RATE_HZ) * e2e_can.G0
-                for k in range(n_record)]
-    samples += [quiet[k % 4] for k in range(n_tail)]
-    e2e_can.write_csv(work / "input.csv", Path(args.record).stem, RATE_HZ, samples)
+    n_samples = write_input(work / "input.csv", input_s, quake_at, args.record, args.scale)
     # cangen's share: 90 % of the bus in frames per second, less the sensor's frames.
     total_fps = args.bus_load * BUS_BITRATE / FRAME_BITS
     cangen_fps = total_fps - RATE_HZ
@@ -329,7 +339,7 @@ def prepare(args, work):
         "target_fps": total_fps, "cangen_burst": burst, "cangen_gap_ms": gap_ms,
         "stall_at_s": args.lead, "stall_s": args.stall, "drop_s": args.drop,
         "where": args.where, "broker_port": free_port(), "modbus_port": free_port(),
-        "input_samples": len(samples),
+        "input_samples": n_samples,
     }
     (work / "config.json").write_text(json.dumps(config, indent=1) + "\n")
     return config
@@ -511,7 +521,13 @@ def main():
     ap.add_argument("--port", type=int, help=argparse.SUPPRESS)
     ap.add_argument("--duration", type=float, help=argparse.SUPPRESS)
     ap.add_argument("--out", help=argparse.SUPPRESS)
+    ap.add_argument("--write-input", help=argparse.SUPPRESS)  # FILE: tools/soak.sh's input
+    ap.add_argument("--seconds", type=float, help=argparse.SUPPRESS)
+    ap.add_argument("--quake-at", type=float, help=argparse.SUPPRESS)
     args = ap.parse_args()
+    if args.write_input:
+        print(write_input(args.write_input, args.seconds, args.quake_at, args.record, args.scale))
+        return 0
     if args.modbus_clients:
         return modbus_clients(args.port, args.modbus_clients, args.poll_hz, args.duration,
                               args.out)
