@@ -237,6 +237,10 @@ bool MqttPublisher::publish(const std::string& topic, const std::string& payload
 // The loop's alarm events into the queue (bounded), its newest snapshot into the state.
 void MqttPublisher::take_mailbox(std::int64_t now_ns) {
   take_results();
+  if (mailbox_.events_dropped() != mailbox_dropped_seen_) {  // the loop's ring was full
+    mailbox_dropped_seen_ = mailbox_.events_dropped();
+    say_dropped();
+  }
   AlarmNotice notice;
   while (mailbox_.take_alarm(notice)) {
     // The oldest waiting event makes room; never the one the broker may be acknowledging.
@@ -248,6 +252,7 @@ void MqttPublisher::take_mailbox(std::int64_t now_ns) {
         queue_.pop_front();
       }
       ++events_dropped_;
+      say_dropped();
     }
     queue_.push_back({alarm_json(notice.event, notice.t_origin), {}});
     most_queued_ = std::max(most_queued_, queue_.size());
@@ -260,6 +265,17 @@ void MqttPublisher::take_mailbox(std::int64_t now_ns) {
   state_ = s;
   have_state_ = true;
   if (changed || now_ns - state_sent_ns_ >= ns_of(settings_.state_interval_s)) state_due_ = true;
+}
+
+// An overflow is said at once, then again each time the count doubles (1, 2, 4, ...): a long
+// outage does not flood the journal, and the count is also in the state (events_dropped).
+void MqttPublisher::say_dropped() {
+  const std::uint64_t dropped = events_dropped_ + mailbox_.events_dropped();
+  if (dropped < next_drop_report_) return;
+  next_drop_report_ = 2 * dropped;
+  say("alarm event queue full (mqtt.event_queue = " + std::to_string(settings_.event_queue) +
+      ", the broker at " + endpoint_text_ + " away): the oldest waiting event dropped, " +
+      std::to_string(dropped) + " so far");
 }
 
 void MqttPublisher::try_connect(std::int64_t now_ns) {
@@ -528,6 +544,7 @@ std::string MqttPublisher::state_json() const {
       .raw("sensor_counters", counters)
       .count("estimator_restarts", s.estimator_restarts)
       .count("heartbeat", s.statuses)
+      .count("events_dropped", events_dropped_ + mailbox_.events_dropped())
       .raw("version", JsonObject()
                           .text("project", kProjectVersion)
                           .text("git", kGitDescription)

@@ -91,6 +91,7 @@ class MqttPublisher final : public StatusOutput {
   void publish_head(std::int64_t now_ns);
   void publish_state(std::int64_t now_ns);
   void lost(const std::string& reason, std::int64_t now_ns);
+  void say_dropped();
   void back_off(std::int64_t now_ns);
   void say_offline();
   void publish_discovery();
@@ -149,6 +150,8 @@ class MqttPublisher final : public StatusOutput {
   std::uint64_t connections_lost_ = 0;
   std::uint64_t events_published_ = 0;  // acknowledged by the broker
   std::uint64_t events_dropped_ = 0;    // the queue was full: the oldest went
+  std::uint64_t next_drop_report_ = 1;     // say_dropped() speaks at this count
+  std::uint64_t mailbox_dropped_seen_ = 0;
   std::uint64_t events_republished_ = 0;
   std::uint64_t states_published_ = 0;
   std::size_t most_queued_ = 0;

@@ -199,8 +199,12 @@ assert received == alarms[:2] + alarms[3:], "received %s of %s" % (seq(received)
 assert mqtt["events_dropped"] == 1 and mqtt["events_published"] == len(alarms) - 1, mqtt
 assert mqtt["most_queued"] == 1, mqtt
 ')
+if ! grep -q 'alarm event queue full (mqtt.event_queue = 1, .*): the oldest waiting event dropped, 1 so far' \
+  "$TMP/box.err"; then
+  problem="${problem}the overflow was not said on stderr: $(head -c 300 "$TMP/box.err")"
+fi
 if ((rc == 0)) && [[ -z "$problem" ]]; then
-  pass "mqtt: a full queue drops its oldest event and counts it"
+  pass "mqtt: a full queue drops its oldest event, counts it and says so"
 else
   fail "mqtt: bounded queue" "exit $rc; $problem"
 fi
