@@ -16,7 +16,8 @@ vcan0 at 1000 Hz, fed the same input by plinth-replay (the sensor node):
 Then it prints, from this one run: samples sent and lost, the sample-to-status latency
 (plinth-monitor --latency: a sensor frame's arrival in the loop to its status ready) median
 and p99 idle and loaded and their ratios, the alarm events the box printed and those the
-witness (mosquitto_sub, QoS 1, subscribing again at each reconnection) received after the broker came back, the
+witness (mosquitto_sub, a persistent QoS 1 session on a broker saving it every second, so
+it outlives the kill) received after the broker came back, the
 queue's high-water mark and overflow counter, the Modbus answers and the bus load reached, the
 box's file descriptors and memory. --check exits 1 when a sample or an alarm event was lost,
 an answer was wrong, or the box's descriptors grew; --max-p99-ratio R also when the loaded
@@ -167,7 +168,9 @@ class Scenario:
     def broker(self):
         conf = self.work / "broker.conf"
         conf.write_text(f"listener {self.broker_port} 127.0.0.1\nallow_anonymous true\n"
-                        "persistence false\nmax_queued_messages 100000\n")
+                        # The witness's session survives the broker's kill: saved every second.
+                        f"persistence true\npersistence_location {self.work}/\n"
+                        "autosave_interval 1\nmax_queued_messages 100000\n")
         p = self.start("broker", [shutil.which("mosquitto") or "/usr/sbin/mosquitto", "-c",
                                   str(conf)])
         if not self.wait_port(self.broker_port, 20):
@@ -196,6 +199,8 @@ class Scenario:
             f'[mqtt]\nbroker = "127.0.0.1:{self.broker_port}"\nbox_id = "{BOX_ID}"\n'
             f"state_interval_s = 0.1\n")
         broker = self.broker()
+        for db in self.work.glob("*.db"):
+            db.unlink()
         witness = self.start(f"{name}.witness", [
             "mosquitto_sub", "-h", "127.0.0.1", "-p", str(self.broker_port), "-c", "-i",
             f"witness-{name}", "-q", "1", "-t", f"plinth/{BOX_ID}/events"])
@@ -272,7 +277,15 @@ class Scenario:
             usage.append(self.box_usage(box.pid))
             box.send_signal(signal.SIGTERM)
         box.wait(60)
-        time.sleep(2.0)  # the witness takes what the box delivered last
+        # The witness takes what the box delivered last (it may reconnect after the box did).
+        alarms = sum('"type": "alarm"' in x
+                     for x in (self.work / f"{name}.box.out").read_text().splitlines())
+        for _ in range(120):
+            got = sum(x.startswith("{") for x in
+                      (self.work / f"{name}.witness.out").read_text().splitlines())
+            if got >= alarms:
+                break
+            time.sleep(0.5)
         witness.send_signal(signal.SIGTERM)
         witness.wait(10)
         broker.send_signal(signal.SIGTERM)

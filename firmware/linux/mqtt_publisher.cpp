@@ -185,6 +185,7 @@ void MqttPublisher::stop() {
 }
 
 void MqttPublisher::on_connect(int rc) {
+  answered_ = true;
   if (rc != 0) {
     ++refusals_;
     const std::string problem =
@@ -280,9 +281,18 @@ void MqttPublisher::say_dropped() {
 
 void MqttPublisher::try_connect(std::int64_t now_ns) {
   if (now_ns < next_attempt_ns_) return;
+  if (socket_open_ && !answered_) {  // the attempt before never reached the broker
+    ++connect_failures_;  // said once while it lasts, whatever the back-off has grown to
+    say_problem("cannot reach the broker at " + endpoint_text_ +
+                ": the connection attempt was not answered");
+  }
   // A new session each time: libmosquitto keeps the unacknowledged publishes and sends them
-  // again once the broker accepted it.
-  const int rc = mosquitto_connect(client_, host_.c_str(), port_, settings_.keepalive_s);
+  // again once the broker accepted it. Asynchronous: a broker that never answers the TCP
+  // handshake (a host gone behind a firewall, a stalled broker's full accept queue) held a
+  // blocking connect ~130 s, the events undrained and stop() waiting that long past its flush
+  // bound; mosquitto_loop completes the connection.
+  answered_ = false;
+  const int rc = mosquitto_connect_async(client_, host_.c_str(), port_, settings_.keepalive_s);
   if (rc == MOSQ_ERR_SUCCESS) {
     socket_open_ = true;
     next_attempt_ns_ = now_ns + ns_of(backoff_s_);  // if the session never starts
@@ -295,6 +305,11 @@ void MqttPublisher::try_connect(std::int64_t now_ns) {
 
 // The connection is gone: say why (once), and try again after the back-off.
 void MqttPublisher::lost(const std::string& reason, std::int64_t now_ns) {
+  say_problem(reason);
+  back_off(now_ns);
+}
+
+void MqttPublisher::say_problem(const std::string& reason) {
   // libmosquitto's own error (a TLS certificate refused, ...) says more.
   const std::string why = error_log_.empty() ? reason : reason + " (" + error_log_ + ")";
   if (why != last_problem_) {
@@ -304,7 +319,6 @@ void MqttPublisher::lost(const std::string& reason, std::int64_t now_ns) {
     say(why + retry);
   }
   last_problem_ = why;
-  back_off(now_ns);
 }
 
 void MqttPublisher::back_off(std::int64_t now_ns) {
@@ -586,7 +600,10 @@ void MqttPublisher::run() {
       continue;
     }
     const int rc = mosquitto_loop(client_, kLoopTimeoutMs, 1);
-    if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED) {
+    if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED && !answered_) {
+      ++connect_failures_;  // the asynchronous connection failed (refused, unreachable, ...)
+      lost("cannot reach the broker at " + endpoint_text_ + ": " + error_text(rc), now);
+    } else if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED) {
       // on_disconnect counted it.
       lost("connection to " + endpoint_text_ + " lost: " + error_text(rc), now);
     } else if (rc == MOSQ_ERR_CONN_REFUSED) {

@@ -92,6 +92,7 @@ class MqttPublisher final : public StatusOutput {
   void publish_state(std::int64_t now_ns);
   void lost(const std::string& reason, std::int64_t now_ns);
   void say_dropped();
+  void say_problem(const std::string& reason);
   void back_off(std::int64_t now_ns);
   void say_offline();
   void publish_discovery();
@@ -121,6 +122,7 @@ class MqttPublisher final : public StatusOutput {
   // The thread's state.
   bool socket_open_ = false;  // a connection attempt or session is under way
   bool connected_ = false;    // the broker accepted the session
+  bool answered_ = false;     // the broker answered this attempt (CONNACK, accepted or not)
   std::int64_t next_attempt_ns_ = 0;
   double backoff_s_ = 0.0;
   std::string last_problem_;  // the latest message printed (printed again only when it changes)
