@@ -168,7 +168,10 @@ class Scenario:
     def broker(self):
         conf = self.work / "broker.conf"
         conf.write_text(f"listener {self.broker_port} 127.0.0.1\nallow_anonymous true\n"
-                        # The witness's session survives the broker's kill: saved every second.
+                        # The witness's session survives the broker's kill: saved every
+                        # second (as root, mosquitto would switch to its own user, who cannot
+                        # write the run's folder).
+                        + ("user root\n" if os.geteuid() == 0 else "") +
                         f"persistence true\npersistence_location {self.work}/\n"
                         "autosave_interval 1\nmax_queued_messages 100000\n")
         p = self.start("broker", [shutil.which("mosquitto") or "/usr/sbin/mosquitto", "-c",
