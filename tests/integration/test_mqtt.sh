@@ -204,8 +204,12 @@ assert received == alarms[:2] + alarms[3:], "received %s of %s" % (seq(received)
 assert mqtt["events_dropped"] == 1 and mqtt["events_published"] == len(alarms) - 1, mqtt
 assert mqtt["most_queued"] == 1, mqtt
 ')
+if ! grep -q 'alarm event queue full (mqtt.event_queue = 1, .*): the oldest waiting event dropped, 1 so far' \
+  "$TMP/box.err"; then
+  problem="${problem}the overflow was not said on stderr: $(head -c 300 "$TMP/box.err")"
+fi
 if ((rc == 0)) && [[ -z "$problem" ]]; then
-  pass "mqtt: a full queue drops its oldest event and counts it"
+  pass "mqtt: a full queue drops its oldest event, counts it and says so"
 else
   fail "mqtt: bounded queue" "exit $rc; $problem"
 fi
@@ -416,6 +420,53 @@ else
   fail "mqtt: wrong password" "stderr: $(head -c 300 "$TMP/stderr")"
 fi
 stop_broker
+
+# 3c. A broker that never answers the TCP handshake (a listener whose accept queue is full:
+#     the kernel drops the SYNs, as a firewall would): the box goes on, says so once, and stops
+#     within its flush bound after the input, not after the kernel's ~130 s of SYN retries per
+#     blocked connect (it took 270 s when the connect blocked).
+SILENT=$(free_port)
+python3 - "$SILENT" >"$TMP/silent.out" 2>&1 <<'PY' &
+import socket, sys, time
+port = int(sys.argv[1])
+server = socket.socket()
+server.bind(("127.0.0.1", port))
+server.listen(0)
+fillers = []
+for _ in range(3):  # fill the accept queue; later SYNs are dropped
+    c = socket.socket()
+    c.setblocking(False)
+    c.connect_ex(("127.0.0.1", port))
+    fillers.append(c)
+print("ready", flush=True)
+time.sleep(120)
+PY
+SILENT_PID=$!
+for _ in $(seq 50); do grep -q ready "$TMP/silent.out" && break; sleep 0.1; done
+started=$(date +%s)
+rc=0
+timeout 100 "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 4 --no-events \
+  --mqtt "127.0.0.1:$SILENT" --mqtt-box-id silent >"$TMP/silent.jsonl" 2>"$TMP/silent.err" || rc=$?
+took=$(($(date +%s) - started))
+kill "$SILENT_PID" 2>/dev/null
+problem=$(python3 - "$TMP/silent.jsonl" "$TMP/silent.err" "$took" <<'PY' 2>&1
+import json, sys
+summary = json.loads(open(sys.argv[1]).read().splitlines()[-1])
+mqtt = summary["mqtt"]
+err = open(sys.argv[2]).read()
+took = int(sys.argv[3])
+assert mqtt["connects"] == 0 and mqtt["connect_failures"] >= 2, mqtt
+assert mqtt["events_undelivered"] == summary["alarm_events"] and mqtt["events_dropped"] == 0, mqtt
+assert err.count("the connection attempt was not answered") == 1, err
+# 9 s of input at --speed 4, then at most the 10 s flush: far below one blocked connect.
+assert took <= 45, "stopped %d s after its start" % took
+PY
+)
+if ((rc == 0)) && [[ -z "$problem" ]]; then
+  pass "mqtt: a broker that never answers: said once, the events kept, stopped within the flush bound"
+else
+  fail "mqtt: unanswered broker" "exit $rc; $problem"
+fi
 
 # 4. Bad settings.
 run_args=(--scene "$ISOLATED" --replay "$AT2")
