@@ -140,6 +140,7 @@ class Outputs {
         ++totals.bus_send_errors;
       }
     }
+    if (u.regional_received) print_line(fw::regional_json(u.regional, s));  // before its events
     for (std::size_t i = 0; i < u.event_count; ++i) {
       const mon::AlarmEventRecord& e = u.events[i];
       print_line(fw::alarm_json(e, t_origin_));
@@ -152,7 +153,6 @@ class Outputs {
       if (e.level == mon::AlarmLevel::kWarning || e.level == mon::AlarmLevel::kAlarm) trigger(s, e);
       post_alarm(e);
     }
-    if (u.regional_received) print_line(fw::regional_json(u.regional, s));
     if (u.status_due) {
       print_line(fw::status_json(s, t_origin_));
       ++snapshot_.statuses;
