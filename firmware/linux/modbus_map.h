@@ -17,14 +17,16 @@
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
+#include "run_identity.h"
 #include "status_outputs.h"
 
 namespace plinth::firmware::modbus {
 
 inline constexpr std::uint16_t kNone = 0xFFFF;  // a register with no value (yet)
-inline constexpr std::uint16_t kMapVersion = 3;  // register 31; 2: holding registers, discrete
+inline constexpr std::uint16_t kMapVersion = 4;  // register 31; 2: holding registers, discrete
                                                  // inputs, causes 10-11, forecast, version;
-                                                 // 3: regional alerts (71-86), cause 15
+                                                 // 3: the files' digests; 4: regional
+                                                 // alerts (86-101), cause 15
 
 template <class Enum>
 struct Code {
@@ -129,8 +131,8 @@ static_assert(pins_every_value(kAckOutcomeCodes, monitor::kAckOutcomeNames));
 static_assert(pins_every_value(kRegionalRefusalCodes, monitor::kRegionalRefusalNames));
 
 // Registers (functions 03 and 04 read the same values), 0-based addresses. 32-bit values: two
-// registers, the high word first; text: two ASCII characters a register, the first in the high
-// byte, NUL-padded.
+// registers, the high word first; 64-bit values: four, the highest word first; text: two ASCII
+// characters a register, the first in the high byte, NUL-padded.
 namespace reg {
 inline constexpr int kAlarmLevel = 0;     // kAlarmLevelCodes
 inline constexpr int kHeartbeat = 1;      // status reports, modulo 65536
@@ -165,20 +167,29 @@ inline constexpr int kVersionMinor = 37;
 inline constexpr int kVersionPatch = 38;
 inline constexpr int kGitDescription = 39;  // kGitDescription, kGitDescriptionWords registers
 inline constexpr int kGitDescriptionWords = 32;  // 64 characters
+// Each file the box runs (run_identity.h): 1 while it was given, then its SHA-256's leading 64
+// bits (kDigestWords registers); a file not given reads 0, then kNone in each register.
+inline constexpr int kSceneGiven = 71;
+inline constexpr int kSceneSha256 = 72;
+inline constexpr int kSceneYGiven = 76;
+inline constexpr int kSceneYSha256 = 77;
+inline constexpr int kConfigGiven = 81;
+inline constexpr int kConfigSha256 = 82;
+inline constexpr int kDigestWords = 4;
 // Regional alerts (docs/regional.md): the worst held alert and the counters.
-inline constexpr int kRegionalHeld = 71;         // alerts held
-inline constexpr int kRegionalProbability = 72;  // of collapse under the worst, x 10000
-inline constexpr int kRegionalSArrivalIn = 73;   // 0.1 s to its S arrival, 0 once due; kNone
-inline constexpr int kRegionalPga = 74;          // its expected PGA, 0.001 g; kNone
-inline constexpr int kRegionalMagnitude = 75;    // its magnitude x 100; kNone
-inline constexpr int kRegionalDistance = 76;     // its epicentral distance, km; kNone
-inline constexpr int kRegionalEventId = 77;      // its event id (32 bits; 0 when none held)
-inline constexpr int kRegionalVersion = 79;      // its version; kNone
-inline constexpr int kRegionalReceived = 80;     // alerts received (32 bits)
-inline constexpr int kRegionalAccepted = 82;     // accepted (32 bits)
-inline constexpr int kRegionalRefused = 84;      // refused, every reason (32 bits)
-inline constexpr int kRegionalLastRefusal = 86;  // kRegionalRefusalCodes
-inline constexpr int kCount = 87;
+inline constexpr int kRegionalHeld = 86;         // alerts held
+inline constexpr int kRegionalProbability = 87;  // of collapse under the worst, x 10000
+inline constexpr int kRegionalSArrivalIn = 88;   // 0.1 s to its S arrival, 0 once due; kNone
+inline constexpr int kRegionalPga = 89;          // its expected PGA, 0.001 g; kNone
+inline constexpr int kRegionalMagnitude = 90;    // its magnitude x 100; kNone
+inline constexpr int kRegionalDistance = 91;     // its epicentral distance, km; kNone
+inline constexpr int kRegionalEventId = 92;      // its event id (32 bits; 0 when none held)
+inline constexpr int kRegionalVersion = 94;      // its version; kNone
+inline constexpr int kRegionalReceived = 95;     // alerts received (32 bits)
+inline constexpr int kRegionalAccepted = 97;     // accepted (32 bits)
+inline constexpr int kRegionalRefused = 99;      // refused, every reason (32 bits)
+inline constexpr int kRegionalLastRefusal = 101;  // kRegionalRefusalCodes
+inline constexpr int kCount = 102;
 }  // namespace reg
 
 // Discrete inputs (function 02): one per alarm level, 1 while that level is shown (exactly one
@@ -195,7 +206,7 @@ inline constexpr int kCount = 2;
 }  // namespace coil
 
 enum class Table : std::uint8_t { kRegister, kDiscreteInput, kCoil };
-enum class Type : std::uint8_t { kUint16, kUint32, kAscii, kBit };
+enum class Type : std::uint8_t { kUint16, kUint32, kUint64, kAscii, kBit };
 enum class Codes : std::uint8_t {
   kPlain,
   kAlarmLevel,
@@ -216,7 +227,7 @@ struct Point {
   const char* name;
   const char* scale;  // the quantity is the raw value times this
   const char* unit;   // of the quantity; "" for codes and counts
-  bool none;          // kNone (65535) means "no value"
+  bool none;          // kNone (65535; in each register of a uint64) means "no value"
   Codes codes;
   int bit_code;       // a discrete input: 1 while the field's code is this one; -1 otherwise
   const char* json;   // the field of the JSON lines with the same value, "" if none
@@ -224,7 +235,7 @@ struct Point {
 };
 
 // The rows, in the CSV's order: registers, discrete inputs, coils, each by address.
-inline constexpr std::size_t kPointCount = 51;
+inline constexpr std::size_t kPointCount = 57;
 [[nodiscard]] const std::array<Point, kPointCount>& points();
 
 // The values the server answers with.
@@ -233,8 +244,13 @@ struct Image {
   std::array<std::uint8_t, discrete::kCount> discrete_inputs{};
 };
 
-// The registers and discrete inputs of `snapshot`, with `alarm_events` alarm events so far.
+// The registers and discrete inputs of `snapshot`, with `alarm_events` alarm events so far; the
+// registers of the run's identity are left as they are.
 void fill(const StatusSnapshot& snapshot, std::uint64_t alarm_events, Image& out);
+
+// The registers that stay for a run: the version (36-70) and the files' digests (71-85), from
+// `identity`. Once, at start.
+void fill_identity(const RunIdentity& identity, Image& out);
 
 // modbus-map.csv: a header, then one line per point.
 [[nodiscard]] std::string map_csv();
