@@ -73,7 +73,9 @@ RegionalJson parse_regional_json(const std::string& payload, std::int64_t now_ut
   }
   bool cancelled = false;
   if (j.contains("cancelled")) {
-    if (!j["cancelled"].is_boolean()) return refused("cancelled", "cancelled: expected true or false");
+    if (!j["cancelled"].is_boolean()) {
+      return refused("cancelled", "cancelled: expected true or false");
+    }
     cancelled = j["cancelled"].get<bool>();
   }
   const double now_s = static_cast<double>(now_utc_ns) * 1e-9;
