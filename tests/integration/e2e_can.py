@@ -807,7 +807,7 @@ def run_checks(args):
               f"{j['jitter_max_us']:.0f} us over {j['frames_sent']} frames at --speed "
               f"{config['speed']:g} ({config['rate'] * config['speed']:g} frames/s)")
         print(f"  the record run took {figures['main_wall_s']:.2f} s (run "
-              f"{figures['main_attempts']} of at most 3)")
+              f"{figures['main_attempts']} of at most 5)")
         lo, hi = figures["bus_send_time_deviation_us"]
         print(f"  sensor frames on the bus vs k / (rate x speed): {lo:.0f} to {hi:.0f} us")
         print(f"  monitor timeline vs plinth-sim: {figures['timeline_vs_sim_us']:.1f} us "
