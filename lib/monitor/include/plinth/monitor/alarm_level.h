@@ -33,8 +33,6 @@ enum class AlarmCause : std::uint8_t {
   kInternalFault = 9,       // the monitor's own self-check failed
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet: nothing to vouch for
-  // 12-14: other branches' causes (outside_model, p_wave, the statue's sensor).
-  kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
 };
 
 // The names in status and alarm lines (also the DBC's VAL_ names).
@@ -46,7 +44,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 13> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 12> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -59,7 +57,6 @@ inline constexpr NameTable<AlarmCause, 13> kAlarmCauseNames{{{
     {AlarmCause::kInternalFault, "internal_fault"},
     {AlarmCause::kCollapseForecast, "collapse_forecast"},
     {AlarmCause::kNotCalibrated, "not_calibrated"},
-    {AlarmCause::kRegionalAlert, "regional_alert"},
 }}};
 
 // The levels the risk raises, lowest first (neither normal nor fault): the ones plinth-eval
