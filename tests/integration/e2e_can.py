@@ -213,7 +213,7 @@ class Dbc:
             raw = (word >> s.start) & mask
             if s.signed and raw >> (s.length - 1):
                 raw -= 1 << s.length
-            # an enumeration's names lie in its range (Cause's skip the reserved 12-14)
+            # an enumeration's names lie in its range (a table may skip reserved values)
             enumeration = s.values is not None and \
                 all(s.raw_min <= v <= s.raw_max for v in s.values)
             if enumeration and raw not in s.values:
