@@ -8,7 +8,8 @@
 #         (AMX): checked before it boots (tools/host-xstate-size.py, docs/can-e2e.md).
 #   qemu  Debian's kernel (linux-image-amd64) in qemu-system-x86_64, KVM where /dev/kvm is
 #         usable (booted again under TCG when KVM aborts the guest), TCG emulation otherwise; an
-#         initramfs built per run from busybox-static and the kernel's modules mounts the host's root through virtio-9p and sets up the bus. It can
+#         initramfs built per run from busybox-static and the kernel's modules mounts the host's
+#         root through virtio-9p and sets up the bus. It can
 #         also give the guest a gpio-sim chip (--gpio-sim; module: tools/build-gpio-sim.sh).
 # auto (the default) takes uml when it starts here, else qemu. See hal/README.md.
 #
