@@ -60,6 +60,7 @@ class RunSink final : public plinth::EventSink {
     if (events_out_ != nullptr) *events_out_ << plinth::host::event_json(e) << '\n';
     if (e.kind == EventKind::kImpact || e.kind == EventKind::kRockingStop) ++impacts;
     if (e.kind == EventKind::kBaseStopHit) ++base_stop_hits;
+    if (e.kind == EventKind::kLiftOff) lift_off = e;
     const char* side = e.side > 0 ? "right" : "left";
     char text[128];
     switch (e.kind) {
@@ -112,6 +113,7 @@ class RunSink final : public plinth::EventSink {
   std::vector<TimelineEntry> timeline{{0.0, "full_contact"}};
   long impacts = 0;
   long base_stop_hits = 0;
+  std::optional<plinth::Event> lift_off;
 
  private:
   std::ostream* events_out_;
@@ -326,7 +328,11 @@ int run(const Options& opt) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   const plinth::host::Outcome outcome = plinth::host::outcome_of(sim.mode().phase);
-  if (events_file) events_file->stream() << plinth::host::end_json(sim.time(), outcome) << '\n';
+  if (events_file) {
+    events_file->stream() << plinth::host::end_json(sim.time(), outcome,
+                                                     sink.lift_off ? sink.lift_off->t : 0.0)
+                          << '\n';
+  }
   if (csv_file) csv_file->commit();
   if (events_file) events_file->commit();
 
@@ -340,6 +346,15 @@ int run(const Options& opt) {
     std::printf("  %10.4f s  %s\n", entry.t, entry.what.c_str());
   }
   const double alpha = std::min(scene.corner1.critical_angle, scene.corner2.critical_angle);
+  if (sink.lift_off) {
+    std::printf("outside the model: at t = %.6g s the block lost contact with its support (%s; "
+                "g + v_G'' = %.4g m/s2). The model has no free flight: this run ends there, and "
+                "neither survival nor collapse is known after it.\n",
+                sink.lift_off->t,
+                sink.lift_off->before < 0.0 ? "the ground falls faster than gravity"
+                                            : "the rocking unloads its pivot, Eq 12",
+                sink.lift_off->before);
+  }
   std::printf("outcome:    %s at t = %.4f s; peak |theta| %.4g rad (%.3g of alpha), peak |u| %.4g m,"
               " peak |x| %.4g m; %ld impacts, %ld base stop hits\n",
               plinth::host::outcome_name(outcome), sim.time(), peak_theta, peak_theta / alpha,

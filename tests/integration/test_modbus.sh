@@ -44,7 +44,7 @@ levels = ["normal", "advisory", "warning", "alarm", "fault"]
 phases = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "fell"]
 causes = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated"]
+          "collapse_forecast", "not_calibrated", "outside_model"]
 def check(name, address, expected):
     assert regs.get(address) == expected, "%s (register %d): %s, status line says %s" % (
         name, address, regs.get(address), expected)

@@ -565,8 +565,10 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   axis.state = nominal.state();
   axis.risk = Risk{};
   axis.worst_member = 0;
+  axis.outside_model = false;
   for (std::size_t m = 0; m < scenes_[k].size(); ++m) {
     const PlanarEstimator& e = ensembles_[k][m];
+    axis.outside_model = axis.outside_model || e.mode().phase == Phase::kLiftedOff;
     const Risk r = overturning_risk(scenes_[k][m], e.mode(), e.state(), config_.risk);
     if (m == 0) axis.nominal_risk = r;
     if (m == 0 || r.total > axis.risk.total) {
@@ -582,6 +584,7 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
   Real risk = 0;
   bool moving = false;
   bool collapse = false;
+  bool outside_model = false;
   status_.probability = 0.0;
   status_.forecast_axis = -1;
   status_.collapse_forecast_s = -1.0;
@@ -591,7 +594,8 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
     if (status_.estimating) update_axis(i, axis);
     risk = axis.risk.total > risk ? axis.risk.total : risk;
     moving = moving || axis.mode.phase != Phase::kFullContact;
-    collapse = collapse || axis.mode.terminal();
+    collapse = collapse || axis.mode.collapsed();
+    outside_model = outside_model || axis.outside_model;
     const ForecastOutcome& f = axis.forecast;
     axis.collapse_forecast_s = -1.0;
     if (!kForecastBuiltIn || !f.valid) continue;
@@ -613,6 +617,7 @@ void Monitor::update_axes_status(monitor::AlarmInput& input) {
   input.probability = static_cast<Real>(status_.probability);
   input.out_of_full_contact = moving;
   input.collapse_detected = collapse;
+  input.outside_model = outside_model;
 }
 
 void Monitor::evaluate(MonitorUpdate& update) {

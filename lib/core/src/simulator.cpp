@@ -107,6 +107,7 @@ void Simulator::start_with_impulse(Real impulse) {
   e.phase = mode_.phase;
   e.state = y_;
   emit_event(e);
+  (void)lift_off_fn_(*this, Real(0));  // a spin fast enough to unload the pivot (Eq 12)
 }
 
 // One step by intervals: the stepper in the current mode, then event after event.

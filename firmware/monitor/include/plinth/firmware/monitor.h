@@ -187,6 +187,9 @@ struct AxisStatus {
   Risk nominal_risk;     // member 0's: the scene file's statue alone, as a box without ensemble
   int members = 1;       // the ensemble's size
   int worst_member = 0;  // whose risk that is
+  // A member's estimate ended outside the model (Phase::kLiftedOff): the box cannot vouch for
+  // this axis until its estimators start again (the alarm policy's outside_model).
+  bool outside_model = false;
   ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
   // Monitor time, s, of that forecast's first collapse (its worst member's); -1: none forecast.
   double collapse_forecast_s = -1.0;

@@ -139,6 +139,7 @@ class Simulator {
   void (*settle_chatter_fn_)(Simulator&, Time t) = nullptr;
   internal::ActiveGuards (*guards_fn_)(const Mode&) = nullptr;
   void (*start_phases_fn_)(Simulator&, Time t) = nullptr;  // whose onset already holds
+  bool (*lift_off_fn_)(Simulator&, Time t) = nullptr;  // lifts off if no normal force is left
   Accelerations (*accelerations_fn_)(const Simulator&, Time t, const State&) = nullptr;
   // exact_full_contact: a quiet whole step of full contact, from time() to t_end (false: take
   // the interval).

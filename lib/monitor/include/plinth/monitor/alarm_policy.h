@@ -37,6 +37,11 @@
 // keeps it after the caller has earned its estimate. While fault_active is set too, that
 // fault's cause is reported; like every fault it never hides an alarm.
 //
+// Outside the model: outside_model (the estimate left the model's validity: the block lifted
+// off its support, which the model cannot follow) shows the fault level, cause kOutsideModel,
+// the same way: at once, for as long as it lasts, above not_calibrated and below a fault's own
+// cause. The box cannot vouch for a statue it no longer models; an alarm still shows above it.
+//
 // Events: one each time the level shown or its latched flag changes (at most two per update:
 // the acknowledgement is applied first, against what the operator saw, then the new input).
 // Sequence numbers start at 0 and increment by one per event, wrapping 255 -> 0. Cause: why the
@@ -111,6 +116,7 @@ struct AlarmInput {
   bool fault_active = false;         // sensor or bus trouble
   AlarmCause fault_cause = AlarmCause::kSensorFault;  // reported while fault_active
   bool not_calibrated = false;  // no trusted offset or initial state (above)
+  bool outside_model = false;   // the estimate left the model's validity (above)
   bool acknowledged = false;  // `acknowledgement` arrived since the last update
   Acknowledgement acknowledgement;
 };
@@ -225,6 +231,7 @@ class AlarmPolicy {
   bool alarm_by_forecast_ = false;
   bool out_of_contact_ = false;  // the latest input's out_of_full_contact
   bool not_calibrated_ = false;  // the latest input's not_calibrated
+  bool outside_model_ = false;   // the latest input's outside_model
   bool fault_input_ = false;     // the latest input's fault (fault_active or an invalid risk)
   AlarmCause fault_cause_ = AlarmCause::kNone;
   AlarmLevel condition_level_ = AlarmLevel::kNormal;
