@@ -111,6 +111,7 @@ std::string describe_rule(const Rule& rule, const CrossingGrids& grids) {
 Report make_report(const EvalTable& table, const CalibrationTargets& targets, bool with_frontier) {
   Report report;
   report.runs = table.runs.size();
+  for (const EvalRun& r : table.runs) report.outside_model += r.outside_model() ? 1U : 0U;
   std::set<std::string> names;
   for (const EvalRun& r : table.runs) names.insert(r.record);
   std::vector<std::string> halves[2];
@@ -150,7 +151,12 @@ Report make_report(const EvalTable& table, const CalibrationTargets& targets, bo
 }
 
 std::string report_text(const Report& report, const CrossingGrids& grids) {
-  std::string out = "plinth-eval: " + std::to_string(report.runs) + " runs\n";
+  std::string out = "plinth-eval: " + std::to_string(report.runs) + " runs";
+  if (report.outside_model > 0) {
+    out += ", of which " + std::to_string(report.outside_model) +
+           " left the model (the true statue lifted off: no truth, counted in no outcome)";
+  }
+  out += "\n";
   for (const LevelReport& l : report.levels) {
     out += l.level + "\n";
     out += "  shown by the box:          " + outcome_text(l.shown) + "\n";
@@ -181,7 +187,8 @@ std::string report_text(const Report& report, const CrossingGrids& grids) {
 }
 
 std::string report_json(const Report& report, const CrossingGrids& grids) {
-  std::string out = "{\"runs\": " + std::to_string(report.runs) + ", \"levels\": [";
+  std::string out = "{\"runs\": " + std::to_string(report.runs) +
+                    ", \"outside_model\": " + std::to_string(report.outside_model) + ", \"levels\": [";
   for (std::size_t i = 0; i < report.levels.size(); ++i) {
     const LevelReport& l = report.levels[i];
     out += i ? ", " : "";

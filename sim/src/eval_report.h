@@ -41,6 +41,7 @@ struct FrontierReport {
 
 struct Report {
   std::size_t runs = 0;
+  std::size_t outside_model = 0;  // of which the true statue lifted off: counted nowhere
   std::vector<LevelReport> levels;  // advisory, warning, alarm
   std::vector<FrontierReport> frontiers;  // with_frontier: risk, then nominal_risk
 };

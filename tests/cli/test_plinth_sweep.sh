@@ -53,7 +53,7 @@ check "a sweep writes its map" test "$RC" -eq 0 -a -s whole.csv
 check "the first line records the settings" \
   grep -q '^# plinth-sweep thresholds grid=mu_s:0.2:0.5:4 scene=' whole.csv
 check "the header names the parameter and the events" grep -qx \
-  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned' whole.csv
+  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned,lift_off' whole.csv
 check "one row per value" test "$(grep -c '^0\.' whole.csv)" -eq 4
 check "no progress bar when stderr is not a terminal" test ! -s "$TMP/err.txt"
 
@@ -139,13 +139,13 @@ check "--compare-ground writes its map" test "$RC" -eq 0 -a -s cmp.csv
 check "its settings line says compare=ground" \
   grep -q '^# plinth-sweep thresholds grid=mu_s:0.2:0.5:4 scene=.* compare=ground$' cmp.csv
 check "its header adds the ground's events, suffixed _ground" grep -qx \
-  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned,sliding_ground,rocking_ground,slide_rocking_ground,overturned_ground' cmp.csv
+  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned,lift_off,sliding_ground,rocking_ground,slide_rocking_ground,overturned_ground,lift_off_ground' cmp.csv
 check "the scene's own columns are those of the run without it" \
-  cmp -s <(tail -n +3 cmp.csv | cut -d, -f1-9) <(tail -n +3 whole.csv)
+  cmp -s <(tail -n +3 cmp.csv | cut -d, -f1-10) <(tail -n +3 whole.csv)
 sweep --scene "$SCENES/non-isolated.toml" --record "$AT2" --param mu_s --from 0.2 --to 0.5 \
   --steps 4 --pga-max 4g --tol 0.05g --dt 4e-3 --out ground.csv
 check "the ground columns are those of a run of non-isolated.toml" \
-  cmp -s <(tail -n +3 cmp.csv | cut -d, -f10-13) <(tail -n +3 ground.csv | cut -d, -f2-4,9)
+  cmp -s <(tail -n +3 cmp.csv | cut -d, -f11-15) <(tail -n +3 ground.csv | cut -d, -f2-4,9,10)
 check "and the block on the ground rocks there" test -n "$(tail -n +3 ground.csv | cut -d, -f3 | tr -d '\n')"
 PERIOD=(--scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 3 --steps 3 --pga-max 4g
         --tol 0.05g --dt 4e-3 --jobs 2)
@@ -157,8 +157,8 @@ sweep --scene "$SCENES/non-isolated.toml" --record "$AT2" --param epsilon --from
   --steps 1 --pga-max 4g --tol 0.05g --dt 4e-3 --out ground1.csv
 alone=$(simulations)
 check "against T (the ground has none) every row holds the one ground row" test \
-  "$(tail -n +3 cmpT.csv | cut -d, -f10,11 | sort -u)" = "$(tail -n +3 ground1.csv | cut -d, -f3,9)"
-check "its header has only rocking and overturned (no friction)" grep -q ',overturned,rocking_ground,overturned_ground$' cmpT.csv
+  "$(tail -n +3 cmpT.csv | cut -d, -f11-13 | sort -u)" = "$(tail -n +3 ground1.csv | cut -d, -f3,9,10)"
+check "its header has only rocking, overturned and lift_off (no friction)" grep -q ',lift_off,rocking_ground,overturned_ground,lift_off_ground$' cmpT.csv
 check "and the ground was searched once" test "$compared" -eq $((plain + alone))
 # Shards, merge and resume with the ground's columns (on the T sweep: cheap).
 sweep "${PERIOD[@]}" --compare-ground --shard 2/2 --out cmpT2.csv
@@ -188,8 +188,8 @@ check "and keeps the map's own column" cmp -s <(tail -n +3 cmpmap2.csv | cut -d,
 sweep --scene "$ISOLATED" --impulse-curve --param T --from 1.5 --to 2.5 --steps 2 \
   --impulse-max 5 --impulse-tol 0.01 --compare-ground --out cmpicurve.csv
 check "a compared impulse curve adds the ground's overturning" grep -qx \
-  'T,rocking,overturned,rocking_closed_form,overturned_closed_form,overturned_ground,overturned_closed_form_ground' cmpicurve.csv
-check "and keeps the curve's own columns" cmp -s <(tail -n +3 cmpicurve.csv | cut -d, -f1-5) <(tail -n +3 icurve.csv)
+  'T,rocking,overturned,rocking_closed_form,overturned_closed_form,lift_off,overturned_ground,overturned_closed_form_ground,lift_off_ground' cmpicurve.csv
+check "and keeps the curve's own columns" cmp -s <(tail -n +3 cmpicurve.csv | cut -d, -f1-6) <(tail -n +3 icurve.csv)
 refuses "--compare-ground on a scene without a base" "--compare-ground: the scene has no \[base\]" \
   --scene "$SCENES/non-isolated.toml" --record "$AT2" --param mu_s --from 0.2 --to 0.5 --steps 2 \
   --compare-ground --out x.csv

@@ -15,6 +15,10 @@ namespace {
 
 constexpr std::array<const char*, kEvalLevels> kLevelNames{"advisory", "warning", "alarm"};
 
+// The column after them when a run may have left the model (EvalRun::model_valid_until_s; a
+// runs file without it has none).
+constexpr std::string_view kModelValidColumn = "model_valid_until_s";
+
 // The header's fixed columns, before the crossing grids.
 constexpr std::array<std::string_view, 10> kFixedColumns{
     "record",          "scene",      "statue",           "scale_g",         "collapsed",
@@ -259,6 +263,8 @@ void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids) {
     if (!line.empty()) line += ',';
     line += c;
   }
+  line += ',';
+  line += kModelValidColumn;
   for (double v : grids.risk) {
     line += ",risk_ge_";
     line += format(v);
@@ -287,6 +293,7 @@ void write_eval_csv_row(std::FILE* out, const EvalRun& r) {
   add(format(r.collapse_time_s));
   add(format(r.peak_ratio));
   for (double t : r.first_shown_s) add(format(t));
+  add(format(r.model_valid_until_s));
   for (double t : r.risk_crossing_s) add(format(t));
   for (double t : r.probability_crossing_s) add(format(t));
   for (double t : r.nominal_risk_crossing_s) add(format(t));
@@ -309,7 +316,8 @@ EvalTable read_eval_csv(const std::string& path) {
     }
   }
   std::vector<double> nominal_grid;
-  for (std::size_t i = kFixedColumns.size(); i < f.size(); ++i) {
+  const bool has_model_valid = f.size() > kFixedColumns.size() && f[kFixedColumns.size()] == kModelValidColumn;
+  for (std::size_t i = kFixedColumns.size() + (has_model_valid ? 1 : 0); i < f.size(); ++i) {
     double v = 0.0;
     if (grid_value(f[i], "risk_ge_", v) && table.grids.probability.empty()) {
       table.grids.risk.push_back(v);
@@ -357,6 +365,12 @@ EvalTable read_eval_csv(const std::string& path) {
       r.first_shown_s[i] = parse_time(f[7 + i], where, kFixedColumns[7 + i]);
     }
     std::size_t c = kFixedColumns.size();
+    if (has_model_valid) {
+      r.model_valid_until_s = parse_time(f[c++], where, kModelValidColumn);
+      if (r.outside_model() && r.collapsed) {
+        throw InputError(where + ": model_valid_until_s: a run that left the model has no collapse");
+      }
+    }
     for (std::size_t i = 0; i < table.grids.risk.size(); ++i, ++c) {
       r.risk_crossing_s.push_back(parse_time(f[c], where, "risk crossing"));
     }

@@ -41,6 +41,9 @@ class OccurrenceSink final : public EventSink {
       case EventKind::kOverturned:
         mark(SweepEvent::kOverturned);
         break;
+      case EventKind::kLiftOff:
+        mark(SweepEvent::kLiftOff);
+        break;
       default:
         break;
     }
@@ -74,6 +77,7 @@ EventSet possible_events(const Scene& scene) {
   EventSet events;
   events.set(static_cast<std::size_t>(SweepEvent::kRocking));
   events.set(static_cast<std::size_t>(SweepEvent::kOverturned));
+  events.set(static_cast<std::size_t>(SweepEvent::kLiftOff));
   events.set(static_cast<std::size_t>(SweepEvent::kSliding), f.sliding);
   events.set(static_cast<std::size_t>(SweepEvent::kSlideRocking), f.sliding);
   events.set(static_cast<std::size_t>(SweepEvent::kBaseStopHit), f.base_stops);

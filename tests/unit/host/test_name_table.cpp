@@ -98,10 +98,10 @@ TEST(NameTable, HostTablesNameEveryValueOnce) {
   using host::SweepEvent;
   using host::SweepParameter;
   expect_complete(host::kOutcomeNames, Outcome::kSurvived, Outcome::kLiftedOff);
-  expect_complete(host::kSweepEventNames, SweepEvent::kSliding, SweepEvent::kOverturned);
+  expect_complete(host::kSweepEventNames, SweepEvent::kSliding, SweepEvent::kLiftOff);
   expect_complete(host::kSweepParameterNames, SweepParameter::kMuS, SweepParameter::kMassRatio);
   expect_complete(host::kImpulseStartNames, ImpulseStart::kFullContact,
-                  ImpulseStart::kSlideRocking);
+                  ImpulseStart::kLiftedOff);
 }
 
 // A name read from the command line: the error names the option and every name there is.
