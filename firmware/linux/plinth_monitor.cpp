@@ -30,6 +30,7 @@
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/limits.h"
+#include "plinth/host/parse_name.h"
 #include "plinth/host/scene_toml.h"
 #include "relay_gpiod.h"
 #include "relay_outputs.h"
@@ -57,6 +58,7 @@ struct Options {
   std::string pga;
   std::optional<double> scale;
   std::string speed = "max";
+  std::string log_time;  // --log-time: warn or refuse; empty: not given (warn)
   double duration = 0.0;
   std::string record_dir;
   std::string frames_out;
@@ -382,6 +384,10 @@ fw::InputOptions input_options(const Options& opt) {
   in.speed = parse_speed(opt.speed);
   in.duration_s = opt.duration;
   in.recorder_frames = !opt.record_dir.empty();
+  if (!opt.log_time.empty()) {
+    in.log_time = plinth::host::parse_name<plinth::hal::kLogTimePolicyNames>(
+        opt.log_time, "--log-time", "policy");
+  }
   return in;
 }
 
@@ -535,6 +541,9 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--scale", opt.scale, "scale factor of the record")
       ->check(plinth::host::kFinite)->excludes("--pga");
   app.add_option("--speed", opt.speed, "replay speed: a factor of real time, or max (default)");
+  app.add_option("--log-time", opt.log_time,
+                 "a candump log's timestamps that go back, stand still or jump: warn (default: "
+                 "named, counted, the box's input fault raised) or refuse (stop at the first)");
   app.add_option("--rate", c.rate_hz, "sensor rate, Hz (100-1000; default: the record's, or 200)")
       ->check(plinth::host::kFinitePositive);
   app.add_option("--steps", c.steps, "solver steps per sample (default 4)")

@@ -29,6 +29,7 @@
 #include "plinth/host/input_error.h"
 #include "plinth/host/limits.h"
 #include "plinth/host/output_file.h"
+#include "plinth/host/parse_name.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/record_sampling.h"
 
@@ -61,6 +62,7 @@ struct Options {
   std::string can_interface;
   std::string log_path;
   std::string log_interface = "vcan0";
+  std::string log_time;  // --log-time: warn or refuse; empty: not given (warn)
   bool report_json = false;
 };
 
@@ -394,6 +396,10 @@ struct Input {
 Input open_input(const Options& opt, const CLI::App& app) {
   Input input;
   if (!is_candump_log(opt.record_path)) {
+    if (app.count("--log-time") > 0) {
+      throw InputError("--log-time: applies to a candump log input only (" + opt.record_path +
+                       " is a record: its samples' time is its sampling interval)");
+    }
     RecordPlan plan = plan_records(opt);
     input.description = plan.description;
     input.clipped_samples = plan.clipped;
@@ -408,8 +414,22 @@ Input open_input(const Options& opt, const CLI::App& app) {
                        opt.record_path + "): its sensor frames are sent again as logged");
     }
   }
-  plinth::replay::LoggedFrames logged =
-      plinth::replay::read_logged_sensor_frames(opt.record_path, opt.t_end_s.value_or(-1.0));
+  const plinth::hal::LogTimePolicy policy =
+      opt.log_time.empty() ? plinth::hal::LogTimePolicy::kWarn
+                           : plinth::host::parse_name<plinth::hal::kLogTimePolicyNames>(
+                                 opt.log_time, "--log-time", "policy");
+  plinth::replay::LoggedFrames logged = plinth::replay::read_logged_sensor_frames(
+      opt.record_path, opt.t_end_s.value_or(-1.0), policy);
+  for (const std::string& warning : logged.time_warnings) {
+    std::fprintf(stderr, "plinth-replay: warning: %s\n", warning.c_str());
+  }
+  if (logged.went_back + logged.jumps > 0) {
+    std::fprintf(stderr,
+                 "plinth-replay: warning: %s: %lld timestamps went back, %lld jumped forward "
+                 "beyond %g s (--log-time refuse stops at the first)\n",
+                 opt.record_path.c_str(), static_cast<long long>(logged.went_back),
+                 static_cast<long long>(logged.jumps), plinth::hal::kMaxLogGapS);
+  }
   input.skipped_log_lines = logged.skipped;
   char text[200];
   std::snprintf(text, sizeof text, "%s: %zu sensor frames over %.4g s", opt.record_path.c_str(),
@@ -563,6 +583,9 @@ int main(int argc, char** argv) {
   app.add_option("--log-interface", opt.log_interface,
                  "interface name written in the log (default vcan0)")
       ->needs(log);
+  app.add_option("--log-time", opt.log_time,
+                 "a candump log's timestamps that go back or jump beyond 10 s: warn (default: "
+                 "named on stderr, sent at the previous time / as a 10 s gap) or refuse");
   app.add_flag("--report-json", opt.report_json,
                "also print the report as one JSON line on stdout");
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {

@@ -85,7 +85,7 @@ struct EventLogic {
   static void start_phases_that_hold(Simulator& sim, Time t) {
     const Scene& s = *sim.scene_;
     const GroundAcceleration ag = sim.excitation_.at(t);
-    if (lift_off_if_unsupported(sim, t)) return;
+    if (sim.lift_off(t)) return;
     for (int pass = 0; pass < 2 && !sim.mode_.terminal(); ++pass) {
       const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
       if constexpr (F.sliding) {
@@ -109,38 +109,6 @@ struct EventLogic {
       }
       return;
     }
-  }
-
-  // The support's normal force on the block reached 0 (guards.h, kLiftOff): the run ends in
-  // Phase::kLiftedOff, the state that of the lift-off.
-  static void lift_off(Simulator& sim, Time t) {
-    const Phase left = sim.mode_.phase;
-    sim.mode_.phase = Phase::kLiftedOff;
-    Event e;
-    e.t = t;
-    e.kind = EventKind::kLiftOff;
-    e.corner = sim.mode_.corner;
-    e.before = sim.scene_->g + sim.excitation_.at(t).vertical;
-    e.phase = sim.mode_.phase;
-    e.overhang = sim.mode_.overhang;
-    e.left = left;
-    e.state = sim.y_;
-    sim.emit_event(e);
-  }
-
-  // After a reset or at a start: a guard is an event where it crosses from negative, so a mode
-  // entered with no normal force left (the ground already falling faster than gravity, a jump
-  // of theta' that unloads the pivot) lifts off here. True when it did.
-  static bool lift_off_if_unsupported(Simulator& sim, Time t) {
-    if (sim.mode_.terminal()) return false;
-    const Scene& s = *sim.scene_;
-    const GroundAcceleration ag = sim.excitation_.at(t);
-    const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
-    if (lift_off_guard(s, sim.mode_, sim.y_, ag, acc, sin_cos(sim.y_[kTheta])) < Real(0)) {
-      return false;
-    }
-    lift_off(sim, t);
-    return true;
   }
 
   static void start_rocking(Simulator& sim, Time t, Corner corner) {
@@ -324,11 +292,11 @@ struct EventLogic {
   static void apply_reset(Simulator& sim, GuardId id, Time t) {
     ++sim.event_count_;
     if (id == GuardId::kLiftOff) {
-      lift_off(sim, t);
+      (void)sim.lift_off(t, true);
       return;
     }
     apply_mode_reset(sim, id, t);
-    (void)lift_off_if_unsupported(sim, t);
+    (void)sim.lift_off(t);
   }
 
   static void apply_mode_reset(Simulator& sim, GuardId id, Time t) {
@@ -448,7 +416,7 @@ struct EventLogic {
         hold_if_pushed(sim, t, sim.y_[kU] > Real(0) ? +1 : -1);
       }
     }
-    (void)lift_off_if_unsupported(sim, t);
+    (void)sim.lift_off(t);
     ++sim.chatter_steps_;
   }
 
@@ -506,8 +474,11 @@ struct EventLogic {
     }
   }
 
-  static Accelerations current_accelerations(const Simulator& sim, Time t, const State& y) {
-    return accelerations(*sim.scene_, sim.mode_, y, sim.excitation_.at(t));
+  static Accelerations current_accelerations(const Simulator& sim, Time t, const State& y,
+                                             GroundAcceleration* ground) {
+    const GroundAcceleration ag = sim.excitation_.at(t);
+    if (ground != nullptr) *ground = ag;
+    return accelerations(*sim.scene_, sim.mode_, y, ag);
   }
 
   // Binds the logic and the stepper's intervals for each phase to `sim` (Simulator::create).
@@ -516,7 +487,6 @@ struct EventLogic {
     sim.settle_chatter_fn_ = &settle_chatter;
     sim.guards_fn_ = &guards_of;
     sim.start_phases_fn_ = &start_phases_that_hold;
-    sim.lift_off_fn_ = &lift_off_if_unsupported;
     sim.accelerations_fn_ = &current_accelerations;
     sim.quiet_full_contact_step_fn_ =
         settings.exact_full_contact && F.base ? &quiet_full_contact_step : nullptr;

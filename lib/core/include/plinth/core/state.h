@@ -24,6 +24,7 @@ struct Accelerations {
   Real theta = 0.0;  // rad/s2
 };
 
+// The terminal phases come last (Mode::terminal compares once).
 enum class Phase : std::uint8_t {
   kFullContact,
   kSliding,
@@ -73,7 +74,7 @@ struct Mode {
     return phase == Phase::kOverturned || phase == Phase::kFell;
   }
   // The run has ended: a collapse, or the model's validity (kLiftedOff).
-  [[nodiscard]] bool terminal() const { return collapsed() || phase == Phase::kLiftedOff; }
+  [[nodiscard]] bool terminal() const { return phase >= Phase::kOverturned; }
 };
 
 }  // namespace plinth
