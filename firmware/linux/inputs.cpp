@@ -281,12 +281,12 @@ class BusInput final : public MonitorInput {
   BusCounters counters_;
 };
 
+}  // namespace
+
 bool is_candump_log(const std::string& path) {
   const std::string extension = std::filesystem::path(path).extension().string();
   return extension == ".log" || extension == ".LOG";
 }
-
-}  // namespace
 
 std::unique_ptr<MonitorInput> open_input(const InputOptions& opt, MonitorConfig& config,
                                          const volatile std::sig_atomic_t& stop) {
@@ -295,10 +295,6 @@ std::unique_ptr<MonitorInput> open_input(const InputOptions& opt, MonitorConfig&
   if (!record &&
       (!opt.pga.empty() || opt.scale || !opt.replay_y_path.empty() || !opt.vertical_path.empty())) {
     throw InputError("--pga, --scale, --replay-y and --vertical apply to an AT2 or CSV record");
-  }
-  if (!log && opt.log_time) {
-    throw InputError("--log-time: applies to a candump log replay only (the time of a record's "
-                     "samples is its sampling interval; a bus's is the receive clock)");
   }
   if (record) {
     RecordSamples samples = record_samples(

@@ -89,6 +89,9 @@ struct InputOptions {
   std::optional<hal::LogTimePolicy> log_time;
 };
 
+// A replay file that is a candump log (.log), not a record.
+[[nodiscard]] bool is_candump_log(const std::string& path);
+
 // Opens the input `options` name (exactly one of replay_path, can_interface) and fits `config`
 // to it: a record replay feeds one ideal ground sensor at the record's rate. `stop` (a signal
 // handler's flag) ends the input. Throws host::InputError naming what is wrong.

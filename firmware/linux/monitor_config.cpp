@@ -565,6 +565,23 @@ void apply_output_overrides(MonitorFile& file, const MonitorOverrides& o) {
   if (!o.mqtt_ca_file.empty()) mqtt.ca_file = o.mqtt_ca_file;
   if (!o.mqtt_cert_file.empty()) mqtt.cert_file = o.mqtt_cert_file;
   if (!o.mqtt_key_file.empty()) mqtt.key_file = o.mqtt_key_file;
+  // An output's options while the output is off have no effect: refused, saying so.
+  if (o.modbus_writes && file.modbus.listen.empty()) {
+    throw InputError("--modbus-writes: lets the Modbus server's coils be written; the server is "
+                     "off (--modbus, or modbus.listen in the configuration file)");
+  }
+  for (const auto& [option, value] :
+       {std::pair<const char*, const std::string*>{"--mqtt-box-id", &o.mqtt_box_id},
+        {"--mqtt-username", &o.mqtt_username},
+        {"--mqtt-password-file", &o.mqtt_password_file},
+        {"--mqtt-ca", &o.mqtt_ca_file},
+        {"--mqtt-cert", &o.mqtt_cert_file},
+        {"--mqtt-key", &o.mqtt_key_file}}) {
+    if (!value->empty() && mqtt.broker.empty()) {
+      throw InputError(std::string(option) + ": sets the MQTT publisher, which is off (--mqtt, "
+                                             "or mqtt.broker in the configuration file)");
+    }
+  }
 }
 
 }  // namespace

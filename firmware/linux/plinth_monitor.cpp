@@ -528,6 +528,25 @@ int run(const Options& opt, const CLI::App& app) {
   return totals.input_fault.empty() || g_stop != 0 ? 0 : kInputFaultExit;
 }
 
+// The options the input chosen has no use for (every option means something).
+void refuse_without_effect(const CLI::App& app, const Options& opt) {
+  using plinth::host::refuse_without_effect;
+  const bool live = !opt.can_interface.empty();
+  const bool log = !live && fw::is_candump_log(opt.replay_path);
+  refuse_without_effect(app, {"--pga", "--scale", "--replay-y", "--vertical"}, !live && !log,
+                        "scales or completes a record replay (.AT2, .csv); a candump log's and a "
+                        "bus's frames are taken as they come");
+  refuse_without_effect(app, {"--duration"}, live,
+                        "stops a live run (--can); a replay ends with its input");
+  refuse_without_effect(app, {"--speed"}, !live,
+                        "paces a replay; a live bus (--can) comes at its own pace");
+  refuse_without_effect(app, {"--log-time"}, log,
+                        "applies to a candump log replay only (a record's samples are timed by "
+                        "its sampling interval, a bus's frames by the receive clock)");
+  refuse_without_effect(app, {"--pre-trigger", "--post-trigger"}, !opt.record_dir.empty(),
+                        "sets the event recorder's captures, which is off (--record-dir)");
+}
+
 void add_options(CLI::App& app, Options& opt) {
   fw::MonitorOverrides& c = opt.config;
   app.add_option("--scene", opt.scene_path, "scene file (TOML), the statue's first axis")->required();
@@ -602,7 +621,8 @@ int main(int argc, char** argv) {
   CLI::App app{"plinth-monitor: the early-warning box's estimator, risk and alarms"};
   Options opt;
   add_options(app, opt);
-  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+  if (const std::optional<int> exit_code =
+          plinth::host::parse_command_line(app, argc, argv, [&] { refuse_without_effect(app, opt); })) {
     return *exit_code;
   }
   std::signal(SIGINT, on_signal);

@@ -309,7 +309,12 @@ int main(int argc, char** argv) {
   CLI::App* merge_command = app.add_subcommand("merge", "join the runs CSVs of shards");
   merge_command->add_option("--out", merge.out_path, "merged CSV")->required();
   merge_command->add_option("inputs", merge.inputs, "the shards' CSV files")->required();
-  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+  const auto checks = [&] {
+    plinth::host::refuse_without_effect(*run, {"--horizon"}, opt.forecast != "off",
+                                        "sets the forecast's horizon, and --forecast is off");
+  };
+  if (const std::optional<int> exit_code =
+          plinth::host::parse_command_line(app, argc, argv, checks)) {
     return *exit_code;
   }
   return plinth::host::run_tool("plinth-eval", [&] {

@@ -392,7 +392,13 @@ int main(int argc, char** argv) {
   app.add_option("--out-interval", opt.out_interval, "time between CSV rows, s (whole steps)")
       ->check(plinth::host::kFinitePositive);
   app.add_option("--events", opt.events_path, "JSON Lines event log");
-  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+  const auto checks = [&] {
+    plinth::host::refuse_without_effect(
+        app, {"--out-interval"}, !opt.out_path.empty(),
+        "sets the time between the rows of --out's CSV; without --out there is no CSV");
+  };
+  if (const std::optional<int> exit_code =
+          plinth::host::parse_command_line(app, argc, argv, checks)) {
     return *exit_code;
   }
   if (!opt.pulse.empty() && (opt.amplitude.empty() || !opt.period)) {

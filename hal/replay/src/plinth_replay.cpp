@@ -92,19 +92,21 @@ bool is_record(const std::string& path) {
   return ext == "at2" || ext == "csv" || ext == "asc";  // PEER, CSV, ESM/ITACA
 }
 
-// "NODE:AXIS:PATH" or "NODE:PATH" (axis x).
+// "NODE:AXIS:PATH" or "NODE:PATH" (axis x), split at the colons as documented: with two colons
+// or more the field between the first two is the axis (a file whose name holds a colon is given
+// with its axis, "1:x:a:b.AT2"); each field that is not what it must be is named.
 Component parse_node_record(const std::string& text) {
-  const std::string usage =
-      "--node-record: expected NODE:AXIS:FILE or NODE:FILE (NODE 1-15, "
-      "AXIS x, y or z), got '" +
-      text + "'";
+  const std::string usage = "--node-record: expected NODE:AXIS:FILE or NODE:FILE (NODE 1-15, "
+                            "AXIS x, y or z), got " + plinth::host::shown(text);
   const std::size_t colon = text.find(':');
-  if (colon == std::string::npos || colon == 0) throw InputError(usage);
+  if (colon == std::string::npos) throw InputError(usage);
   Component component;
   component.given_as = "--node-record " + text;
   const std::string node_text = text.substr(0, colon);
-  if (node_text.size() > 2 || node_text.find_first_not_of("0123456789") != std::string::npos) {
-    throw InputError(usage);
+  if (node_text.empty() || node_text.size() > 2 ||
+      node_text.find_first_not_of("0123456789") != std::string::npos) {
+    throw InputError("--node-record: the node " + plinth::host::shown(node_text) + " in " +
+                     plinth::host::shown(text) + " is not a number from 1 to 15 (NODE:AXIS:FILE)");
   }
   component.node = std::stoi(node_text);
   if (component.node < plinth::can::kFirstSensorNode ||
@@ -112,11 +114,19 @@ Component parse_node_record(const std::string& text) {
     throw InputError("--node-record: node " + node_text + " is not 1-15 in '" + text + "'");
   }
   std::string rest = text.substr(colon + 1);
-  if (rest.size() > 2 && rest[1] == ':' && (rest[0] == 'x' || rest[0] == 'y' || rest[0] == 'z')) {
-    component.axis = static_cast<Axis>(rest[0] - 'x');
-    rest = rest.substr(2);
+  if (const std::size_t second = rest.find(':'); second != std::string::npos) {
+    const std::string axis = rest.substr(0, second);
+    if (axis != "x" && axis != "y" && axis != "z") {
+      throw InputError("--node-record: unknown axis " + plinth::host::shown(axis) + " in " +
+                       plinth::host::shown(text) + " (one of x, y, z; NODE:AXIS:FILE)");
+    }
+    component.axis = static_cast<Axis>(axis[0] - 'x');
+    rest = rest.substr(second + 1);
   }
-  if (rest.empty()) throw InputError(usage);
+  if (rest.empty()) {
+    throw InputError("--node-record: no file in " + plinth::host::shown(text) +
+                     " (NODE:AXIS:FILE or NODE:FILE)");
+  }
   component.path = rest;
   return component;
 }
