@@ -14,6 +14,7 @@
 
 #include "plinth/host/input_error.h"
 #include "plinth/host/text_file.h"
+#include "plinth/host/toml_names.h"
 #include "status_outputs.h"
 
 namespace plinth::firmware {
@@ -265,6 +266,14 @@ class KeyLines {
     const auto binding =
         std::find_if(table.begin(), table.end(), [&](const Binding& b) { return b.key == key; });
     if (binding == table.end()) {
+      // A value where a table of settings belongs (alarm_policy.advisory = 0.1) is the wrong
+      // type, not an unknown key.
+      const std::string inside = key + ".";
+      if (std::any_of(table.begin(), table.end(),
+                      [&](const Binding& b) { return b.key.rfind(inside, 0) == 0; })) {
+        throw InputError(cat(where(name), ": ", name, ": expected a table (", name,
+                             ".<key> = ...), got ", host::toml_type_name(value.type())));
+      }
       throw InputError(cat(where(name), ": ", name, ": unknown key (docs/monitor.md lists them)"));
     }
     if (!binding->store(value)) {

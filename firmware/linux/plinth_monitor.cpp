@@ -288,7 +288,8 @@ std::string option_of(const std::string& field) {
       {"sample_rate", "--rate"},
       {"steps_per_sample", "--steps"},
       {"stuck_samples", "--stuck-samples"},
-      {"node", "--node"}};
+      {"node", "--node"},
+      {"base.", "--scene"}};
   for (const auto& [key, option] : kOptions) {
     if (field.find(key) != std::string::npos) return option;
   }

@@ -278,7 +278,7 @@ int run(const Options& opt) {
   settings.step = opt.dt;
   plinth::Simulator sim;
   plinth::host::throw_if_simulator_error(
-      plinth::Simulator::create(scene, excitation, settings, sim));
+      plinth::Simulator::create(scene, excitation, settings, sim), scene, settings.step);
 
   const double t_end = opt.t_end ? *opt.t_end : std::max(10.0, excitation.duration() + 5.0);
   const StepPlan plan = plan_steps(opt, t_end);

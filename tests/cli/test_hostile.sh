@@ -363,5 +363,108 @@ expect_failure "sweep: no 'vector::reserve'" '--steps' -- --scene "$ISOLATED" --
   --param T --from 1 --to 2 --steps 2147483647 --out r.csv
 if grep -q 'vector::' "$TMP/stderr"; then fail "sweep: no library message" "$(first_stderr_line)"; fi
 
+
+echo "# 7. messages name the culprit (issue 25): derived quantities, invisible characters, missing"
+echo "#    interfaces, malformed fields, wrong types"
+# Invisible characters in what the user gave appear escaped, and no message carries a raw
+# control character or byte order mark (every tool prints through plinth::host::printable).
+printf '\xef\xbb\xbft,a [g]\n0,0\n0.01,0.1\n' >bom-header.csv
+printf 't,a [\xef\xbb\xbfg]\n0,0\n0.01,0.1\n' >bom-unit.csv
+printf 't,a [g]\r0,0\r0.01,0.1\r' >lone-cr.csv
+printf '[block]\nhalf_width = 0.3\nslenderness = 3\nmass = 1000\n"half\twidth" = 3\n' >tab-key.toml
+# invisible NAME BINARY ESCAPE -- ARGS...: fails with ESCAPE (fixed text) on stderr, no raw control
+# character there but line feeds.
+invisible() {
+  local name=$1 escape=$3
+  BIN=$2
+  shift 4
+  run "$@"
+  if ((RC != 1 && RC != 2)); then
+    fail "$name" "exit $RC; stderr: $(first_stderr_line)"
+  elif LC_ALL=C grep -q $'[\x01-\x09\x0b-\x1f\x7f]\|\xef\xbb\xbf' "$TMP/stderr"; then
+    fail "$name" "a raw control character on stderr: $(cat -A "$TMP/stderr" | head -c 200)"
+  elif ! grep -qF -- "$escape" "$TMP/stderr"; then
+    fail "$name" "no '$escape' on stderr: $(first_stderr_line)"
+  else
+    pass "$name"
+  fi
+}
+invisible "sim: a carriage return in --pga is shown as \\r" "$SIM" 'g\r' -- --scene "$ISOLATED" \
+  --record "$AT2" --pga $'0.3g\r'
+invisible "sim: a tab in a number is shown as \\t" "$SIM" "'1\t'" -- --scene "$ISOLATED" \
+  --record "$AT2" --dt $'1\t'
+invisible "sim: a byte order mark in a unit is shown as \\ufeff" "$SIM" '\ufeffg' -- \
+  --scene "$ISOLATED" --record bom-unit.csv
+invisible "sim: a lone carriage return in a record is named and shown" "$SIM" \
+  'lone-cr.csv:1: column 8: a carriage return not followed by a line feed' -- \
+  --scene "$ISOLATED" --record lone-cr.csv
+invisible "sim: a tab in a scene key is shown as \\t" "$SIM" 'block.half\twidth: unknown key' -- \
+  --scene tab-key.toml --record "$AT2"
+invisible "monitor: a tab in a file name is shown as \\t" "$MONITOR" 'no\tsuch.toml' -- \
+  --scene "$ISOLATED" --replay "$AT2" --config $'no\tsuch.toml'
+invisible "replay: a tab in --node-record is shown as \\t" "$REPLAY" "'1\t'" -- \
+  --record "$AT2" --log x.log --node-record $'1\t:x:'"$AT2"
+BIN=$SIM
+expect_success "sim: a byte order mark before a CSV header is read" --scene "$ISOLATED" \
+  --record bom-header.csv
+# A malformed header field is named as malformed, not as missing.
+sed '4s/DT= *[.0-9]*/DT= abc/' "$AT2" >dt-malformed.AT2
+sed '4s/NPTS= *[0-9]*/NPTS= x12/' "$AT2" >npts-malformed.AT2
+ESM=$SRC/tests/data/records/HL.DLFA..HNE.D.20190728.160908.C.ACC.ASC
+sed 's/^SAMPLING_INTERVAL_S:.*/SAMPLING_INTERVAL_S: abc/' "$ESM" >interval-malformed.ASC
+sed 's/^UNITS:.*/UNITS:/' "$ESM" >units-empty.ASC
+expect_failure "sim: DT= abc is malformed, not missing" 'dt-malformed.AT2:4: DT is malformed: .*found .abc.' \
+  -- --scene "$ISOLATED" --record dt-malformed.AT2
+expect_failure "sim: NPTS= x12 is malformed" 'npts-malformed.AT2:4: NPTS is malformed: .*found .x12.' \
+  -- --scene "$ISOLATED" --record npts-malformed.AT2
+expect_failure "sim: an ESM SAMPLING_INTERVAL_S: abc is malformed" \
+  'interval-malformed.ASC:[0-9]+: SAMPLING_INTERVAL_S is malformed' -- --scene "$ISOLATED" \
+  --record interval-malformed.ASC
+expect_failure "sim: an ESM UNITS: without a value is malformed" \
+  'units-empty.ASC:[0-9]+: UNITS is malformed: the line has no value' -- --scene "$ISOLATED" \
+  --record units-empty.ASC
+# A value of the wrong type is said to be one, not an unknown key.
+printf '[alarm_policy]\nadvisory = 0.1\n' >wrong-type.toml
+printf 'monitor = 3\n' >wrong-table.toml
+printf 'gravity = "9.8"\n[block]\nhalf_width = 0.3\nslenderness = 3\nmass = 1000\n' >wrong-gravity.toml
+BIN=$MONITOR
+expect_failure "monitor: a number where a table belongs" \
+  'wrong-type.toml:2: alarm_policy.advisory: expected a table .*got a float' -- \
+  --scene "$ISOLATED" --replay "$AT2" --config wrong-type.toml
+expect_failure "monitor: a number for a whole table" 'wrong-table.toml:1: monitor: expected a table' \
+  -- --scene "$ISOLATED" --replay "$AT2" --config wrong-table.toml
+BIN=$SIM
+expect_failure "sim: a string for a number" 'gravity: expected a number, got a string' -- \
+  --scene wrong-gravity.toml --record "$AT2"
+# A derived quantity: the inputs that made it so, and the limit.
+printf '[block]\nhalf_width = 1e200\nslenderness = 3\nmass = 1e100\n' >huge-inertia.toml
+printf '[block]\nhalf_width = 0.3\nslenderness = 3\nmass = 1000\n[base]\nmass_ratio = 1\nperiod = 1e-5\ndamping_ratio = 0.1\n' >stiff-base.toml
+printf '[block]\nhalf_width = 0.3\nslenderness = 3\nmass = 1000\n[base]\nmass_ratio = 1\nperiod = 1e-300\ndamping_ratio = 0.1\n' >rigid-base.toml
+printf '[block]\nhalf_width = 0.3\nslenderness = 3\nmass = 1000\n[base]\nmass_ratio = 0.01\nperiod = 0.004\ndamping_ratio = 0.1\n' >light-base.toml
+expect_failure "sim: a derived inertia names the keys it came from" \
+  'block.inertia: .*not given.*block.mass = 1e\+100.*block.half_width = 1e\+200.*block.slenderness = 3' \
+  -- --scene huge-inertia.toml --record "$AT2"
+expect_failure "sim: a step too large names --dt, the base's keys and the limit" \
+  '--dt 0.0001: too large .*base.period T = 1e-05 s.*the largest stable step is 2.81e-06 s' \
+  -- --scene stiff-base.toml --record "$AT2"
+expect_failure "sim: a base no step can integrate is blamed itself" \
+  "the scene's base \(base.period T = 1e-300 s.*too stiff or too light to integrate at any usable step" \
+  -- --scene rigid-base.toml --record "$AT2"
+BIN=$MONITOR
+expect_failure "monitor: too few steps per sample names --steps and the fewest stable" \
+  '--steps 1 \(estimator.steps_per_sample\): is too few .*\(limit [0-9]+\)' \
+  -- --scene light-base.toml --replay "$AT2" --steps 1
+expect_failure "monitor: a base no step count makes stable names base.period" \
+  '--scene stiff-base.toml \(base.period\): makes the scene.s base too stiff' \
+  -- --scene stiff-base.toml --replay "$AT2"
+# A missing CAN interface is reported as missing (before this kernel's lack of CAN, if any).
+expect_failure "monitor: a missing CAN interface is said to be missing" \
+  'cannot open CAN interface nosuchcan0: the interface does not exist' -- --scene "$ISOLATED" \
+  --can nosuchcan0
+BIN=$REPLAY
+expect_failure "replay: a missing CAN interface is said to be missing" \
+  'cannot open CAN interface nosuchcan0: the interface does not exist' -- --record "$AT2" \
+  --can nosuchcan0 --speed max
+
 echo "$PASSED passed, $FAILED failed"
 ((FAILED == 0))

@@ -20,9 +20,20 @@ Error validate(const EstimatorSettings& st, const Scene& scene) {
   PLINTH_TRY(validate_feature_set(scene));
   if (const auto limit = static_cast<Time>(largest_stable_step(scene, solver.stepper));
       solver.step > limit) {
-    return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
-            "gives a solver step too large for a stable integration of this scene's base; "
-            "raise it so that 1 / (rate * steps) is below the limit",
+    // The input to change, and its limit: the fewest steps per sample that are stable at this
+    // rate, or, when even the most are not, the scene's base (its period, or its mass).
+    const Time fewest = std::ceil(1.0 / (st.sample_rate_hz * limit));
+    if (fewest <= 64.0) {
+      return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
+              "is too few for a stable integration of this scene's base at this sample rate "
+              "(1 / (rate * steps) must not exceed the base's largest stable step): give at "
+              "least the limit",
+              static_cast<double>(fewest)};
+    }
+    return {ErrorCode::kOutOfRange, "base.period",
+            "makes the scene's base too stiff (or too light) for the box: its largest stable "
+            "step (the limit, s) is shorter than a sample period over 64 steps, the most the "
+            "box takes; a longer period or a heavier base",
             limit};
   }
   return ok_error();

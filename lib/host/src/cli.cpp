@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 #include <exception>
+#include <iostream>
+#include <sstream>
 #include <string>
 
 #include "plinth/version/version.h"
@@ -60,31 +62,7 @@ void refuse_without_effect(const CLI::App& app, std::initializer_list<const char
   }
 }
 
-std::string shown(std::string_view text) {
-  std::string out = "'";
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const auto c = static_cast<unsigned char>(text[i]);
-    if (text.substr(i, 3) == "\xEF\xBB\xBF") {
-      out += "\\ufeff";
-      i += 2;
-    } else if (c == '\t') {
-      out += "\\t";
-    } else if (c == '\r') {
-      out += "\\r";
-    } else if (c == '\n') {
-      out += "\\n";
-    } else if (c < 0x20 || c == 0x7F) {
-      char hex[8];
-      std::snprintf(hex, sizeof hex, "\\x%02X", c);
-      out += hex;
-    } else if (c == '\\') {
-      out += "\\\\";
-    } else {
-      out += static_cast<char>(c);
-    }
-  }
-  return out + "'";
-}
+
 
 const CLI::Validator kFinite([](const std::string& text) { return check_finite(text, false); },
                              "FINITE");
@@ -104,7 +82,10 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv,
     refuse_options_beside_subcommand(app);
     if (checks) checks();
   } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+    std::ostringstream failure;  // CLI11's message, printed with the user's text escaped
+    const int code = app.exit(e, std::cout, failure);
+    std::fputs(printable(failure.str()).c_str(), stderr);
+    return code == 0 ? 0 : 2;
   }
   return std::nullopt;
 }
@@ -113,7 +94,7 @@ int run_tool(const char* name, const std::function<int()>& run) {
   try {
     return run();
   } catch (const std::exception& error) {  // InputError (the user's input) and anything else
-    std::fprintf(stderr, "%s: error: %s\n", name, error.what());
+    std::fprintf(stderr, "%s: error: %s\n", name, printable(error.what()).c_str());
     return 1;
   }
 }

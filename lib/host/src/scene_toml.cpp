@@ -25,6 +25,7 @@
 #include "plinth/core/name_table.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/text_file.h"
+#include "plinth/host/toml_names.h"
 
 namespace plinth::host {
 namespace {
@@ -37,23 +38,7 @@ std::string format_number(double value) {
   return std::string(buffer.data(), result.ptr);
 }
 
-// What a TOML value is, for messages ("expected a number, got a string").
-constexpr NameTable<toml::node_type, 10> kNodeTypeNames{{{
-    {toml::node_type::none, "nothing"},
-    {toml::node_type::table, "a table"},
-    {toml::node_type::array, "an array"},
-    {toml::node_type::string, "a string"},
-    {toml::node_type::integer, "an integer"},
-    {toml::node_type::floating_point, "a float"},
-    {toml::node_type::boolean, "a boolean"},
-    {toml::node_type::date, "a date"},
-    {toml::node_type::time, "a time"},
-    {toml::node_type::date_time, "a date-time"},
-}}};
-
-std::string_view type_name(toml::node_type type) {
-  return kNodeTypeNames.name(type, "an unknown type");
-}
+std::string_view type_name(toml::node_type type) { return toml_type_name(type); }
 
 std::string join(std::span<const std::string_view> words) {
   std::string out;
@@ -324,6 +309,12 @@ class Loader {
       record("block.inertia", *inertia);
     } else {
       blk.inertia = homogeneous_rectangle_inertia(blk.mass, blk.half_width, blk.com_height);
+      // Not in the file: a complaint about it names the keys it was made from.
+      derived_["block.inertia"] = "not given: m (b^2 + h^2) / 3 = " + format_number(blk.inertia) +
+                                  " from " + mass.number.key + " = " +
+                                  format_number(mass.number.value) + ", " + b.key + " = " +
+                                  format_number(b.value) + ", " + height.number.key + " = " +
+                                  format_number(height.number.value);
     }
   }
 
@@ -408,6 +399,10 @@ class Loader {
   [[noreturn]] void report(const Error& error) const {
     const std::string field = error.field;
     const auto it = provenance_.find(field);
+    if (const auto derived = derived_.find(field);
+        it == provenance_.end() && derived != derived_.end()) {
+      fail(0, field, error.reason + std::string(" (") + derived->second + ")");
+    }
     if (it == provenance_.end()) fail(0, field, error.reason);
     const Provenance& p = it->second;
     std::string what = error.reason;
@@ -467,6 +462,8 @@ class Loader {
 
   std::string origin_;
   std::map<std::string, Provenance, std::less<>> provenance_;
+  // Core fields computed from several keys, none of them the field's own: how.
+  std::map<std::string, std::string, std::less<>> derived_;
 };
 
 // The document with the uncertain keys set: key i at `value(i)`.

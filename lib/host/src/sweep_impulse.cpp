@@ -29,7 +29,8 @@ Simulator impulse_simulator(const Scene& scene, double dt, EventSink* sink) {
   SolverSettings solver;
   solver.step = dt;
   Simulator sim;
-  throw_if_simulator_error(Simulator::create(scene, Excitation::none(), solver, sim));
+  throw_if_simulator_error(Simulator::create(scene, Excitation::none(), solver, sim), scene,
+                           solver.step);
   sim.set_event_sink(sink);
   return sim;
 }

@@ -115,7 +115,7 @@ Occurrences simulate_occurrences(const Scene& scene, const Record& record, doubl
   Simulator sim;
   const Excitation excitation =
       Excitation::record(record.horizontal_signal(), {}, pga_mps2 / record.peak_horizontal());
-  throw_if_simulator_error(Simulator::create(scene, excitation, solver, sim));
+  throw_if_simulator_error(Simulator::create(scene, excitation, solver, sim), scene, solver.step);
   OccurrenceSink sink;
   sim.set_event_sink(&sink);
   sim.start_at_rest();

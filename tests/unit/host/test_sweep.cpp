@@ -309,7 +309,8 @@ TEST(Sweep, BadInputsSayWhatIsWrong) {
   const SweepPlan stiff =
       plan_thresholds(iso, brienza(), SweepParameter::kPeriod, {"T", 0.01, 0.01, 1}, big_step);
   EXPECT_THAT(input_error_text([&] { (void)testing::run_whole_plan(stiff); }),
-              HasSubstr("--param T = 0.01: --dt: "));
+              HasSubstr("--param T = 0.01: --dt 0.01: too large for a stable integration of this "
+                        "scene's base (base.period T = 0.01 s"));
   SweepSettings bad = coarse();
   bad.tolerance_g = 0.0;
   EXPECT_THAT(input_error_text([&] { validate(bad); }), HasSubstr("--tol"));

@@ -9,6 +9,8 @@
 #include <string>
 #include <string_view>
 
+#include "plinth/host/input_error.h"  // shown, printable
+
 namespace plinth::host {
 
 // A finite number; a finite number greater than zero. (CLI11's PositiveNumber lets NaN through
@@ -33,10 +35,6 @@ extern const CLI::Validator kFinitePositive;
 void refuse_without_effect(const CLI::App& app, std::initializer_list<const char*> options,
                            bool applies, const std::string& reason);
 
-// A text shown in a message with its invisible characters escaped (a tab as \t, a carriage
-// return as \r, a UTF-8 byte order mark as \ufeff, any other control byte as \xNN) and
-// quoted: what the user typed or the file held, as it is.
-[[nodiscard]] std::string shown(std::string_view text);
 
 // Runs a tool's work and returns its exit code: `run`'s, or 1 after an InputError or any other
 // exception, printed on stderr as "NAME: error: what".
