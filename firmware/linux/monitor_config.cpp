@@ -274,6 +274,15 @@ class KeyLines {
         throw InputError(cat(where(name), ": ", name, ": expected a table (", name,
                              ".<key> = ...), got ", host::toml_type_name(value.type())));
       }
+      // A table where a value belongs (estimator.sample_rate_hz = { ... }): the same.
+      const auto holder = std::find_if(table.begin(), table.end(), [&](const Binding& b) {
+        return key.rfind(b.key + ".", 0) == 0;
+      });
+      if (holder != table.end()) {
+        const std::string held = name.substr(0, name.size() - (key.size() - holder->key.size()));
+        throw InputError(
+            cat(where(name), ": ", held, ": expected ", holder->expected, ", got a table"));
+      }
       throw InputError(cat(where(name), ": ", name, ": unknown key (docs/monitor.md lists them)"));
     }
     if (!binding->store(value)) {

@@ -203,12 +203,20 @@ struct StepPlan {
   std::int64_t out_every = 1;
 };
 
-StepPlan plan_steps(const Options& opt, double t_end) {
+// `t_end`: --t-end, or the excitation's duration + 5 s (at least 10 s), whose input a message
+// about the run's length names: the pulse's --period or the record.
+StepPlan plan_steps(const Options& opt, double t_end, double excitation_duration) {
   using plinth::host::given;
+  std::string run_of = " (a run of " + plinth::host::number_text(t_end) + " s";
+  if (!opt.t_end && excitation_duration + 5.0 > 10.0) {
+    const std::string source = !opt.record_path.empty()
+                                   ? "the record " + plinth::host::shown(opt.record_path)
+                                   : "the pulse of " + given("--period", opt.period.value_or(0.0));
+    run_of += ": " + source + " lasts " + plinth::host::number_text(excitation_duration) +
+              " s, and 5 s after it; --t-end shortens it";
+  }
   const std::string subject =
-      given("--dt", opt.dt) + (opt.t_end
-                                   ? " and " + given("--t-end", t_end)
-                                   : " (a run of " + plinth::host::number_text(t_end) + " s)");
+      given("--dt", opt.dt) + (opt.t_end ? " and " + given("--t-end", t_end) : run_of + ")");
   StepPlan plan;
   plan.steps = plinth::host::bounded_count(std::round(t_end / opt.dt), plinth::host::kMaxRunSteps,
                                            subject, "the run would take", "solver steps");
@@ -281,7 +289,7 @@ int run(const Options& opt) {
       plinth::Simulator::create(scene, excitation, settings, sim), scene, settings.step);
 
   const double t_end = opt.t_end ? *opt.t_end : std::max(10.0, excitation.duration() + 5.0);
-  const StepPlan plan = plan_steps(opt, t_end);
+  const StepPlan plan = plan_steps(opt, t_end, excitation.duration());
   std::optional<plinth::host::OutputFile> csv_file;
   std::optional<plinth::host::OutputFile> events_file;
   if (!opt.out_path.empty()) csv_file.emplace("--out", opt.out_path);

@@ -404,6 +404,24 @@ invisible "monitor: a tab in a file name is shown as \\t" "$MONITOR" 'no\tsuch.t
   --scene "$ISOLATED" --replay "$AT2" --config $'no\tsuch.toml'
 invisible "replay: a tab in --node-record is shown as \\t" "$REPLAY" "'1\t'" -- \
   --record "$AT2" --log x.log --node-record $'1\t:x:'"$AT2"
+# The class walked: each invisible character at each place a user's text reaches a message (an
+# option's value, a file name, a record's header, a parameter's name, a compound value).
+INVISIBLE=($'\t' $'\r' $'\xef\xbb\xbf' $'\x01' $'\x1b' $'\x7f')
+ESCAPES=('\t' '\r' '\ufeff' '\x01' '\x1B' '\x7F')
+for i in "${!INVISIBLE[@]}"; do
+  c=${INVISIBLE[$i]}
+  e=${ESCAPES[$i]}
+  printf 't,a [g%sx]\n0,0\n0.01,0.1\n' "$c" >"unit-$i.csv"
+  invisible "sim --pga with $e" "$SIM" "$e" -- --scene "$ISOLATED" --record "$AT2" --pga "0.3g$c"
+  invisible "sim --record name with $e" "$SIM" "$e" -- --scene "$ISOLATED" --record "no${c}such.csv"
+  invisible "sim: a record's unit with $e" "$SIM" "$e" -- --scene "$ISOLATED" --record "unit-$i.csv"
+  invisible "sweep --param with $e" "$SWEEP" "$e" -- --scene "$ISOLATED" --record "$AT2" \
+    --param "T$c" --from 1 --to 2 --steps 2 --out "p-$i.csv"
+  invisible "monitor --config name with $e" "$MONITOR" "$e" -- --scene "$ISOLATED" --replay "$AT2" \
+    --config "no${c}such.toml"
+  invisible "replay --node-record with $e" "$REPLAY" "$e" -- --record "$AT2" --log x.log \
+    --node-record "1$c:x:$AT2"
+done
 BIN=$SIM
 expect_success "sim: a byte order mark before a CSV header is read" --scene "$ISOLATED" \
   --record bom-header.csv
@@ -457,6 +475,17 @@ expect_failure "monitor: too few steps per sample names --steps and the fewest s
 expect_failure "monitor: a base no step count makes stable names base.period" \
   '--scene stiff-base.toml \(base.period\): makes the scene.s base too stiff' \
   -- --scene stiff-base.toml --replay "$AT2"
+# A step count names what set the run's length: --t-end, the pulse's --period, the record.
+BIN=$SIM
+expect_failure "sim: a run's steps name the pulse's --period" \
+  'a run of 1e\+09 s: the pulse of --period 1e\+09 lasts' '--t-end shortens it' 'solver steps' -- \
+  --scene "$ISOLATED" --pulse sine --amplitude 0.1g --period 1e9
+expect_failure "sim: a run's steps name the record" \
+  "--dt 1e-20 \(a run of [0-9.]+ s: the record '.*irpinia1980_brienza_000.AT2' lasts" 'solver steps' -- \
+  --scene "$ISOLATED" --record "$AT2" --dt 1e-20
+expect_failure "sim: a run's steps name --t-end" '--dt 1e-20 and --t-end 3: ' 'solver steps' -- \
+  --scene "$ISOLATED" --impulse 0.1 --dt 1e-20 --t-end 3
+BIN=$MONITOR
 # A missing CAN interface is reported as missing (before this kernel's lack of CAN, if any).
 expect_failure "monitor: a missing CAN interface is said to be missing" \
   'cannot open CAN interface nosuchcan0: the interface does not exist' -- --scene "$ISOLATED" \

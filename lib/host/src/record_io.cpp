@@ -131,10 +131,8 @@ std::vector<std::string_view> split_commas(std::string_view text) {
 
 std::string quote(std::string_view text) {
   constexpr std::size_t kShown = 40;  // characters of a bad token shown in a message
-  std::string result(1, '\'');
-  result.append(text.substr(0, kShown));
-  if (text.size() > kShown) result.append("...");
-  result.push_back('\'');
+  std::string result = shown(text.substr(0, kShown));  // invisible characters escaped
+  if (text.size() > kShown) result.insert(result.size() - 1, "...");
   return result;
 }
 

@@ -1,6 +1,9 @@
 // The box's configuration file (firmware/linux/monitor_config.h).
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <regex>
+#include <set>
 #include <string>
 
 #include "box_file_error.h"
@@ -109,6 +112,51 @@ TEST(MonitorConfigFile, BadInputNamesFileLineAndKey) {
   } catch (const host::InputError& e) {
     EXPECT_STREQ(e.what(), "/nowhere/box.toml: cannot open configuration file (no such file)");
   }
+}
+
+// Issue 25: a value of the wrong type is reported as one, never as an unknown key. The walk
+// covers every key the example file shows (commented ones too): each table given a number,
+// each key given a table (or, where a table belongs, a boolean).
+TEST(MonitorConfigFile, EveryKeyOfTheWrongTypeIsSaidToBeOne) {
+  std::ifstream example(kSource + "/firmware/monitor.example.toml");
+  ASSERT_TRUE(example);
+  const std::regex header(R"(^#?\s*\[(\[?)([a-z_]+)\]\]?\s*(#.*)?$)");
+  const std::regex assignment(R"(^#?\s*([a-z_]+)\s*=\s*([-+.0-9"\[{]|true|false).*$)");
+  std::string line;
+  std::string table;
+  bool array_of_tables = false;
+  std::set<std::string> tables;
+  int keys = 0;
+  while (std::getline(example, line)) {
+    std::smatch m;
+    if (std::regex_match(line, m, header)) {
+      table = m[2];
+      array_of_tables = m[1].length() > 0;
+      if (!array_of_tables) tables.insert(table);
+      continue;
+    }
+    if (table.empty() || !std::regex_match(line, m, assignment)) continue;
+    const std::string key = m[1];
+    const std::string head = array_of_tables ? "[[" + table + "]]\nnode = 1\n" : "[" + table + "]\n";
+    const std::string name = table + (array_of_tables ? "[0]." : ".") + key;
+    const bool holds_a_table = m[2] == "{";
+    const std::string text = head + key + (holds_a_table ? " = true\n" : " = { x = 1 }\n");
+    const std::string message = box_file_error(text);
+    SCOPED_TRACE(text);
+    EXPECT_EQ(message.find("unknown key"), std::string::npos) << message;
+    if (key == "node" && array_of_tables) continue;  // given twice: the repeat is named
+    EXPECT_NE(message.find(name + ": expected "), std::string::npos) << message;
+    if (!holds_a_table) {
+      EXPECT_NE(message.find("got a table"), std::string::npos) << message;
+    }
+    ++keys;
+  }
+  EXPECT_GT(keys, 60);
+  for (const std::string& t : tables) {
+    const std::string message = box_file_error(t + " = 3\n");
+    EXPECT_NE(message.find(t + ": expected a table"), std::string::npos) << message;
+  }
+  EXPECT_GT(tables.size(), 12U);
 }
 
 // A directory was read as an empty file (the defaults, silently); /dev/zero grew memory.

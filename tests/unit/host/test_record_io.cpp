@@ -24,6 +24,7 @@ namespace plinth::host {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::string lowercase_for_test(std::string text) {
   for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -721,6 +722,27 @@ TEST_F(EsmErrorTest, HeaderThatLies) {
               HasSubstr(path_ + ":13: truncated data: found 3 values, NDATA=4"));
   EXPECT_THAT(error_for("", "", "1\n2\n3\n4\n5\n"),
               HasSubstr(path_ + ":15: more values than NDATA=4"));
+}
+
+// Issue 25: each header field the reader needs is named as missing when its line is absent and
+// as malformed when its line is there with no value or a value that is not one.
+TEST_F(EsmErrorTest, EachRequiredFieldMissingOrMalformed) {
+  const std::vector<std::pair<std::string, std::string>> fields = {
+      {"SAMPLING_INTERVAL_S", "0.005000"}, {"NDATA", "4"}, {"UNITS", "cm/s^2"}};
+  for (const auto& [key, value] : fields) {
+    const std::string line = key + ": " + value + "\n";
+    EXPECT_THAT(error_for(line, ""),
+                HasSubstr(path_ + ": missing header line '" + key + ": <value>'"));
+    const std::string empty = error_for(line, key + ":\n");
+    EXPECT_THAT(empty, HasSubstr(key + " is malformed: the line has no value after '" + key + ":'"));
+    EXPECT_THAT(empty, Not(HasSubstr("missing")));
+    const std::string garbage = error_for(line, key + ": 4\x01x\n");
+    EXPECT_THAT(garbage, HasSubstr("'4\\x01x'")) << key;
+    EXPECT_THAT(garbage, Not(HasSubstr("missing"))) << key;
+    if (key != "UNITS") {
+      EXPECT_THAT(garbage, HasSubstr(key + " is malformed")) << garbage;
+    }
+  }
 }
 
 TEST_F(EsmErrorTest, MissingOrBadKeys) {
