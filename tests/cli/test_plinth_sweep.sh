@@ -83,6 +83,54 @@ sweep "${SMALL[@]}" --out again.csv
 check "a finished sweep is resumed, not rerun" grep -q '4 resumed from again.csv), 0 simulations' "$TMP/out.txt"
 check "and its file is unchanged" cmp -s again.csv whole.csv
 
+# A finished file that differs only in line endings or formatting is resumed, and rewritten as
+# plinth-sweep writes it (issue 25). The class walked: CRLF, classic Mac CR, a byte order mark,
+# a spreadsheet's save (every field quoted, spaces after commas, the settings line padded with
+# empty fields, numbers as 2.000000000E-01), blank lines and no final line feed.
+declare -A RESAVED=(
+  [crlf]="sed 's/\$/\r/'"
+  [cr]="tr '\n' '\r'"
+  [bom]="sed '1s/^/\xef\xbb\xbf/'"
+  [spreadsheet]="awk 'NR == 1 { printf \"\\\"%s\\\",,,,,,,,,\r\n\", \$0; next }
+    { n = split(\$0, f, \",\"); out = \"\"
+      for (i = 1; i <= n; i++) { v = f[i]; if (v ~ /^[0-9.]+\$/) v = sprintf(\"%.9E\", v)
+        out = out (i > 1 ? \", \" : \"\") \"\\\"\" v \"\\\"\" }
+      printf \"%s\r\n\", out }'"
+  [blank-lines]="awk '{ print } NR == 3 { print \"\"; print \",,,\" }' | head -c -1"
+)
+for variant in "${!RESAVED[@]}"; do
+  eval "${RESAVED[$variant]}" <whole.csv >"resaved-$variant.csv"
+  if cmp -s "resaved-$variant.csv" whole.csv; then
+    fail "a file resaved ($variant) is resumed" "the variant changed nothing"
+    continue
+  fi
+  sweep "${SMALL[@]}" --out "resaved-$variant.csv"
+  check "a file resaved ($variant) is resumed" \
+    grep -q "4 resumed from resaved-$variant.csv), 0 simulations" "$TMP/out.txt"
+  check "and rewritten as plinth-sweep writes it ($variant)" cmp -s "resaved-$variant.csv" whole.csv
+done
+# A file that cannot be continued says why and keeps its rows beside (never replaced unseen).
+sed 's/tol_g=0.05/tol_g=0.1/' whole.csv >othertol.csv
+cp othertol.csv othertol.orig
+sweep "${SMALL[@]}" --out othertol.csv
+check "a file of another sweep says why it is not resumed" \
+  grep -q "othertol.csv comes from another sweep (tol_g: 0.1 in the file, 0.05 in this run); not resumed: its 4 row(s) are kept as othertol.csv.kept" "$TMP/err.txt"
+check "and its rows are kept" cmp -s othertol.csv.kept othertol.orig
+check "and the run writes its own" cmp -s othertol.csv whole.csv
+cp othertol.orig othertol.csv
+sweep "${SMALL[@]}" --out othertol.csv
+check "a second one is kept beside the first" cmp -s othertol.csv.kept-2 othertol.orig
+printf 'not a sweep\n' >notsweep.csv
+sweep "${SMALL[@]}" --out notsweep.csv
+check "a file that is not a sweep CSV says so and is kept" \
+  grep -q "notsweep.csv:1: not a plinth-sweep CSV.*not resumed: it is kept as notsweep.csv.kept" "$TMP/err.txt"
+check "unchanged" grep -qx 'not a sweep' notsweep.csv.kept
+sed '3s/^0\.2,/0.25,/' whole.csv >offgrid.csv
+cp offgrid.csv offgrid.orig
+refuses "a row off the grid stops the run, naming it" "offgrid.csv: row '0.25' is not a point of this sweep's grid" \
+  "${SMALL[@]}" --out offgrid.csv
+check "and leaves the file as it was" cmp -s offgrid.csv offgrid.orig
+
 # Interrupt: SIGINT once a row is written; the rows so far are kept; a rerun resumes.
 LONG=(--scene "$ISOLATED" --record "$AT2" --param mu_s --from 0.3 --to 1.5 --steps 9
       --pga-max 4g --tol 0.02g --dt 4e-3 --jobs 1)
@@ -179,6 +227,7 @@ cp plainT.csv plainfirst.csv
 sweep "${PERIOD[@]}" --compare-ground --out plainfirst.csv
 check "a map made without --compare-ground is replaced, saying why" \
   grep -q "another sweep (compare: none in the file, ground in this run)" "$TMP/err.txt"
+check "and keeping its rows beside" cmp -s plainfirst.csv.kept plainT.csv
 check "by the compared map" cmp -s plainfirst.csv cmpT.csv
 sweep --scene "$ISOLATED" --record "$AT2" --param lambda --from 3 --to 4 --steps 2 \
   --param2 epsilon --from2 -0.3 --to2 0.3 --steps2 2 --event rocking --pga-max 4g --tol 0.05g \

@@ -7,6 +7,7 @@
 #include <string_view>
 #include <system_error>
 
+#include "plinth/host/csv_line.h"
 #include "plinth/host/input_error.h"
 
 namespace plinth::host {
@@ -39,35 +40,6 @@ std::string csv_field(const std::string& text) {
     out += c;
   }
   return out + "\"";
-}
-
-// Splits one CSV line (RFC 4180 quoting); false on an unterminated quote.
-bool split_csv(const std::string& line, std::vector<std::string>& fields) {
-  fields.clear();
-  std::string field;
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        field += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        field += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields.push_back(field);
-      field.clear();
-    } else {
-      field += c;
-    }
-  }
-  fields.push_back(field);
-  return !quoted;
 }
 
 double parse_number(const std::string& text, const std::string& where, std::string_view column) {
