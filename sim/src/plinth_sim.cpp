@@ -183,6 +183,15 @@ plinth::Excitation record_excitation(const Options& opt, double g, plinth::host:
     vertical_text = "; vertical: " + opt.vertical_path +
                     (record.vertical.empty() ? "" : " (in place of the record's own column)");
   }
+  if (record.dt < opt.dt) {  // said, not refused: the run is still the record's low-passed view
+    std::fprintf(stderr,
+                 "plinth-sim: note: %s is sampled every %s s, finer than --dt %s: the integration "
+                 "sees the record at its steps only (a --dt of at most %s follows every sample)\n",
+                 plinth::host::shown(opt.record_path).c_str(),
+                 plinth::host::number_text(record.dt).c_str(),
+                 plinth::host::number_text(opt.dt).c_str(),
+                 plinth::host::number_text(record.dt).c_str());
+  }
   const double gamma = plinth::host::record_scale(record, opt.record_path, opt.pga, opt.scale, g);
   if (!opt.vertical_path.empty()) {
     plinth::host::check_scaled_peak(
@@ -196,6 +205,10 @@ plinth::Excitation record_excitation(const Options& opt, double g, plinth::host:
   text = line + vertical_text;
   return plinth::Excitation::record(record.horizontal_signal(), vertical_signal, gamma);
 }
+
+// The fewest solver steps in a pulse's period (a one-sine pulse sampled 20 times: its peak
+// within 1.3 %).
+constexpr double kMinStepsPerPulse = 20.0;
 
 // The steps of the run and between CSV rows, within the limits (limits.h).
 struct StepPlan {
@@ -265,6 +278,14 @@ int run(const Options& opt) {
     if (!(std::fabs(amplitude) / g <= plinth::host::kMaxScaledPeakG)) {
       throw InputError("--amplitude " + opt.amplitude + ": limit " +
                        plinth::host::number_text(plinth::host::kMaxScaledPeakG) + " g");
+    }
+    // A pulse the step cannot follow would be sampled at a few points, or at none: outside
+    // what the integration assumes (docs/model.md, "Other limits of the model").
+    if (*opt.period < kMinStepsPerPulse * opt.dt) {
+      throw InputError(plinth::host::given("--period", *opt.period) + ": a pulse shorter than " +
+                       plinth::host::number_text(kMinStepsPerPulse) + " solver steps (" +
+                       plinth::host::given("--dt", opt.dt) +
+                       ") is not followed by the integration; a smaller --dt or a longer --period");
     }
     excitation = opt.pulse == "sine" ? plinth::Excitation::sine_pulse(amplitude, *opt.period)
                                      : plinth::Excitation::cosine_pulse(amplitude, *opt.period);

@@ -469,6 +469,17 @@ expect_failure "sim: a step too large names --dt, the base's keys and the limit"
 expect_failure "sim: a base no step can integrate is blamed itself" \
   "the scene's base \(base.period T = 1e-300 s.*too stiff or too light to integrate at any usable step" \
   -- --scene rigid-base.toml --record "$AT2"
+expect_failure "sim: a pulse shorter than 20 steps is refused" \
+  '--period 0.001: a pulse shorter than 20 solver steps \(--dt 0.0001\)' -- \
+  --scene "$ISOLATED" --pulse sine --amplitude 0.1g --period 1e-3
+sed '4s/DT= *[.0-9]*/DT= .00005/' "$AT2" >fine.AT2
+if expect_success "sim: a record finer than --dt runs" --scene "$ISOLATED" --record fine.AT2; then
+  if grep -q "note: 'fine.AT2' is sampled every 5e-05 s, finer than --dt 0.0001" "$TMP/stderr"; then
+    pass "sim: a record finer than --dt is said to be"
+  else
+    fail "sim: a record finer than --dt is said to be" "$(first_stderr_line)"
+  fi
+fi
 BIN=$MONITOR
 expect_failure "monitor: too few steps per sample names --steps and the fewest stable" \
   '--steps 1 \(estimator.steps_per_sample\): is too few .*\(limit [0-9]+\)' \
