@@ -57,6 +57,17 @@ std::function<bool(const toml::node&)> integer_into(int& target) {
   };
 }
 
+// A count or size: an integer from 0 to 2^53.
+std::function<bool(const toml::node&)> count_into(std::uint64_t& target) {
+  return [&target](const toml::node& n) {
+    if (!n.is_integer()) return false;
+    const std::int64_t v = n.value<std::int64_t>().value_or(-1);
+    if (v < 0 || v > (std::int64_t{1} << 53)) return false;
+    target = static_cast<std::uint64_t>(v);
+    return true;
+  };
+}
+
 std::function<bool(const toml::node&)> flag_into(bool& target) {
   return [&target](const toml::node& n) {
     if (!n.is_boolean()) return false;
@@ -177,6 +188,10 @@ void output_bindings(std::vector<Binding>& b, ModbusSettings& modbus, MqttSettin
   b.push_back({"mqtt.state_interval_s", number_into(mqtt.state_interval_s), "a number"});
   b.push_back({"mqtt.reconnect_min_s", number_into(mqtt.reconnect_min_s), "a number"});
   b.push_back({"mqtt.reconnect_max_s", number_into(mqtt.reconnect_max_s), "a number"});
+  b.push_back({"mqtt.commands", flag_into(mqtt.commands), "true or false"});
+  b.push_back({"mqtt.discovery", flag_into(mqtt.discovery), "true or false"});
+  b.push_back({"mqtt.discovery_prefix", string_into(mqtt.discovery_prefix),
+               "a string (topic levels)"});
 }
 
 std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
@@ -221,6 +236,12 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
   relay_bindings(b, f.relays, relay_active_low);
   b.push_back({"watchdog.notify", flag_into(f.watchdog.notify), "true or false"});
   b.push_back({"watchdog.test_stall_after_s", number_into(f.watchdog.test_stall_after_s),
+               "a number (s; test only)"});
+  b.push_back({"recorder.max_captures", count_into(f.recorder.retention.max_captures),
+               "an integer from 0 (no limit) to 2^53"});
+  b.push_back({"recorder.max_bytes", count_into(f.recorder.retention.max_bytes),
+               "an integer from 0 (no limit) to 2^53"});
+  b.push_back({"recorder.test_pause_mid_write_s", number_into(f.recorder.test_pause_mid_write_s),
                "a number (s; test only)"});
   output_bindings(b, f.modbus, f.mqtt);
   for (auto [name, thresholds] : {std::pair<const char*, monitor::RiskThresholds*>{"advisory", &alarm.advisory},
@@ -481,6 +502,10 @@ void check_outputs(MonitorFile& file, const KeyLines& lines, const std::string& 
     lines.fail("mqtt.topic_prefix",
                "mqtt.topic_prefix: expected topic levels (no '+' or '#', no empty level)");
   }
+  if (!topic_part(mqtt.discovery_prefix, true)) {
+    lines.fail("mqtt.discovery_prefix",
+               "mqtt.discovery_prefix: expected topic levels (no '+' or '#', no empty level)");
+  }
   const auto range = [&](const char* key, double value, double low, double high) {
     if (!(value >= low && value <= high)) {
       lines.fail(key, cat(key, ": must lie in [", number_text(low), ", ", number_text(high), "]"));
@@ -539,6 +564,11 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   if (!std::isfinite(file.watchdog.test_stall_after_s) || file.watchdog.test_stall_after_s < 0.0) {
     lines.fail("watchdog.test_stall_after_s",
                "watchdog.test_stall_after_s: must be a finite number of seconds >= 0");
+  }
+  if (!std::isfinite(file.recorder.test_pause_mid_write_s) ||
+      file.recorder.test_pause_mid_write_s < 0.0 || file.recorder.test_pause_mid_write_s > 600.0) {
+    lines.fail("recorder.test_pause_mid_write_s",
+               "recorder.test_pause_mid_write_s: must be a number of seconds in [0, 600]");
   }
   check(file.config, lines);
   check_outputs(file, lines, origin);

@@ -6,40 +6,21 @@
 #include <optional>
 #include <string>
 
+#include "capture_store.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/firmware/record_replay.h"
+#include "modbus_server.h"
+#include "mqtt_publisher.h"
 #include "relay_outputs.h"
 #include "supervisor.h"
 
 namespace plinth::firmware {
 
-// [modbus]: the Modbus TCP server (docs/integration.md). Off while `listen` is empty.
-struct ModbusSettings {
-  std::string listen;        // modbus.listen, "HOST:PORT" (checked when read)
-  std::string listen_where;  // how messages name it: "box.toml:12: modbus.listen" or "--modbus"
-  bool writes = false;       // modbus.writes: the acknowledge and reset coils may be written
-  int max_clients = 8;       // modbus.max_clients: connections at once, 1..64
-};
-
-// [mqtt]: the MQTT publisher (docs/integration.md). Off while `broker` is empty.
-struct MqttSettings {
-  std::string broker;                   // mqtt.broker, "HOST:PORT" (checked when read)
-  std::string broker_where;             // "box.toml:20: mqtt.broker" or "--mqtt"
-  std::string box_id;                   // mqtt.box_id: in the topics; default: the host name
-  std::string topic_prefix = "plinth";  // mqtt.topic_prefix: topics are PREFIX/BOX/...
-  std::string username;                 // mqtt.username
-  std::string password;                 // mqtt.password (better: password_file)
-  std::string password_file;            // mqtt.password_file: its first line is the password
-  std::string ca_file;    // mqtt.tls_ca_file: TLS on, the broker's certificate checked with it
-  std::string cert_file;  // mqtt.tls_cert_file, mqtt.tls_key_file: a client certificate
-  std::string key_file;
-  std::string files_where;        // "box.toml" or "--mqtt-*", for messages about the files
-  int keepalive_s = 10;           // mqtt.keepalive_s, 5..3600
-  int event_queue = 1000;         // mqtt.event_queue: alarm events held while away, 1..100000
-  double state_interval_s = 1.0;  // mqtt.state_interval_s: state at most this often (and at
-                                  // every level change), 0.001..3600
-  double reconnect_min_s = 0.5;   // mqtt.reconnect_min_s: first back-off, doubled to ...
-  double reconnect_max_s = 30.0;  // mqtt.reconnect_max_s
+// [recorder]: the event recorder's folder (docs/monitor.md, "Event recorder").
+struct RecorderFileSettings {
+  RetentionLimits retention;  // recorder.max_captures, recorder.max_bytes (0: no limit)
+  // recorder.test_pause_mid_write_s, TEST ONLY (event_recorder.h); a box never sets it.
+  double test_pause_mid_write_s = 0.0;
 };
 
 struct MonitorFile {
@@ -47,8 +28,9 @@ struct MonitorFile {
   std::string second_scene_path;  // monitor.second_scene, resolved against the file's folder
   RelaySettings relays;           // [relays]
   WatchdogSettings watchdog;      // [watchdog]
-  ModbusSettings modbus;
-  MqttSettings mqtt;
+  RecorderFileSettings recorder;  // [recorder]
+  ModbusSettings modbus;          // [modbus]
+  MqttSettings mqtt;              // [mqtt]
 };
 
 // Reads `path` over `defaults`. Throws host::InputError naming the file, the line and the key

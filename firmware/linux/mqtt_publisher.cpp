@@ -4,14 +4,18 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <mutex>
+#include <nlohmann/json.hpp>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/json_text.h"
 #include "plinth/host/text_file.h"
+#include "plinth/version/version.h"
 #include "status_json.h"
 
 namespace plinth::firmware {
@@ -85,13 +89,24 @@ extern "C" void disconnect_callback(mosquitto*, void* self, int rc) {
 extern "C" void publish_callback(mosquitto*, void* self, int mid) {
   static_cast<MqttPublisher*>(self)->on_publish(mid);
 }
+extern "C" void message_callback(mosquitto*, void* self, const mosquitto_message* message) {
+  if (message == nullptr || message->topic == nullptr) return;
+  const std::size_t length =
+      message->payload == nullptr ? 0U : static_cast<std::size_t>(message->payloadlen);
+  const std::string payload(static_cast<const char*>(message->payload), length);
+  static_cast<MqttPublisher*>(self)->on_message(message->topic, payload);
+}
 extern "C" void log_callback(mosquitto*, void* self, int level, const char* text) {
   if ((level & MOSQ_LOG_ERR) != 0) static_cast<MqttPublisher*>(self)->on_error_log(text);
 }
 
 }  // namespace
 
-MqttPublisher::MqttPublisher(const MqttSettings& settings) : settings_(settings) {
+MqttPublisher::MqttPublisher(const MqttSettings& settings, const RunIdentity& identity)
+    : settings_(settings) {
+  for (const NamedDigest& d : named_digests(identity)) {
+    digests_.push_back({d.member, d.file, d.digest->has_value() ? hex(**d.digest) : ""});
+  }
   static std::once_flag library;
   std::call_once(library, [] { mosquitto_lib_init(); });
   const Endpoint endpoint = parse_endpoint(settings.broker, settings.broker_where);
@@ -107,6 +122,8 @@ MqttPublisher::MqttPublisher(const MqttSettings& settings) : settings_(settings)
   state_topic_ = base + "state";
   events_topic_ = base + "events";
   availability_topic_ = base + "availability";
+  command_topic_ = base + "command";
+  reply_topic_ = command_topic_ + "/reply";
 
   std::string password = settings_.password;
   if (!settings_.password_file.empty()) {
@@ -151,6 +168,7 @@ MqttPublisher::MqttPublisher(const MqttSettings& settings) : settings_(settings)
   mosquitto_connect_callback_set(client_, connect_callback);
   mosquitto_disconnect_callback_set(client_, disconnect_callback);
   mosquitto_publish_callback_set(client_, publish_callback);
+  mosquitto_message_callback_set(client_, message_callback);
   mosquitto_log_callback_set(client_, log_callback);
   backoff_s_ = settings_.reconnect_min_s;
   thread_ = std::thread([this] { run(); });
@@ -182,6 +200,11 @@ void MqttPublisher::on_connect(int rc) {
   if (problem != last_problem_ && !last_problem_.empty()) say(problem);
   last_problem_ = problem;
   (void)publish(availability_topic_, "online", true, nullptr);
+  // Also while commands are off: the reply says so.
+  if (mosquitto_subscribe(client_, nullptr, command_topic_.c_str(), kQos) != MOSQ_ERR_SUCCESS) {
+    say("cannot subscribe to " + command_topic_);
+  }
+  publish_discovery();
   state_due_ = have_state_;
   head_sent_ns_ = 0;  // the head event goes out again if the broker never acknowledged it
 }
@@ -213,6 +236,7 @@ bool MqttPublisher::publish(const std::string& topic, const std::string& payload
 
 // The loop's alarm events into the queue (bounded), its newest snapshot into the state.
 void MqttPublisher::take_mailbox(std::int64_t now_ns) {
+  take_results();
   AlarmNotice notice;
   while (mailbox_.take_alarm(notice)) {
     // The oldest waiting event makes room; never the one the broker may be acknowledging.
@@ -290,6 +314,175 @@ void MqttPublisher::publish_head(std::int64_t now_ns) {
   head_sent_ns_ = now_ns;
 }
 
+// An operator's command (docs/integration.md, "Commands"): {"command": "acknowledge",
+// "level": .., "sequence": .., "id": ..}; level and sequence default to what the box shows.
+// A well-formed acknowledgement goes to the loop; the reply waits for its outcome.
+void MqttPublisher::on_message(const std::string& topic, const std::string& payload) {
+  if (topic != command_topic_) return;
+  ++commands_received_;
+  nlohmann::json command = nlohmann::json::parse(payload, nullptr, false);
+  std::string id_json = "null";
+  const auto refuse = [&](const std::string& why) {
+    reply(id_json, "refused", why, "");
+    say("command refused: " + why + ": " + payload.substr(0, 200));
+  };
+  if (command.is_discarded()) return refuse("not JSON");
+  if (!command.is_object()) return refuse("expected a JSON object");
+  if (command.contains("id")) {
+    const nlohmann::json& id = command["id"];
+    if (!id.is_string() && !id.is_number_integer()) {
+      return refuse("id: expected a string or an integer");
+    }
+    id_json = id.dump();
+  }
+  for (const auto& [key, value] : command.items()) {
+    if (key != "command" && key != "level" && key != "sequence" && key != "id") {
+      return refuse("unknown member \"" + key + "\" (expected command, level, sequence, id)");
+    }
+  }
+  if (!command.contains("command") || !command["command"].is_string()) {
+    return refuse("command: expected \"acknowledge\"");
+  }
+  if (command["command"].get<std::string>() != "acknowledge") {
+    return refuse("command: unknown command " + command["command"].dump() +
+                  " (expected \"acknowledge\")");
+  }
+  if (!settings_.commands) return refuse("commands are off (mqtt.commands = false)");
+  CommandRequest request;
+  request.level = state_.latched;
+  request.event_sequence = state_.event_sequence;
+  if (command.contains("level")) {
+    const nlohmann::json& level = command["level"];
+    if (!level.is_string() ||
+        !monitor::kAlarmLevelNames.parse(level.get<std::string>(), request.level)) {
+      return refuse(std::string("level: expected ") +
+                    joined_names<monitor::kAlarmLevelNames>("one of ").data());
+    }
+  }
+  if (command.contains("sequence")) {
+    const nlohmann::json& sequence = command["sequence"];
+    if (!sequence.is_number_integer() || sequence.get<std::int64_t>() < 0 ||
+        sequence.get<std::int64_t>() > 255) {
+      return refuse("sequence: expected an integer from 0 to 255");
+    }
+    request.event_sequence = static_cast<std::uint8_t>(sequence.get<int>());
+  }
+  if (pending_.size() >= OutputMailbox::kCommandSlots) {
+    return refuse("busy: " + std::to_string(pending_.size()) + " commands under way");
+  }
+  request.id = next_command_id_++;
+  if (!mailbox_.post_command(request)) return refuse("busy: the loop has not taken commands");
+  pending_[request.id] = {id_json, JsonObject()
+                                       .text("level", monitor::alarm_level_name(request.level))
+                                       .count("sequence", request.event_sequence)
+                                       .close()};
+}
+
+// {"id": .., "command": "acknowledge", "result": "accepted" | "refused", "reason": ..,
+// "level": .., "sequence": .., "outcome": ..}: `details` are the members after "reason".
+void MqttPublisher::reply(const std::string& id_json, const std::string& result,
+                          const std::string& why, const std::string& details) {
+  (result == "accepted" ? commands_accepted_ : commands_refused_) += 1;
+  JsonObject line;
+  line.raw("id", id_json).text("command", "acknowledge").text("result", result);
+  if (!why.empty()) line.text("reason", why);
+  std::string text = line.close();
+  if (!details.empty()) text.replace(text.size() - 1, 1, ", " + details.substr(1));
+  (void)publish(reply_topic_, text, false, nullptr);
+}
+
+// The loop's outcomes of the commands under way.
+void MqttPublisher::take_results() {
+  CommandResult result;
+  while (mailbox_.take_result(result)) {
+    const auto it = pending_.find(result.id);
+    if (it == pending_.end()) continue;
+    const bool released = result.outcome == monitor::AckOutcome::kReleased ||
+                          result.outcome == monitor::AckOutcome::kReleasedConditionHolds;
+    const std::string outcome = monitor::ack_outcome_name(result.outcome);
+    std::string details = it->second.details;
+    details.replace(details.size() - 1, 1, ", \"outcome\": " + host::json_quoted(outcome) + "}");
+    reply(it->second.id_json, released ? "accepted" : "refused", released ? "" : outcome, details);
+    pending_.erase(it);
+  }
+}
+
+// Home Assistant MQTT discovery: retained configs under DISCOVERY/<component>/<node>/<object>/
+// for the level, the latched level, the risk, the forecast's probability, the connection, the
+// digest of each file given (diagnostic: a device block has no key for them) and, with commands
+// on, an acknowledge button; one device per box.
+void MqttPublisher::publish_discovery() {
+  if (!settings_.discovery) return;
+  std::string node = "plinth_" + settings_.box_id;  // [A-Za-z0-9_-] only in discovery topics
+  for (char& c : node) {
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') c = '_';
+  }
+  const std::string device = JsonObject()
+                                 .raw("identifiers", json_array({host::json_quoted(node)}))
+                                 .text("name", "plinth " + settings_.box_id)
+                                 .text("manufacturer", "plinth")
+                                 .text("model", "plinth-monitor")
+                                 .text("sw_version", kVersionText)
+                                 .close();
+  std::vector<std::string> levels;
+  for (const auto& level : monitor::kAlarmLevelNames) {
+    levels.push_back(host::json_quoted(level.name));
+  }
+  const auto config = [&](const char* component, const char* object, JsonObject entity) {
+    const std::string topic =
+        settings_.discovery_prefix + "/" + component + "/" + node + "/" + object + "/config";
+    entity.text("unique_id", node + "_" + object).raw("device", device);
+    if (publish(topic, entity.close(), true, nullptr)) ++discovery_configs_;
+  };
+  const auto state_sensor = [&](const char* name, const char* template_text) {
+    JsonObject e;
+    e.text("name", name)
+        .text("state_topic", state_topic_)
+        .text("value_template", template_text)
+        .text("availability_topic", availability_topic_);
+    return e;
+  };
+  config("sensor", "level",
+         state_sensor("Alarm level", "{{ value_json.level }}")
+             .text("device_class", "enum")
+             .raw("options", json_array(levels)));
+  config("sensor", "latched",
+         state_sensor("Latched level", "{{ value_json.latched }}")
+             .text("device_class", "enum")
+             .raw("options", json_array(levels)));
+  config("sensor", "risk",
+         state_sensor("Overturning risk", "{{ value_json.risk }}")
+             .text("state_class", "measurement")
+             .count("suggested_display_precision", 4));
+  config("sensor", "probability",
+         state_sensor("Collapse probability", "{{ value_json.forecast.probability }}")
+             .text("state_class", "measurement")
+             .count("suggested_display_precision", 4));
+  for (const DigestMember& d : digests_) {
+    if (d.hex.empty()) continue;
+    const std::string value_template = "{{ value_json." + d.member + " }}";
+    config("sensor", d.member.c_str(),
+           state_sensor((d.file + " SHA-256").c_str(), value_template.c_str())
+               .text("entity_category", "diagnostic"));
+  }
+  config("binary_sensor", "availability",
+         JsonObject()
+             .text("name", "Online")
+             .text("state_topic", availability_topic_)
+             .text("payload_on", "online")
+             .text("payload_off", "offline")
+             .text("device_class", "connectivity")
+             .text("entity_category", "diagnostic"));
+  if (settings_.commands) {
+    config("button", "acknowledge",
+           JsonObject()
+               .text("name", "Acknowledge")
+               .text("command_topic", command_topic_)
+               .text("payload_press", "{\"command\": \"acknowledge\", \"id\": \"home-assistant\"}")
+               .text("availability_topic", availability_topic_));
+  }
+}
+
 std::string MqttPublisher::state_json() const {
   const StatusSnapshot& s = state_;
   JsonObject phase;
@@ -297,19 +490,52 @@ std::string MqttPublisher::state_json() const {
   for (int i = 0; i < s.axis_count && i < kMaxAxes; ++i) {
     phase.text(axes[i], phase_name(s.phase[static_cast<std::size_t>(i)]));
   }
-  return JsonObject()
-      .text("box", settings_.box_id)
+  const bool forecast = s.forecast_axis >= 0 && s.forecast_axis < kMaxAxes;
+  const bool worst = forecast && s.forecast_worst_member >= 0;
+  JsonObject forecast_json;
+  forecast_json.fixed("probability", s.probability, 4)
+      .raw("axis", forecast ? host::json_quoted(axes[s.forecast_axis]) : "null")
+      .raw("worst_member", worst ? std::to_string(s.forecast_worst_member) : "null");
+  if (s.collapse_forecast) {
+    forecast_json.fixed("collapse_t", s.collapse_forecast_t, 3)
+        .fixed("collapse_in_s", std::max(s.collapse_forecast_t - s.t, 0.0), 3);
+  } else {
+    forecast_json.raw("collapse_t", "null").raw("collapse_in_s", "null");
+  }
+  const monitor::SensorCounters& c = s.sensor_counters;
+  const std::string counters = JsonObject()
+                                   .count("fed", c.fed)
+                                   .count("bridged", c.bridged)
+                                   .count("missing", c.missing)
+                                   .count("timeouts", c.timeouts)
+                                   .count("faults", c.faults)
+                                   .count("rejected", c.non_finite + c.out_of_range +
+                                                          c.undefined_status)
+                                   .close();
+  JsonObject state;
+  state.text("box", settings_.box_id)
       .fixed("t", s.t, 6)
       .text("time", utc_text(s.wall_time_ns))
       .text("level", monitor::alarm_level_name(s.level))
       .text("latched", monitor::alarm_level_name(s.latched))
       .text("cause", monitor::alarm_cause_name(s.cause))
       .fixed("risk", s.risk, 4)
+      .raw("forecast", forecast_json.close())
       .raw("phase", phase.close())
       .flag("estimating", s.estimating)
       .text("sensor", monitor::health_state_name(s.sensor))
+      .text("sensors_state", monitor::health_state_name(s.sensors_state))
+      .raw("sensor_counters", counters)
+      .count("estimator_restarts", s.estimator_restarts)
       .count("heartbeat", s.statuses)
-      .close();
+      .raw("version", JsonObject()
+                          .text("project", kProjectVersion)
+                          .text("git", kGitDescription)
+                          .close());
+  for (const DigestMember& d : digests_) {
+    state.raw(d.member, d.hex.empty() ? "null" : host::json_quoted(d.hex));
+  }
+  return state.close();
 }
 
 void MqttPublisher::publish_state(std::int64_t now_ns) {
@@ -380,6 +606,10 @@ std::string MqttPublisher::summary_json() const {
       .count("events_undelivered", queue_.size())
       .count("most_queued", most_queued_)
       .count("states_published", states_published_)
+      .count("discovery_configs", discovery_configs_)
+      .count("commands_received", commands_received_)
+      .count("commands_accepted", commands_accepted_)
+      .count("commands_refused", commands_refused_)
       .close();
 }
 

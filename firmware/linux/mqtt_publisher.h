@@ -1,33 +1,64 @@
-// plinth-monitor's MQTT publisher (libmosquitto), on its own thread (status_outputs.h):
-//   PREFIX/BOX/state         retained JSON: level, latched, cause, risk, phase per axis, times
-//   PREFIX/BOX/events        every alarm line, QoS 1, in order
-//   PREFIX/BOX/availability  retained "online"; the Last Will, and a clean stop, say "offline"
+// plinth-monitor's MQTT client (libmosquitto), on its own thread (status_outputs.h):
+//   PREFIX/BOX/state          retained JSON: level, latched, cause, risk, the forecast, phase per
+//                             axis, sensor counters, version and the files' digests, times
+//   PREFIX/BOX/events         every alarm line, QoS 1, in order
+//   PREFIX/BOX/availability   retained "online"; the Last Will, and a clean stop, say "offline"
+//   PREFIX/BOX/command        the operator's acknowledgement (subscribed; mqtt.commands)
+//   PREFIX/BOX/command/reply  accepted or refused, and why
+//   DISCOVERY/.../config      retained Home Assistant discovery (mqtt.discovery)
 // Alarm events wait in a bounded queue while the broker is away (the oldest dropped and
 // counted when it is full) and go out one at a time, each once the broker acknowledged the one
 // before, so a broker restart loses none and keeps their order. Reconnects with exponential
-// back-off. Username/password and TLS (a CA, optionally a client certificate). Topics and
+// back-off. Username/password and TLS (a CA, optionally a client certificate). Who may publish
+// a command is the broker's ACL: MQTT does not tell a subscriber who published. Topics and
 // payloads: docs/integration.md. Host code: allocates and throws.
 #pragma once
 
 #include <atomic>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <string>
 #include <thread>
 #include <vector>
 
-#include "monitor_config.h"
+#include "run_identity.h"
 #include "status_outputs.h"
 
 struct mosquitto;
 
 namespace plinth::firmware {
 
+// The box's [mqtt] table (docs/integration.md). Off while `broker` is empty.
+struct MqttSettings {
+  std::string broker;                   // mqtt.broker, "HOST:PORT" (checked when read)
+  std::string broker_where;             // "box.toml:20: mqtt.broker" or "--mqtt"
+  std::string box_id;                   // mqtt.box_id: in the topics; default: the host name
+  std::string topic_prefix = "plinth";  // mqtt.topic_prefix: topics are PREFIX/BOX/...
+  std::string username;                 // mqtt.username
+  std::string password;                 // mqtt.password (better: password_file)
+  std::string password_file;            // mqtt.password_file: its first line is the password
+  std::string ca_file;    // mqtt.tls_ca_file: TLS on, the broker's certificate checked with it
+  std::string cert_file;  // mqtt.tls_cert_file, mqtt.tls_key_file: a client certificate
+  std::string key_file;
+  std::string files_where;        // "box.toml" or "--mqtt-*", for messages about the files
+  int keepalive_s = 10;           // mqtt.keepalive_s, 5..3600
+  int event_queue = 1000;         // mqtt.event_queue: alarm events held while away, 1..100000
+  double state_interval_s = 1.0;  // mqtt.state_interval_s: state at most this often (and at
+                                  // every level change), 0.001..3600
+  double reconnect_min_s = 0.5;   // mqtt.reconnect_min_s: first back-off, doubled to ...
+  double reconnect_max_s = 30.0;  // mqtt.reconnect_max_s
+  bool commands = false;          // mqtt.commands: acknowledgements on PREFIX/BOX/command
+  bool discovery = true;          // mqtt.discovery: Home Assistant discovery configs
+  std::string discovery_prefix = "homeassistant";  // mqtt.discovery_prefix
+};
+
 class MqttPublisher final : public StatusOutput {
  public:
   // Checks the settings (the password and TLS files are read now: a missing one is an
-  // host::InputError naming its key and flag), then connects on its own thread.
-  explicit MqttPublisher(const MqttSettings& settings);
+  // host::InputError naming its key and flag), then connects on its own thread. The state
+  // carries `identity`'s digests for the whole run.
+  MqttPublisher(const MqttSettings& settings, const RunIdentity& identity);
   ~MqttPublisher() override;
   MqttPublisher(const MqttPublisher&) = delete;
   MqttPublisher& operator=(const MqttPublisher&) = delete;
@@ -46,6 +77,7 @@ class MqttPublisher final : public StatusOutput {
   void on_disconnect(int rc);
   void on_publish(int mid);
   void on_error_log(const char* text);
+  void on_message(const std::string& topic, const std::string& payload);
 
  private:
   struct QueuedEvent {
@@ -61,15 +93,25 @@ class MqttPublisher final : public StatusOutput {
   void lost(const std::string& reason, std::int64_t now_ns);
   void back_off(std::int64_t now_ns);
   void say_offline();
+  void publish_discovery();
+  void reply(const std::string& id_json, const std::string& result, const std::string& why,
+             const std::string& details);
+  void take_results();
   [[nodiscard]] bool publish(const std::string& topic, const std::string& payload, bool retain,
                              int* mid);
   [[nodiscard]] std::string state_json() const;
 
   MqttSettings settings_;
+  struct DigestMember {
+    std::string member;  // "scene_sha256", ...
+    std::string file;    // "Scene", ...
+    std::string hex;     // "" when the file was not given
+  };
+  std::vector<DigestMember> digests_;  // the run's identity, written once
   std::string endpoint_text_;  // "HOST:PORT (where)"
   std::string host_;
   int port_ = 0;
-  std::string state_topic_, events_topic_, availability_topic_;
+  std::string state_topic_, events_topic_, availability_topic_, command_topic_, reply_topic_;
   mosquitto* client_ = nullptr;
   OutputMailbox mailbox_;
   std::atomic<bool> stopping_{false};
@@ -91,6 +133,14 @@ class MqttPublisher final : public StatusOutput {
   StatusSnapshot state_sent_;
   int offline_mid_ = -1;
   bool offline_acknowledged_ = false;
+  // Commands handed to the loop, by CommandRequest::id: the reply's id (JSON) and what the
+  // operator quoted.
+  struct PendingCommand {
+    std::string id_json;
+    std::string details;  // "level" and "sequence" members of the reply
+  };
+  std::map<std::uint32_t, PendingCommand> pending_;
+  std::uint32_t next_command_id_ = 1;
 
   // Counters, read after the thread ended.
   std::uint64_t connects_ = 0;
@@ -102,6 +152,10 @@ class MqttPublisher final : public StatusOutput {
   std::uint64_t events_republished_ = 0;
   std::uint64_t states_published_ = 0;
   std::size_t most_queued_ = 0;
+  std::uint64_t commands_received_ = 0;
+  std::uint64_t commands_accepted_ = 0;  // acknowledgements the monitor released a latch with
+  std::uint64_t commands_refused_ = 0;
+  std::uint64_t discovery_configs_ = 0;  // config messages published
 };
 
 }  // namespace plinth::firmware

@@ -29,6 +29,13 @@ void copy_status(const Monitor& monitor, double t_origin, StatusSnapshot& snapsh
   snapshot.level = s.alarm;
   snapshot.latched = s.latched;
   snapshot.risk = s.risk;
+  snapshot.probability = s.probability;
+  snapshot.forecast_axis = s.forecast_axis;
+  snapshot.forecast_worst_member =
+      s.forecast_axis >= 0 ? s.axes[static_cast<std::size_t>(s.forecast_axis)].forecast.worst_member
+                           : -1;
+  snapshot.collapse_forecast = s.collapse_forecast_s >= 0.0;
+  snapshot.collapse_forecast_t = s.collapse_forecast_s - t_origin;
   snapshot.axis_count = s.axis_count;
   for (std::size_t i = 0; i < snapshot.phase.size(); ++i) snapshot.phase[i] = s.axes[i].mode.phase;
   snapshot.estimating = s.estimating;

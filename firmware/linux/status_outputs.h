@@ -2,7 +2,8 @@
 // MQTT, ...; docs/integration.md). The loop copies a StatusSnapshot after each update and each
 // alarm event into every output's mailbox: lock-free, no allocation, never a wait on an output's
 // thread (a full event ring drops the event and counts it). Operator commands (acknowledge,
-// reset) come back the same way, one ring per output, polled by the loop.
+// reset) come back the same way, one ring per output, polled by the loop, and each command's
+// result goes back to its output.
 #pragma once
 
 #include <array>
@@ -33,6 +34,14 @@ struct StatusSnapshot {
   std::uint8_t event_sequence = 0;  // of the latest alarm event (an acknowledgement quotes it)
   bool any_event = false;
   double risk = 0.0;
+  // The forecast (MonitorStatus): the highest probability over the axes, its axis (-1: no
+  // forecast yet), that axis's member collapsing first (-1: none) and the JSON lines' time of
+  // the first forecast collapse (collapse_forecast false: none forecast).
+  double probability = 0.0;
+  int forecast_axis = -1;
+  int forecast_worst_member = -1;
+  bool collapse_forecast = false;
+  double collapse_forecast_t = 0.0;
   int axis_count = 1;
   std::array<Phase, kMaxAxes> phase{};
   bool estimating = false;
@@ -60,6 +69,13 @@ struct CommandRequest {
   OperatorCommand command = OperatorCommand::kAcknowledge;
   monitor::AlarmLevel level = monitor::AlarmLevel::kNormal;  // kAcknowledge: the latched level
   std::uint8_t event_sequence = 0;  // kAcknowledge: the latest event the operator saw
+  std::uint32_t id = 0;             // the output's own, quoted by the result
+};
+
+// What the loop did with a command: the acknowledgement's outcome (kNone for a reset).
+struct CommandResult {
+  std::uint32_t id = 0;
+  monitor::AckOutcome outcome = monitor::AckOutcome::kNone;
 };
 
 // The newest of a stream of values, one writer and one reader, without locks (a triple buffer):
@@ -128,12 +144,16 @@ class OutputMailbox {
     if (!events_.push(notice)) events_dropped_.fetch_add(1, std::memory_order_relaxed);
   }
   [[nodiscard]] bool take_command(CommandRequest& out) noexcept { return commands_.pop(out); }
+  // Dropped when the ring is full: an output that reads the results (MqttPublisher) keeps at
+  // most kCommandSlots commands under way; one that does not (ModbusServer) loses nothing.
+  void post_result(const CommandResult& result) noexcept { (void)results_.push(result); }
 
   // Output side.
   [[nodiscard]] bool take_status(StatusSnapshot& out) noexcept { return status_.take(out); }
   [[nodiscard]] bool take_alarm(AlarmNotice& out) noexcept { return events_.pop(out); }
   // False when the ring is full (the loop has not polled): the command is refused.
   [[nodiscard]] bool post_command(const CommandRequest& c) noexcept { return commands_.push(c); }
+  [[nodiscard]] bool take_result(CommandResult& out) noexcept { return results_.pop(out); }
   // Alarm events the loop could not hand over (the ring was full).
   [[nodiscard]] std::uint64_t events_dropped() const noexcept {
     return events_dropped_.load(std::memory_order_relaxed);
@@ -143,6 +163,7 @@ class OutputMailbox {
   LatestValue<StatusSnapshot> status_;
   SpscRing<AlarmNotice, kEventSlots> events_;
   SpscRing<CommandRequest, kCommandSlots> commands_;
+  SpscRing<CommandResult, 2 * kCommandSlots> results_;
   std::atomic<std::uint64_t> events_dropped_{0};
 };
 

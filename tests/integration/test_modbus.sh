@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # plinth-monitor's Modbus TCP server against the real mbpoll client on loopback
-# (docs/integration.md): the input registers equal the JSON status lines, several clients at
-# once, a coil write refused while writes are off, acknowledge and reset when they are on, and
-# bad addresses refused with a message naming the key or flag.
+# (docs/integration.md): every row of the shipped map (firmware/linux/modbus-map.csv) read with
+# mbpoll equals what the JSON lines and --version say (modbus_map_check.py), the holding
+# registers equal the input registers, one discrete input per level; the files' digests as
+# sha256sum prints them, with and without a second scene and a box file; several clients at once, a
+# coil write refused while writes are off, register writes always refused, acknowledge and
+# reset when writes are on, and bad addresses refused with a message naming the key or flag.
 #
 # Environment: PLINTH_MONITOR, PLINTH_SIM, PLINTH_SOURCE_DIR. Exit 77 (skip) when mbpoll is
 # missing, unless CI=true.
@@ -12,14 +15,44 @@ set -u
 source "$(dirname "${BASH_SOURCE[0]}")/outputs_harness.sh"
 require_tools mbpoll
 ISOLATED=$SCENES/paper-isolated.toml
+ECCENTRIC=$SCENES/paper-eccentric.toml
 
-# registers PORT: the 32 input registers, one "address value" a line.
-registers() {
-  mbpoll -m tcp -t 3 -0 -r 0 -c 32 -1 -o 2 -p "$1" 127.0.0.1 2>/dev/null |
-    sed -n 's/^\[\([0-9]*\)\]:[[:space:]]*\([0-9]*\).*/\1 \2/p'
+MAP=$SRC/firmware/linux/modbus-map.csv
+# The map's extent: registers, discrete inputs, coils.
+read -r REGISTERS DISCRETE COILS < <(python3 - "$MAP" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1], newline="")))
+end = lambda t: max(int(r["address"]) + int(r["words"]) for r in rows if r["table"] == t)
+print(end("register"), end("discrete_input"), end("coil"))
+PY
+)
+
+# read_table TYPE NAME PORT COUNT: mbpoll's read of one table as "NAME address value" lines
+# (TYPE: mbpoll's -t, 0 coils, 1 discrete inputs, 3 input registers, 4 holding registers).
+read_table() {
+  mbpoll -m tcp -t "$1" -0 -r 0 -c "$4" -1 -o 2 -p "$3" 127.0.0.1 2>/dev/null |
+    sed -n "s/^\[\([0-9]*\)\]:[[:space:]]*\([0-9]*\).*/$2 \1 \2/p"
 }
+# registers PORT: the input registers, one "address value" a line.
+registers() { read_table 3 input "$1" "$REGISTERS" | cut -d' ' -f2-; }
 # register PORT ADDRESS
 register() { registers "$1" | awk -v a="$2" '$1 == a { print $2 }'; }
+# digest PORT ADDRESS: the four registers from ADDRESS as 16 lowercase hex digits (mbpoll's
+# hex display, the high word first), as sha256sum starts.
+digest() {
+  mbpoll -m tcp -t 3:hex -0 -r "$2" -c 4 -1 -p "$1" 127.0.0.1 2>/dev/null |
+    sed -n 's/^\[[0-9]*\]:[[:space:]]*0x\([0-9A-Fa-f]\{4\}\).*/\1/p' | tr -d '\n' |
+    tr 'A-F' 'a-f'
+}
+# sha16 FILE: sha256sum's first 16 hex digits.
+sha16() { sha256sum "$1" | cut -c1-16; }
+# read_map PORT: every table of the map.
+read_map() {
+  read_table 3 input "$1" "$REGISTERS"
+  read_table 4 holding "$1" "$REGISTERS"
+  read_table 1 discrete "$1" "$DISCRETE"
+  read_table 0 coil "$1" "$COILS"
+}
 
 # wait_listening PORT: until the server answers.
 wait_listening() {
@@ -31,47 +64,17 @@ wait_listening() {
   return 1
 }
 
-# Checks the registers read in $TMP/regs against the newest status line and alarm line of
-# $TMP/box.out; the heartbeat lies between the status counts before and after the read.
-check_registers() {
-  python3 - "$TMP/regs" "$TMP/box.out" "$1" "$2" <<'PY'
-import json, sys
-regs = dict(tuple(map(int, l.split())) for l in open(sys.argv[1]) if l.strip())
-lines = [json.loads(l) for l in open(sys.argv[2]) if l.startswith("{")]
-status = [l for l in lines if l["type"] == "status"][-1]
-alarm = [l for l in lines if l["type"] == "alarm"][-1]
-levels = ["normal", "advisory", "warning", "alarm", "fault"]
-phases = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "fell"]
-causes = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
-          "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", "outside_model"]
-def check(name, address, expected):
-    assert regs.get(address) == expected, "%s (register %d): %s, status line says %s" % (
-        name, address, regs.get(address), expected)
-check("alarm level", 0, levels.index(status["alarm"]))
-check("risk x 10000", 2, round(status["risk"] * 10000))
-check("latched", 3, levels.index(status["latched"]))
-check("cause", 4, causes.index(alarm["cause"]))
-check("event sequence", 5, alarm["sequence"])
-check("axis count", 6, 1)
-check("phase x", 7, phases.index(status["phase"]))
-check("phase y", 8, 65535)
-check("estimating", 9, int(status["estimating"]))
-check("sensor health", 10, ["ok", "degraded", "fault"].index(status["sensor"]))
-check("map version", 31, 1)
-before, after = int(sys.argv[3]), int(sys.argv[4])
-assert before <= regs[1] <= after, "heartbeat %d not within the status lines %d..%d" % (
-    regs[1], before, after)
-PY
-}
 status_count() { grep -c '"type": "status"' "$TMP/box.out"; }
 
 # 1. Writes off: the registers against the status lines after the overturn (a steady state:
 #    alarm latched, risk 1, for the record's last 24 s, 12 s at --speed 2: time for the reads below
-#    even on a loaded machine), three clients polling at once, a coil write refused.
+#    even on a loaded machine), three clients polling at once, a coil write refused. A box file
+#    that sets nothing: its digest in registers 81-85.
 PORT=$(free_port)
+echo "# monitor_modbus: the Modbus server from the command line" >"$TMP/run1.toml"
+STARTED=$(date +%s.%N)
 "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
-  --modbus "127.0.0.1:$PORT" >"$TMP/box.out" 2>"$TMP/box.err" &
+  --modbus "127.0.0.1:$PORT" --config "$TMP/run1.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
 BOX=$!
 if ! wait_listening "$PORT"; then
   fail "modbus: the server answers" "no answer on port $PORT; stderr: $(head -c 300 "$TMP/box.err")"
@@ -79,16 +82,25 @@ else
   pass "modbus: the server answers mbpoll"
   pollers=()
   for i in 1 2 3; do
-    timeout 3 mbpoll -m tcp -t 3 -0 -r 0 -c 32 -l 20 -p "$PORT" 127.0.0.1 >"$TMP/poller$i" 2>&1 &
+    timeout 3 mbpoll -m tcp -t 3 -0 -r 0 -c "$REGISTERS" -l 20 -p "$PORT" 127.0.0.1 \
+      >"$TMP/poller$i" 2>&1 &
     pollers+=($!)
   done
   if wait_for "$TMP/box.out" '"phase": "overturned"' 30; then
+    read_map "$PORT" | sed 's/^/first /' >"$TMP/reads"
     before=$(status_count)
-    registers "$PORT" >"$TMP/regs"
+    read_map "$PORT" >>"$TMP/reads"
     after=$(status_count)
-    problem=$(check_registers "$before" "$after" 2>&1)
-    if [[ -z "$problem" ]]; then pass "modbus: registers equal the status and alarm lines"
-    else fail "modbus: registers" "$problem"; fi
+    cp "$TMP/box.out" "$TMP/at_read.out"
+    elapsed=$(echo "$(date +%s.%N) - $STARTED" | bc)
+    scene=$(digest "$PORT" 72)
+    config=$(digest "$PORT" 82)
+    if [[ "$scene" == "$(sha16 "$ISOLATED")" && "$config" == "$(sha16 "$TMP/run1.toml")" ]]; then
+      pass "modbus: registers 72-75, 82-85: sha256sum's first 16 hex digits of scene, box file"
+    else
+      sums="$(sha16 "$ISOLATED"), $(sha16 "$TMP/run1.toml")"
+      fail "modbus: digests" "scene $scene, box file $config; sha256sum: $sums"
+    fi
     first=$(register "$PORT" 1)
     sleep 0.5
     second=$(register "$PORT" 1)
@@ -129,6 +141,39 @@ PY
 )
 if [[ -z "$problem" ]]; then pass "modbus: the summary counts clients and refused writes"
 else fail "modbus: summary" "$problem"; fi
+if [[ -s "$TMP/reads" ]]; then
+  problem=$(python3 "$(dirname "${BASH_SOURCE[0]}")/modbus_map_check.py" "$MAP" "$TMP/reads" \
+    "$TMP/at_read.out" "$TMP/box.out" "$("$BIN" --version)" "$before" "$after" "$elapsed" 2>&1)
+  rows=$(($(wc -l <"$MAP") - 1))
+  if [[ -z "$problem" ]]; then
+    pass "modbus: all $rows rows of modbus-map.csv as the JSON lines and --version say (functions 01-04)"
+  else
+    fail "modbus: the map, row by row" "$problem"
+  fi
+fi
+
+# 1b. Two axes (--scene-y), no box file: the second scene's digest in registers 76-80, 81-85
+#     say none (0, then 65535 in each).
+PORT=$(free_port)
+"$BIN" --scene "$ISOLATED" --scene-y "$ECCENTRIC" --replay "$AT2" --speed 1 --no-events \
+  --modbus "127.0.0.1:$PORT" >"$TMP/box.out" 2>"$TMP/box.err" &
+BOX=$!
+if wait_listening "$PORT"; then
+  scene_y=$(digest "$PORT" 77)
+  config=$(digest "$PORT" 82)
+  flags="$(register "$PORT" 71) $(register "$PORT" 76) $(register "$PORT" 81)"
+  if [[ "$scene_y" == "$(sha16 "$ECCENTRIC")" && "$config" == ffffffffffffffff &&
+    "$flags" == "1 1 0" ]]; then
+    pass "modbus: a second scene's digest in 77-80; no box file: 81 reads 0, 82-85 65535"
+  else
+    fail "modbus: digests, two axes" \
+      "given $flags, scene_y $scene_y (sha256sum $(sha16 "$ECCENTRIC")), box file $config"
+  fi
+else
+  fail "modbus: two axes" "no answer on port $PORT; stderr: $(head -c 300 "$TMP/box.err")"
+fi
+kill -INT "$BOX" 2>/dev/null
+wait "$BOX" 2>/dev/null
 
 # 2. Writes on (the configuration file): acknowledge releases the latch (the collapse holds the
 #    alarm), reset starts the monitor again.
@@ -170,6 +215,14 @@ PY
     else fail "modbus: acknowledge" "$problem"; fi
   else
     fail "modbus: acknowledge" "exit $rc: $(tail -n 2 "$TMP/write.out")"
+  fi
+  mbpoll -m tcp -t 4 -0 -r 0 -1 -p "$PORT" 127.0.0.1 0 >"$TMP/write.out" 2>&1
+  rc=$?
+  if ((rc != 0)) && grep -q "Illegal function" "$TMP/write.out" && [[ "$(register "$PORT" 0)" == 3 ]]
+  then
+    pass "modbus: a holding register write is refused (Illegal function) even with writes on"
+  else
+    fail "modbus: register write" "exit $rc: $(tail -n 2 "$TMP/write.out")"
   fi
   mbpoll -m tcp -t 0 -0 -r 1 -1 -p "$PORT" 127.0.0.1 1 >"$TMP/write.out" 2>&1
   if wait_for "$TMP/box.out" '"command": "reset"' 5; then

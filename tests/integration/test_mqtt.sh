@@ -3,8 +3,12 @@
 # loopback with its own configuration (docs/integration.md): a password file, a plain and a TLS
 # listener (a CA and a server certificate made here with openssl), persistence. Checks: every
 # alarm line arrives on the events topic, in order, across a broker restart in the middle of a
-# replay; the retained state and availability; the Last Will when the box is killed (-9); a
-# wrong password refused with a clear message; bad settings refused naming the key or flag.
+# replay; the retained state and availability; the acknowledge command (an ACL lets only the
+# operator publish it; replies accepted or refused with the reason); Home Assistant discovery,
+# on and off; the state's forecast, counters, version and the digests of the scene and box files
+# (as sha256sum prints them; null for a file not given); the Last Will when the box is killed
+# (-9); a wrong password refused with a clear message; bad settings refused naming the key or
+# flag.
 #
 # Environment: PLINTH_MONITOR, PLINTH_SIM, PLINTH_SOURCE_DIR. Exit 77 (skip) when mosquitto,
 # its clients or openssl are missing, unless CI=true.
@@ -15,6 +19,8 @@ source "$(dirname "${BASH_SOURCE[0]}")/outputs_harness.sh"
 require_tools mosquitto mosquitto_sub mosquitto_pub mosquitto_passwd openssl
 MOSQUITTO=$(command -v mosquitto || echo /usr/sbin/mosquitto)
 ISOLATED=$SCENES/paper-isolated.toml
+ECCENTRIC=$SCENES/paper-eccentric.toml
+sha() { sha256sum "$1" | cut -d' ' -f1; }
 BROKER_PID=
 BOX=
 cleanup() {
@@ -38,6 +44,20 @@ openssl x509 -req -in "$TMP/server.csr" -CA "$TMP/ca.crt" -CAkey "$TMP/ca.key" -
   -days 2 -extfile "$TMP/server.ext" -out "$TMP/server.crt" 2>/dev/null
 mosquitto_passwd -c -b "$TMP/passwd" box box-secret 2>/dev/null
 mosquitto_passwd -b "$TMP/passwd" watcher watcher-secret 2>/dev/null
+mosquitto_passwd -b "$TMP/passwd" operator operator-secret 2>/dev/null
+# Who may do what: the box publishes its topics and reads its commands; the watcher only reads;
+# the operator alone may publish a command (MQTT does not tell the box who published).
+cat >"$TMP/acl" <<EOF
+user box
+topic readwrite plinth/#
+topic write homeassistant/#
+user watcher
+topic read plinth/#
+topic read homeassistant/#
+user operator
+topic write plinth/+/command
+topic read plinth/+/command/reply
+EOF
 echo box-secret >"$TMP/box.pw"
 echo wrong >"$TMP/wrong.pw"
 cat >"$TMP/broker.conf" <<EOF
@@ -46,6 +66,7 @@ persistence true
 persistence_location $TMP/db/
 allow_anonymous false
 password_file $TMP/passwd
+acl_file $TMP/acl
 listener $PLAIN 127.0.0.1
 listener $TLS 127.0.0.1
 cafile $TMP/ca.crt
@@ -94,12 +115,19 @@ restart_replay() {
   "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
     --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
   BOX=$!
-  if wait_for "$TMP/box.out" '"level": "normal"' 30; then
+  # The box is held (SIGSTOP) as soon as it writes its normal event, until that event reached
+  # the subscriber and the broker stopped: on a loaded machine the subscriber runs seconds behind
+  # the box, and the advisory would otherwise reach the broker before it stops.
+  if wait_for "$TMP/box.out" '"level": "normal"' 30 && kill -STOP "$BOX" &&
+    wait_for "$TMP/events.out" '"level": "normal"' 30; then
+    sleep 0.5
     stop_broker
+    kill -CONT "$BOX"
     wait_for "$TMP/box.out" '"level": "alarm", "previous"' 30
     sleep 1
     start_broker || fail "mqtt: the broker starts again" "$(tail -n 3 "$TMP/broker.log")"
   else
+    kill -CONT "$BOX" 2>/dev/null
     fail "mqtt: replay" "no normal level within 30 s"
   fi
   wait "$BOX"
@@ -193,6 +221,167 @@ else
   fail "mqtt: wrong CA" "stderr: $(head -c 300 "$TMP/stderr")"
 fi
 
+# 1d. Commands and Home Assistant discovery (plain listener): after the overturn the watcher's
+#     acknowledgement is refused by the broker's ACL (MQTT v5 tells the publisher: Not
+#     authorized) and never reaches the box; the operator's malformed, wrong-level and stale
+#     ones are refused with the reason, the last one accepted (the latch released); the
+#     discovery configs are retained, the state carries the forecast, counters, version and
+#     digests (the scene's and the box file's; no second scene: null).
+OPERATOR=(-h 127.0.0.1 -p "$PLAIN" -u operator -P operator-secret)
+printf '[mqtt]\nbroker = "127.0.0.1:%s"\nbox_id = "b6"\nusername = "box"\n' "$PLAIN" >"$TMP/box.toml"
+printf '%s\n' 'password_file = "box.pw"' 'state_interval_s = 0.2' 'commands = true' >>"$TMP/box.toml"
+DIGESTS=("$(sha "$ISOLATED")" "$(sha "$TMP/box.toml")")
+mosquitto_sub "${OPERATOR[@]}" -q 1 -t plinth/b6/command/reply >"$TMP/replies.out" 2>&1 &
+REPLIES=$!
+sleep 0.5
+# --speed 1: the 24 s after the overturn leave time for the commands on a loaded machine.
+"$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 1 --no-events \
+  --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
+BOX=$!
+ack() { mosquitto_pub "${OPERATOR[@]}" -q 1 -t plinth/b6/command -m "$1"; }
+if wait_for "$TMP/box.out" '"phase": "overturned"' 30; then
+  mosquitto_pub "${WATCH[@]}" -V mqttv5 -q 1 -t plinth/b6/command \
+    -m '{"command": "acknowledge", "id": "watcher"}' >"$TMP/denied.out" 2>&1
+  sleep 0.5
+  ack 'acknowledge'
+  ack '{"command": "acknowledge", "level": "warning", "id": "op-1"}'
+  ack '{"command": "acknowledge", "sequence": 0, "id": 2}'
+  ack '{"command": "acknowledge", "id": "op-3"}'
+  wait_for "$TMP/replies.out" '"op-3"' 10
+  sleep 0.5
+  mosquitto_sub "${WATCH[@]}" -W 2 -v -t 'homeassistant/+/plinth_b6/#' >"$TMP/discovery.out" 2>&1
+  mosquitto_sub "${WATCH[@]}" -C 1 -W 2 -t plinth/b6/state >"$TMP/state.out" 2>&1
+else
+  fail "mqtt: commands" "no overturn within 30 s; stderr: $(head -c 300 "$TMP/box.err")"
+fi
+wait "$BOX"
+rc=$?
+BOX=
+kill "$REPLIES" 2>/dev/null
+wait "$REPLIES" 2>/dev/null
+problem=$(python3 - "$TMP/box.out" "$TMP/replies.out" "$TMP/denied.out" 2>&1 <<'PY'
+import json, sys
+lines = [json.loads(l) for l in open(sys.argv[1])]
+replies = [json.loads(l) for l in open(sys.argv[2]) if l.startswith("{")]
+assert len(replies) == 4, "4 replies expected, got %s" % open(sys.argv[2]).read()[:600]
+assert "Not authorized" in open(sys.argv[3]).read(), "the watcher's publish was not refused"
+commands = [l for l in lines if l["type"] == "command"]
+assert [c["source"] for c in commands] == ["mqtt"] * 3, commands  # not the watcher's
+raised = [l for l in lines if l["type"] == "alarm" and l["level"] == "alarm"][0]
+assert [r["id"] for r in replies] == [None, "op-1", 2, "op-3"], replies
+assert [r["result"] for r in replies] == ["refused"] * 3 + ["accepted"], replies
+assert replies[0]["reason"] == "not JSON", replies[0]
+assert replies[1]["reason"] == "wrong level" and replies[1]["level"] == "warning", replies[1]
+assert replies[2]["reason"] == "stale sequence" and replies[2]["sequence"] == 0, replies[2]
+last = replies[3]
+assert last["outcome"] == "released, condition holds" and "reason" not in last, last
+assert last["level"] == "alarm" and last["sequence"] == raised["sequence"], (last, raised)
+assert commands[-1]["outcome"] == last["outcome"], commands[-1]
+ack = [l for l in lines if l["type"] == "alarm"][-1]
+assert ack["cause"] == "acknowledged" and ack["latched"] is False, ack
+mqtt = lines[-1]["mqtt"]
+assert mqtt["commands_received"] == 4 and mqtt["commands_accepted"] == 1, mqtt
+assert mqtt["commands_refused"] == 3 and mqtt["discovery_configs"] >= 8, mqtt
+PY
+)
+if ((rc == 0)) && [[ -z "$problem" ]]; then
+  pass "mqtt: operator's acknowledgement accepted, bad ones refused with reasons, ACL keeps others out"
+else
+  fail "mqtt: commands" "exit $rc; $problem; replies: $(head -c 600 "$TMP/replies.out")"
+fi
+problem=$(python3 - "$TMP/discovery.out" "$TMP/state.out" "$("$BIN" --version)" "${DIGESTS[@]}" 2>&1 <<'PY'
+import json, sys
+configs = dict(l.split(" ", 1) for l in open(sys.argv[1]).read().splitlines()
+               if l.startswith("homeassistant/"))
+configs = {topic: json.loads(payload) for topic, payload in configs.items()}
+prefix = "homeassistant/%s/plinth_b6/%s/config"
+expected = {prefix % ("sensor", "level"): "{{ value_json.level }}",
+            prefix % ("sensor", "latched"): "{{ value_json.latched }}",
+            prefix % ("sensor", "risk"): "{{ value_json.risk }}",
+            prefix % ("sensor", "probability"): "{{ value_json.forecast.probability }}"}
+digests = {prefix % ("sensor", "scene_sha256"): "{{ value_json.scene_sha256 }}",
+           prefix % ("sensor", "config_sha256"): "{{ value_json.config_sha256 }}"}
+expected.update(digests)  # no second scene: no sensor for its digest
+others = {prefix % ("binary_sensor", "availability"), prefix % ("button", "acknowledge")}
+assert set(configs) == set(expected) | others, sorted(configs)
+for topic in digests:
+    assert configs[topic]["entity_category"] == "diagnostic", configs[topic]
+version = sys.argv[3].split(" ", 1)[1]
+for topic, config in configs.items():
+    assert config["unique_id"].startswith("plinth_b6_"), config
+    assert config["device"]["identifiers"] == ["plinth_b6"], config
+    assert config["device"]["sw_version"] == version, config
+for topic, template in expected.items():
+    c = configs[topic]
+    assert c["state_topic"] == "plinth/b6/state" and c["value_template"] == template, c
+    assert c["availability_topic"] == "plinth/b6/availability", c
+assert configs[prefix % ("sensor", "level")]["options"][-1] == "fault"
+online = configs[prefix % ("binary_sensor", "availability")]
+assert online["state_topic"] == "plinth/b6/availability" and online["payload_on"] == "online"
+button = configs[prefix % ("button", "acknowledge")]
+assert button["command_topic"] == "plinth/b6/command", button
+assert json.loads(button["payload_press"])["command"] == "acknowledge", button
+state = json.loads(open(sys.argv[2]).read())
+assert state["forecast"]["probability"] == 1.0 and state["forecast"]["axis"] == "x", state
+assert state["forecast"]["worst_member"] == 0 and state["forecast"]["collapse_in_s"] == 0, state
+assert state["sensor_counters"]["fed"] > 1000 and state["sensor_counters"]["missing"] == 0, state
+assert state["sensors_state"] == "ok" and state["estimator_restarts"] == 1, state
+assert "%s (%s)" % (state["version"]["project"], state["version"]["git"]) == version, state
+scene, config = sys.argv[4:6]  # sha256sum's
+assert state["scene_sha256"] == scene and state["config_sha256"] == config, (state, scene, config)
+assert "scene_y_sha256" in state and state["scene_y_sha256"] is None, state
+PY
+)
+if [[ -z "$problem" ]]; then
+  pass "mqtt: discovery configs retained; the state: forecast, counters, version, digests"
+else
+  fail "mqtt: discovery and state" "$problem"
+fi
+
+# 1e. Commands off (the default) and discovery off: the reply says why, no config published. Two
+#     axes: the state carries the second scene's digest too.
+printf '[mqtt]\nbroker = "127.0.0.1:%s"\nbox_id = "b7"\nusername = "box"\n' "$PLAIN" >"$TMP/box.toml"
+printf '%s\n' 'password_file = "box.pw"' 'discovery = false' >>"$TMP/box.toml"
+DIGESTS=("$(sha "$ISOLATED")" "$(sha "$ECCENTRIC")" "$(sha "$TMP/box.toml")")
+mosquitto_sub "${OPERATOR[@]}" -C 1 -W 30 -t plinth/b7/command/reply >"$TMP/replies.out" 2>&1 &
+REPLIES=$!
+"$BIN" --scene "$ISOLATED" --scene-y "$ECCENTRIC" --replay "$AT2" --speed 4 --no-events \
+  --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
+BOX=$!
+for ((i = 0; i < 100; i++)); do
+  [[ "$(mosquitto_sub "${WATCH[@]}" -C 1 -W 1 -t plinth/b7/availability 2>/dev/null)" == online ]] &&
+    break
+done
+mosquitto_pub "${OPERATOR[@]}" -q 1 -t plinth/b7/command -m '{"command": "acknowledge", "id": 7}'
+wait "$REPLIES"
+discovered=$(mosquitto_sub "${WATCH[@]}" -W 2 -v -t 'homeassistant/+/plinth_b7/#' 2>/dev/null | wc -l)
+kill -INT "$BOX" 2>/dev/null
+wait "$BOX" 2>/dev/null
+BOX=
+reply='"id": 7, "command": "acknowledge", "result": "refused", '
+reply+='"reason": "commands are off (mqtt.commands = false)"'
+if grep -qF "$reply" "$TMP/replies.out" && ((discovered == 0)) &&
+  ! grep -q '"type": "command"' "$TMP/box.out"; then
+  pass "mqtt: with commands off the reply says so; discovery off publishes no config"
+else
+  fail "mqtt: commands and discovery off" "reply: $(cat "$TMP/replies.out"); $discovered configs"
+fi
+mosquitto_sub "${WATCH[@]}" -C 1 -W 2 -t plinth/b7/state >"$TMP/state.out" 2>&1
+problem=$(python3 - "$TMP/state.out" "$TMP/box.out" "${DIGESTS[@]}" 2>&1 <<'PY'
+import json, sys
+state = json.loads(open(sys.argv[1]).read())
+first = [json.loads(l) for l in open(sys.argv[2]) if l.startswith('{"type": "status"')][0]
+got = [state[k] for k in ("scene_sha256", "scene_y_sha256", "config_sha256")]
+assert got == sys.argv[3:6], "state %s, sha256sum %s" % (got, sys.argv[3:6])
+assert got == [first[k] for k in ("scene_sha256", "scene_y_sha256", "config_sha256")], first
+PY
+)
+if [[ -z "$problem" ]]; then
+  pass "mqtt: two axes: the state's three digests are sha256sum's and the first status line's"
+else
+  fail "mqtt: digests, two axes" "$problem"
+fi
+
 # 2. The Last Will: the box killed (-9) while connected on the plain listener.
 "$BIN" --scene "$ISOLATED" --replay "$AT2" --speed 1 --no-events --mqtt "127.0.0.1:$PLAIN" \
   --mqtt-box-id b2 --mqtt-username box --mqtt-password-file "$TMP/box.pw" \
@@ -240,6 +429,12 @@ expect_failure "mqtt: a box id with a slash" "--mqtt-box-id" "topic level" -- \
   "${run_args[@]}" --mqtt 127.0.0.1:1883 --mqtt-box-id a/b
 printf '[mqtt]\nbroker = "127.0.0.1:1883"\nevent_queue = 0\n' >"$TMP/bad.toml"
 expect_failure "mqtt: event_queue out of range" "bad.toml:3" "mqtt.event_queue" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+printf '[mqtt]\nbroker = "127.0.0.1:1883"\ndiscovery_prefix = "ha/#"\n' >"$TMP/bad.toml"
+expect_failure "mqtt: a discovery prefix with a wildcard" "bad.toml:3" "mqtt.discovery_prefix" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+printf '[mqtt]\ncommands = "yes"\n' >"$TMP/bad.toml"
+expect_failure "mqtt: commands not a boolean" "bad.toml:2" "mqtt.commands" "true or false" -- \
   "${run_args[@]}" --config "$TMP/bad.toml"
 printf '[mqtt]\nbroker = "127.0.0.1"\n' >"$TMP/bad.toml"
 expect_failure "mqtt: broker without a port in the file" "bad.toml:2" "mqtt.broker" -- \

@@ -128,6 +128,15 @@ TEST(OutputKeys, ReadWithTheirLinesAndPathsResolved) {
   EXPECT_EQ(f.mqtt.password_file, "/etc/plinth/mqtt.pw");
   EXPECT_EQ(f.mqtt.ca_file, "/etc/ssl/site-ca.crt");
   EXPECT_EQ(f.mqtt.event_queue, 50);
+  EXPECT_FALSE(f.mqtt.commands) << "commands are off unless the file turns them on";
+  EXPECT_TRUE(f.mqtt.discovery);
+  EXPECT_EQ(f.mqtt.discovery_prefix, "homeassistant");
+  const MonitorFile g = load_monitor_text(
+      "[mqtt]\ncommands = true\ndiscovery = false\ndiscovery_prefix = \"site/ha\"\n",
+      "/etc/plinth/box.toml", MonitorConfig{});
+  EXPECT_TRUE(g.mqtt.commands);
+  EXPECT_FALSE(g.mqtt.discovery);
+  EXPECT_EQ(g.mqtt.discovery_prefix, "site/ha");
 }
 
 TEST(OutputKeys, BadValuesNameTheLineAndKey) {
@@ -144,6 +153,9 @@ TEST(OutputKeys, BadValuesNameTheLineAndKey) {
   EXPECT_EQ(config_error("[mqtt]\npassword = \"x\"\npassword_file = \"y\"\n")
                 .rfind("/etc/plinth/box.toml:2: mqtt.password: give", 0),
             0U);
+  EXPECT_EQ(config_error("[mqtt]\ndiscovery_prefix = \"ha/+\"\n"),
+            "/etc/plinth/box.toml:2: mqtt.discovery_prefix: expected topic levels (no '+' or "
+            "'#', no empty level)");
   EXPECT_EQ(config_error("[mqtt]\nbrokers = \"h:1\"\n")
                 .rfind("/etc/plinth/box.toml:2: mqtt.brokers: unknown key", 0),
             0U);
