@@ -482,10 +482,10 @@ if expect_success "sim: a record finer than --dt runs" --scene "$ISOLATED" --rec
 fi
 BIN=$MONITOR
 expect_failure "monitor: too few steps per sample names --steps and the fewest stable" \
-  '--steps 1 \(estimator.steps_per_sample\): is too few .*\(limit [0-9]+\)' \
+  '--steps 1 \(estimator.steps_per_sample\): too few for this base at this rate .*\(limit [0-9]+\)' \
   -- --scene light-base.toml --replay "$AT2" --steps 1
 expect_failure "monitor: a base no step count makes stable names base.period" \
-  '--scene stiff-base.toml \(base.period\): makes the scene.s base too stiff' \
+  '--scene stiff-base.toml \(base.period\): too short for the box: 64 steps per sample are unstable' \
   -- --scene stiff-base.toml --replay "$AT2"
 # A step count names what set the run's length: --t-end, the pulse's --period, the record.
 BIN=$SIM

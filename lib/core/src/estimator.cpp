@@ -20,20 +20,18 @@ Error validate(const EstimatorSettings& st, const Scene& scene) {
   PLINTH_TRY(validate_feature_set(scene));
   if (const auto limit = static_cast<Time>(largest_stable_step(scene, solver.stepper));
       solver.step > limit) {
-    // The input to change, and its limit: the fewest steps per sample that are stable at this
-    // rate, or, when even the most are not, the scene's base (its period, or its mass).
-    const Time fewest = std::ceil(1.0 / (st.sample_rate_hz * limit));
-    if (fewest <= 64.0) {
+    // The input to change, and its limit: the fewest stable steps per sample at this rate, or
+    // the base's period when even the most (64) are not. (No std::ceil: 256 B of flash.)
+    const Time steps_needed = Time(1) / (st.sample_rate_hz * limit);
+    if (steps_needed <= Time(64)) {
+      int fewest = static_cast<int>(steps_needed);
+      fewest += static_cast<Time>(fewest) < steps_needed ? 1 : 0;
       return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
-              "is too few for a stable integration of this scene's base at this sample rate "
-              "(1 / (rate * steps) must not exceed the base's largest stable step): give at "
-              "least the limit",
+              "too few for this base at this rate (limit: the fewest stable)",
               static_cast<double>(fewest)};
     }
     return {ErrorCode::kOutOfRange, "base.period",
-            "makes the scene's base too stiff (or too light) for the box: its largest stable "
-            "step (the limit, s) is shorter than a sample period over 64 steps, the most the "
-            "box takes; a longer period or a heavier base",
+            "too short for the box: 64 steps per sample are unstable (limit: the stable step, s)",
             limit};
   }
   return ok_error();
