@@ -16,6 +16,7 @@
 #include "plinth/host/json_text.h"
 #include "plinth/host/text_file.h"
 #include "plinth/version/version.h"
+#include "regional_json.h"
 #include "status_json.h"
 
 namespace plinth::firmware {
@@ -124,6 +125,8 @@ MqttPublisher::MqttPublisher(const MqttSettings& settings, const RunIdentity& id
   availability_topic_ = base + "availability";
   command_topic_ = base + "command";
   reply_topic_ = command_topic_ + "/reply";
+  regional_topic_ = settings_.regional_topic.empty() ? settings_.topic_prefix + "/regional_alert"
+                                                     : settings_.regional_topic;
 
   std::string password = settings_.password;
   if (!settings_.password_file.empty()) {
@@ -185,6 +188,7 @@ void MqttPublisher::stop() {
 }
 
 void MqttPublisher::on_connect(int rc) {
+  answered_ = true;
   if (rc != 0) {
     ++refusals_;
     const std::string problem =
@@ -203,6 +207,10 @@ void MqttPublisher::on_connect(int rc) {
   // Also while commands are off: the reply says so.
   if (mosquitto_subscribe(client_, nullptr, command_topic_.c_str(), kQos) != MOSQ_ERR_SUCCESS) {
     say("cannot subscribe to " + command_topic_);
+  }
+  if (settings_.regional_alerts &&
+      mosquitto_subscribe(client_, nullptr, regional_topic_.c_str(), kQos) != MOSQ_ERR_SUCCESS) {
+    say("cannot subscribe to " + regional_topic_);
   }
   publish_discovery();
   state_due_ = have_state_;
@@ -237,6 +245,10 @@ bool MqttPublisher::publish(const std::string& topic, const std::string& payload
 // The loop's alarm events into the queue (bounded), its newest snapshot into the state.
 void MqttPublisher::take_mailbox(std::int64_t now_ns) {
   take_results();
+  if (mailbox_.events_dropped() != mailbox_dropped_seen_) {  // the loop's ring was full
+    mailbox_dropped_seen_ = mailbox_.events_dropped();
+    say_dropped();
+  }
   AlarmNotice notice;
   while (mailbox_.take_alarm(notice)) {
     // The oldest waiting event makes room; never the one the broker may be acknowledging.
@@ -248,6 +260,7 @@ void MqttPublisher::take_mailbox(std::int64_t now_ns) {
         queue_.pop_front();
       }
       ++events_dropped_;
+      say_dropped();
     }
     queue_.push_back({alarm_json(notice.event, notice.t_origin), {}});
     most_queued_ = std::max(most_queued_, queue_.size());
@@ -262,11 +275,31 @@ void MqttPublisher::take_mailbox(std::int64_t now_ns) {
   if (changed || now_ns - state_sent_ns_ >= ns_of(settings_.state_interval_s)) state_due_ = true;
 }
 
+// An overflow is said at once, then again each time the count doubles (1, 2, 4, ...): a long
+// outage does not flood the journal, and the count is also in the state (events_dropped).
+void MqttPublisher::say_dropped() {
+  const std::uint64_t dropped = events_dropped_ + mailbox_.events_dropped();
+  if (dropped < next_drop_report_) return;
+  next_drop_report_ = 2 * dropped;
+  say("alarm event queue full (mqtt.event_queue = " + std::to_string(settings_.event_queue) +
+      ", the broker at " + endpoint_text_ + " away): the oldest waiting event dropped, " +
+      std::to_string(dropped) + " so far");
+}
+
 void MqttPublisher::try_connect(std::int64_t now_ns) {
   if (now_ns < next_attempt_ns_) return;
+  if (socket_open_ && !answered_) {  // the attempt before never reached the broker
+    ++connect_failures_;  // said once while it lasts, whatever the back-off has grown to
+    say_problem("cannot reach the broker at " + endpoint_text_ +
+                ": the connection attempt was not answered");
+  }
   // A new session each time: libmosquitto keeps the unacknowledged publishes and sends them
-  // again once the broker accepted it.
-  const int rc = mosquitto_connect(client_, host_.c_str(), port_, settings_.keepalive_s);
+  // again once the broker accepted it. Asynchronous: a broker that never answers the TCP
+  // handshake (a host gone behind a firewall, a stalled broker's full accept queue) held a
+  // blocking connect ~130 s, the events undrained and stop() waiting that long past its flush
+  // bound; mosquitto_loop completes the connection.
+  answered_ = false;
+  const int rc = mosquitto_connect_async(client_, host_.c_str(), port_, settings_.keepalive_s);
   if (rc == MOSQ_ERR_SUCCESS) {
     socket_open_ = true;
     next_attempt_ns_ = now_ns + ns_of(backoff_s_);  // if the session never starts
@@ -279,6 +312,11 @@ void MqttPublisher::try_connect(std::int64_t now_ns) {
 
 // The connection is gone: say why (once), and try again after the back-off.
 void MqttPublisher::lost(const std::string& reason, std::int64_t now_ns) {
+  say_problem(reason);
+  back_off(now_ns);
+}
+
+void MqttPublisher::say_problem(const std::string& reason) {
   // libmosquitto's own error (a TLS certificate refused, ...) says more.
   const std::string why = error_log_.empty() ? reason : reason + " (" + error_log_ + ")";
   if (why != last_problem_) {
@@ -288,7 +326,6 @@ void MqttPublisher::lost(const std::string& reason, std::int64_t now_ns) {
     say(why + retry);
   }
   last_problem_ = why;
-  back_off(now_ns);
 }
 
 void MqttPublisher::back_off(std::int64_t now_ns) {
@@ -318,6 +355,7 @@ void MqttPublisher::publish_head(std::int64_t now_ns) {
 // "level": .., "sequence": .., "id": ..}; level and sequence default to what the box shows.
 // A well-formed acknowledgement goes to the loop; the reply waits for its outcome.
 void MqttPublisher::on_message(const std::string& topic, const std::string& payload) {
+  if (settings_.regional_alerts && topic == regional_topic_) return on_regional_alert(payload);
   if (topic != command_topic_) return;
   ++commands_received_;
   nlohmann::json command = nlohmann::json::parse(payload, nullptr, false);
@@ -378,6 +416,26 @@ void MqttPublisher::on_message(const std::string& topic, const std::string& payl
                                        .close()};
 }
 
+// A regional alert (docs/regional.md, "MQTT"), its UTC times made relative to now: to the loop,
+// which checks its values (or counts it malformed when it is no alert at all).
+void MqttPublisher::on_regional_alert(const std::string& payload) {
+  ++regional_received_;
+  const RegionalJson parsed = parse_regional_json(payload, wall_clock_ns());
+  RegionalRequest request;
+  request.alert = parsed.alert;
+  if (!parsed.ok) {
+    ++regional_malformed_;
+    request.malformed = true;
+    request.field = parsed.field;
+    say("regional alert malformed: " + parsed.problem + ": " + payload.substr(0, 200));
+  }
+  if (!mailbox_.post_regional(request)) {
+    ++regional_lost_;
+    say("regional alert lost: the loop has not taken the " +
+        std::to_string(OutputMailbox::kRegionalSlots) + " before it");
+  }
+}
+
 // {"id": .., "command": "acknowledge", "result": "accepted" | "refused", "reason": ..,
 // "level": .., "sequence": .., "outcome": ..}: `details` are the members after "reason".
 void MqttPublisher::reply(const std::string& id_json, const std::string& result,
@@ -422,7 +480,7 @@ void MqttPublisher::publish_discovery() {
                                  .text("name", "plinth " + settings_.box_id)
                                  .text("manufacturer", "plinth")
                                  .text("model", "plinth-monitor")
-                                 .text("sw_version", kVersionText)
+                                 .text("sw_version", version::kVersionText)
                                  .close();
   std::vector<std::string> levels;
   for (const auto& level : monitor::kAlarmLevelNames) {
@@ -483,6 +541,38 @@ void MqttPublisher::publish_discovery() {
   }
 }
 
+namespace {
+
+// The state's "regional": null before any alert; the worst held alert (null: none held) with
+// its time to the S arrival, and the counters.
+std::string regional_state_json(const RegionalSnapshot& r) {
+  if (r.received == 0) return "null";
+  std::string alert = "null";
+  if (r.held > 0) {
+    alert = JsonObject()
+                .count("event_id", r.event_id)
+                .count("version", r.version)
+                .fixed("magnitude", r.magnitude, 2)
+                .fixed("distance_km", r.distance_km, 1)
+                .fixed("pga_g", r.pga_g, 4)
+                .fixed("sigma_ln", r.sigma_ln, 2)
+                .fixed("probability", r.probability, 4)
+                .fixed("time_to_s_arrival_s", r.time_to_s_arrival_s, 1)
+                .fixed("s_arrival_t", r.s_arrival_t, 3)
+                .close();
+  }
+  return JsonObject()
+      .count("held", static_cast<std::uint64_t>(r.held))
+      .raw("alert", alert)
+      .count("received", r.received)
+      .count("accepted", r.accepted)
+      .count("refused", r.refused)
+      .text("last_refusal", monitor::regional_refusal_name(r.last_refusal))
+      .close();
+}
+
+}  // namespace
+
 std::string MqttPublisher::state_json() const {
   const StatusSnapshot& s = state_;
   JsonObject phase;
@@ -527,10 +617,12 @@ std::string MqttPublisher::state_json() const {
       .text("sensors_state", monitor::health_state_name(s.sensors_state))
       .raw("sensor_counters", counters)
       .count("estimator_restarts", s.estimator_restarts)
+      .raw("regional", regional_state_json(s.regional))
       .count("heartbeat", s.statuses)
+      .count("events_dropped", events_dropped_ + mailbox_.events_dropped())
       .raw("version", JsonObject()
-                          .text("project", kProjectVersion)
-                          .text("git", kGitDescription)
+                          .text("project", version::kProjectVersion)
+                          .text("git", version::kGitDescription)
                           .close());
   for (const DigestMember& d : digests_) {
     state.raw(d.member, d.hex.empty() ? "null" : host::json_quoted(d.hex));
@@ -569,7 +661,10 @@ void MqttPublisher::run() {
       continue;
     }
     const int rc = mosquitto_loop(client_, kLoopTimeoutMs, 1);
-    if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED) {
+    if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED && !answered_) {
+      ++connect_failures_;  // the asynchronous connection failed (refused, unreachable, ...)
+      lost("cannot reach the broker at " + endpoint_text_ + ": " + error_text(rc), now);
+    } else if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED) {
       // on_disconnect counted it.
       lost("connection to " + endpoint_text_ + " lost: " + error_text(rc), now);
     } else if (rc == MOSQ_ERR_CONN_REFUSED) {
@@ -610,6 +705,9 @@ std::string MqttPublisher::summary_json() const {
       .count("commands_received", commands_received_)
       .count("commands_accepted", commands_accepted_)
       .count("commands_refused", commands_refused_)
+      .count("regional_received", regional_received_)
+      .count("regional_malformed", regional_malformed_)
+      .count("regional_lost", regional_lost_)
       .close();
 }
 

@@ -5,6 +5,8 @@
 //   PREFIX/BOX/availability   retained "online"; the Last Will, and a clean stop, say "offline"
 //   PREFIX/BOX/command        the operator's acknowledgement (subscribed; mqtt.commands)
 //   PREFIX/BOX/command/reply  accepted or refused, and why
+//   PREFIX/regional_alert     the site's regional early-warning alerts from the integrator's
+//                             bridge (subscribed; mqtt.regional_alerts, mqtt.regional_topic)
 //   DISCOVERY/.../config      retained Home Assistant discovery (mqtt.discovery)
 // Alarm events wait in a bounded queue while the broker is away (the oldest dropped and
 // counted when it is full) and go out one at a time, each once the broker acknowledged the one
@@ -49,6 +51,11 @@ struct MqttSettings {
   double reconnect_min_s = 0.5;   // mqtt.reconnect_min_s: first back-off, doubled to ...
   double reconnect_max_s = 30.0;  // mqtt.reconnect_max_s
   bool commands = false;          // mqtt.commands: acknowledgements on PREFIX/BOX/command
+  // mqtt.regional_alerts: take regional alerts (docs/regional.md) from mqtt.regional_topic
+  // (default PREFIX/regional_alert: one bridge for the site's boxes, each with its statue's
+  // fragility; PREFIX/BOX/regional_alert or any other topic for a box of its own).
+  bool regional_alerts = false;
+  std::string regional_topic;
   bool discovery = true;          // mqtt.discovery: Home Assistant discovery configs
   std::string discovery_prefix = "homeassistant";  // mqtt.discovery_prefix
 };
@@ -91,12 +98,15 @@ class MqttPublisher final : public StatusOutput {
   void publish_head(std::int64_t now_ns);
   void publish_state(std::int64_t now_ns);
   void lost(const std::string& reason, std::int64_t now_ns);
+  void say_dropped();
+  void say_problem(const std::string& reason);
   void back_off(std::int64_t now_ns);
   void say_offline();
   void publish_discovery();
   void reply(const std::string& id_json, const std::string& result, const std::string& why,
              const std::string& details);
   void take_results();
+  void on_regional_alert(const std::string& payload);
   [[nodiscard]] bool publish(const std::string& topic, const std::string& payload, bool retain,
                              int* mid);
   [[nodiscard]] std::string state_json() const;
@@ -112,6 +122,7 @@ class MqttPublisher final : public StatusOutput {
   std::string host_;
   int port_ = 0;
   std::string state_topic_, events_topic_, availability_topic_, command_topic_, reply_topic_;
+  std::string regional_topic_;
   mosquitto* client_ = nullptr;
   OutputMailbox mailbox_;
   std::atomic<bool> stopping_{false};
@@ -120,6 +131,7 @@ class MqttPublisher final : public StatusOutput {
   // The thread's state.
   bool socket_open_ = false;  // a connection attempt or session is under way
   bool connected_ = false;    // the broker accepted the session
+  bool answered_ = false;     // the broker answered this attempt (CONNACK, accepted or not)
   std::int64_t next_attempt_ns_ = 0;
   double backoff_s_ = 0.0;
   std::string last_problem_;  // the latest message printed (printed again only when it changes)
@@ -149,6 +161,8 @@ class MqttPublisher final : public StatusOutput {
   std::uint64_t connections_lost_ = 0;
   std::uint64_t events_published_ = 0;  // acknowledged by the broker
   std::uint64_t events_dropped_ = 0;    // the queue was full: the oldest went
+  std::uint64_t next_drop_report_ = 1;     // say_dropped() speaks at this count
+  std::uint64_t mailbox_dropped_seen_ = 0;
   std::uint64_t events_republished_ = 0;
   std::uint64_t states_published_ = 0;
   std::size_t most_queued_ = 0;
@@ -156,6 +170,9 @@ class MqttPublisher final : public StatusOutput {
   std::uint64_t commands_accepted_ = 0;  // acknowledgements the monitor released a latch with
   std::uint64_t commands_refused_ = 0;
   std::uint64_t discovery_configs_ = 0;  // config messages published
+  std::uint64_t regional_received_ = 0;   // messages on the regional topic
+  std::uint64_t regional_malformed_ = 0;  // of which not an alert (handed on as malformed)
+  std::uint64_t regional_lost_ = 0;       // not handed on: the loop had not taken the earlier
 };
 
 }  // namespace plinth::firmware

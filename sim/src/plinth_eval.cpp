@@ -67,7 +67,7 @@ struct ReportOptions {
   bool frontier = false;  // also the frontier of the rules (make_report)
   std::string calibration_path;  // choose the rules on this other runs file
   std::string false_alarm =
-      plinth::host::false_alarm_name(plinth::eval::CalibrationTargets{}.false_alarm);
+      plinth::host::false_alarm_name(plinth::sim::CalibrationTargets{}.false_alarm);
 };
 
 struct FragilityOptions {
@@ -115,8 +115,8 @@ void refuse_repeated_names(const std::vector<std::string>& paths, const char* op
   }
 }
 
-plinth::eval::BoxSettings box_settings(const RunOptions& opt) {
-  plinth::eval::BoxSettings box;
+plinth::sim::BoxSettings box_settings(const RunOptions& opt) {
+  plinth::sim::BoxSettings box;
   box.rate_hz = opt.rate_hz;
   box.steps_per_sample = opt.steps_per_sample;
   box.knows_true_statue = opt.box_knows_statue;
@@ -174,8 +174,8 @@ int run_eval(const RunOptions& opt) {
     throw InputError("--statues: expected 1 to " + std::to_string(kMaxStatues) + ", got " +
                      std::to_string(opt.statues));
   }
-  const plinth::eval::BoxSettings box = box_settings(opt);
-  plinth::eval::TruthSettings truth;
+  const plinth::sim::BoxSettings box = box_settings(opt);
+  plinth::sim::TruthSettings truth;
   truth.step_s = opt.truth_step_s;
   std::vector<plinth::host::UncertainScene> scenes;
   std::vector<std::vector<plinth::Scene>> statues;
@@ -201,7 +201,7 @@ int run_eval(const RunOptions& opt) {
     const std::size_t r = index / per_record;
     const std::size_t s = index % per_record / static_cast<std::size_t>(opt.statues);
     const auto j = static_cast<int>(index % static_cast<std::size_t>(opt.statues));
-    return plinth::eval::EvalCase{&records[r],   file_name(opt.record_paths[r]),
+    return plinth::sim::EvalCase{&records[r],   file_name(opt.record_paths[r]),
                                   &scenes[s],    file_name(opt.scene_paths[s]),
                                   j,             opt.seed,
                                   grid,          &statues[s][static_cast<std::size_t>(j)],
@@ -218,13 +218,13 @@ int run_eval(const RunOptions& opt) {
         std::vector<EvalRun> job;
         for (int i = 0; i < grid.steps; ++i) {
           if (run.stop->load()) throw plinth::host::JobCancelled();
-          job.push_back(plinth::eval::run_case(case_of(index, grid.at(i)), box, truth, grids));
+          job.push_back(plinth::sim::run_case(case_of(index, grid.at(i)), box, truth, grids));
           if (job.back().collapsed && !opt.all_scales) break;
         }
         results[index] = std::move(job);
       },
       [&](std::size_t index) {
-        const plinth::eval::EvalCase c = case_of(index, 0.0);
+        const plinth::sim::EvalCase c = case_of(index, 0.0);
         return c.record_name + ", " + c.scene_name + ", statue " + std::to_string(c.statue);
       });
   progress.finish();
@@ -264,42 +264,42 @@ void write_text(const std::string& path, const std::string& text) {
 }
 
 int run_report(const ReportOptions& opt) {
-  plinth::eval::CalibrationTargets targets;
+  plinth::sim::CalibrationTargets targets;
   if (!plinth::host::parse_false_alarm(opt.false_alarm, targets.false_alarm)) {
     throw InputError("--false-alarm: expected margin or peak, got '" + opt.false_alarm + "'");
   }
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
-  plinth::eval::require_margins(table, targets, opt.runs_path);
+  plinth::sim::require_margins(table, targets, opt.runs_path);
   EvalTable calibration;
   if (!opt.calibration_path.empty()) {
     calibration = plinth::host::read_eval_csv(opt.calibration_path);
     if (calibration.runs.empty()) throw InputError(opt.calibration_path + ": no runs");
-    plinth::eval::require_margins(calibration, targets, opt.calibration_path + " (--calibrate-on)");
+    plinth::sim::require_margins(calibration, targets, opt.calibration_path + " (--calibrate-on)");
   }
-  const plinth::eval::Report report = plinth::eval::make_report(
+  const plinth::sim::Report report = plinth::sim::make_report(
       table, targets, opt.frontier, opt.calibration_path.empty() ? nullptr : &calibration);
-  std::fputs(plinth::eval::report_text(report, table.grids).c_str(), stdout);
+  std::fputs(plinth::sim::report_text(report, table.grids).c_str(), stdout);
   if (!opt.json_path.empty()) {
-    write_text(opt.json_path, plinth::eval::report_json(report, table.grids));
+    write_text(opt.json_path, plinth::sim::report_json(report, table.grids));
   }
-  if (!opt.plot_path.empty()) plinth::eval::plot_roc(table, opt.plot_path);
+  if (!opt.plot_path.empty()) plinth::sim::plot_roc(table, opt.plot_path);
   return 0;
 }
 
 int run_fragility(const FragilityOptions& opt) {
-  plinth::eval::CollapseIntensityRule rule{};
-  if (!plinth::eval::parse_collapse_intensity(opt.collapse_intensity, rule)) {
+  plinth::sim::CollapseIntensityRule rule{};
+  if (!plinth::sim::parse_collapse_intensity(opt.collapse_intensity, rule)) {
     throw InputError("--collapse-intensity: expected interval or grid, got '" +
                      opt.collapse_intensity + "'");
   }
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
-  const std::vector<plinth::eval::SceneFragility> scenes =
-      plinth::eval::scene_fragilities(table, opt.runs_path, rule);
-  std::fputs(plinth::eval::fragility_text(scenes, rule).c_str(), stdout);
-  if (!opt.json_path.empty()) write_text(opt.json_path, plinth::eval::fragility_json(scenes, rule));
-  if (!opt.plot_path.empty()) plinth::eval::plot_fragility(scenes, opt.plot_path);
+  const std::vector<plinth::sim::SceneFragility> scenes =
+      plinth::sim::scene_fragilities(table, opt.runs_path, rule);
+  std::fputs(plinth::sim::fragility_text(scenes, rule).c_str(), stdout);
+  if (!opt.json_path.empty()) write_text(opt.json_path, plinth::sim::fragility_json(scenes, rule));
+  if (!opt.plot_path.empty()) plinth::sim::plot_fragility(scenes, opt.plot_path);
   return 0;
 }
 

@@ -39,7 +39,7 @@ PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", "outside_model"]
+          "collapse_forecast", "not_calibrated", "outside_model", None, None, "regional_alert"]
 SCENARIOS = ("main", "stop", "garbage", "burst")
 # Sent by canplayer in the garbage case, each one refused by the DBC (or not for the monitor).
 GARBAGE = (
@@ -151,7 +151,7 @@ class Signal:
         self.factor, self.offset = factor, offset
         self.raw_min = round((minimum - offset) / factor)
         self.raw_max = round((maximum - offset) / factor)
-        # The VAL_ table's raw values: an enumeration's (its whole range), or a quantity's
+        # The VAL_ table's raw values: an enumeration's (within its range), or a quantity's
         # special value outside its range (255 "none")
         self.values = None
         self.reserved_mask = 0  # flag bits the comment reserves ("bits 4-7 reserved, must be 0")
@@ -160,7 +160,7 @@ class Signal:
 class Dbc:
     """The messages of plinth.dbc, read from the file itself, and a decoder that refuses what
     the DBC makes invalid: a length other than the message's, raw values outside [min|max] and
-    missing from the signal's VAL_ table (an enumeration's table is its range; a quantity's
+    missing from the signal's VAL_ table (an enumeration's table lies in its range; a quantity's
     names a special value outside it), bits no signal covers, flag bits a comment reserves."""
 
     def __init__(self, path):
@@ -213,8 +213,9 @@ class Dbc:
             raw = (word >> s.start) & mask
             if s.signed and raw >> (s.length - 1):
                 raw -= 1 << s.length
+            # an enumeration's names lie in its range (Cause's skip the reserved 13-14)
             enumeration = s.values is not None and \
-                s.values == set(range(s.raw_min, s.raw_max + 1))
+                all(s.raw_min <= v <= s.raw_max for v in s.values)
             if enumeration and raw not in s.values:
                 return None, f"{s.name} {raw} not in its VAL_ table"
             if not s.raw_min <= raw <= s.raw_max and not (s.values and raw in s.values):
@@ -807,7 +808,7 @@ def run_checks(args):
               f"{j['jitter_max_us']:.0f} us over {j['frames_sent']} frames at --speed "
               f"{config['speed']:g} ({config['rate'] * config['speed']:g} frames/s)")
         print(f"  the record run took {figures['main_wall_s']:.2f} s (run "
-              f"{figures['main_attempts']} of at most 3)")
+              f"{figures['main_attempts']} of at most 5)")
         lo, hi = figures["bus_send_time_deviation_us"]
         print(f"  sensor frames on the bus vs k / (rate x speed): {lo:.0f} to {hi:.0f} us")
         print(f"  monitor timeline vs plinth-sim: {figures['timeline_vs_sim_us']:.1f} us "

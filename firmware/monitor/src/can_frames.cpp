@@ -3,6 +3,9 @@
 #include <cmath>
 
 namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
 namespace {
 
 template <typename Domain, typename Wire>
@@ -43,7 +46,8 @@ static_assert(same_number(AlarmCause::kInternalFault, can::AlarmCause::kInternal
 static_assert(same_number(AlarmCause::kCollapseForecast, can::AlarmCause::kCollapseForecast));
 static_assert(same_number(AlarmCause::kNotCalibrated, can::AlarmCause::kNotCalibrated));
 static_assert(same_number(AlarmCause::kOutsideModel, can::AlarmCause::kOutsideModel));
-static_assert(monitor::kAlarmCauseNames.size() == 13);
+static_assert(same_number(AlarmCause::kRegionalAlert, can::AlarmCause::kRegionalAlert));
+static_assert(monitor::kAlarmCauseNames.size() == 14);
 
 // The sensors' status bits (SensorAcceleration.Status): passed through as they are.
 static_assert(monitor::sensor_flags::kSaturated == can::sensor_status::kSaturated);
@@ -77,7 +81,22 @@ monitor::AlarmLevel from_wire(can::AlarmLevel level) {
   return static_cast<monitor::AlarmLevel>(level);
 }
 
-can::MonitorStatus status_message(const MonitorStatus& status, int axis, std::uint8_t sequence) {
+monitor::RegionalAlert regional_alert_of(const can::RegionalAlertOrigin& origin,
+                                         const can::RegionalAlert& alert, double origin_before_s) {
+  monitor::RegionalAlert a;
+  a.event_id = alert.event_id;
+  a.version = alert.version;
+  a.cancelled = origin.cancelled;
+  a.magnitude = static_cast<Real>(origin.magnitude);
+  a.distance_km = static_cast<Real>(origin.distance_km);
+  a.origin_age_s = static_cast<Real>(origin.origin_age_s + origin_before_s);
+  a.pga_g = static_cast<Real>(alert.pga_g);
+  a.sigma_ln = static_cast<Real>(alert.sigma_ln);
+  a.s_arrival_in_s = static_cast<Real>(alert.s_arrival_in_s);
+  return a;
+}
+
+can::MonitorStatus status_message(const BoxStatus& status, int axis, std::uint8_t sequence) {
   const AxisStatus& a = status.axes[static_cast<std::size_t>(axis)];
   can::MonitorStatus m;
   m.axis = static_cast<std::uint8_t>(axis);
@@ -95,7 +114,7 @@ can::MonitorStatus status_message(const MonitorStatus& status, int axis, std::ui
   return m;
 }
 
-can::CollapseForecast forecast_message(const MonitorStatus& status, int axis, double horizon_s,
+can::CollapseForecast forecast_message(const BoxStatus& status, int axis, double horizon_s,
                                        std::uint8_t sequence) {
   const AxisStatus& a = status.axes[static_cast<std::size_t>(axis)];
   const ForecastOutcome& f = a.forecast;

@@ -11,7 +11,7 @@
 #include "plinth/hal/can_codec.h"
 #include "plinth/hal/candump_log.h"
 
-namespace plinth::replay {
+namespace plinth::hal::replay {
 
 enum class FrameKind : std::uint8_t { kAcceleration, kHeartbeat };
 
@@ -116,4 +116,4 @@ class LogSchedule final : public FrameSchedule {
   std::size_t index_ = 0;
 };
 
-}  // namespace plinth::replay
+}  // namespace plinth::hal::replay

@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include "plinth/monitor/alarm_level.h"
+
 namespace plinth::host {
 
 inline constexpr double kQuietPeakRatio = 0.5;  // of the overturning angle: below it, quiet
@@ -55,10 +57,6 @@ struct PgaGrid {
   friend bool operator==(const PgaGrid&, const PgaGrid&) = default;
 };
 
-enum class EvalLevel : std::size_t { kAdvisory = 0, kWarning = 1, kAlarm = 2 };
-inline constexpr std::size_t kEvalLevels = 3;
-[[nodiscard]] const char* eval_level_name(EvalLevel level);
-
 // The threshold grids of the first-crossing times (every run of a file shares them).
 struct CrossingGrids {
   std::vector<double> risk;         // reactive risk of the worst member, dimensionless
@@ -84,8 +82,8 @@ struct EvalRun {
   // >= 0: the true statue lifted off then (Phase::kLiftedOff): the model ends, so the truth is
   // unknown and the run counts in no outcome (outcome_of skips it); -1: the model held.
   double model_valid_until_s = -1.0;
-  // The box: first time each level was shown (-1: never).
-  std::array<double, kEvalLevels> first_shown_s{-1.0, -1.0, -1.0};
+  // The box: first time each risk level was shown (-1: never), in monitor::kRiskLevels' order.
+  std::array<double, monitor::kRiskLevels.size()> first_shown_s{-1.0, -1.0, -1.0};
   // First time each grid threshold was reached (-1: never), same order as the grids.
   std::vector<double> risk_crossing_s;
   std::vector<double> probability_crossing_s;
@@ -171,7 +169,9 @@ template <class FirstTime>
   return o;
 }
 
-[[nodiscard]] WarningOutcome level_outcome(const std::vector<EvalRun>& runs, EvalLevel level);
+// `level`: one of monitor::kRiskLevels.
+[[nodiscard]] WarningOutcome level_outcome(const std::vector<EvalRun>& runs,
+                                           monitor::AlarmLevel level);
 
 // Which reactive risk a rule reads: the worst member's (the box's) or the nominal statue's alone
 // (today's box, EvalRun::nominal_risk_crossing_s).
