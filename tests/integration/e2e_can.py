@@ -39,7 +39,7 @@ PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", "outside_model", None, None, "regional_alert"]
+          "collapse_forecast", "not_calibrated", "outside_model"]
 SCENARIOS = ("main", "stop", "garbage", "burst")
 # Sent by canplayer in the garbage case, each one refused by the DBC (or not for the monitor).
 GARBAGE = (
@@ -213,7 +213,7 @@ class Dbc:
             raw = (word >> s.start) & mask
             if s.signed and raw >> (s.length - 1):
                 raw -= 1 << s.length
-            # an enumeration's names lie in its range (Cause's skip the reserved 13-14)
+            # an enumeration's names lie in its range
             enumeration = s.values is not None and \
                 all(s.raw_min <= v <= s.raw_max for v in s.values)
             if enumeration and raw not in s.values:
