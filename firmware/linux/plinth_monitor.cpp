@@ -308,6 +308,16 @@ void start_monitor(fw::Monitor& monitor, fw::FrameDecoder& decoder,
     decoder.start(config);
     return;
   }
+  // Too few steps per sample where even the most the box takes (64) are too few: the scene's
+  // base is the culprit, too stiff or light for the box (lib/core estimator.cpp).
+  const bool steps_needed = std::string(e.field) == "estimator.steps_per_sample" && e.limit > 0.0;
+  if (steps_needed && std::ceil(e.limit) > 64.0) {
+    throw InputError("--scene " + app["--scene"]->as<std::string>() +
+                     " (base.period): too short for the box: a stable estimate needs " +
+                     plinth::host::number_text(std::ceil(e.limit)) +
+                     " solver steps a sample at this rate, more than the 64 the box takes (a "
+                     "longer base.period, a heavier base, or a lower sample rate)");
+  }
   const std::string option = option_of(e.field);
   std::string where;
   if (!option.empty() && app.count(option) > 0) {
@@ -318,7 +328,9 @@ void start_monitor(fw::Monitor& monitor, fw::FrameDecoder& decoder,
     where = std::string("monitor setting ") + e.field;
   }
   std::string message = where + ": " + e.reason;
-  if (e.limit != 0.0 && std::isfinite(e.limit) && message.find('[') == std::string::npos) {
+  if (steps_needed) {
+    message += " (limit " + plinth::host::number_text(std::ceil(e.limit)) + ")";
+  } else if (e.limit != 0.0 && std::isfinite(e.limit) && message.find('[') == std::string::npos) {
     message += " (limit " + plinth::host::number_text(e.limit) + ")";
   }
   throw InputError(message);

@@ -20,19 +20,11 @@ Error validate(const EstimatorSettings& st, const Scene& scene) {
   PLINTH_TRY(validate_feature_set(scene));
   if (const auto limit = static_cast<Time>(largest_stable_step(scene, solver.stepper));
       solver.step > limit) {
-    // The input to change, and its limit: the fewest stable steps per sample at this rate, or
-    // the base's period when even the most (64) are not. (No std::ceil: 256 B of flash.)
-    const Time steps_needed = Time(1) / (st.sample_rate_hz * limit);
-    if (steps_needed <= Time(64)) {
-      int fewest = static_cast<int>(steps_needed);
-      fewest += static_cast<Time>(fewest) < steps_needed ? 1 : 0;
-      return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
-              "too few for this base at this rate (limit: the fewest stable)",
-              static_cast<double>(fewest)};
-    }
-    return {ErrorCode::kOutOfRange, "base.period",
-            "too short for the box: 64 steps per sample are unstable (limit: the stable step, s)",
-            limit};
+    // The limit: the steps per sample a stable integration needs at this rate (the tools round
+    // it up). Above 64, the most the box takes, the base is the culprit: the tools say so.
+    return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
+            "too few for this base at this rate (limit: the steps needed)",
+            static_cast<double>(Time(1) / (st.sample_rate_hz * limit))};
   }
   return ok_error();
 }

@@ -63,17 +63,7 @@ struct EventLogic {
 
   static void emit_event(Simulator& sim, Time t, EventKind kind, int side = 0,
                          Real before = Real(0), Real after = Real(0)) {
-    Event e;
-    e.t = t;
-    e.kind = kind;
-    e.corner = sim.mode_.corner;
-    e.side = static_cast<std::int8_t>(side);
-    e.before = before;
-    e.after = after;
-    e.phase = sim.mode_.phase;
-    e.overhang = sim.mode_.overhang;
-    e.state = sim.y_;
-    sim.emit_event(e);
+    sim.emit_event(t, kind, side, before, after);
   }
 
   // On entering a mode (at the start or after a reset), the onset conditions that already hold

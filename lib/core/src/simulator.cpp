@@ -150,18 +150,27 @@ bool Simulator::lift_off(Time t, bool located) {
           Real(0)) {
     return false;
   }
+  const Phase left = mode_.phase;
+  mode_.phase = Phase::kLiftedOff;
+  emit_event(t, EventKind::kLiftOff, 0, scene_->g + ag.vertical, Real(0), left);
+  return true;
+}
+
+void Simulator::emit_event(Time t, EventKind kind, int side, Real before, Real after,
+                           Phase left) {
+  if (sink_ == nullptr) return;
   Event e;
   e.t = t;
-  e.kind = EventKind::kLiftOff;
+  e.kind = kind;
   e.corner = mode_.corner;
-  e.before = scene_->g + ag.vertical;
-  e.left = mode_.phase;
-  mode_.phase = Phase::kLiftedOff;
+  e.side = static_cast<std::int8_t>(side);
+  e.before = before;
+  e.after = after;
   e.phase = mode_.phase;
   e.overhang = mode_.overhang;
+  e.left = left;
   e.state = y_;
-  emit_event(e);
-  return true;
+  sink_->on_event(e);
 }
 
 }  // namespace plinth

@@ -136,7 +136,6 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   collapse_ = in.collapse_detected;
   out_of_contact_ = in.out_of_full_contact;
   not_calibrated_ = in.not_calibrated;
-  outside_model_ = in.outside_model;
 
   // Trouble is shown at once; it clears only after lower_hold_s without it.
   const bool fault = in.fault_active || !risk_valid;
@@ -172,11 +171,11 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   }
 }
 
-// Alarm above all; then fault (held, outside the model or not calibrated); then the risk level.
+// Alarm above all; then fault (held, or not calibrated); then the risk level.
 AlarmLevel AlarmPolicy::shown_level() const {
   const AlarmLevel risk_level = higher(condition_level_, latched_level_);
   if (risk_level == AlarmLevel::kAlarm) return AlarmLevel::kAlarm;
-  if (fault_.active || outside_model_ || not_calibrated_) return AlarmLevel::kFault;
+  if (fault_.active || not_calibrated_) return AlarmLevel::kFault;
   return risk_level;
 }
 
@@ -184,10 +183,8 @@ AlarmLevel AlarmPolicy::shown_level() const {
 AlarmCause AlarmPolicy::cause_of(AlarmLevel level) const {
   switch (level) {
     case AlarmLevel::kNormal: return AlarmCause::kNone;
-    case AlarmLevel::kFault:  // a fault now, else outside the model, not calibrated, a fault held
-      if (fault_input_) return fault_cause_;
-      if (outside_model_) return AlarmCause::kOutsideModel;
-      return not_calibrated_ ? AlarmCause::kNotCalibrated : fault_cause_;
+    case AlarmLevel::kFault:  // a fault now, else not calibrated, else a fault held
+      return fault_input_ || !not_calibrated_ ? fault_cause_ : AlarmCause::kNotCalibrated;
     case AlarmLevel::kAdvisory:
       return out_of_contact_ ? AlarmCause::kPhaseChange : AlarmCause::kRiskThreshold;
     case AlarmLevel::kWarning:

@@ -344,35 +344,6 @@ TEST(AlarmPolicy, NotCalibratedIsAFaultWithoutHold) {
   EXPECT_EQ(q.at(510, 0.0).level, AlarmLevel::kNormal);
 }
 
-// Outside the model (the estimate lifted off): the fault level at once, cause outside_model,
-// for as long as it lasts; it names itself above not_calibrated, a sensor fault names its own
-// cause above it, and an alarm shows above it.
-TEST(AlarmPolicy, OutsideTheModelIsAFaultThatNamesItself) {
-  AlarmPolicySettings s = latching(false, true);
-  Policy p(s);
-  p.base.outside_model = true;
-  expect_change(p.at(0, 0.0), AlarmLevel::kFault, AlarmLevel::kNormal, AlarmCause::kOutsideModel,
-                false);
-  EXPECT_EQ(p.at(100, 0.95).level, AlarmLevel::kAlarm);  // an alarm shows above it, latched
-  EXPECT_EQ(p.at(150, 0.0).level, AlarmLevel::kAlarm);   // held by its latch
-  const AlarmOutput acked = p.ack(200, 0.0, AlarmLevel::kAlarm, 1);
-  expect_change(acked, AlarmLevel::kFault, AlarmLevel::kAlarm, AlarmCause::kAcknowledged, false);
-  p.base.outside_model = false;
-  expect_change(p.at(201, 0.0), AlarmLevel::kNormal, AlarmLevel::kFault, AlarmCause::kNone, false);
-
-  Policy q(s);  // with not_calibrated too: outside_model is the cause
-  q.base.not_calibrated = true;
-  q.base.outside_model = true;
-  expect_change(q.at(0, 0.0), AlarmLevel::kFault, AlarmLevel::kNormal, AlarmCause::kOutsideModel,
-                false);
-  Policy r(s);  // with a sensor fault: the fault's own cause
-  r.base.outside_model = true;
-  r.base.fault_active = true;
-  r.base.fault_cause = AlarmCause::kSensorFault;
-  expect_change(r.at(0, 0.0), AlarmLevel::kFault, AlarmLevel::kNormal, AlarmCause::kSensorFault,
-                false);
-}
-
 TEST(AlarmPolicy, AFaultNeverHidesAnAlarm) {
   Policy p(latching(false, true));
   (void)p.at(0, 0.9);  // event 0: alarm

@@ -117,6 +117,10 @@ class Simulator {
   void emit_event(const Event& event) {
     if (sink_ != nullptr) sink_->on_event(event);
   }
+  // The event `kind` at t, of the current mode and state: one copy out of line for every
+  // feature set's event logic (the Cortex-M image's flash), built only when a sink listens.
+  void emit_event(Time t, EventKind kind, int side, Real before, Real after,
+                  Phase left = Phase::kFullContact);
   // The guards of the current mode, after it changed.
   void refresh_guards() { active_guards_ = guards_fn_(mode_); }
   void step_intervals(Time t_end);

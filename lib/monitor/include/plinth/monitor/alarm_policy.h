@@ -64,7 +64,6 @@ struct AlarmInput {
   bool fault_active = false;         // sensor or bus trouble
   AlarmCause fault_cause = AlarmCause::kSensorFault;  // reported while fault_active
   bool not_calibrated = false;  // no trusted offset or initial state (AlarmPolicy, below)
-  bool outside_model = false;   // the estimate left the model's validity (AlarmPolicy, below)
   bool acknowledged = false;  // `acknowledgement` arrived since the last update
   Acknowledgement acknowledgement;
 };
@@ -153,11 +152,8 @@ struct HeldCondition {
 // Fault: fault_active (or an invalid risk input: an internal fault) shows the fault level at
 // once, until lower_hold_s after it clears. Not calibrated: not_calibrated shows the fault
 // level, cause kNotCalibrated, exactly while it lasts (no hold: a state of knowledge); an
-// active fault's own cause is reported instead. Outside the model: outside_model (the block
-// lifted off its support, which the model cannot follow) the same, cause kOutsideModel, above
-// not_calibrated and below a fault's own cause. The level shown: alarm if the risk level
-// (condition or latch) is alarm, else fault while a fault, outside_model or not_calibrated
-// holds, else the
+// active fault's own cause is reported instead. The level shown: alarm if the risk level
+// (condition or latch) is alarm, else fault while a fault or not_calibrated holds, else the
 // risk level: a fault never hides an alarm, it hides a warning or advisory (stale while the
 // input is not trusted), which show again with an event when it ends.
 // Events: one each time the level shown or its latched flag changes, at most two per update
@@ -210,7 +206,6 @@ class AlarmPolicy {
   bool alarm_by_forecast_ = false;
   bool out_of_contact_ = false;  // the latest input's out_of_full_contact
   bool not_calibrated_ = false;  // the latest input's not_calibrated
-  bool outside_model_ = false;   // the latest input's outside_model
   bool fault_input_ = false;     // the latest input's fault (fault_active or an invalid risk)
   AlarmCause fault_cause_ = AlarmCause::kNone;
   AlarmLevel condition_level_ = AlarmLevel::kNormal;

@@ -156,23 +156,12 @@ template <Features F>
 //    Y = m (g + v_G'') + m b'_i theta'' - m h'_i theta'^2: besides the ground's fall, the
 //    pivot unloads when the rotation accelerates the wrong way or spins fast (centripetal term);
 //  - about the support's corner, Eq 14 (x' = 0 in pure rocking), with its Coriolis term.
-// Written out as printed (what contact_force gives, m (a_C + a_G + g) projected on the
-// contact's normal, without its matrices); tests/unit/core/test_lift_off.cpp checks each against
-// the printed form and against contact_force.
+// Computed by sticking_contact_force (one copy of the contact's equations: the Cortex-M image's
+// flash); tests/unit/core/test_lift_off.cpp checks it against each printed form above.
 [[nodiscard]] inline Real lift_off_guard(const Scene& s, const Mode& mode, const State& y,
                                          GroundAcceleration ag, const Accelerations& acc,
                                          const SinCos& trig) {
-  const Real gravity = s.g + ag.vertical;
-  if (!mode.rocking()) return -gravity;
-  const PivotDistance pivot = pivot_distance(s, mode.corner, mode.overhang, y[kX]);
-  const Real spin = y[kThetaDot] * y[kThetaDot];
-  if (!pivot.overhanging) {  // Eq 12: x'' does not enter it about a body corner
-    const LeverArms arm = lever_arms(s, pivot.offset(), trig);
-    return -(gravity + arm.horizontal * acc.theta - arm.vertical * spin);
-  }
-  // Eq 14 (the offset is +b_hat_1 about corner 1, -b_hat_2 about corner 2)
-  return -(gravity * trig.cos - (acc.u + ag.horizontal) * trig.sin +
-           Real(2) * y[kXDot] * y[kThetaDot] + pivot.offset() * acc.theta - s.h * spin);
+  return -sticking_contact_force(s, mode, y, ag, acc, trig).normal / s.m;
 }
 
 // det(with friction) / det(frictionless) of slide-rocking about the mode's pivot in `direction`
