@@ -52,7 +52,7 @@ inline constexpr CodeTable<monitor::AlarmLevel, 5> kAlarmLevelCodes{{{
     {monitor::AlarmLevel::kAlarm, 3},
     {monitor::AlarmLevel::kFault, 4},
 }}};
-inline constexpr CodeTable<monitor::AlarmCause, 12> kAlarmCauseCodes{{{
+inline constexpr CodeTable<monitor::AlarmCause, 13> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kNone, 0},
     {monitor::AlarmCause::kRiskThreshold, 1},
     {monitor::AlarmCause::kPhaseChange, 2},
@@ -65,14 +65,16 @@ inline constexpr CodeTable<monitor::AlarmCause, 12> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kInternalFault, 9},
     {monitor::AlarmCause::kCollapseForecast, 10},
     {monitor::AlarmCause::kNotCalibrated, 11},
+    {monitor::AlarmCause::kOutsideModel, 12},
 }}};
-inline constexpr CodeTable<Phase, 6> kPhaseCodes{{{
+inline constexpr CodeTable<Phase, 7> kPhaseCodes{{{
     {Phase::kFullContact, 0},
     {Phase::kSliding, 1},
     {Phase::kRocking, 2},
     {Phase::kSlideRocking, 3},
     {Phase::kOverturned, 4},
     {Phase::kFell, 5},
+    {Phase::kLiftedOff, 6},
 }}};
 inline constexpr CodeTable<monitor::HealthState, 3> kHealthStateCodes{{{
     {monitor::HealthState::kOk, 0},

@@ -47,7 +47,7 @@ constexpr std::array<SignalLayout, 6> kHeartbeatSignals{{
 // MonitorStatus (0x320 + axis)
 enum StatusSignal : std::size_t { kPhase, kCorner, kAlarmLevel, kRisk, kStSequence, kSampleAge };
 constexpr std::array<SignalLayout, 6> kStatusSignals{{
-    {"Phase", 0, 4, false, 1.0, 0.0, 0, 5, "", true, kNoSpecialRaw},
+    {"Phase", 0, 4, false, 1.0, 0.0, 0, 6, "", true, kNoSpecialRaw},
     {"Corner", 4, 4, false, 1.0, 0.0, 0, 2, "", true, kNoSpecialRaw},
     {"AlarmLevel", 8, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"Risk", 16, 16, false, 0.0001, 0.0, 0, 10000, "", false, kNoSpecialRaw},
@@ -60,7 +60,7 @@ enum EventSignal : std::size_t { kLevel, kPreviousLevel, kCause, kLatched, kTime
 constexpr std::array<SignalLayout, 6> kEventSignals{{
     {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
-    {"Cause", 8, 8, false, 1.0, 0.0, 0, 11, "", true, kNoSpecialRaw},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 12, "", true, kNoSpecialRaw},
     {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true, kNoSpecialRaw},
     {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false, kNoSpecialRaw},
     {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},

@@ -27,7 +27,9 @@ TEST(ModbusMap, TheShippedCsvIsTheCodesMap) {
 
 TEST(ModbusMap, EveryCauseHasItsCodeInTheCsv) {
   const std::string csv = map_csv();
-  EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated"), std::string::npos);
+  EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model\""),
+            std::string::npos);
+  EXPECT_NE(csv.find("4=overturned;5=fell;6=lifted_off\""), std::string::npos);
   EXPECT_NE(csv.find("\"0=normal;1=advisory;2=warning;3=alarm;4=fault\""), std::string::npos);
 }
 
@@ -36,8 +38,10 @@ TEST(ModbusMap, EveryCauseHasItsCodeInTheCsv) {
 TEST(ModbusMap, CodesArePinned) {
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kCollapseForecast), 10);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kNotCalibrated), 11);
+  EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kOutsideModel), 12);
   EXPECT_EQ(kAlarmLevelCodes.code(monitor::AlarmLevel::kFault), 4);
   EXPECT_EQ(kPhaseCodes.code(Phase::kFell), 5);
+  EXPECT_EQ(kPhaseCodes.code(Phase::kLiftedOff), 6);
   EXPECT_EQ(kHealthStateCodes.code(monitor::HealthState::kDegraded), 1);
   EXPECT_EQ(kAckOutcomeCodes.code(monitor::AckOutcome::kNothingLatched), 5);
 }

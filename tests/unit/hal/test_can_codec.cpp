@@ -351,7 +351,7 @@ TEST(CanRoundTrip, SensorHeartbeatEverySmallFieldAndUptimeSweep) {
 
 TEST(CanRoundTrip, MonitorStatusEveryEnumCombinationAndAxis) {
   for (std::uint8_t axis = 0; axis < kMonitorAxisCount; ++axis) {
-    for (unsigned p = 0; p <= 5; ++p) {
+    for (unsigned p = 0; p <= 6; ++p) {
       for (unsigned c = 0; c <= 2; ++c) {
         for (unsigned a = 0; a <= 4; ++a) {
           MonitorStatus m;
@@ -413,7 +413,7 @@ TEST(CanRoundTrip, MonitorStatusEveryRiskSequenceAndAge) {
 TEST(CanRoundTrip, AlarmEventEveryEnumCombinationAndTimeSweep) {
   for (unsigned l = 0; l <= 4; ++l) {
     for (unsigned p = 0; p <= 4; ++p) {
-      for (unsigned c = 0; c <= 9; ++c) {
+      for (unsigned c = 0; c <= 12; ++c) {
         for (const bool latched : {false, true}) {
           AlarmEvent m;
           m.level = static_cast<AlarmLevel>(l);
@@ -704,7 +704,7 @@ TEST(CanReject, UndefinedSensorStatusFlags) {
 
 TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   // Decode: every raw value above the VAL_ table.
-  for (unsigned v = 6; v <= 15; ++v) {
+  for (unsigned v = 7; v <= 15; ++v) {
     MonitorStatus d;
     const DecodeResult r = decode(make_frame(0x320, Bytes{static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -731,7 +731,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
     EXPECT_STREQ(rk.signal, "Level");
   }
-  for (unsigned v = 12; v <= 255; ++v) {
+  for (unsigned v = 13; v <= 255; ++v) {
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -740,7 +740,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   // Encode: values no enumerator names.
   CanFrame f;
   MonitorStatus s;
-  s.phase = static_cast<Phase>(6);
+  s.phase = static_cast<Phase>(7);
   EXPECT_EQ(encode(s, f).error, CodecError::kInvalidEnum);
   s = MonitorStatus{};
   s.corner = static_cast<Corner>(3);
@@ -749,7 +749,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  e.cause = static_cast<AlarmCause>(12);
+  e.cause = static_cast<AlarmCause>(13);
   EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
   e = AlarmEvent{};
   e.previous_level = static_cast<AlarmLevel>(255);
@@ -971,7 +971,7 @@ TEST(CanReject, OutputsUntouchedOnFailure) {
   MonitorStatus m;
   m.risk = 0.25;
   m.sequence = 9;
-  Bytes bad{0x06};  // Phase 6: not in the table
+  Bytes bad{0x07};  // Phase 7: not in the table
   ASSERT_FALSE(decode(make_frame(0x320, bad), m).ok());
   EXPECT_EQ(m.risk, 0.25);
   EXPECT_EQ(m.sequence, 9);

@@ -80,6 +80,7 @@ enum class Phase : std::uint8_t {
   kSlideRocking = 3,
   kOverturned = 4,
   kFell = 5,
+  kLiftedOff = 6,
 };
 // The corner the block rocks about; kNone when it does not rock.
 enum class Corner : std::uint8_t { kNone = 0, kLeft = 1, kRight = 2 };
@@ -103,6 +104,7 @@ enum class AlarmCause : std::uint8_t {
   kInternalFault = 9,       // the monitor's own self-check failed
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet
+  kOutsideModel = 12,       // the estimate left the model's validity (lift-off)
 };
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.
