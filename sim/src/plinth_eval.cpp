@@ -48,6 +48,7 @@ struct RunOptions {
   double rate_hz = 200.0;
   int steps_per_sample = 4;
   bool box_knows_statue = false;
+  bool statue_sensor = false;
   // The box's own continuation unless told (plinth::ForecastSettings, docs/forecast.md).
   std::string forecast = plinth::kContinuationNames.name(plinth::ForecastSettings{}.continuation);
   double horizon_s = 4.0;
@@ -96,6 +97,7 @@ plinth::sim::BoxSettings box_settings(const RunOptions& opt) {
   box.rate_hz = opt.rate_hz;
   box.steps_per_sample = opt.steps_per_sample;
   box.knows_true_statue = opt.box_knows_statue;
+  box.statue_sensor = opt.statue_sensor;
   if (opt.forecast == "off") {
     box.forecast.enabled = false;
   } else if (!plinth::kContinuationNames.parse(opt.forecast, box.forecast.continuation)) {
@@ -275,6 +277,9 @@ int main(int argc, char** argv) {
   run->add_option("--steps", opt.steps_per_sample, "the box's solver steps per sample (default 4)");
   run->add_flag("--box-knows-statue", opt.box_knows_statue,
                 "give the box the true statue, not the scene file: what knowing it would buy");
+  run->add_flag("--statue-sensor", opt.statue_sensor,
+                "give the box a gyroscope on the statue (a BMI088's noise, offset and delay, "
+                "simulated from the truth: docs/forecast.md)");
   run->add_option("--forecast", opt.forecast,
                   "strongest_window, recent_window or off (default the box's, " + opt.forecast +
                       ")");

@@ -135,7 +135,18 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
                             "redundancy.tolerance_m_s2"));
   PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
                             "plate.window_s", "plate.threshold_m_s2"));
-  return validate_sensors(c, sensor_index);
+  PLINTH_TRY(validate_sensors(c, sensor_index));
+  if (!c.statue_sensor.present) return ok_error();
+  PLINTH_TRY(validate(c.statue_sensor));
+  std::array<SensorConfig, kMaxSensors> sensors{};
+  const int count = resolved_sensors(c, sensors);
+  for (int i = 0; i < count; ++i) {
+    if (sensors[static_cast<std::size_t>(i)].node == c.statue_sensor.node) {
+      return {ErrorCode::kInconsistent, "statue_sensor.node",
+              "is an accelerometer's node; each sensor has its own"};
+    }
+  }
+  return ok_error();
 }
 
 }  // namespace plinth::firmware

@@ -40,6 +40,17 @@ Error Monitor::start(const MonitorConfig& config,
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
+  status_.has_statue_sensor = config.statue_sensor.present;
+  if (config.statue_sensor.present) {
+    PLINTH_TRY(statue_.start(config.statue_sensor, config.estimator.sample_period()));
+    for (int i = 0; i < config.axis_count; ++i) {
+      PLINTH_TRY(filters_[static_cast<std::size_t>(i)].start(
+          config.statue_sensor.filter, config.estimator, config.risk, ensemble(i).size()));
+    }
+    status_.statue_sensor = statue_.health();
+  }
+  measured_.fill(false);
+  statue_restarts_ = 0;
   last_ground_.setZero();
   frames_not_encoded_ = 0;
   have_epoch_ = false;
@@ -93,6 +104,10 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
   sensors_.tick(sample.receive_time_ns, sensor);
+  if (config_.statue_sensor.present) {  // its timeout, on the ground sensors' clock
+    statue_.tick(sample.receive_time_ns);
+    status_.statue_sensor = statue_.health();
+  }
   const monitor::SensorUpdate fed = sensors_.receive(sensor, sample);
   // Each fed sample in turn: the primary's goes on to the estimators at once (the next one's
   // conditioning is told whether they are quiet).
@@ -106,9 +121,20 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
   evaluate(update);
 }
 
-void Monitor::push_ensembles(const Vector3r& g) {
+// Each axis's members take the sample; with the statue sensor's newest rate fresh, the axis's
+// filter weighs them on it (a restart of the statue's stream loses the tilt: the filters start
+// again).
+void Monitor::push_ensembles(const Vector3r& g, std::int64_t receive_time_ns) {
+  const bool measuring = config_.statue_sensor.present && statue_.usable(receive_time_ns);
+  if (measuring && statue_.restarts() != statue_restarts_) {
+    statue_restarts_ = statue_.restarts();
+    for (StatueFilter& f : filters_) f.reset();
+  }
   for (int i = 0; i < status_.axis_count; ++i) {
-    ensembles_[static_cast<std::size_t>(i)].push({g[i], g.z()});
+    const auto k = static_cast<std::size_t>(i);
+    ensembles_[k].push({g[i], g.z()});
+    measured_[k] = measuring;
+    if (measuring) filters_[k].on_sample(ensembles_[k], {g[i], g.z()}, {statue_.axis_rate(i)});
   }
 }
 
@@ -119,6 +145,8 @@ void Monitor::feed_estimators() {
     if (in.start) {
       for (int i = 0; i < status_.axis_count; ++i) {
         ensembles_[static_cast<std::size_t>(i)].restart({g[i], g.z()});
+        if (config_.statue_sensor.present) filters_[static_cast<std::size_t>(i)].reset();
+        measured_[static_cast<std::size_t>(i)] = false;
       }
       ++status_.estimator_restarts;
       status_.estimator_start_ns = in.time_ns - epoch_ns_;
@@ -128,9 +156,9 @@ void Monitor::feed_estimators() {
       const long n = in.bridged + 1;
       for (long j = 1; j < n; ++j) {
         const auto w = static_cast<Real>(static_cast<double>(j) / static_cast<double>(n));
-        push_ensembles(last_ground_ + w * (g - last_ground_));
+        push_ensembles(last_ground_ + w * (g - last_ground_), in.time_ns);
       }
-      push_ensembles(g);
+      push_ensembles(g, in.time_ns);
     }
     status_.estimating = true;
     status_.newest_sample_time_ns = in.time_ns - epoch_ns_;
@@ -143,18 +171,33 @@ void Monitor::feed_estimators() {
   }
 }
 
-// One axis: the nominal statue's mode and state, the worst member's risk, the forecast.
+// One axis: the nominal statue's mode and state, the worst member's risk, the forecast; with
+// the statue sensor measuring, the measured phase, tilt and rate, the filter's risk (weighted
+// once informative, else the worst member's) and the forecast's probability weighted alike.
 void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
+  const auto k = static_cast<std::size_t>(axis_index);
   const Ensemble& statues = ensemble(axis_index);
   axis.mode = statues.nominal().mode();
   axis.state = statues.nominal().state();
   statues.risk(axis);
   axis.forecast = statues.forecaster().latest();
+  axis.statue = StatueAxisStatus{};
+  if (!measured_[k]) return;
+  const StatueEstimate& e = filters_[k].estimate();
+  axis.mode = e.mode;
+  axis.state[kTheta] = e.tilt;
+  axis.state[kThetaDot] = e.rotation_rate;
+  axis.risk = e.risk;
+  axis.worst_member = e.risk_member;
+  axis.forecast.probability = weighted_collapse_probability(axis.forecast, e);
+  axis.statue = {true, e.informative, e.explained, e.weighted, e.effective_members,
+                 e.best_score, e.best_member};
 }
 
 // The axes' part of the status: mode, state, risk, the forecast.
 void Monitor::update_axes_status() {
   Real risk = 0;
+  status_.statue_unexplained = false;
   status_.probability = 0.0;
   status_.forecast_axis = -1;
   status_.collapse_forecast_s = -1.0;
@@ -162,6 +205,7 @@ void Monitor::update_axes_status() {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
     if (status_.estimating) update_axis(i, axis);
+    status_.statue_unexplained = status_.statue_unexplained || !axis.statue.explained;
     risk = axis.risk.total > risk ? axis.risk.total : risk;
     const ForecastOutcome& f = axis.forecast;
     axis.collapse_forecast_s = -1.0;
@@ -248,8 +292,26 @@ void Monitor::report(MonitorUpdate& update) {
   }
 }
 
+MonitorUpdate Monitor::on_statue_sample(const monitor::SensorSample& sample) {
+  MonitorUpdate update = new_update();
+  if (!config_.statue_sensor.present) {
+    report_state(update);
+    return update;
+  }
+  status_.time_ns = monitor_time(sample.receive_time_ns);
+  statue_.on_sample(sample, !status_.estimating || quiet());
+  status_.statue_sensor = statue_.health();
+  status_.statue_sensor_ready = statue_.ready();
+  evaluate(update);
+  return update;
+}
+
 MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
   MonitorUpdate update = new_update();
+  if (have_epoch_ && config_.statue_sensor.present) {
+    statue_.tick(receive_time_ns);
+    status_.statue_sensor = statue_.health();
+  }
   if (have_epoch_) {
     sensors_.tick(receive_time_ns);
     status_.time_ns = monitor_time(receive_time_ns);

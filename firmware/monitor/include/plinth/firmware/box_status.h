@@ -19,9 +19,23 @@ namespace plinth::firmware {
 
 // One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box
 // without ensemble) and the rest.
+// What the statue sensor makes of an axis (StatueFilter's estimate, statue_filter.h).
+struct StatueAxisStatus {
+  bool measured = false;     // the filter took the statue sensor's newest sample
+  bool informative = false;  // the weights tell the members apart
+  bool explained = true;     // some member explains the measured motion
+  bool weighted = false;     // the risk is the weighted members' (informative and explained)
+  Real effective_members = 0.0;
+  Real best_score = 0.0;     // the best member's mean normalised innovation
+  int best_member = 0;
+};
+
 struct AxisStatus : EnsembleRisk {
-  Mode mode;  // the nominal statue's (member 0)
+  // The nominal statue's (member 0); with the statue sensor measuring, the measured phase,
+  // tilt and rotation rate.
+  Mode mode;
   State state = State::Zero();
+  StatueAxisStatus statue;
   int members = 1;       // the ensemble's size
   ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
   // Monitor time, s, of that forecast's first collapse (its worst member's); -1: none forecast.
@@ -86,6 +100,12 @@ struct BoxStatus : SensorSetStatus {
   std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
   std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
   std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
+  // The statue sensor (statue_sensor.h): configured, its rate stream's health, its offset known;
+  // unexplained: on some axis no member explains its motion (fault, kStatueUnexplained).
+  bool has_statue_sensor = false;
+  monitor::SensorHealth statue_sensor;
+  bool statue_sensor_ready = false;
+  bool statue_unexplained = false;
 };
 
 }  // namespace plinth::firmware

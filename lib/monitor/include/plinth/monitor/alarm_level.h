@@ -33,6 +33,8 @@ enum class AlarmCause : std::uint8_t {
   kInternalFault = 9,       // the monitor's own self-check failed
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet: nothing to vouch for
+  // 12 is outside_model's (the hostile branch), 13 p_wave's (the pwave branch) on the wire.
+  kStatueUnexplained = 14,  // no member of the ensemble explains the statue sensor's motion
 };
 
 // The names in status and alarm lines (also the DBC's VAL_ names).
@@ -44,7 +46,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 12> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 13> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -57,6 +59,7 @@ inline constexpr NameTable<AlarmCause, 12> kAlarmCauseNames{{{
     {AlarmCause::kInternalFault, "internal_fault"},
     {AlarmCause::kCollapseForecast, "collapse_forecast"},
     {AlarmCause::kNotCalibrated, "not_calibrated"},
+    {AlarmCause::kStatueUnexplained, "statue_unexplained"},
 }}};
 
 // The levels the risk raises, lowest first (neither normal nor fault): the ones plinth-eval
