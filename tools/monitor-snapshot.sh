@@ -161,13 +161,16 @@ if [ "$network" = 1 ]; then
     return 1
   }
   # The input registers 0-38 but those that count with the wall clock (1 heartbeat, 12-13
-  # uptime, 14-15 samples fed: the replay goes on), then the discrete inputs (one per level),
-  # "input|discrete address value" (the git description, registers 39-70, is the build's).
+  # uptime, 14-15 samples fed: the replay goes on), the files' 71-81 (the scenes' given and
+  # digest, the box file's given; not its digest, 82-85: the file holds a free port), then the
+  # discrete inputs (one per level), "input|discrete address value" (the git description,
+  # registers 39-70, is the build's).
   registers() {
     local t
-    for t in 3:input:39 1:discrete:5; do
-      mbpoll -m tcp -t "${t%%:*}" -0 -r 0 -c "${t##*:}" -1 -o 2 -p "$1" 127.0.0.1 2>/dev/null |
-        sed -n "s/^\\[\\([0-9]*\\)\\]:[[:space:]]*\\([0-9]*\\).*/$(echo "$t" | cut -d: -f2) \\1 \\2/p"
+    for t in 3:input:0:39 3:input:71:11 1:discrete:0:5; do
+      IFS=: read -r fn table first count <<<"$t"
+      mbpoll -m tcp -t "$fn" -0 -r "$first" -c "$count" -1 -o 2 -p "$1" 127.0.0.1 2>/dev/null |
+        sed -n "s/^\\[\\([0-9]*\\)\\]:[[:space:]]*\\([0-9]*\\).*/$table \\1 \\2/p"
     done | grep -vE '^input (1|12|13|14|15) '
   }
   # test_modbus.sh: after the overturn (a steady state), then the acknowledge coil; the lines
@@ -240,7 +243,9 @@ for line in sys.stdin:
         d["mqtt"] = {k: v for k, v in d["mqtt"].items() if k.startswith("events")}
     print(json.dumps(d))' >"$out/mqtt/lines.jsonl"
 fi
-# Where this run's files were, and the wall time, are not outputs.
+# Where this run's files were, the wall time and the build's version (the first status line's
+# and each capture's "version") are not outputs.
 find "$out" -type f \( -name '*.jsonl' -o -name '*.json' -o -name '*.txt' -o -name '*.stderr' \) -print0 |
-  xargs -0 sed -i -e "s|$out|OUT|g" -e "s|$tmp|TMP|g" -e 's/wall time [0-9.]* s/wall time W s/'
+  xargs -0 sed -i -e "s|$out|OUT|g" -e "s|$tmp|TMP|g" -e 's/wall time [0-9.]* s/wall time W s/' \
+    -e 's/"version": "[^"]*"/"version": "V"/g'
 echo "monitor-snapshot: written to $out ($(find "$out" -type f | wc -l) files)"
