@@ -114,13 +114,14 @@ class StatueImu {
     // White noise of the density over the output's band (half the rate).
     noise_rad_s_ = model.noise_density_deg_s_rthz * std::sqrt(rate_hz / 2.0) * to_rad;
   }
-  monitor::SensorSample sample(const monitor::SensorSample& ground, double rate_rad_s) {
-    monitor::SensorSample s = ground;
-    s.status = 0;
+  fw::StatueSample sample(const monitor::SensorSample& ground, double rate_rad_s) {
+    fw::StatueSample s;
+    s.receive_time_ns = ground.receive_time_ns;
+    s.sequence = ground.sequence;
     Eigen::Vector3d omega(0.0, -rate_rad_s, 0.0);
     for (int i = 0; i < 3; ++i) omega[i] += offset_rad_s_[static_cast<std::size_t>(i)] +
                                             noise_rad_s_ * gauss_(random_);
-    s.acceleration_g = omega.cast<Real>();
+    s.rotation_rate_rad_s = omega.cast<Real>();
     return s;
   }
   [[nodiscard]] double delay_s() const { return model_.delay_s; }

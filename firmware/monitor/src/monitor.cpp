@@ -47,7 +47,7 @@ Error Monitor::start(const MonitorConfig& config,
       PLINTH_TRY(filters_[static_cast<std::size_t>(i)].start(
           config.statue_sensor.filter, config.estimator, config.risk, ensemble(i).size()));
     }
-    status_.statue_sensor = statue_.health();
+    note_statue_health();
   }
   measured_.fill(false);
   statue_restarts_ = 0;
@@ -106,7 +106,7 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
   sensors_.tick(sample.receive_time_ns, sensor);
   if (config_.statue_sensor.present) {  // its timeout, on the ground sensors' clock
     statue_.tick(sample.receive_time_ns);
-    status_.statue_sensor = statue_.health();
+    note_statue_health();
   }
   const monitor::SensorUpdate fed = sensors_.receive(sensor, sample);
   // Each fed sample in turn: the primary's goes on to the estimators at once (the next one's
@@ -292,7 +292,13 @@ void Monitor::report(MonitorUpdate& update) {
   }
 }
 
-MonitorUpdate Monitor::on_statue_sample(const monitor::SensorSample& sample) {
+void Monitor::note_statue_health() {
+  status_.statue_rate = statue_.rate_health();
+  status_.statue_acceleration = statue_.acceleration_health();
+  status_.statue_sensor_ready = statue_.ready();
+}
+
+MonitorUpdate Monitor::on_statue_sample(const StatueSample& sample) {
   MonitorUpdate update = new_update();
   if (!config_.statue_sensor.present) {
     report_state(update);
@@ -300,8 +306,20 @@ MonitorUpdate Monitor::on_statue_sample(const monitor::SensorSample& sample) {
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
   statue_.on_sample(sample, !status_.estimating || quiet());
-  status_.statue_sensor = statue_.health();
-  status_.statue_sensor_ready = statue_.ready();
+  note_statue_health();
+  evaluate(update);
+  return update;
+}
+
+MonitorUpdate Monitor::on_statue_acceleration(const monitor::SensorSample& sample) {
+  MonitorUpdate update = new_update();
+  if (!config_.statue_sensor.present) {
+    report_state(update);
+    return update;
+  }
+  status_.time_ns = monitor_time(sample.receive_time_ns);
+  statue_.on_acceleration(sample);
+  note_statue_health();
   evaluate(update);
   return update;
 }
@@ -310,7 +328,7 @@ MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
   MonitorUpdate update = new_update();
   if (have_epoch_ && config_.statue_sensor.present) {
     statue_.tick(receive_time_ns);
-    status_.statue_sensor = statue_.health();
+    note_statue_health();
   }
   if (have_epoch_) {
     sensors_.tick(receive_time_ns);

@@ -1,6 +1,7 @@
 #include "plinth/firmware/statue_sensor.h"
 
 #include <cmath>
+#include <cstring>
 
 #include "plinth/monitor/conditioning.h"
 
@@ -9,6 +10,69 @@ namespace plinth::firmware {
 namespace {
 // rad/s: the spread of a quiet window's rates (a BMI088's noise at 200 Hz is ~0.004 rad/s rms).
 constexpr Real kQuietSpreadRadS = Real(0.05);
+
+// lib/monitor's SensorHealthTracker compares a stream's three values with two limits; its names
+// say g for the ground's accelerometers. The gyroscope's stream crosses into it here only: its
+// values and limits in rad/s.
+monitor::SensorHealthSettings tracker_settings(const StatueSensorHealthSettings& h,
+                                               double sample_period_s, Real full_scale,
+                                               Real max_valid) {
+  monitor::SensorHealthSettings t;
+  t.sample_period_s = sample_period_s;
+  t.timeout_s = h.timeout_s;
+  t.max_bridge_samples = h.max_bridge_samples;
+  t.recovery_samples = h.recovery_samples;
+  t.stuck_samples = h.stuck_samples;
+  t.full_scale_g = full_scale;
+  t.max_valid_g = max_valid;
+  return t;
+}
+
+monitor::SensorSample tracker_sample(const StatueSample& s) {
+  monitor::SensorSample t;
+  t.receive_time_ns = s.receive_time_ns;
+  t.sequence = s.sequence;
+  t.status = s.status;
+  t.acceleration_g = s.rotation_rate_rad_s;  // rad/s: tracker_settings' limits are too
+  return t;
+}
+
+// The tracker's field names as the statue sensor's keys.
+const char* health_field(const char* tracker_field, bool rate) {
+  const struct {
+    const char* tracker;
+    const char* rate;
+    const char* acceleration;
+  } kFields[] = {
+      {"sensor_health.timeout_s", "statue_sensor.health.timeout_s", nullptr},
+      {"sensor_health.max_bridge_samples", "statue_sensor.health.max_bridge_samples", nullptr},
+      {"sensor_health.recovery_samples", "statue_sensor.health.recovery_samples", nullptr},
+      {"sensor_health.stuck_samples", "statue_sensor.health.stuck_samples", nullptr},
+      {"sensor_health.full_scale_g", "statue_sensor.health.rate_full_scale_rad_s",
+       "statue_sensor.health.acceleration_full_scale_g"},
+      {"sensor_health.max_valid_g", "statue_sensor.health.rate_max_valid_rad_s",
+       "statue_sensor.health.acceleration_max_valid_g"},
+  };
+  for (const auto& f : kFields) {
+    if (std::strcmp(f.tracker, tracker_field) == 0) {
+      return rate || f.acceleration == nullptr ? f.rate : f.acceleration;
+    }
+  }
+  return "statue_sensor.health";
+}
+
+Error validate_health(const StatueSensorHealthSettings& h, double sample_period_s) {
+  const Error rate = monitor::validate(
+      tracker_settings(h, sample_period_s, h.rate_full_scale_rad_s, h.rate_max_valid_rad_s));
+  if (!rate.ok()) return {rate.code, health_field(rate.field, true), rate.reason, rate.limit};
+  const Error acceleration = monitor::validate(tracker_settings(
+      h, sample_period_s, h.acceleration_full_scale_g, h.acceleration_max_valid_g));
+  if (!acceleration.ok()) {
+    return {acceleration.code, health_field(acceleration.field, false), acceleration.reason,
+            acceleration.limit};
+  }
+  return ok_error();
+}
 }  // namespace
 
 Error validate(const StatueSensorSettings& s) {
@@ -35,11 +99,21 @@ Error validate(const StatueSensorSettings& s) {
   return validate(s.filter);
 }
 
-Error StatueSensor::start(const StatueSensorSettings& settings, double sample_period_s) {
+Error validate(const StatueSensorSettings& settings, double sample_period_s) {
   PLINTH_TRY(validate(settings));
-  monitor::SensorHealthSettings health = settings.health;
-  health.sample_period_s = sample_period_s;
-  PLINTH_TRY(monitor::SensorHealthTracker::create(health, health_tracker_));
+  return validate_health(settings.health, sample_period_s);
+}
+
+Error StatueSensor::start(const StatueSensorSettings& settings, double sample_period_s) {
+  PLINTH_TRY(validate(settings, sample_period_s));
+  const StatueSensorHealthSettings& h = settings.health;
+  PLINTH_TRY(monitor::SensorHealthTracker::create(
+      tracker_settings(h, sample_period_s, h.rate_full_scale_rad_s, h.rate_max_valid_rad_s),
+      rate_tracker_));
+  PLINTH_TRY(monitor::SensorHealthTracker::create(
+      tracker_settings(h, sample_period_s, h.acceleration_full_scale_g,
+                       h.acceleration_max_valid_g),
+      acceleration_tracker_));
   settings_ = settings;
   const double samples = std::ceil(settings.offset_window_s / sample_period_s);
   window_samples_ = samples < 2.0 ? 2 : static_cast<int>(samples);
@@ -51,16 +125,22 @@ Error StatueSensor::start(const StatueSensorSettings& settings, double sample_pe
   have_sample_ = false;
   newest_ns_ = 0;
   restarts_ = 0;
-  health_ = health_tracker_.health();
+  rate_health_ = rate_tracker_.health();
+  acceleration_health_ = acceleration_tracker_.health();
   return ok_error();
 }
 
-void StatueSensor::on_sample(const monitor::SensorSample& sample, bool quiet) {
-  const monitor::SensorUpdate update = health_tracker_.on_sample(sample);
-  health_ = update.health;
+void StatueSensor::on_acceleration(const monitor::SensorSample& sample) {
+  acceleration_health_ = acceleration_tracker_.on_sample(sample).health;
+}
+
+void StatueSensor::on_sample(const StatueSample& sample, bool quiet) {
+  const monitor::SensorUpdate update = rate_tracker_.on_sample(tracker_sample(sample));
+  rate_health_ = update.health;
   for (std::size_t i = 0; i < update.fed_count; ++i) {
     const monitor::FedSample& fed = update.fed[i];
     if (fed.restart) ++restarts_;
+    // tracker_sample() put the rates where the tracker keeps its values.
     const Vector3r statue = settings_.sensor_to_statue * fed.acceleration_g;  // rad/s
     // The offset: the mean of the first quiet window (a start-up rate offset of a MEMS
     // gyroscope is up to +-1 deg/s; its drift in a museum's temperature is far smaller).
@@ -87,7 +167,9 @@ void StatueSensor::on_sample(const monitor::SensorSample& sample, bool quiet) {
 }
 
 bool StatueSensor::usable(std::int64_t now_ns) const {
-  if (!ready_ || !have_sample_ || health_.state == monitor::HealthState::kFault) return false;
+  if (!ready_ || !have_sample_ || rate_health_.state == monitor::HealthState::kFault) {
+    return false;
+  }
   const std::int64_t age = now_ns - newest_ns_;
   return static_cast<double>(age) <= settings_.max_age_s * 1e9;
 }

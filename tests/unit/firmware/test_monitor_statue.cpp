@@ -52,11 +52,13 @@ struct StatueRun {
     ground.sequence = static_cast<std::uint8_t>(n & 0xFF);
     ground.acceleration_g = Vector3r(static_cast<Real>(a), 0, 1);
     if (statue) {
-      monitor::SensorSample s = ground;
+      StatueSample s;
+      s.receive_time_ns = ground.receive_time_ns;
+      s.sequence = ground.sequence;
       const double rate = n < kQuiet ? 0.0 : statue_rate(n);
-      s.acceleration_g = Vector3r(static_cast<Real>(0.003 * gauss(random)),
-                                  static_cast<Real>(-rate + 0.01 + 0.003 * gauss(random)),
-                                  static_cast<Real>(0.003 * gauss(random)));
+      s.rotation_rate_rad_s = Vector3r(static_cast<Real>(0.003 * gauss(random)),
+                                       static_cast<Real>(-rate + 0.01 + 0.003 * gauss(random)),
+                                       static_cast<Real>(0.003 * gauss(random)));
       (void)monitor->on_statue_sample(s);
     }
     return *monitor->on_sample(ground).status;
@@ -108,7 +110,7 @@ TEST(MonitorStatue, ASilentStatueSensorLeavesTheWorstMembersRisk) {
   EnsembleRisk r;
   run.monitor->ensemble(0).risk(r);
   EXPECT_EQ(s.axes[0].risk.total, r.risk.total);
-  EXPECT_EQ(s.statue_sensor.state, monitor::HealthState::kFault);  // timed out
+  EXPECT_EQ(s.statue_rate.state, monitor::HealthState::kFault);  // timed out
 }
 
 // A loose sensor swinging on a quiet ground: no member explains it; the level is fault with
@@ -142,6 +144,42 @@ TEST(MonitorStatue, RefusesAStatueSensorOnAGroundSensorsNode) {
   c = statue_config();
   c.statue_sensor.filter.memory_s = -1;
   EXPECT_EQ(std::string(run.start(c).field), "statue_filter.memory_s");
+  // The streams' health, named by the statue sensor's keys with their units.
+  c = statue_config();
+  c.statue_sensor.health.rate_max_valid_rad_s = 10;  // below rate_full_scale_rad_s
+  EXPECT_EQ(std::string(run.start(c).field), "statue_sensor.health.rate_max_valid_rad_s");
+  c = statue_config();
+  c.statue_sensor.health.acceleration_full_scale_g = -1;
+  EXPECT_EQ(std::string(run.start(c).field), "statue_sensor.health.acceleration_full_scale_g");
+  c = statue_config();
+  c.statue_sensor.health.timeout_s = 0.001;  // within a bridgeable gap at 200 Hz
+  EXPECT_EQ(std::string(run.start(c).field), "statue_sensor.health.timeout_s");
+}
+
+// The accelerometer's stream has its own health: a gyroscope that streams while the
+// accelerometer is silent is measured, and the status says which stream is at fault.
+TEST(MonitorStatue, EachStreamHasItsOwnHealth) {
+  StatueRun run;
+  ASSERT_TRUE(run.start(statue_config()).ok());
+  const auto still = [](long) { return 0.0; };
+  for (long n = 0; n < kQuiet + 100; ++n) {
+    (void)run.step(n, 0.05, still);
+    if (n < 100) {
+      monitor::SensorSample a;
+      a.receive_time_ns = std::llround(static_cast<double>(n) / kRate * 1e9);
+      a.sequence = static_cast<std::uint8_t>(n & 0xFF);
+      a.acceleration_g = Vector3r(Real(0.001) * static_cast<Real>(n % 7), 0, 1);
+      if (n == 50) a.acceleration_g.x() = Real(8.1);  // at full scale: saturated, degraded
+      (void)run.monitor->on_statue_acceleration(a);
+    }
+  }
+  const BoxStatus& s = *run.monitor->poll().status;
+  EXPECT_EQ(s.statue_rate.state, monitor::HealthState::kOk);
+  EXPECT_EQ(s.statue_acceleration.state, monitor::HealthState::kFault);
+  EXPECT_EQ(s.statue_acceleration.cause, monitor::HealthCause::kTimeout);
+  EXPECT_EQ(s.statue_acceleration.counters.received, 100U);
+  EXPECT_EQ(s.statue_acceleration.counters.saturated, 1U);
+  EXPECT_TRUE(s.axes[0].statue.measured);
 }
 
 // The fault's place: after the sensors', the disagreement's and the bus's.

@@ -17,8 +17,6 @@
 
 namespace plinth::firmware {
 
-// One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box
-// without ensemble) and the rest.
 // What the statue sensor makes of an axis (StatueFilter's estimate, statue_filter.h).
 struct StatueAxisStatus {
   bool measured = false;     // the filter took the statue sensor's newest sample
@@ -30,6 +28,8 @@ struct StatueAxisStatus {
   int best_member = 0;
 };
 
+// One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box
+// without ensemble) and the rest.
 struct AxisStatus : EnsembleRisk {
   // The nominal statue's (member 0); with the statue sensor measuring, the measured phase,
   // tilt and rotation rate.
@@ -100,10 +100,12 @@ struct BoxStatus : SensorSetStatus {
   std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
   std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
   std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
-  // The statue sensor (statue_sensor.h): configured, its rate stream's health, its offset known;
-  // unexplained: on some axis no member explains its motion (fault, kStatueUnexplained).
+  // The statue sensor (statue_sensor.h): configured, its gyroscope's and accelerometer's
+  // streams' health, its rate offset known; unexplained: on some axis no member explains its
+  // motion (fault, kStatueUnexplained).
   bool has_statue_sensor = false;
-  monitor::SensorHealth statue_sensor;
+  monitor::SensorHealth statue_rate;
+  monitor::SensorHealth statue_acceleration;
   bool statue_sensor_ready = false;
   bool statue_unexplained = false;
 };

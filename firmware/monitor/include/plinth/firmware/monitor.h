@@ -86,10 +86,12 @@ class Monitor {
   }
   // One decoded sample of sensor `sensor` (its index in the configured order).
   [[nodiscard]] MonitorUpdate on_sensor_sample(int sensor, const monitor::SensorSample& sample);
-  // One rate sample of the statue sensor (its values in rad/s, sensor frame; statue_sensor.h):
-  // its health and offset; the estimators' next samples take it to each axis's StatueFilter.
-  // Ignored (a status, if due) without a statue sensor configured.
-  [[nodiscard]] MonitorUpdate on_statue_sample(const monitor::SensorSample& sample);
+  // One gyroscope sample of the statue sensor (statue_sensor.h): its health and offset; the
+  // estimators' next samples take it to each axis's StatueFilter. Ignored (a status, if due)
+  // without a statue sensor configured.
+  [[nodiscard]] MonitorUpdate on_statue_sample(const StatueSample& sample);
+  // One accelerometer sample of the statue sensor (g, sensor frame): its stream's health.
+  [[nodiscard]] MonitorUpdate on_statue_acceleration(const monitor::SensorSample& sample);
   // Call periodically with the receive clock's time: sensor timeouts, heartbeats.
   [[nodiscard]] MonitorUpdate on_tick(std::int64_t receive_time_ns);
   // An operator acknowledges the latched level, quoting the latest alarm event (from the bus,
@@ -133,6 +135,7 @@ class Monitor {
   void feed_estimators();
   void push_ensembles(const Vector3r& ground_m_s2, std::int64_t receive_time_ns);
   [[nodiscard]] bool quiet() const;
+  void note_statue_health();
   [[nodiscard]] MonitorUpdate new_update() const;
   void take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update);
   void update_axis(int axis_index, AxisStatus& axis) const;
