@@ -62,14 +62,25 @@ const char* health_field(const char* tracker_field, bool rate) {
 }
 
 Error validate_health(const StatueSensorHealthSettings& h, double sample_period_s) {
-  const Error rate = monitor::validate(
-      tracker_settings(h, sample_period_s, h.rate_full_scale_rad_s, h.rate_max_valid_rad_s));
-  if (!rate.ok()) return {rate.code, health_field(rate.field, true), rate.reason, rate.limit};
-  const Error acceleration = monitor::validate(tracker_settings(
-      h, sample_period_s, h.acceleration_full_scale_g, h.acceleration_max_valid_g));
-  if (!acceleration.ok()) {
-    return {acceleration.code, health_field(acceleration.field, false), acceleration.reason,
-            acceleration.limit};
+  const struct {
+    Real full_scale;
+    Real max_valid;
+    bool rate;
+    const char* below;  // max_valid's reason, in the statue sensor's names
+  } streams[] = {
+      {h.rate_full_scale_rad_s, h.rate_max_valid_rad_s, true,
+       "must not be below rate_full_scale_rad_s"},
+      {h.acceleration_full_scale_g, h.acceleration_max_valid_g, false,
+       "must not be below acceleration_full_scale_g"},
+  };
+  for (const auto& stream : streams) {
+    const Error e = monitor::validate(
+        tracker_settings(h, sample_period_s, stream.full_scale, stream.max_valid));
+    if (e.ok()) continue;
+    const bool below = std::strcmp(e.field, "sensor_health.max_valid_g") == 0 &&
+                       e.code == ErrorCode::kInconsistent;
+    return {e.code, health_field(e.field, stream.rate), below ? stream.below : e.reason,
+            e.limit};
   }
   return ok_error();
 }

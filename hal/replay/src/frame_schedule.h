@@ -12,7 +12,7 @@
 
 namespace plinth::hal::replay {
 
-enum class FrameKind : std::uint8_t { kAcceleration, kHeartbeat };
+enum class FrameKind : std::uint8_t { kAcceleration, kHeartbeat, kRotation };
 
 struct ScheduledFrame {
   std::int64_t virtual_ns = 0;  // since the replay started, at speed 1
@@ -77,7 +77,8 @@ class RecordSchedule final : public FrameSchedule {
   std::vector<std::uint8_t> status_since_;  // per node: flags since its last heartbeat
 };
 
-// The sensor frames (SensorAcceleration and SensorHeartbeat of any node) of a candump log, sent
+// The sensor frames (SensorAcceleration, SensorHeartbeat and StatueRotation of any node: the
+// ground sensors' and the statue sensor's) of a candump log, sent
 // again as logged, at their logged times relative to the first of them (times that go backwards
 // are held at the previous one). Other lines are skipped and counted.
 struct LoggedFrames {

@@ -86,7 +86,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 3);
+  EXPECT_EQ(at(reg::kMapVersion), 4);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";
@@ -94,6 +94,43 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   for (int level = 0; level < discrete::kCount; ++level) {
     EXPECT_EQ(image.discrete_inputs[static_cast<std::size_t>(level)], level == 2 ? 1 : 0) << level;
   }
+}
+
+// The statue sensor's registers: kNone without one; with one, its streams' health, its offset,
+// and per axis the weights' code (pinned: 0 not measured .. 3 unexplained) and effective members.
+TEST(ModbusMap, TheStatueSensorsRegisters) {
+  StatusSnapshot s;
+  Image image;
+  fill(s, 0, image);
+  const auto at = [&](int address) { return image.registers[static_cast<std::size_t>(address)]; };
+  for (int r = reg::kStatueRateHealth; r <= reg::kStatueEffectiveMembersY; ++r) {
+    EXPECT_EQ(at(r), kNone) << r;
+  }
+  s.has_statue_sensor = true;
+  s.axis_count = 1;
+  s.statue_rate = monitor::HealthState::kOk;
+  s.statue_acceleration = monitor::HealthState::kDegraded;
+  s.statue_ready = true;
+  s.statue_axes[0] = {true, true, true, true, Real(2.345), Real(1.1), 4};
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kStatueRateHealth), 0);
+  EXPECT_EQ(at(reg::kStatueAccelerationHealth), 1);
+  EXPECT_EQ(at(reg::kStatueReady), 1);
+  EXPECT_EQ(at(reg::kStatueWeightsX), 2) << "weighted";
+  EXPECT_EQ(at(reg::kStatueEffectiveMembersX), 235);
+  EXPECT_EQ(at(reg::kStatueWeightsY), kNone) << "one axis";
+  EXPECT_EQ(at(reg::kStatueEffectiveMembersY), kNone);
+  s.axis_count = 2;
+  s.statue_axes[0].explained = false;
+  s.statue_axes[0].weighted = false;
+  s.statue_axes[1] = {true, false, true, false, Real(17), Real(0), 0};
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kStatueWeightsX), 3) << "unexplained";
+  EXPECT_EQ(at(reg::kStatueWeightsY), 1) << "uninformative";
+  EXPECT_EQ(at(reg::kStatueEffectiveMembersY), 1700);
+  s.statue_axes[1].measured = false;
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kStatueWeightsY), 0) << "not measured";
 }
 
 std::uint64_t read64(const Image& image, int address) {
