@@ -292,7 +292,7 @@ const std::array<Point, kPointCount>& points() { return kPoints; }
 
 StatueWeights statue_weights(const StatueAxisStatus& axis) {
   if (!axis.measured) return StatueWeights::kNotMeasured;
-  if (!axis.explained) return StatueWeights::kUnexplained;
+  if (axis.unexplained) return StatueWeights::kUnexplained;
   return axis.weighted ? StatueWeights::kWeighted : StatueWeights::kUninformative;
 }
 

@@ -180,6 +180,7 @@ void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int&
       {"statue_filter.informative_fraction", &f.informative_fraction},
       {"statue_filter.credible_weight", &f.credible_weight},
       {"statue_filter.unexplained_score", &f.unexplained_score},
+      {"statue_filter.ruled_out_fraction", &f.ruled_out_fraction},
   };
   for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
   const std::pair<const char*, int*> integers[] = {

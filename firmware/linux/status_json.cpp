@@ -259,11 +259,12 @@ std::string statue_weights_json(const StatueAxisStatus& a) {
   return JsonObject()
       .flag("measured", a.measured)
       .flag("informative", a.informative)
-      .flag("explained", a.explained)
+      .flag("explained", !a.unexplained)
       .flag("weighted", a.weighted)
       .general("effective_members", a.effective_members, 4)
       .count("best_member", static_cast<std::uint64_t>(a.best_member))
       .general("best_score", a.best_score, 4)
+      .count("ruled_out", static_cast<std::uint64_t>(a.ruled_out))
       .close();
 }
 

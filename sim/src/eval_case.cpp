@@ -31,6 +31,7 @@ struct Truth {
   bool collapsed = false;
   double collapse_time_s = -1.0;
   double peak_ratio = 0.0;  // max |theta| / alpha of the corner it rocks on
+  double first_motion_s = -1.0;  // s: first out of full contact; -1: never
   double step_s = 0.0;
   std::vector<double> rotation_rate;  // theta' at each step's end, rad/s ([0]: t = 0)
 
@@ -70,6 +71,9 @@ Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& setti
   while (sim.time() < t_end - 0.5 * solver.step && !sim.mode().terminal()) {
     sim.step();
     truth.rotation_rate.push_back(sim.state()[kThetaDot]);
+    if (truth.first_motion_s < 0.0 && sim.mode().phase != Phase::kFullContact) {
+      truth.first_motion_s = sim.time();
+    }
     const double theta = sim.state()[kTheta];
     const double ratio = theta >= 0.0 ? theta / s.corner1.critical_angle
                                       : -theta / s.corner2.critical_angle;
@@ -92,11 +96,7 @@ fw::MonitorConfig box_config(const BoxSettings& box) {
   config.alarm.raise_hold_s = box.raise_hold_s;
   config.conditioning.startup_window_s = box.startup_window_s;
   fw::configure_record_replay(config, box.rate_hz);
-  if (box.statue_sensor) {
-    config.statue_sensor.present = true;
-    config.statue_sensor.node = 2;
-    config.statue_sensor.offset_window_s = box.startup_window_s;
-  }
+  if (box.statue_sensor) fw::configure_replay_statue_sensor(config);
   return config;
 }
 
@@ -114,14 +114,12 @@ class StatueImu {
     // White noise of the density over the output's band (half the rate).
     noise_rad_s_ = model.noise_density_deg_s_rthz * std::sqrt(rate_hz / 2.0) * to_rad;
   }
-  fw::StatueSample sample(const monitor::SensorSample& ground, double rate_rad_s) {
-    fw::StatueSample s;
-    s.receive_time_ns = ground.receive_time_ns;
-    s.sequence = ground.sequence;
-    Eigen::Vector3d omega(0.0, -rate_rad_s, 0.0);
-    for (int i = 0; i < 3; ++i) omega[i] += offset_rad_s_[static_cast<std::size_t>(i)] +
-                                            noise_rad_s_ * gauss_(random_);
-    s.rotation_rate_rad_s = omega.cast<Real>();
+  fw::StatueSample sample(const fw::MonitorConfig& config, std::int64_t n, double rate_rad_s) {
+    fw::StatueSample s = fw::replay_statue_sample(config, n, static_cast<Real>(rate_rad_s), 0);
+    for (int i = 0; i < 3; ++i) {
+      s.rotation_rate_rad_s[i] += static_cast<Real>(offset_rad_s_[static_cast<std::size_t>(i)] +
+                                                    noise_rad_s_ * gauss_(random_));
+    }
     return s;
   }
   [[nodiscard]] double delay_s() const { return model_.delay_s; }
@@ -194,7 +192,7 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
     const double t = static_cast<double>(k) / rate;
     if (imu) {
       const double rate_now = n < lead_in ? 0.0 : truth.rate_at(t - imu->delay_s());
-      (void)monitor->on_statue_sample(imu->sample(s, rate_now));
+      (void)monitor->on_statue_sample(imu->sample(config, static_cast<std::int64_t>(n), rate_now));
     }
     const fw::MonitorUpdate update = monitor->on_sample(s);
     if (n < lead_in) continue;
@@ -226,6 +224,7 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.collapsed = truth.collapsed;
   run.collapse_time_s = truth.collapse_time_s;
   run.peak_ratio = truth.peak_ratio;
+  run.first_motion_s = truth.first_motion_s;
   run_box(c, gamma, box, grids, truth, run);
   return run;
 }

@@ -60,4 +60,21 @@ monitor::SensorSample record_replay_sample(const MonitorConfig& config, std::int
   return sample;
 }
 
+void configure_replay_statue_sensor(MonitorConfig& config) {
+  config.statue_sensor.present = true;
+  config.statue_sensor.node = 2;
+  config.statue_sensor.offset_window_s = config.conditioning.startup_window_s;
+  config.statue_sensor.health.stuck_samples = 0;
+}
+
+StatueSample replay_statue_sample(const MonitorConfig& config, std::int64_t n, Real theta_dot_x,
+                                  Real theta_dot_y) {
+  const monitor::SensorSample ground = record_replay_sample(config, n, Eigen::Vector3d::Zero(), 0);
+  StatueSample sample;
+  sample.receive_time_ns = ground.receive_time_ns;
+  sample.sequence = ground.sequence;
+  sample.rotation_rate_rad_s = Vector3r(theta_dot_y, -theta_dot_x, 0);
+  return sample;
+}
+
 }  // namespace plinth::firmware

@@ -137,6 +137,10 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
                             "plate.window_s", "plate.threshold_m_s2"));
   PLINTH_TRY(validate_sensors(c, sensor_index));
   if (!c.statue_sensor.present) return ok_error();
+  if (!kStatueSensorBuiltIn) {
+    return {ErrorCode::kOutOfRange, "statue_sensor",
+            "this build has no statue sensor (PLINTH_STATUE_SENSOR=OFF)"};
+  }
   PLINTH_TRY(validate(c.statue_sensor, c.estimator.sample_period()));
   std::array<SensorConfig, kMaxSensors> sensors{};
   const int count = resolved_sensors(c, sensors);

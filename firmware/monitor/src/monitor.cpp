@@ -40,11 +40,11 @@ Error Monitor::start(const MonitorConfig& config,
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
-  status_.has_statue_sensor = config.statue_sensor.present;
-  if (config.statue_sensor.present) {
-    PLINTH_TRY(statue_.start(config.statue_sensor, config.estimator.sample_period()));
+  status_.has_statue_sensor = kStatueSensorBuiltIn && config.statue_sensor.present;
+  if (status_.has_statue_sensor) {
+    PLINTH_TRY(room().sensor.start(config.statue_sensor, config.estimator.sample_period()));
     for (int i = 0; i < config.axis_count; ++i) {
-      PLINTH_TRY(filters_[static_cast<std::size_t>(i)].start(
+      PLINTH_TRY(room().filters[static_cast<std::size_t>(i)].start(
           config.statue_sensor.filter, config.estimator, config.risk, ensemble(i).size()));
     }
     note_statue_health();
@@ -104,8 +104,8 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
   sensors_.tick(sample.receive_time_ns, sensor);
-  if (config_.statue_sensor.present) {  // its timeout, on the ground sensors' clock
-    statue_.tick(sample.receive_time_ns);
+  if (statue_present()) {  // its timeout, on the ground sensors' clock
+    room().sensor.tick(sample.receive_time_ns);
     note_statue_health();
   }
   const monitor::SensorUpdate fed = sensors_.receive(sensor, sample);
@@ -125,16 +125,18 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
 // filter weighs them on it (a restart of the statue's stream loses the tilt: the filters start
 // again).
 void Monitor::push_ensembles(const Vector3r& g, std::int64_t receive_time_ns) {
-  const bool measuring = config_.statue_sensor.present && statue_.usable(receive_time_ns);
-  if (measuring && statue_.restarts() != statue_restarts_) {
-    statue_restarts_ = statue_.restarts();
-    for (StatueFilter& f : filters_) f.reset();
+  const bool measuring = statue_present() && room().sensor.usable(receive_time_ns);
+  if (measuring && room().sensor.restarts() != statue_restarts_) {
+    statue_restarts_ = room().sensor.restarts();
+    for (StatueFilter& f : room().filters) f.reset();
   }
   for (int i = 0; i < status_.axis_count; ++i) {
     const auto k = static_cast<std::size_t>(i);
     ensembles_[k].push({g[i], g.z()});
     measured_[k] = measuring;
-    if (measuring) filters_[k].on_sample(ensembles_[k], {g[i], g.z()}, {statue_.axis_rate(i)});
+    if (measuring) {
+      room().filters[k].on_sample(ensembles_[k], {g[i], g.z()}, {room().sensor.axis_rate(i)});
+    }
   }
 }
 
@@ -145,7 +147,7 @@ void Monitor::feed_estimators() {
     if (in.start) {
       for (int i = 0; i < status_.axis_count; ++i) {
         ensembles_[static_cast<std::size_t>(i)].restart({g[i], g.z()});
-        if (config_.statue_sensor.present) filters_[static_cast<std::size_t>(i)].reset();
+        if (statue_present()) room().filters[static_cast<std::size_t>(i)].reset();
         measured_[static_cast<std::size_t>(i)] = false;
       }
       ++status_.estimator_restarts;
@@ -182,16 +184,16 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   statues.risk(axis);
   axis.forecast = statues.forecaster().latest();
   axis.statue = StatueAxisStatus{};
-  if (!measured_[k]) return;
-  const StatueEstimate& e = filters_[k].estimate();
+  if (!kStatueSensorBuiltIn || !measured_[k]) return;
+  const StatueEstimate& e = room().filters[k].estimate();
   axis.mode = e.mode;
   axis.state[kTheta] = e.tilt;
   axis.state[kThetaDot] = e.rotation_rate;
   axis.risk = e.risk;
   axis.worst_member = e.risk_member;
   axis.forecast.probability = weighted_collapse_probability(axis.forecast, e);
-  axis.statue = {true, e.informative, e.explained, e.weighted, e.effective_members,
-                 e.best_score, e.best_member};
+  axis.statue = {true,          e.informative, !e.explained, e.weighted, e.effective_members,
+                 e.best_score,  e.best_member, e.ruled_out};
 }
 
 // The axes' part of the status: mode, state, risk, the forecast.
@@ -205,7 +207,7 @@ void Monitor::update_axes_status() {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
     if (status_.estimating) update_axis(i, axis);
-    status_.statue_unexplained = status_.statue_unexplained || !axis.statue.explained;
+    status_.statue_unexplained = status_.statue_unexplained || axis.statue.unexplained;
     risk = axis.risk.total > risk ? axis.risk.total : risk;
     const ForecastOutcome& f = axis.forecast;
     axis.collapse_forecast_s = -1.0;
@@ -293,19 +295,19 @@ void Monitor::report(MonitorUpdate& update) {
 }
 
 void Monitor::note_statue_health() {
-  status_.statue_rate = statue_.rate_health();
-  status_.statue_acceleration = statue_.acceleration_health();
-  status_.statue_sensor_ready = statue_.ready();
+  status_.statue_rate = room().sensor.rate_health();
+  status_.statue_acceleration = room().sensor.acceleration_health();
+  status_.statue_sensor_ready = room().sensor.ready();
 }
 
 MonitorUpdate Monitor::on_statue_sample(const StatueSample& sample) {
   MonitorUpdate update = new_update();
-  if (!config_.statue_sensor.present) {
+  if (!statue_present()) {
     report_state(update);
     return update;
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
-  statue_.on_sample(sample, !status_.estimating || quiet());
+  room().sensor.on_sample(sample, !status_.estimating || quiet());
   note_statue_health();
   evaluate(update);
   return update;
@@ -313,12 +315,12 @@ MonitorUpdate Monitor::on_statue_sample(const StatueSample& sample) {
 
 MonitorUpdate Monitor::on_statue_acceleration(const monitor::SensorSample& sample) {
   MonitorUpdate update = new_update();
-  if (!config_.statue_sensor.present) {
+  if (!statue_present()) {
     report_state(update);
     return update;
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
-  statue_.on_acceleration(sample);
+  room().sensor.on_acceleration(sample);
   note_statue_health();
   evaluate(update);
   return update;
@@ -326,8 +328,8 @@ MonitorUpdate Monitor::on_statue_acceleration(const monitor::SensorSample& sampl
 
 MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
   MonitorUpdate update = new_update();
-  if (have_epoch_ && config_.statue_sensor.present) {
-    statue_.tick(receive_time_ns);
+  if (have_epoch_ && statue_present()) {
+    room().sensor.tick(receive_time_ns);
     note_statue_health();
   }
   if (have_epoch_) {

@@ -125,7 +125,8 @@ Error StatueSensor::start(const StatueSensorSettings& settings, double sample_pe
       tracker_settings(h, sample_period_s, h.acceleration_full_scale_g,
                        h.acceleration_max_valid_g),
       acceleration_tracker_));
-  settings_ = settings;
+  sensor_to_statue_ = settings.sensor_to_statue;
+  max_age_ns_ = settings.max_age_s * 1e9;
   const double samples = std::ceil(settings.offset_window_s / sample_period_s);
   window_samples_ = samples < 2.0 ? 2 : static_cast<int>(samples);
   summed_ = 0;
@@ -152,7 +153,7 @@ void StatueSensor::on_sample(const StatueSample& sample, bool quiet) {
     const monitor::FedSample& fed = update.fed[i];
     if (fed.restart) ++restarts_;
     // tracker_sample() put the rates where the tracker keeps its values.
-    const Vector3r statue = settings_.sensor_to_statue * fed.acceleration_g;  // rad/s
+    const Vector3r statue = sensor_to_statue_ * fed.acceleration_g;  // rad/s
     // The offset: the mean of the first quiet window (a start-up rate offset of a MEMS
     // gyroscope is up to +-1 deg/s; its drift in a museum's temperature is far smaller).
     // A window whose rates spread beyond kQuietSpread on an axis is the statue moving: again.
@@ -182,7 +183,7 @@ bool StatueSensor::usable(std::int64_t now_ns) const {
     return false;
   }
   const std::int64_t age = now_ns - newest_ns_;
-  return static_cast<double>(age) <= settings_.max_age_s * 1e9;
+  return static_cast<double>(age) <= max_age_ns_;
 }
 
 }  // namespace plinth::firmware

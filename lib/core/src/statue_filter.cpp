@@ -10,6 +10,9 @@ namespace {
 
 // A change of theta' over an interval is a signal beyond this many times one rate's noise.
 constexpr Real kSignal = 4;
+// A member's own theta' agrees with the measured one within this many standard deviations
+// (the innovation's: noise and model tolerance).
+constexpr Real kAgreement = 3;
 
 bool positive_finite(double x) { return std::isfinite(x) && x > 0.0; }
 
@@ -70,19 +73,30 @@ Error validate(const StatueFilterSettings& s) {
   if (!positive_finite(s.unexplained_score)) {
     return {ErrorCode::kOutOfRange, "statue_filter.unexplained_score", "must be finite and > 0"};
   }
+  if (!positive_finite(s.ruled_out_fraction) || s.ruled_out_fraction > 1) {
+    return {ErrorCode::kOutOfRange, "statue_filter.ruled_out_fraction", "must lie in (0, 1]"};
+  }
   return ok_error();
 }
 
 double weighted_collapse_probability(const ForecastOutcome& forecast,
                                      const StatueEstimate& estimate) {
-  if (!forecast.valid || !estimate.weighted) return forecast.probability;
+  const std::uint32_t left_out = estimate.ruled_out_members | estimate.disagreeing_members;
+  if (!forecast.valid || (!estimate.weighted && left_out == 0)) return forecast.probability;
   Real p = 0;
+  int counted = 0;
   for (int m = 0; m < forecast.members && m < kMaxEnsembleMembers; ++m) {
-    if ((forecast.collapsing_members >> static_cast<unsigned>(m) & 1U) != 0U) {
-      p += estimate.weights[static_cast<std::size_t>(m)];
+    const auto bit = static_cast<unsigned>(m);
+    const bool collapses = (forecast.collapsing_members >> bit & 1U) != 0U;
+    if (estimate.weighted) {
+      p += collapses ? estimate.weights[static_cast<std::size_t>(m)] : Real(0);
+    } else if ((left_out >> bit & 1U) == 0U) {
+      ++counted;
+      p += collapses ? Real(1) : Real(0);
     }
   }
-  return static_cast<double>(p);
+  if (estimate.weighted) return static_cast<double>(p);
+  return counted > 0 ? static_cast<double>(p) / counted : forecast.probability;
 }
 
 Error StatueFilter::start(const StatueFilterSettings& settings, const EstimatorSettings& rate,
@@ -124,6 +138,7 @@ void StatueFilter::reset() {
   interval_start_tilt_ = 0;
   interval_impact_ = false;
   interval_terminal_ = false;
+  interval_moved_ = false;
   previous_acceleration_.fill(0);
   predicted_change_.fill(0);
   evidence_.fill(0);
@@ -179,6 +194,7 @@ void StatueFilter::measure(const Ensemble& members, const StatueMeasurement& mea
     interval_impact_ = true;
   }
   if (mode.terminal()) interval_terminal_ = true;
+  if (mode.phase != Phase::kFullContact) interval_moved_ = true;
   estimate_.mode = mode;
   estimate_.tilt = tilt;
   estimate_.rotation_rate = rate;
@@ -207,11 +223,11 @@ void StatueFilter::on_sample(const Ensemble& members, GroundAcceleration ground,
   }
   have_previous_ = true;
   estimate_.measuring = true;
-  if (++interval_count_ > interval_samples_) finish_interval();
+  if (++interval_count_ > interval_samples_) finish_interval(members);
   weigh(members);
 }
 
-void StatueFilter::finish_interval() {
+void StatueFilter::finish_interval(const Ensemble& members) {
   const Real measured_change = estimate_.rotation_rate - interval_start_rate_;
   if (!interval_impact_ && !interval_terminal_) {
     const Real noise2 = Real(2) * settings_.rate_noise_rad_s * settings_.rate_noise_rad_s;
@@ -233,12 +249,26 @@ void StatueFilter::finish_interval() {
     }
     ++estimate_.intervals;
   }
+  // The statue stood throughout: a member whose own simulation rocks is contradicted by its
+  // rate (its theta' against the measured one, the flow's innovation at the interval's end).
+  if (!interval_moved_ && !interval_terminal_) {
+    const Real noise2 = Real(2) * settings_.rate_noise_rad_s * settings_.rate_noise_rad_s;
+    for (int m = 0; m < members_; ++m) {
+      const PlanarEstimator& e = members.member(m);
+      if (e.mode().phase == Phase::kFullContact) continue;
+      const Real own = e.state()[kThetaDot];
+      const Real nu = own - estimate_.rotation_rate;
+      const Real scale = settings_.model_tolerance * std::fabs(own);
+      evidence_[static_cast<std::size_t>(m)] -= Real(0.5) * nu * nu / (noise2 + scale * scale);
+    }
+  }
   predicted_change_.fill(0);
   interval_count_ = 1;  // this sample starts the next interval
   interval_start_rate_ = estimate_.rotation_rate;
   interval_start_tilt_ = estimate_.tilt;
   interval_impact_ = false;
   interval_terminal_ = estimate_.mode.terminal();
+  interval_moved_ = estimate_.mode.phase != Phase::kFullContact;
 }
 
 void StatueFilter::weigh(const Ensemble& members) {
@@ -258,8 +288,9 @@ void StatueFilter::weigh(const Ensemble& members) {
     sum2 += w * w;
   }
   estimate_.effective_members = Real(1) / sum2;
-  estimate_.informative = members_ > 1 && estimate_.effective_members <=
-                                              settings_.informative_fraction * members_;
+  estimate_.informative =
+      members_ > 1 && estimate_.effective_members <=
+                          settings_.informative_fraction * static_cast<Real>(members_);
   // Explained.
   estimate_.best_member = 0;
   estimate_.best_score = 0;
@@ -273,6 +304,16 @@ void StatueFilter::weigh(const Ensemble& members) {
     }
   }
   estimate_.explained = estimate_.best_score < settings_.unexplained_score;
+  // Ruled out: only while some member explains the motion (else every member stays).
+  estimate_.ruled_out = 0;
+  estimate_.ruled_out_members = 0;
+  for (int m = 0; m < members_ && estimate_.explained; ++m) {
+    if (estimate_.weights[static_cast<std::size_t>(m)] * static_cast<Real>(members_) <
+        settings_.ruled_out_fraction) {
+      ++estimate_.ruled_out;
+      estimate_.ruled_out_members |= 1U << static_cast<unsigned>(m);
+    }
+  }
 
   // Risk: each member's at the measured phase and state.
   std::array<Real, kMaxEnsembleMembers> risks{};
@@ -306,15 +347,28 @@ void StatueFilter::weigh(const Ensemble& members) {
     estimate_.risk_member = chosen;
     return;
   }
-  // The worst member's: of the measured state and of the members' own simulations.
-  EnsembleRisk simulated;
-  members.risk(simulated);
-  estimate_.risk = simulated.risk;
-  estimate_.risk_member = simulated.worst_member;
+  // The worst member's not ruled out: of the measured state, and of its own simulation while
+  // that agrees with the measured rate (a member just kicked into rocking by its base's stops
+  // while the statue stands is contradicted at once, before its evidence's next interval).
+  estimate_.risk = Risk{};
+  estimate_.risk_member = -1;
+  estimate_.disagreeing_members = 0;
+  const Real noise2 = Real(2) * settings_.rate_noise_rad_s * settings_.rate_noise_rad_s;
   for (int m = 0; m < members_; ++m) {
+    if ((estimate_.ruled_out_members >> static_cast<unsigned>(m) & 1U) != 0U) continue;
     const auto k = static_cast<std::size_t>(m);
-    if (risks[k] > estimate_.risk.total) {
-      estimate_.risk = member_risks[k];
+    const PlanarEstimator& e = members.member(m);
+    const Real own_rate = e.state()[kThetaDot];
+    const Real nu = own_rate - estimate_.rotation_rate;
+    const Real scale = settings_.model_tolerance *
+                       std::fmax(std::fabs(own_rate), std::fabs(estimate_.rotation_rate));
+    const bool agrees = !estimate_.explained || nu * nu <= kAgreement * kAgreement *
+                                                               (noise2 + scale * scale);
+    if (!agrees) estimate_.disagreeing_members |= 1U << static_cast<unsigned>(m);
+    const Risk own = agrees ? overturning_risk(e.scene(), e.mode(), e.state(), risk_) : Risk{};
+    const Risk& worse = own.total >= risks[k] ? own : member_risks[k];
+    if (estimate_.risk_member < 0 || worse.total > estimate_.risk.total) {
+      estimate_.risk = worse;
       estimate_.risk_member = m;
     }
   }

@@ -36,7 +36,8 @@ GroundAcceleration shaking(int n, double amplitude_g) {
 // The box's members, the true statue (an estimator fed the same ground: its theta' is what the
 // gyroscope measures, with white noise of `noise_rad_s`, a BMI088's at 200 Hz) and the filter.
 struct FilterRun {
-  FilterRun(std::vector<Scene> statues, const Scene& truth_scene, double noise_rad_s = 0.002)
+  FilterRun(std::vector<Scene> statues, const Scene& truth_scene, double noise_rad_s = 0.002,
+            const StatueFilterSettings& settings = {})
       : scenes(std::move(statues)),
         truth_scene_(truth_scene),
         ensemble(std::make_unique<Ensemble>()),
@@ -45,9 +46,18 @@ struct FilterRun {
     EXPECT_TRUE(ensemble->start(scenes, ensemble_estimator_settings(), no_forecast(), {}).ok());
     ensemble->restart({});
     EXPECT_TRUE(truth->start(truth_scene_, ensemble_estimator_settings(), {}).ok());
-    EXPECT_TRUE(filter.start({}, ensemble_estimator_settings(), {}, static_cast<int>(scenes.size())).ok());
+    EXPECT_TRUE(filter
+                    .start(settings, ensemble_estimator_settings(), {},
+                           static_cast<int>(scenes.size()))
+                    .ok());
   }
   // One sample; `measured` replaces the true statue's rate when given (not the model).
+  // The box's risk without the sensor: the ensemble's worst member's.
+  [[nodiscard]] Real worst_member_risk() const {
+    EnsembleRisk r;
+    ensemble->risk(r);
+    return r.risk.total;
+  }
   void push(GroundAcceleration g, const double* measured = nullptr) {
     ensemble->push(g);
     truth->push(g);
@@ -76,6 +86,9 @@ TEST(StatueFilter, SettingsNameTheirField) {
   s = {};
   s.credible_weight = Real(1.5);
   EXPECT_EQ(validate(s).field, std::string("statue_filter.credible_weight"));
+  s = {};
+  s.ruled_out_fraction = Real(0);
+  EXPECT_EQ(validate(s).field, std::string("statue_filter.ruled_out_fraction"));
   s = {};
   s.interval_s = 0.001;  // shorter than a sample at 200 Hz
   StatueFilter f;
@@ -134,9 +147,7 @@ TEST(StatueFilter, AStandingStatueRulesTheFragileMemberOut) {
   double worst_without_sensor = 0.0;
   for (int n = 0; n < 800; ++n) {
     run.push(shaking(n, 0.5));
-    EnsembleRisk r;
-    run.ensemble->risk(r);
-    worst_without_sensor = std::fmax(worst_without_sensor, r.risk.total);
+    worst_without_sensor = std::fmax(worst_without_sensor, run.worst_member_risk());
   }
   ASSERT_GT(worst_without_sensor, 0.9);  // the paper's block, simulated, overturns
   const StatueEstimate& e = run.filter.estimate();
@@ -146,6 +157,62 @@ TEST(StatueFilter, AStandingStatueRulesTheFragileMemberOut) {
   EXPECT_TRUE(e.explained) << e.best_score;
   EXPECT_TRUE(e.weighted);
   EXPECT_LT(e.risk.total, 0.05);
+}
+
+// Three members, the statue one of the two wide ones: ruling the slender one out leaves two
+// equally likely, never informative. The slender member's own simulation rocks while the statue
+// stands: its own theta' disagrees with the measured one at once (its own risk no longer counts)
+// and the intervals of standing rule it out; the risk is the wide members', the forecast's
+// probability theirs.
+TEST(StatueFilter, AMemberTheStandingStatueContradictsIsLeftOut) {
+  FilterRun run({wide_block(), make(paper_block()), wide_block()}, wide_block());
+  double worst_without_sensor = 0.0;
+  for (int n = 0; n < 800; ++n) {
+    run.push(shaking(n, 0.5));
+    worst_without_sensor = std::fmax(worst_without_sensor, run.worst_member_risk());
+    const StatueEstimate& e = run.filter.estimate();
+    if (run.ensemble->member(1).mode().rocking()) {
+      ASSERT_LT(e.risk.total, 0.5) << n;  // never the rocking member's own risk
+    }
+  }
+  ASSERT_GT(worst_without_sensor, 0.9);  // the paper's block, simulated, overturns
+  const StatueEstimate& e = run.filter.estimate();
+  EXPECT_FALSE(e.informative);  // two wide members remain, alike
+  EXPECT_TRUE(e.explained);
+  EXPECT_EQ(e.ruled_out, 1);
+  EXPECT_EQ(e.ruled_out_members, 0b010U);
+  EXPECT_LT(e.risk.total, 0.05);
+  EXPECT_NE(e.risk_member, 1);
+  ForecastOutcome f;
+  f.valid = true;
+  f.members = 3;
+  f.collapsing = 1;
+  f.probability = 1.0 / 3.0;
+  f.collapsing_members = 0b010;  // the slender member's forecast collapses
+  EXPECT_EQ(weighted_collapse_probability(f, e), 0.0);
+}
+
+// A member whose own theta' disagrees with the measured one is left out of the risk at once,
+// before any evidence (ruling out made as hard as can be): the statue stands while the slender
+// member rocks in its own simulation.
+TEST(StatueFilter, AMemberWhoseOwnRateDisagreesIsLeftOutAtOnce) {
+  StatueFilterSettings settings;
+  settings.ruled_out_fraction = Real(1e-30);
+  settings.memory_s = 1e-3;  // the evidence forgotten within an interval
+  FilterRun run({wide_block(), make(paper_block()), wide_block()}, wide_block(), 0.002,
+                settings);
+  bool disagreed = false;
+  for (int n = 0; n < 800; ++n) {
+    run.push(shaking(n, 0.5));
+    const StatueEstimate& e = run.filter.estimate();
+    const PlanarEstimator& slender = run.ensemble->member(1);
+    if (!slender.mode().rocking() || std::fabs(slender.state()[kThetaDot]) < 0.1) continue;
+    disagreed = true;
+    ASSERT_EQ(e.disagreeing_members, 0b010U) << n;
+    ASSERT_EQ(e.ruled_out, 0) << n;
+    ASSERT_NE(e.risk_member, 1) << n;
+  }
+  EXPECT_TRUE(disagreed);
 }
 
 // Before the measurement is informative, the risk is the worst member's (as without the sensor).
@@ -226,6 +293,17 @@ TEST(StatueFilter, TheForecastIsWeightedOnceTheEstimateIs) {
   EXPECT_EQ(weighted_collapse_probability(f, e), f.probability);
   e.weighted = true;
   EXPECT_NEAR(weighted_collapse_probability(f, e), 0.2, 1e-6);
+  // Not weighted: the members neither ruled out nor disagreeing, counted.
+  e.weighted = false;
+  e.disagreeing_members = 0b001;
+  EXPECT_NEAR(weighted_collapse_probability(f, e), 0.5, 1e-12);
+  e.ruled_out_members = 0b010;
+  e.ruled_out = 1;
+  EXPECT_NEAR(weighted_collapse_probability(f, e), 1.0, 1e-12);
+  e.disagreeing_members = 0b100;
+  EXPECT_EQ(weighted_collapse_probability(f, e), 0.0);
+  e.disagreeing_members = 0b101;  // none left: the forecast's own
+  EXPECT_EQ(weighted_collapse_probability(f, e), f.probability);
 }
 
 }  // namespace

@@ -111,7 +111,7 @@ TEST(ModbusMap, TheStatueSensorsRegisters) {
   s.statue_rate = monitor::HealthState::kOk;
   s.statue_acceleration = monitor::HealthState::kDegraded;
   s.statue_ready = true;
-  s.statue_axes[0] = {true, true, true, true, Real(2.345), Real(1.1), 4};
+  s.statue_axes[0] = {true, true, false, true, Real(2.345), Real(1.1), 4};
   fill(s, 0, image);
   EXPECT_EQ(at(reg::kStatueRateHealth), 0);
   EXPECT_EQ(at(reg::kStatueAccelerationHealth), 1);
@@ -121,9 +121,9 @@ TEST(ModbusMap, TheStatueSensorsRegisters) {
   EXPECT_EQ(at(reg::kStatueWeightsY), kNone) << "one axis";
   EXPECT_EQ(at(reg::kStatueEffectiveMembersY), kNone);
   s.axis_count = 2;
-  s.statue_axes[0].explained = false;
+  s.statue_axes[0].unexplained = true;
   s.statue_axes[0].weighted = false;
-  s.statue_axes[1] = {true, false, true, false, Real(17), Real(0), 0};
+  s.statue_axes[1] = {true, false, false, false, Real(17), Real(0), 0};
   fill(s, 0, image);
   EXPECT_EQ(at(reg::kStatueWeightsX), 3) << "unexplained";
   EXPECT_EQ(at(reg::kStatueWeightsY), 1) << "uninformative";

@@ -89,7 +89,7 @@ TEST(MonitorStatue, AStandingStatueTakesTheFragileMembersRiskAway) {
   const AxisStatus& axis = s.axes[0];
   EXPECT_TRUE(axis.statue.measured);
   EXPECT_TRUE(axis.statue.weighted);
-  EXPECT_TRUE(axis.statue.explained);
+  EXPECT_FALSE(axis.statue.unexplained);
   EXPECT_EQ(axis.mode.phase, Phase::kFullContact);
   EXPECT_GT(worst_simulated, 0.9);
   EXPECT_LT(s.risk, 0.05);

@@ -21,11 +21,12 @@ namespace plinth::firmware {
 struct StatueAxisStatus {
   bool measured = false;     // the filter took the statue sensor's newest sample
   bool informative = false;  // the weights tell the members apart
-  bool explained = true;     // some member explains the measured motion
+  bool unexplained = false;  // no member explains the measured motion
   bool weighted = false;     // the risk is the weighted members' (informative and explained)
   Real effective_members = 0.0;
   Real best_score = 0.0;     // the best member's mean normalised innovation
   int best_member = 0;
+  int ruled_out = 0;         // members the measured motion ruled out (their risk not counted)
 };
 
 // One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box

@@ -125,9 +125,10 @@ class Monitor {
     return sensors_.config(sensor);
   }
   [[nodiscard]] const MonitorConfig& config() const { return config_; }
-  // The statue sensor's filter of `axis` (started only with a statue sensor).
+  // The statue sensor's filter of `axis` (started only with a statue sensor; a build without
+  // one has none: kStatueSensorBuiltIn).
   [[nodiscard]] const StatueFilter& statue_filter(int axis) const {
-    return filters_[static_cast<std::size_t>(axis)];
+    return statue_room_[0].filters[static_cast<std::size_t>(axis)];
   }
 
  private:
@@ -135,6 +136,10 @@ class Monitor {
   void feed_estimators();
   void push_ensembles(const Vector3r& ground_m_s2, std::int64_t receive_time_ns);
   [[nodiscard]] bool quiet() const;
+  // A statue sensor configured, in a build that has it (kStatueSensorBuiltIn).
+  [[nodiscard]] bool statue_present() const {
+    return kStatueSensorBuiltIn && config_.statue_sensor.present;
+  }
   void note_statue_health();
   [[nodiscard]] MonitorUpdate new_update() const;
   void take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update);
@@ -151,8 +156,15 @@ class Monitor {
   SensorSet sensors_;
   Vector3r last_ground_ = Vector3r::Zero();  // the estimators' newest input, m/s2
   std::array<Ensemble, kMaxAxes> ensembles_{};
-  StatueSensor statue_;
-  std::array<StatueFilter, kMaxAxes> filters_{};
+  // The statue sensor and each axis's filter: none in a build without it, so that neither its
+  // code nor its data take a microcontroller's room (statue_present() guards every use).
+  struct StatueRoom {
+    StatueSensor sensor;
+    std::array<StatueFilter, kMaxAxes> filters{};
+  };
+  std::array<StatueRoom, kStatueSensorBuiltIn ? 1 : 0> statue_room_{};
+  [[nodiscard]] StatueRoom& room() { return statue_room_[0]; }
+  [[nodiscard]] const StatueRoom& room() const { return statue_room_[0]; }
   std::array<bool, kMaxAxes> measured_{};  // each filter took the newest estimator sample
   std::uint64_t statue_restarts_ = 0;      // the statue stream's restarts the filters know
   monitor::AlarmPolicy alarm_;

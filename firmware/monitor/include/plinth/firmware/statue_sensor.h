@@ -98,7 +98,8 @@ class StatueSensor {
   [[nodiscard]] std::uint64_t restarts() const { return restarts_; }
 
  private:
-  StatueSensorSettings settings_;
+  Matrix3r sensor_to_statue_;  // set by start()
+  double max_age_ns_ = 0.0;
   monitor::SensorHealthTracker rate_tracker_;
   monitor::SensorHealthTracker acceleration_tracker_;
   monitor::SensorHealth rate_health_;

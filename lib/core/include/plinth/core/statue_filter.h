@@ -28,8 +28,15 @@
 // the members (uniform weights give all of them: nothing has been learned while the statue and
 // every member sit still). The risk is then the highest member risk that members holding at
 // least credible_weight of the weight reach (each member's overturning_risk at the measured
-// phase and state); before, the worst member's (of its own simulation and of the measured
-// state), as the box without the sensor.
+// phase and state). Before, the worst member's over the members not ruled out, of the measured
+// state and of its own simulation, the latter only while the member's own theta' agrees with
+// the measured one (within 3 standard deviations of the innovation: a member its base's stops
+// just kicked into rocking while the statue stands is contradicted at once, before its next
+// interval's evidence); the forecast's probability likewise counts the others. A member is
+// ruled out once its weight is below ruled_out_fraction of the uniform 1 / members. Besides the
+// flow's innovations, an interval through which the statue stood in full contact weighs
+// against a member whose own simulation rocks (its theta' against the measured one): the
+// evidence that the members' own trajectories give while they still follow the statue's.
 //
 // Explained: the smallest member's mean normalised innovation nu^2 / s^2 (forgetting over
 // score_memory_s, over the intervals whose measured or predicted change is beyond 4 times the
@@ -49,7 +56,15 @@
 #include "plinth/core/risk.h"
 #include "plinth/core/state.h"
 
+#ifndef PLINTH_STATUE_SENSOR
+#define PLINTH_STATUE_SENSOR 1
+#endif
+
 namespace plinth {
+
+// A build without the statue sensor (a microcontroller's with 64 KB of flash: its filter takes
+// about 10 KB) refuses one in its settings; the monitor's code for it is left out.
+inline constexpr bool kStatueSensorBuiltIn = PLINTH_STATUE_SENSOR != 0;
 
 struct StatueFilterSettings {
   Real rate_noise_rad_s = Real(0.003);  // rad/s: one measured rate's noise (gyro noise, bias left)
@@ -63,6 +78,7 @@ struct StatueFilterSettings {
   Real informative_fraction = Real(0.5);  // informative: effective members <= this * members
   Real credible_weight = Real(0.2);       // the risk: reached by members holding this weight
   Real unexplained_score = Real(6);       // mean nu^2 / s^2 of the best member above: unexplained
+  Real ruled_out_fraction = Real(0.1);    // weight below this x 1 / members: ruled out, (0, 1]
 };
 
 // Checks the settings; the Error names the field ("statue_filter.memory_s", ...).
@@ -87,12 +103,18 @@ struct StatueEstimate {
   Risk risk;                  // the filter's risk (as above)
   int risk_member = 0;        // whose risk that is
   bool weighted = false;      // the risk is the weighted members' (informative and explained)
+  int ruled_out = 0;          // members ruled out (explained only; 0 while unexplained)
+  std::uint32_t ruled_out_members = 0;  // bit m: member m ruled out
+  // bit m: member m's own theta' disagrees with the measured one now (not weighted only): its
+  // own simulation's risk and forecast do not count.
+  std::uint32_t disagreeing_members = 0;
   std::array<Real, kMaxEnsembleMembers> weights{};  // weights[0 .. members)
 };
 
 // The forecast's probability of a collapse with the members weighted: the weight of the members
-// that collapse within the horizon when the estimate is weighted, else the forecast's own
-// (collapsing / members).
+// that collapse within the horizon when the estimate is weighted; else, with members ruled out
+// or disagreeing, the collapsing members among the others over their number; else (or none
+// left) the forecast's own (collapsing / members).
 [[nodiscard]] double weighted_collapse_probability(const ForecastOutcome& forecast,
                                                    const StatueEstimate& estimate);
 
@@ -115,7 +137,7 @@ class StatueFilter {
   void measure(const Ensemble& members, const StatueMeasurement& measured);
   [[nodiscard]] Real predicted_rate_change(const Ensemble& members, int m,
                                            GroundAcceleration ground) const;
-  void finish_interval();
+  void finish_interval(const Ensemble& members);
   void weigh(const Ensemble& members);
   [[nodiscard]] State measured_state(const PlanarEstimator& member) const;
 
@@ -137,6 +159,7 @@ class StatueFilter {
   Real interval_start_tilt_ = 0.0;
   bool interval_impact_ = false;
   bool interval_terminal_ = false;
+  bool interval_moved_ = false;  // the measured statue left full contact in the interval
   std::array<Real, kMaxEnsembleMembers> previous_acceleration_{};  // theta'' rad/s2
   std::array<Real, kMaxEnsembleMembers> predicted_change_{};       // rad/s
   std::array<Real, kMaxEnsembleMembers> evidence_{};

@@ -79,6 +79,9 @@ struct EvalRun {
   bool collapsed = false;
   double collapse_time_s = -1.0;  // -1: none
   double peak_ratio = 0.0;        // max |theta| / alpha over the run (1 at a collapse)
+  // When the true statue first left full contact (-1: never). Not a column of the runs file:
+  // plinth-eval run --motion-out writes it beside the levels' times.
+  double first_motion_s = -1.0;
   // The box: first time each risk level was shown (-1: never), in monitor::kRiskLevels' order.
   std::array<double, monitor::kRiskLevels.size()> first_shown_s{-1.0, -1.0, -1.0};
   // First time each grid threshold was reached (-1: never), same order as the grids.
