@@ -95,9 +95,9 @@ std::string status_statue_sensor(const BoxStatus& s) {
         .close();
   };
   return JsonObject()
-      .raw("rate", stream(s.statue_rate))
-      .raw("acceleration", stream(s.statue_acceleration))
-      .flag("ready", s.statue_sensor_ready)
+      .raw("rate", stream(s.statue_sensor.rate))
+      .raw("acceleration", stream(s.statue_sensor.acceleration))
+      .flag("ready", s.statue_sensor.ready)
       .flag("unexplained", s.statue_unexplained)
       .raw("weights",
            per_axis(s, [](const AxisStatus& a) { return statue_weights_json(a.statue); }))
@@ -319,10 +319,11 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
       .count("failovers_continued", s.failovers_continued)
       .raw("sensors", summary_sensors(s));
   if (s.has_statue_sensor) {
+    const StatueSensorStatus& statue = s.statue_sensor;
     line.raw("statue_sensor", JsonObject()
-                                  .raw("rate", sensor_counters(s.statue_rate))
-                                  .raw("acceleration", sensor_counters(s.statue_acceleration))
-                                  .flag("ready", s.statue_sensor_ready)
+                                  .raw("rate", sensor_counters(statue.rate))
+                                  .raw("acceleration", sensor_counters(statue.acceleration))
+                                  .flag("ready", statue.ready)
                                   .close());
   }
   if (totals.recorder) {

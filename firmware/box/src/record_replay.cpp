@@ -61,10 +61,12 @@ monitor::SensorSample record_replay_sample(const MonitorConfig& config, std::int
 }
 
 void configure_replay_statue_sensor(MonitorConfig& config) {
-  config.statue_sensor.present = true;
-  config.statue_sensor.node = 2;
-  config.statue_sensor.offset_window_s = config.conditioning.startup_window_s;
-  config.statue_sensor.health.stuck_samples = 0;
+  config.statue_sensor.present = true;  // refused by a build without the statue sensor
+  if (StatueSensorSettings* statue = statue_settings(config.statue_sensor)) {
+    statue->node = 2;
+    statue->offset_window_s = config.conditioning.startup_window_s;
+    statue->health.stuck_samples = 0;
+  }
 }
 
 StatueSample replay_statue_sample(const MonitorConfig& config, std::int64_t n, Real theta_dot_x,

@@ -16,8 +16,8 @@ monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& co
   const bool sensor_fault = status.sensor.state == monitor::HealthState::kFault;
   const bool disagreement = status.disagreement;
   const bool mismatch_fault = status.plate_mismatch && config.plate.raises_fault;
-  input.fault_active =
-      sensor_fault || disagreement || mismatch_fault || bus_fault || status.statue_unexplained;
+  const bool unexplained = kStatueSensorBuiltIn && status.statue_unexplained;
+  input.fault_active = sensor_fault || disagreement || mismatch_fault || bus_fault || unexplained;
   input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status.sensor.cause)
                       : (disagreement || mismatch_fault) ? monitor::AlarmCause::kSensorDisagreement
                       : bus_fault                        ? monitor::AlarmCause::kBusError

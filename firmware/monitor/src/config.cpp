@@ -137,15 +137,16 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
                             "plate.window_s", "plate.threshold_m_s2"));
   PLINTH_TRY(validate_sensors(c, sensor_index));
   if (!c.statue_sensor.present) return ok_error();
-  if (!kStatueSensorBuiltIn) {
+  const StatueSensorSettings* statue = statue_settings(c.statue_sensor);
+  if (statue == nullptr) {
     return {ErrorCode::kOutOfRange, "statue_sensor",
             "this build has no statue sensor (PLINTH_STATUE_SENSOR=OFF)"};
   }
-  PLINTH_TRY(validate(c.statue_sensor, c.estimator.sample_period()));
+  PLINTH_TRY(validate(*statue, c.estimator.sample_period()));
   std::array<SensorConfig, kMaxSensors> sensors{};
   const int count = resolved_sensors(c, sensors);
   for (int i = 0; i < count; ++i) {
-    if (sensors[static_cast<std::size_t>(i)].node == c.statue_sensor.node) {
+    if (sensors[static_cast<std::size_t>(i)].node == statue->node) {
       return {ErrorCode::kInconsistent, "statue_sensor.node",
               "is an accelerometer's node; each sensor has its own"};
     }

@@ -13,7 +13,8 @@ void FrameDecoder::start(const MonitorConfig& config) {
   for (int i = 0; i < count_; ++i) {
     nodes_[static_cast<std::size_t>(i)] = sensors[static_cast<std::size_t>(i)].node;
   }
-  statue_node_ = config.statue_sensor.present ? config.statue_sensor.node : -1;
+  const StatueSensorSettings* statue = statue_settings(config.statue_sensor);
+  statue_node_ = statue != nullptr && statue->present ? statue->node : -1;
   counters_ = FrameCounters{};
 }
 

@@ -40,17 +40,20 @@ Error Monitor::start(const MonitorConfig& config,
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
-  status_.has_statue_sensor = kStatueSensorBuiltIn && config.statue_sensor.present;
+  const StatueSensorSettings* statue = statue_settings(config.statue_sensor);
+  status_.has_statue_sensor = statue != nullptr && statue->present;
   if (status_.has_statue_sensor) {
-    PLINTH_TRY(room().sensor.start(config.statue_sensor, config.estimator.sample_period()));
+    PLINTH_TRY(room().sensor.start(*statue, config.estimator.sample_period()));
     for (int i = 0; i < config.axis_count; ++i) {
       PLINTH_TRY(room().filters[static_cast<std::size_t>(i)].start(
-          config.statue_sensor.filter, config.estimator, config.risk, ensemble(i).size()));
+          statue->filter, config.estimator, config.risk, ensemble(i).size()));
     }
     note_statue_health();
   }
-  measured_.fill(false);
-  statue_restarts_ = 0;
+  if (statue_present()) {
+    measured_.fill(false);
+    statue_restarts_ = 0;
+  }
   last_ground_.setZero();
   frames_not_encoded_ = 0;
   have_epoch_ = false;
@@ -133,7 +136,7 @@ void Monitor::push_ensembles(const Vector3r& g, std::int64_t receive_time_ns) {
   for (int i = 0; i < status_.axis_count; ++i) {
     const auto k = static_cast<std::size_t>(i);
     ensembles_[k].push({g[i], g.z()});
-    measured_[k] = measuring;
+    if (statue_present()) measured_[k] = measuring;
     if (measuring) {
       room().filters[k].on_sample(ensembles_[k], {g[i], g.z()}, {room().sensor.axis_rate(i)});
     }
@@ -147,8 +150,10 @@ void Monitor::feed_estimators() {
     if (in.start) {
       for (int i = 0; i < status_.axis_count; ++i) {
         ensembles_[static_cast<std::size_t>(i)].restart({g[i], g.z()});
-        if (statue_present()) room().filters[static_cast<std::size_t>(i)].reset();
-        measured_[static_cast<std::size_t>(i)] = false;
+        if (statue_present()) {
+          room().filters[static_cast<std::size_t>(i)].reset();
+          measured_[static_cast<std::size_t>(i)] = false;
+        }
       }
       ++status_.estimator_restarts;
       status_.estimator_start_ns = in.time_ns - epoch_ns_;
@@ -183,8 +188,9 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   axis.state = statues.nominal().state();
   statues.risk(axis);
   axis.forecast = statues.forecaster().latest();
+  if (!statue_present()) return;
   axis.statue = StatueAxisStatus{};
-  if (!kStatueSensorBuiltIn || !measured_[k]) return;
+  if (!measured_[k]) return;
   const StatueEstimate& e = room().filters[k].estimate();
   axis.mode = e.mode;
   axis.state[kTheta] = e.tilt;
@@ -199,7 +205,7 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
 // The axes' part of the status: mode, state, risk, the forecast.
 void Monitor::update_axes_status() {
   Real risk = 0;
-  status_.statue_unexplained = false;
+  if (statue_present()) status_.statue_unexplained = false;
   status_.probability = 0.0;
   status_.forecast_axis = -1;
   status_.collapse_forecast_s = -1.0;
@@ -207,7 +213,9 @@ void Monitor::update_axes_status() {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
     if (status_.estimating) update_axis(i, axis);
-    status_.statue_unexplained = status_.statue_unexplained || axis.statue.unexplained;
+    if (statue_present()) {
+      status_.statue_unexplained = status_.statue_unexplained || axis.statue.unexplained;
+    }
     risk = axis.risk.total > risk ? axis.risk.total : risk;
     const ForecastOutcome& f = axis.forecast;
     axis.collapse_forecast_s = -1.0;
@@ -295,9 +303,9 @@ void Monitor::report(MonitorUpdate& update) {
 }
 
 void Monitor::note_statue_health() {
-  status_.statue_rate = room().sensor.rate_health();
-  status_.statue_acceleration = room().sensor.acceleration_health();
-  status_.statue_sensor_ready = room().sensor.ready();
+  if (StatueSensorStatus* s = statue_part<StatueSensorStatus>(status_.statue_sensor)) {
+    *s = {room().sensor.rate_health(), room().sensor.acceleration_health(), room().sensor.ready()};
+  }
 }
 
 MonitorUpdate Monitor::on_statue_sample(const StatueSample& sample) {

@@ -85,7 +85,7 @@ TEST(MonitorStatue, AStandingStatueTakesTheFragileMembersRiskAway) {
   }
   const BoxStatus& s = *run.monitor->poll().status;
   EXPECT_TRUE(s.has_statue_sensor);
-  EXPECT_TRUE(s.statue_sensor_ready);
+  EXPECT_TRUE(s.statue_sensor.ready);
   const AxisStatus& axis = s.axes[0];
   EXPECT_TRUE(axis.statue.measured);
   EXPECT_TRUE(axis.statue.weighted);
@@ -110,7 +110,7 @@ TEST(MonitorStatue, ASilentStatueSensorLeavesTheWorstMembersRisk) {
   EnsembleRisk r;
   run.monitor->ensemble(0).risk(r);
   EXPECT_EQ(s.axes[0].risk.total, r.risk.total);
-  EXPECT_EQ(s.statue_rate.state, monitor::HealthState::kFault);  // timed out
+  EXPECT_EQ(s.statue_sensor.rate.state, monitor::HealthState::kFault);  // timed out
 }
 
 // A loose sensor swinging on a quiet ground: no member explains it; the level is fault with
@@ -174,11 +174,11 @@ TEST(MonitorStatue, EachStreamHasItsOwnHealth) {
     }
   }
   const BoxStatus& s = *run.monitor->poll().status;
-  EXPECT_EQ(s.statue_rate.state, monitor::HealthState::kOk);
-  EXPECT_EQ(s.statue_acceleration.state, monitor::HealthState::kFault);
-  EXPECT_EQ(s.statue_acceleration.cause, monitor::HealthCause::kTimeout);
-  EXPECT_EQ(s.statue_acceleration.counters.received, 100U);
-  EXPECT_EQ(s.statue_acceleration.counters.saturated, 1U);
+  EXPECT_EQ(s.statue_sensor.rate.state, monitor::HealthState::kOk);
+  EXPECT_EQ(s.statue_sensor.acceleration.state, monitor::HealthState::kFault);
+  EXPECT_EQ(s.statue_sensor.acceleration.cause, monitor::HealthCause::kTimeout);
+  EXPECT_EQ(s.statue_sensor.acceleration.counters.received, 100U);
+  EXPECT_EQ(s.statue_sensor.acceleration.counters.saturated, 1U);
   EXPECT_TRUE(s.axes[0].statue.measured);
 }
 

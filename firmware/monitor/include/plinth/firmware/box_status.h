@@ -6,11 +6,13 @@
 
 #include <array>
 #include <cstdint>
+#include <type_traits>
 
 #include "plinth/core/ensemble.h"
 #include "plinth/core/forecast.h"
 #include "plinth/core/risk.h"
 #include "plinth/core/state.h"
+#include "plinth/core/statue_filter.h"
 #include "plinth/firmware/config.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/sensor_health.h"
@@ -28,6 +30,17 @@ struct StatueAxisStatus {
   int best_member = 0;
   int ruled_out = 0;         // members the measured motion ruled out (their risk not counted)
 };
+
+// The statue sensor's streams: its gyroscope's and accelerometer's health, its rate offset
+// known.
+struct StatueSensorStatus {
+  monitor::SensorHealth rate;
+  monitor::SensorHealth acceleration;
+  bool ready = false;
+};
+struct NoStatueSensorStatus {};
+using StatueSensorStatusField =
+    std::conditional_t<kStatueSensorBuiltIn, StatueSensorStatus, NoStatueSensorStatus>;
 
 // One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box
 // without ensemble) and the rest.
@@ -101,13 +114,11 @@ struct BoxStatus : SensorSetStatus {
   std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
   std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
   std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
-  // The statue sensor (statue_sensor.h): configured, its gyroscope's and accelerometer's
-  // streams' health, its rate offset known; unexplained: on some axis no member explains its
-  // motion (fault, kStatueUnexplained).
+  // The statue sensor (statue_sensor.h): configured, its streams (none in a build without it:
+  // statue_part), and unexplained: on some axis no member explains its motion (fault,
+  // kStatueUnexplained).
   bool has_statue_sensor = false;
-  monitor::SensorHealth statue_rate;
-  monitor::SensorHealth statue_acceleration;
-  bool statue_sensor_ready = false;
+  StatueSensorStatusField statue_sensor;
   bool statue_unexplained = false;
 };
 

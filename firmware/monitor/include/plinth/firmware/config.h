@@ -103,8 +103,9 @@ struct MonitorConfig {
   std::array<SensorConfig, kMaxSensors> sensors{};
   RedundancySettings redundancy;
   PlateCheckSettings plate;
-  // The IMU on the statue (statue_sensor.h): absent unless `present`.
-  StatueSensorSettings statue_sensor;
+  // The IMU on the statue (statue_sensor.h): absent unless `present`; a build without the
+  // statue sensor holds `present` alone (statue_settings() gives the rest when built).
+  StatueSensorConfig statue_sensor;
 };
 
 // Checks every part; the Error names the field ("monitor.axis_count", "estimator....", ...).

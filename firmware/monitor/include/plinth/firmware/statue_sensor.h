@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 
 #include "plinth/core/error.h"
 #include "plinth/core/real.h"
@@ -60,6 +61,19 @@ struct StatueSensorSettings {
   double max_age_s = 0.01;       // s: a rate older than this is not the statue's now
   StatueFilterSettings filter;   // its rate_noise_rad_s is the gyroscope's noise
 };
+
+// A build without the statue sensor (kStatueSensorBuiltIn false) keeps only whether one is
+// configured (it refuses it); MonitorConfig holds StatueSensorConfig.
+struct NoStatueSensorSettings {
+  bool present = false;
+};
+using StatueSensorConfig =
+    std::conditional_t<kStatueSensorBuiltIn, StatueSensorSettings, NoStatueSensorSettings>;
+// The statue sensor's settings in a build that has it; nullptr in one that has not.
+template <class Held>
+[[nodiscard]] constexpr auto* statue_settings(Held& config) {
+  return statue_part<StatueSensorSettings>(config);
+}
 
 // Checks the settings; the Error names the field ("statue_sensor.node", ...). The first
 // leaves out the streams' health, which the second checks at the estimator's sample period.
