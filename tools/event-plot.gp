@@ -29,9 +29,9 @@ plot "trace.tsv" using 1:($5 / g0) with lines lc rgb "#1f77b4" title "x", \
 set ylabel "rotation (deg)"
 set yrange [-th_max:th_max]
 set y2label "phase"
-set y2range [-0.5:5.5]
+set y2range [-0.5:6.5]
 set y2tics ("full contact" 0, "sliding" 1, "rocking" 2, "slide-rocking" 3, "overturned" 4, \
-            "fell" 5)
+            "fell" 5, "lifted off" 6)
 set ytics nomirror
 plot "trace.tsv" using 1:($6 * deg) with lines lc rgb "#1f77b4" lw 2 title "rotation x", \
      "trace.tsv" using 1:(axes > 1 ? $9 * deg : NaN) with lines lc rgb "#ff7f0e" lw 2 \

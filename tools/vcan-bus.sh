@@ -7,8 +7,9 @@
 #         through hostfs. Does not start on a host whose XSAVE state is larger than 2696 bytes
 #         (AMX): checked before it boots (tools/host-xstate-size.py, docs/can-e2e.md).
 #   qemu  Debian's kernel (linux-image-amd64) in qemu-system-x86_64, KVM where /dev/kvm is
-#         usable, TCG emulation otherwise; an initramfs built per run from busybox-static and the
-#         kernel's modules mounts the host's root through virtio-9p and sets up the bus. It can
+#         usable (booted again under TCG when KVM aborts the guest), TCG emulation otherwise; an
+#         initramfs built per run from busybox-static and the kernel's modules mounts the host's
+#         root through virtio-9p and sets up the bus. It can
 #         also give the guest a gpio-sim chip (--gpio-sim; module: tools/build-gpio-sim.sh).
 # auto (the default) takes uml when it starts here, else qemu. See hal/README.md.
 #
@@ -479,7 +480,7 @@ route_qemu() {
   return "$status"
 }
 
-qemu_boot() {  # ACCELERATOR OPTIONS...
+qemu_boot() {  # ACCELERATOR OPTIONS... (route_qemu's kernel_image and run)
   boot_guest "$run/qemu.log" qemu-system-x86_64 -nodefaults -no-user-config -machine pc \
     "$@" -cpu max -m "$mem" -smp "$cpus" -kernel "$kernel_image" \
     -initrd "$run/initramfs.cpio" -append "console=ttyS0 panic=-1 quiet $qemu_kernel_options" \

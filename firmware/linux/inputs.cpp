@@ -84,10 +84,9 @@ class RecordInput final : public MonitorInput {
 // kMaxLogGapS counted and not ticked through; each raises the input fault.
 class LogInput final : public MonitorInput {
  public:
-  LogInput(hal::CandumpLogReader reader, double speed, const volatile std::sig_atomic_t& stop)
-      : reader_(std::move(reader)), pacer_(speed), stop_(stop) {
-    last_ns_by_id_.fill(-1);
-  }
+  LogInput(hal::CandumpLogReader reader, double speed, hal::LogTimePolicy policy,
+           const volatile std::sig_atomic_t& stop)
+      : reader_(std::move(reader)), pacer_(speed), policy_(policy), stop_(stop) {}
 
   bool next(InputItem& item) override {
     if (!pending_ && !read_frame()) return false;
@@ -131,8 +130,7 @@ class LogInput final : public MonitorInput {
       fault_until_ns_ = 0;
       fault_change_ = true;
     }
-    previous_ns_ = frame_.timestamp_ns;
-    last_ns_by_id_[frame_.frame.id & hal::kStandardIdMask] = frame_.timestamp_ns;
+    time_check_.take(frame_.timestamp_ns, frame_.frame.id);
     pending_ = true;
     return pacer_.wait_until(frame_.timestamp_ns - *first_ns_, stop_);
   }
@@ -140,40 +138,41 @@ class LogInput final : public MonitorInput {
   // Whether frame_'s time can be monitor time; counts and raises the fault when it cannot, or
   // when it jumps beyond kMaxLogGapS (then the ticks skip the rest of the gap).
   bool usable_time() {
-    if (!first_ns_) return true;
     const std::int64_t t = frame_.timestamp_ns;
+    const hal::LogTimeStep step = time_check_.check(t, frame_.frame.id);
+    if (step.problem == hal::LogTimeProblem::kNone) return true;
+    const std::string what = reader_.path() + ":" + std::to_string(reader_.line_number()) + ": " +
+                             time_check_.describe(step, t);
+    if (policy_ == hal::LogTimePolicy::kRefuse) throw InputError(what + " (--log-time refuse)");
     const std::int64_t max_gap_ns = std::llround(kMaxLogGapS * 1e9);
-    const char* what = nullptr;
-    const std::uint64_t gaps_before = time_.gaps;
-    if (t < previous_ns_) {
-      ++time_.went_back;
-      what = "timestamp goes back";
-    } else if (t == last_ns_by_id_[frame_.frame.id & hal::kStandardIdMask]) {
-      ++time_.stood_still;
-      what = "timestamp stands still (the previous frame's of this identifier)";
-    } else if (t - previous_ns_ > max_gap_ns) {
-      ++time_.gaps;
-      what = "timestamp jumps forward beyond the 10 s gap limit";
-      next_tick_ns_ = std::max(next_tick_ns_, t - max_gap_ns);
+    switch (step.problem) {
+      case hal::LogTimeProblem::kWentBack: ++time_.went_back; break;
+      case hal::LogTimeProblem::kStoodStill: ++time_.stood_still; break;
+      default:
+        ++time_.gaps;
+        next_tick_ns_ = std::max(next_tick_ns_, t - max_gap_ns);
+        break;
     }
-    if (what == nullptr) return true;
-    if (time_.first.empty()) {
-      time_.first = reader_.path() + ":" + std::to_string(reader_.line_number()) + ": " + what;
+    if (time_.total() <= kLogTimeWarnings) {
+      std::fprintf(stderr, "plinth-monitor: warning: %s%s\n", what.c_str(),
+                   time_.total() == kLogTimeWarnings ? " (further ones are counted in the summary)"
+                                                      : "");
     }
+    if (time_.first.empty()) time_.first = what;
     if (fault_until_ns_ == 0) fault_change_ = true;
-    fault_until_ns_ = std::max(t, previous_ns_) + std::llround(kInputFaultHoldS * 1e9);
-    return time_.gaps > gaps_before;  // a gap's frame is given, one back or still is not
+    fault_until_ns_ = std::max(t, time_check_.previous_ns()) + std::llround(kInputFaultHoldS * 1e9);
+    return step.problem == hal::LogTimeProblem::kJumped;  // given; one back or still is not
   }
 
   hal::CandumpLogReader reader_;
   hal::Pacer pacer_;
+  hal::LogTimePolicy policy_;
   const volatile std::sig_atomic_t& stop_;
   hal::TimedFrame frame_;
   bool pending_ = false;  // frame_ is read, not yet given
   std::optional<std::int64_t> first_ns_;
   std::int64_t next_tick_ns_ = 0;
-  std::int64_t previous_ns_ = 0;  // the latest usable frame's time
-  std::array<std::int64_t, hal::kStandardIdMask + 1> last_ns_by_id_{};  // -1: none yet
+  hal::LogTimeCheck time_check_;  // the latest usable frame's time, and each identifier's
   std::int64_t fault_until_ns_ = 0;                                     // 0: no input fault held
   bool fault_change_ = false;  // the fault is to be raised or cleared before the frame
   InputTimeCounters time_;
@@ -286,12 +285,12 @@ class BusInput final : public MonitorInput {
   BusCounters counters_;
 };
 
+}  // namespace
+
 bool is_candump_log(const std::string& path) {
   const std::string extension = std::filesystem::path(path).extension().string();
   return extension == ".log" || extension == ".LOG";
 }
-
-}  // namespace
 
 std::unique_ptr<MonitorInput> open_input(const InputOptions& opt, MonitorConfig& config,
                                          const volatile std::sig_atomic_t& stop) {
@@ -312,7 +311,8 @@ std::unique_ptr<MonitorInput> open_input(const InputOptions& opt, MonitorConfig&
   if (log) {
     hal::CandumpLogReaderOpenResult opened = hal::CandumpLogReader::open(opt.replay_path);
     if (!opened.ok()) throw InputError(opened.message);
-    return std::make_unique<LogInput>(std::move(*opened.reader), opt.speed, stop);
+    return std::make_unique<LogInput>(std::move(*opened.reader), opt.speed,
+                                      opt.log_time.value_or(hal::LogTimePolicy::kWarn), stop);
   }
   hal::SocketCanOpenResult opened = hal::SocketCanPort::open(opt.can_interface);
   if (!opened.ok()) throw InputError(opened.message);

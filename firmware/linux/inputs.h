@@ -10,6 +10,7 @@
 #include <string>
 
 #include "plinth/firmware/monitor.h"
+#include "plinth/hal/candump_log.h"
 #include "plinth/hal/frame_io.h"
 #include "plinth/monitor/sensor_health.h"
 
@@ -43,11 +44,15 @@ struct BusCounters {
   std::uint64_t dropped_frames = 0;  // frames the kernel dropped before we read them
 };
 
-// A log's timestamps that cannot be monitor time (docs/monitor.md, "Time in logs"): a frame
-// stamped before the previous one, or at the same microsecond, is not given to the monitor; a
-// jump forward beyond kMaxLogGapS is given, but not ticked through beyond that gap. Each raises
-// the input fault (as a bus fault) until kInputFaultHoldS of well-stamped frames have passed.
-inline constexpr double kMaxLogGapS = 10.0;
+// A log's timestamps that cannot be monitor time (docs/monitor.md, "Time in logs";
+// hal::LogTimeCheck): with --log-time warn (the default) a frame stamped before the previous
+// one, or at the same microsecond, is not given to the monitor; a jump forward beyond
+// kMaxLogGapS is given, but not ticked through beyond that gap. Each is named on stderr (the
+// first kLogTimeWarnings of them, with the line and the size) and raises the input fault (as a
+// bus fault) until kInputFaultHoldS of well-stamped frames have passed. With --log-time refuse
+// the first one ends the run (host::InputError, the same text).
+inline constexpr double kMaxLogGapS = hal::kMaxLogGapS;
+inline constexpr std::uint64_t kLogTimeWarnings = 10;
 inline constexpr double kInputFaultHoldS = 2.0;
 struct InputTimeCounters {
   std::uint64_t went_back = 0;
@@ -83,7 +88,12 @@ struct InputOptions {
   double speed = 0.0;             // replay: a factor of real time; 0: as fast as possible
   double duration_s = 0.0;        // live: stop after this long; 0: at the stop flag only
   bool recorder_frames = false;   // record: also give each sample as its frame
+  // candump log: the policy for its time (above); not given: warn. Refused for other inputs.
+  std::optional<hal::LogTimePolicy> log_time;
 };
+
+// A replay file that is a candump log (.log), not a record.
+[[nodiscard]] bool is_candump_log(const std::string& path);
 
 // Opens the input `options` name (exactly one of replay_path, can_interface) and fits `config`
 // to it: a record replay feeds one ideal ground sensor at the record's rate. `stop` (a signal

@@ -87,7 +87,7 @@ constexpr std::array<Point, kPointCount> kPoints = {{
     word(reg::kCommands, "commands", "",
          "operator commands carried out (acknowledge and reset), modulo 65536"),
     word(reg::kAlarmEvents, "alarm_events", "", "alarm events so far, modulo 65536"),
-    word(reg::kMapVersion, "map_version", "", "the version of this map: 4"),
+    word(reg::kMapVersion, "map_version", "", "the version of this map: 5"),
     scaled(reg::kProbability, "probability", "0.0001", "", false, "status.probability",
            "the forecast's probability of a collapse within its horizon, 0 .. 1"),
     word(reg::kForecastAxis, "forecast_axis", "",
@@ -157,13 +157,14 @@ constexpr std::array<Point, kPointCount> kPoints = {{
                "write 1: the monitor starts again as at power-up; needs modbus.writes"),
 }};
 
-// The registers follow each other without gaps up to reg::kCount, the discrete inputs are the
-// level codes 0 .. discrete::kCount - 1.
+// The registers follow each other without gaps up to reg::kCount but the reserved ones, the
+// discrete inputs are the level codes 0 .. discrete::kCount - 1.
 constexpr bool contiguous() {
   int next = 0;
   int bits = 0;
   for (const Point& p : kPoints) {
     if (p.table == Table::kRegister) {
+      if (next == reg::kRegionalReserved) next += reg::kRegionalReservedWords;
       if (p.address != next) return false;
       next += p.words;
     } else if (p.table == Table::kDiscreteInput) {
@@ -173,7 +174,7 @@ constexpr bool contiguous() {
   return next == reg::kCount && bits == discrete::kCount;
 }
 static_assert(contiguous());
-static_assert(kMapVersion == 4, "the map_version row says 4");
+static_assert(kMapVersion == 5, "the map_version row says 5");
 
 void put16(std::uint16_t* r, int address, std::uint64_t value) {
   r[address] = static_cast<std::uint16_t>(value & 0xFFFFU);
@@ -332,6 +333,7 @@ void fill(const StatusSnapshot& s, std::uint64_t alarm_events, Image& out) {
                              : static_cast<std::uint16_t>(std::clamp(collapse_in_ms, 0.0,
                                                                      kNone - 1.0)));
   put16(r, reg::kForecastWorstMember, index_or_none(s.forecast_worst_member));
+  for (int i = 0; i < reg::kRegionalReservedWords; ++i) put16(r, reg::kRegionalReserved + i, kNone);
   const bool statue = s.has_statue_sensor;
   put16(r, reg::kStatueRateHealth, statue ? kHealthStateCodes.code(s.statue_rate) : kNone);
   put16(r, reg::kStatueAccelerationHealth,

@@ -14,6 +14,7 @@
 
 #include "plinth/host/input_error.h"
 #include "plinth/host/text_file.h"
+#include "plinth/host/toml_names.h"
 #include "status_outputs.h"
 
 namespace plinth::firmware {
@@ -331,6 +332,23 @@ class KeyLines {
     const auto binding =
         std::find_if(table.begin(), table.end(), [&](const Binding& b) { return b.key == key; });
     if (binding == table.end()) {
+      // A value where a table of settings belongs (alarm_policy.advisory = 0.1) is the wrong
+      // type, not an unknown key.
+      const std::string inside = key + ".";
+      if (std::any_of(table.begin(), table.end(),
+                      [&](const Binding& b) { return b.key.rfind(inside, 0) == 0; })) {
+        throw InputError(cat(where(name), ": ", name, ": expected a table (", name,
+                             ".<key> = ...), got ", host::toml_type_name(value.type())));
+      }
+      // A table where a value belongs (estimator.sample_rate_hz = { ... }): the same.
+      const auto holder = std::find_if(table.begin(), table.end(), [&](const Binding& b) {
+        return key.rfind(b.key + ".", 0) == 0;
+      });
+      if (holder != table.end()) {
+        const std::string held = name.substr(0, name.size() - (key.size() - holder->key.size()));
+        throw InputError(
+            cat(where(name), ": ", held, ": expected ", holder->expected, ", got a table"));
+      }
       throw InputError(cat(where(name), ": ", name, ": unknown key (docs/monitor.md lists them)"));
     }
     if (!binding->store(value)) {
@@ -666,6 +684,23 @@ void apply_output_overrides(MonitorFile& file, const MonitorOverrides& o) {
   if (!o.mqtt_ca_file.empty()) mqtt.ca_file = o.mqtt_ca_file;
   if (!o.mqtt_cert_file.empty()) mqtt.cert_file = o.mqtt_cert_file;
   if (!o.mqtt_key_file.empty()) mqtt.key_file = o.mqtt_key_file;
+  // An output's options while the output is off have no effect: refused, saying so.
+  if (o.modbus_writes && file.modbus.listen.empty()) {
+    throw InputError("--modbus-writes: lets the Modbus server's coils be written; the server is "
+                     "off (--modbus, or modbus.listen in the configuration file)");
+  }
+  for (const auto& [option, value] :
+       {std::pair<const char*, const std::string*>{"--mqtt-box-id", &o.mqtt_box_id},
+        {"--mqtt-username", &o.mqtt_username},
+        {"--mqtt-password-file", &o.mqtt_password_file},
+        {"--mqtt-ca", &o.mqtt_ca_file},
+        {"--mqtt-cert", &o.mqtt_cert_file},
+        {"--mqtt-key", &o.mqtt_key_file}}) {
+    if (!value->empty() && mqtt.broker.empty()) {
+      throw InputError(std::string(option) + ": sets the MQTT publisher, which is off (--mqtt, "
+                                             "or mqtt.broker in the configuration file)");
+    }
+  }
 }
 
 }  // namespace

@@ -202,6 +202,7 @@ void MqttPublisher::stop() {
 }
 
 void MqttPublisher::on_connect(int rc) {
+  answered_ = true;
   if (rc != 0) {
     ++refusals_;
     const std::string problem =
@@ -254,6 +255,10 @@ bool MqttPublisher::publish(const std::string& topic, const std::string& payload
 // The loop's alarm events into the queue (bounded), its newest snapshot into the state.
 void MqttPublisher::take_mailbox(std::int64_t now_ns) {
   take_results();
+  if (mailbox_.events_dropped() != mailbox_dropped_seen_) {  // the loop's ring was full
+    mailbox_dropped_seen_ = mailbox_.events_dropped();
+    say_dropped();
+  }
   AlarmNotice notice;
   while (mailbox_.take_alarm(notice)) {
     // The oldest waiting event makes room; never the one the broker may be acknowledging.
@@ -265,6 +270,7 @@ void MqttPublisher::take_mailbox(std::int64_t now_ns) {
         queue_.pop_front();
       }
       ++events_dropped_;
+      say_dropped();
     }
     queue_.push_back({alarm_json(notice.event, notice.t_origin), {}});
     most_queued_ = std::max(most_queued_, queue_.size());
@@ -279,11 +285,31 @@ void MqttPublisher::take_mailbox(std::int64_t now_ns) {
   if (changed || now_ns - state_sent_ns_ >= ns_of(settings_.state_interval_s)) state_due_ = true;
 }
 
+// An overflow is said at once, then again each time the count doubles (1, 2, 4, ...): a long
+// outage does not flood the journal, and the count is also in the state (events_dropped).
+void MqttPublisher::say_dropped() {
+  const std::uint64_t dropped = events_dropped_ + mailbox_.events_dropped();
+  if (dropped < next_drop_report_) return;
+  next_drop_report_ = 2 * dropped;
+  say("alarm event queue full (mqtt.event_queue = " + std::to_string(settings_.event_queue) +
+      ", the broker at " + endpoint_text_ + " away): the oldest waiting event dropped, " +
+      std::to_string(dropped) + " so far");
+}
+
 void MqttPublisher::try_connect(std::int64_t now_ns) {
   if (now_ns < next_attempt_ns_) return;
+  if (socket_open_ && !answered_) {  // the attempt before never reached the broker
+    ++connect_failures_;  // said once while it lasts, whatever the back-off has grown to
+    say_problem("cannot reach the broker at " + endpoint_text_ +
+                ": the connection attempt was not answered");
+  }
   // A new session each time: libmosquitto keeps the unacknowledged publishes and sends them
-  // again once the broker accepted it.
-  const int rc = mosquitto_connect(client_, host_.c_str(), port_, settings_.keepalive_s);
+  // again once the broker accepted it. Asynchronous: a broker that never answers the TCP
+  // handshake (a host gone behind a firewall, a stalled broker's full accept queue) held a
+  // blocking connect ~130 s, the events undrained and stop() waiting that long past its flush
+  // bound; mosquitto_loop completes the connection.
+  answered_ = false;
+  const int rc = mosquitto_connect_async(client_, host_.c_str(), port_, settings_.keepalive_s);
   if (rc == MOSQ_ERR_SUCCESS) {
     socket_open_ = true;
     next_attempt_ns_ = now_ns + ns_of(backoff_s_);  // if the session never starts
@@ -296,6 +322,11 @@ void MqttPublisher::try_connect(std::int64_t now_ns) {
 
 // The connection is gone: say why (once), and try again after the back-off.
 void MqttPublisher::lost(const std::string& reason, std::int64_t now_ns) {
+  say_problem(reason);
+  back_off(now_ns);
+}
+
+void MqttPublisher::say_problem(const std::string& reason) {
   // libmosquitto's own error (a TLS certificate refused, ...) says more.
   const std::string why = error_log_.empty() ? reason : reason + " (" + error_log_ + ")";
   if (why != last_problem_) {
@@ -305,7 +336,6 @@ void MqttPublisher::lost(const std::string& reason, std::int64_t now_ns) {
     say(why + retry);
   }
   last_problem_ = why;
-  back_off(now_ns);
 }
 
 void MqttPublisher::back_off(std::int64_t now_ns) {
@@ -546,6 +576,7 @@ std::string MqttPublisher::state_json() const {
       .raw("statue_sensor", statue_sensor_state(s, axes))
       .count("estimator_restarts", s.estimator_restarts)
       .count("heartbeat", s.statuses)
+      .count("events_dropped", events_dropped_ + mailbox_.events_dropped())
       .raw("version", JsonObject()
                           .text("project", version::kProjectVersion)
                           .text("git", version::kGitDescription)
@@ -587,7 +618,10 @@ void MqttPublisher::run() {
       continue;
     }
     const int rc = mosquitto_loop(client_, kLoopTimeoutMs, 1);
-    if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED) {
+    if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED && !answered_) {
+      ++connect_failures_;  // the asynchronous connection failed (refused, unreachable, ...)
+      lost("cannot reach the broker at " + endpoint_text_ + ": " + error_text(rc), now);
+    } else if (rc != MOSQ_ERR_SUCCESS && rc != MOSQ_ERR_CONN_REFUSED) {
       // on_disconnect counted it.
       lost("connection to " + endpoint_text_ + " lost: " + error_text(rc), now);
     } else if (rc == MOSQ_ERR_CONN_REFUSED) {

@@ -91,6 +91,8 @@ class MqttPublisher final : public StatusOutput {
   void publish_head(std::int64_t now_ns);
   void publish_state(std::int64_t now_ns);
   void lost(const std::string& reason, std::int64_t now_ns);
+  void say_dropped();
+  void say_problem(const std::string& reason);
   void back_off(std::int64_t now_ns);
   void say_offline();
   void publish_discovery();
@@ -120,6 +122,7 @@ class MqttPublisher final : public StatusOutput {
   // The thread's state.
   bool socket_open_ = false;  // a connection attempt or session is under way
   bool connected_ = false;    // the broker accepted the session
+  bool answered_ = false;     // the broker answered this attempt (CONNACK, accepted or not)
   std::int64_t next_attempt_ns_ = 0;
   double backoff_s_ = 0.0;
   std::string last_problem_;  // the latest message printed (printed again only when it changes)
@@ -149,6 +152,8 @@ class MqttPublisher final : public StatusOutput {
   std::uint64_t connections_lost_ = 0;
   std::uint64_t events_published_ = 0;  // acknowledged by the broker
   std::uint64_t events_dropped_ = 0;    // the queue was full: the oldest went
+  std::uint64_t next_drop_report_ = 1;     // say_dropped() speaks at this count
+  std::uint64_t mailbox_dropped_seen_ = 0;
   std::uint64_t events_republished_ = 0;
   std::uint64_t states_published_ = 0;
   std::size_t most_queued_ = 0;

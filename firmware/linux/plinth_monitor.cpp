@@ -31,6 +31,7 @@
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/limits.h"
+#include "plinth/host/parse_name.h"
 #include "plinth/host/scene_toml.h"
 #include "relay_gpiod.h"
 #include "relay_outputs.h"
@@ -59,6 +60,7 @@ struct Options {
   std::string pga;
   std::optional<double> scale;
   std::string speed = "max";
+  std::string log_time;  // --log-time: warn or refuse; empty: not given (warn)
   double duration = 0.0;
   std::string record_dir;
   std::string frames_out;
@@ -283,7 +285,8 @@ std::string option_of(const std::string& field) {
       {"sample_rate", "--rate"},
       {"steps_per_sample", "--steps"},
       {"stuck_samples", "--stuck-samples"},
-      {"node", "--node"}};
+      {"node", "--node"},
+      {"base.", "--scene"}};
   for (const auto& [key, option] : kOptions) {
     if (field.find(key) != std::string::npos) return option;
   }
@@ -305,6 +308,16 @@ void start_monitor(fw::Monitor& monitor, fw::FrameDecoder& decoder,
     decoder.start(config);
     return;
   }
+  // Too few steps per sample where even the most the box takes (64) are too few: the scene's
+  // base is the culprit, too stiff or light for the box (lib/core estimator.cpp).
+  const bool steps_needed = std::string(e.field) == "estimator.steps_per_sample" && e.limit > 0.0;
+  if (steps_needed && std::ceil(e.limit) > 64.0) {
+    throw InputError("--scene " + app["--scene"]->as<std::string>() +
+                     " (base.period): too short for the box: a stable estimate needs " +
+                     plinth::host::number_text(std::ceil(e.limit)) +
+                     " solver steps a sample at this rate, more than the 64 the box takes (a "
+                     "longer base.period, a heavier base, or a lower sample rate)");
+  }
   const std::string option = option_of(e.field);
   std::string where;
   if (!option.empty() && app.count(option) > 0) {
@@ -315,7 +328,9 @@ void start_monitor(fw::Monitor& monitor, fw::FrameDecoder& decoder,
     where = std::string("monitor setting ") + e.field;
   }
   std::string message = where + ": " + e.reason;
-  if (e.limit != 0.0 && std::isfinite(e.limit) && message.find('[') == std::string::npos) {
+  if (steps_needed) {
+    message += " (limit " + plinth::host::number_text(std::ceil(e.limit)) + ")";
+  } else if (e.limit != 0.0 && std::isfinite(e.limit) && message.find('[') == std::string::npos) {
     message += " (limit " + plinth::host::number_text(e.limit) + ")";
   }
   throw InputError(message);
@@ -388,6 +403,10 @@ fw::InputOptions input_options(const Options& opt) {
   in.speed = parse_speed(opt.speed);
   in.duration_s = opt.duration;
   in.recorder_frames = !opt.record_dir.empty();
+  if (!opt.log_time.empty()) {
+    in.log_time = plinth::host::parse_name<plinth::hal::kLogTimePolicyNames>(
+        opt.log_time, "--log-time", "policy");
+  }
   return in;
 }
 
@@ -549,6 +568,25 @@ int run(const Options& opt, const CLI::App& app) {
   return totals.input_fault.empty() || g_stop != 0 ? 0 : kInputFaultExit;
 }
 
+// The options the input chosen has no use for (every option means something).
+void refuse_without_effect(const CLI::App& app, const Options& opt) {
+  using plinth::host::refuse_without_effect;
+  const bool live = !opt.can_interface.empty();
+  const bool log = !live && fw::is_candump_log(opt.replay_path);
+  refuse_without_effect(app, {"--pga", "--scale", "--replay-y", "--vertical"}, !live && !log,
+                        "scales or completes a record replay (.AT2, .csv); a candump log's and a "
+                        "bus's frames are taken as they come");
+  refuse_without_effect(app, {"--duration"}, live,
+                        "stops a live run (--can); a replay ends with its input");
+  refuse_without_effect(app, {"--speed"}, !live,
+                        "paces a replay; a live bus (--can) comes at its own pace");
+  refuse_without_effect(app, {"--log-time"}, log,
+                        "applies to a candump log replay only (a record's samples are timed by "
+                        "its sampling interval, a bus's frames by the receive clock)");
+  refuse_without_effect(app, {"--pre-trigger", "--post-trigger"}, !opt.record_dir.empty(),
+                        "sets the event recorder's captures, which is off (--record-dir)");
+}
+
 void add_options(CLI::App& app, Options& opt) {
   fw::MonitorOverrides& c = opt.config;
   app.add_option("--scene", opt.scene_path, "scene file (TOML), the statue's first axis")->required();
@@ -562,6 +600,9 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--scale", opt.scale, "scale factor of the record")
       ->check(plinth::host::kFinite)->excludes("--pga");
   app.add_option("--speed", opt.speed, "replay speed: a factor of real time, or max (default)");
+  app.add_option("--log-time", opt.log_time,
+                 "a candump log's timestamps that go back, stand still or jump: warn (default: "
+                 "named, counted, the box's input fault raised) or refuse (stop at the first)");
   app.add_option("--rate", c.rate_hz, "sensor rate, Hz (100-1000; default: the record's, or 200)")
       ->check(plinth::host::kFinitePositive);
   app.add_option("--steps", c.steps, "solver steps per sample (default 4)")
@@ -627,7 +668,8 @@ int main(int argc, char** argv) {
   CLI::App app{"plinth-monitor: the early-warning box's estimator, risk and alarms"};
   Options opt;
   add_options(app, opt);
-  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+  if (const std::optional<int> exit_code =
+          plinth::host::parse_command_line(app, argc, argv, [&] { refuse_without_effect(app, opt); })) {
     return *exit_code;
   }
   std::signal(SIGINT, on_signal);

@@ -21,7 +21,7 @@ SampleTrace::SampleTrace(const std::string& path, int axis_count, double t_origi
   std::fputs("# plinth-monitor --trace: one line per sample the estimators took\n"
              "# alarm, latched: 0 normal, 1 advisory, 2 warning, 3 alarm, 4 fault\n"
              "# phase: 0 full_contact, 1 sliding, 2 rocking, 3 slide_rocking, 4 overturned, "
-             "5 fell; nan: not estimating\n"
+             "5 fell, 6 lifted_off; nan: not estimating\n"
              "# t_s\trisk\talarm\tlatched",
              file_.get());
   for (int axis = 0; axis < axis_count; ++axis) {

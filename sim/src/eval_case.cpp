@@ -30,6 +30,7 @@ constexpr double kFreeRockingTailS = 3.0;
 struct Truth {
   bool collapsed = false;
   double collapse_time_s = -1.0;
+  double lift_off_s = -1.0;  // the statue lifted off then: the model, and the truth, end
   double peak_ratio = 0.0;  // max |theta| / alpha of the corner it rocks on
   double first_motion_s = -1.0;  // s: first out of full contact; -1: never
   double step_s = 0.0;
@@ -79,7 +80,9 @@ Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& setti
                                       : -theta / s.corner2.critical_angle;
     truth.peak_ratio = std::max(truth.peak_ratio, ratio);
   }
-  if (sim.mode().terminal()) {
+  if (sim.mode().phase == Phase::kLiftedOff) {
+    truth.lift_off_s = sim.time();
+  } else if (sim.mode().collapsed()) {
     truth.collapsed = true;
     truth.collapse_time_s = sim.time();
     truth.peak_ratio = std::max(truth.peak_ratio, 1.0);
@@ -157,11 +160,12 @@ void note_level(monitor::AlarmLevel shown, double t,
   }
 }
 
-// The box on the case's motion; stops at `stop_s` (the true collapse: what comes after cannot
-// make a hit), else at the end of the record and its tail.
+// The box on the case's motion; stops at the true collapse (what comes after cannot make a hit)
+// or the true statue's lift-off (nothing after it is known), else at the end of the record and
+// its tail.
 void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
              const host::CrossingGrids& grids, const Truth& truth, EvalRun& run) {
-  const double stop_s = truth.collapse_time_s;
+  const double stop_s = truth.collapsed ? truth.collapse_time_s : truth.lift_off_s;
   const fw::MonitorConfig config = box_config(box);
   auto monitor = std::make_unique<fw::Monitor>();  // an ensemble is too big for the stack
   const std::span<const Scene> members = box.knows_true_statue
@@ -224,6 +228,7 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.collapsed = truth.collapsed;
   run.collapse_time_s = truth.collapse_time_s;
   run.peak_ratio = truth.peak_ratio;
+  run.model_valid_until_s = truth.lift_off_s;
   run.first_motion_s = truth.first_motion_s;
   run_box(c, gamma, box, grids, truth, run);
   return run;

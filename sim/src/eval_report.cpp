@@ -209,6 +209,7 @@ Report make_report(const EvalTable& table, const CalibrationTargets& targets, bo
   }
   Report report;
   report.runs = table.runs.size();
+  for (const EvalRun& r : table.runs) report.outside_model += r.outside_model() ? 1U : 0U;
   report.false_alarm = targets.false_alarm;
   report.margins_known = table.has_grid;
   std::vector<std::string> halves[2];
@@ -263,13 +264,17 @@ Report make_report(const EvalTable& table, const CalibrationTargets& targets, bo
 
 std::string report_text(const Report& report, const CrossingGrids& grids) {
   const bool m = report.margins_known;
-  std::string out = "plinth-eval: " + std::to_string(report.runs) + " runs; false alarms for the "
-                    "calibration and the frontier: " +
-                    (report.false_alarm == host::FalseAlarm::kMargin
-                         ? "unneeded alarms (--false-alarm margin: raised in runs whose collapse "
-                           "margin is >= 2)\n"
-                         : "alarms in quiet runs (--false-alarm peak: peak below half the "
-                           "overturning angle)\n");
+  std::string out = "plinth-eval: " + std::to_string(report.runs) + " runs";
+  if (report.outside_model > 0) {
+    out += ", of which " + std::to_string(report.outside_model) +
+           " left the model (the true statue lifted off: no truth, counted in no outcome)";
+  }
+  out += std::string("; false alarms for the calibration and the frontier: ") +
+         (report.false_alarm == host::FalseAlarm::kMargin
+              ? "unneeded alarms (--false-alarm margin: raised in runs whose collapse "
+                "margin is >= 2)\n"
+              : "alarms in quiet runs (--false-alarm peak: peak below half the "
+                "overturning angle)\n");
   if (!m) {
     out += "collapse margins: not in this file (no seed and pga grid columns: a plinth-eval "
            "before the margin)\n";
@@ -314,7 +319,9 @@ std::string report_text(const Report& report, const CrossingGrids& grids) {
 
 std::string report_json(const Report& report, const CrossingGrids& grids) {
   const bool m = report.margins_known;
-  std::string out = "{\"runs\": " + std::to_string(report.runs) + ", \"false_alarm\": " +
+  std::string out = "{\"runs\": " + std::to_string(report.runs) +
+                    ", \"outside_model\": " + std::to_string(report.outside_model) +
+                    ", \"false_alarm\": " +
                     host::json_quoted(host::false_alarm_name(report.false_alarm)) +
                     ", \"margins_known\": " + (m ? "true" : "false") + ", \"levels\": [";
   for (std::size_t i = 0; i < report.levels.size(); ++i) {

@@ -47,6 +47,7 @@ struct FrontierReport {
 
 struct Report {
   std::size_t runs = 0;
+  std::size_t outside_model = 0;  // of which the true statue lifted off: counted nowhere
   host::FalseAlarm false_alarm = host::FalseAlarm::kMargin;  // what calibration and frontier count
   bool margins_known = false;  // the runs file records the grid (host::EvalTable::has_grid)
   std::vector<LevelReport> levels;  // advisory, warning, alarm

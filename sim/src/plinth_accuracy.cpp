@@ -88,6 +88,7 @@ struct Observed {
   double t_slide = kNaN;                                // first sliding_start, s
   double peak_theta = 0.0, peak_u = 0.0, peak_x = 0.0;  // rad, m, m
   bool collapsed = false;                               // overturned or fell
+  bool lifted_off = false;  // the model ended (Phase::kLiftedOff): neither collapse nor not
   std::int64_t steps = 0;
   double simulated = 0.0;  // s
   double wall = 0.0;       // s, the fastest of the repetitions
@@ -215,7 +216,8 @@ std::optional<Observed> simulate(const Input& in, double pga_g, double t_end,
     o.peak_theta = std::max(peak_theta, sink.peak_theta);
     o.peak_u = std::max(peak_u, sink.peak_u);
     o.peak_x = std::max(peak_x, sink.peak_x);
-    o.collapsed = sim.mode().terminal();
+    o.collapsed = sim.mode().collapsed();
+    o.lifted_off = sim.mode().phase == plinth::Phase::kLiftedOff;
     o.steps = sim.step_count();
     o.simulated = sim.time();
   }
@@ -271,7 +273,7 @@ Errors errors_of(const Observed& o, const Observed& r) {
           relative_error(o.peak_theta, r.peak_theta),
           relative_error(o.peak_u, r.peak_u),
           relative_error(o.peak_x, r.peak_x),
-          o.collapsed != r.collapsed};
+          o.collapsed != r.collapsed || o.lifted_off != r.lifted_off};
 }
 
 // One row of the raw table: a case (or threshold case), a variant, a step.

@@ -256,11 +256,20 @@ int run_eval(const RunOptions& opt) {
   write_runs(opt.out_path, grids, results);
   if (!opt.motion_path.empty()) write_motion(opt.motion_path, results);
   std::size_t runs = 0;
-  for (const auto& job : results) runs += job.size();
+  std::size_t outside_model = 0;
+  for (const auto& job : results) {
+    runs += job.size();
+    for (const EvalRun& r : job) outside_model += r.outside_model() ? 1U : 0U;
+  }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::printf("plinth-eval: %zu runs of %zu cases (shard %d/%d), %d jobs, wall time %.1f s -> %s\n",
               runs, indices.size(), run.shard_index, run.shard_count, run.jobs, wall,
               opt.out_path.c_str());
+  if (outside_model > 0) {
+    std::printf("plinth-eval: %zu runs left the model (the true statue lifted off; their "
+                "model_valid_until_s says when): no truth, counted in no outcome\n",
+                outside_model);
+  }
   return 0;
 }
 
@@ -416,7 +425,12 @@ int main(int argc, char** argv) {
   CLI::App* merge_command = app.add_subcommand("merge", "join the runs CSVs of shards");
   merge_command->add_option("--out", merge.out_path, "merged CSV")->required();
   merge_command->add_option("inputs", merge.inputs, "the shards' CSV files")->required();
-  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+  const auto checks = [&] {
+    plinth::host::refuse_without_effect(*run, {"--horizon"}, opt.forecast != "off",
+                                        "sets the forecast's horizon, and --forecast is off");
+  };
+  if (const std::optional<int> exit_code =
+          plinth::host::parse_command_line(app, argc, argv, checks)) {
     return *exit_code;
   }
   return plinth::host::run_tool("plinth-eval", [&] {

@@ -60,6 +60,7 @@ class RunSink final : public plinth::EventSink {
     if (events_out_ != nullptr) *events_out_ << plinth::host::event_json(e) << '\n';
     if (e.kind == EventKind::kImpact || e.kind == EventKind::kRockingStop) ++impacts;
     if (e.kind == EventKind::kBaseStopHit) ++base_stop_hits;
+    if (e.kind == EventKind::kLiftOff) lift_off = e;
     const char* side = e.side > 0 ? "right" : "left";
     char text[128];
     switch (e.kind) {
@@ -112,6 +113,7 @@ class RunSink final : public plinth::EventSink {
   std::vector<TimelineEntry> timeline{{0.0, "full_contact"}};
   long impacts = 0;
   long base_stop_hits = 0;
+  std::optional<plinth::Event> lift_off;
 
  private:
   std::ostream* events_out_;
@@ -181,6 +183,15 @@ plinth::Excitation record_excitation(const Options& opt, double g, plinth::host:
     vertical_text = "; vertical: " + opt.vertical_path +
                     (record.vertical.empty() ? "" : " (in place of the record's own column)");
   }
+  if (record.dt < opt.dt) {  // said, not refused: the run is still the record's low-passed view
+    std::fprintf(stderr,
+                 "plinth-sim: note: %s is sampled every %s s, finer than --dt %s: the integration "
+                 "sees the record at its steps only (a --dt of at most %s follows every sample)\n",
+                 plinth::host::shown(opt.record_path).c_str(),
+                 plinth::host::number_text(record.dt).c_str(),
+                 plinth::host::number_text(opt.dt).c_str(),
+                 plinth::host::number_text(record.dt).c_str());
+  }
   const double gamma = plinth::host::record_scale(record, opt.record_path, opt.pga, opt.scale, g);
   if (!opt.vertical_path.empty()) {
     plinth::host::check_scaled_peak(
@@ -195,18 +206,30 @@ plinth::Excitation record_excitation(const Options& opt, double g, plinth::host:
   return plinth::Excitation::record(record.horizontal_signal(), vertical_signal, gamma);
 }
 
+// The fewest solver steps in a pulse's period (a one-sine pulse sampled 20 times: its peak
+// within 1.3 %).
+constexpr double kMinStepsPerPulse = 20.0;
+
 // The steps of the run and between CSV rows, within the limits (limits.h).
 struct StepPlan {
   std::int64_t steps = 0;
   std::int64_t out_every = 1;
 };
 
-StepPlan plan_steps(const Options& opt, double t_end) {
+// `t_end`: --t-end, or the excitation's duration + 5 s (at least 10 s), whose input a message
+// about the run's length names: the pulse's --period or the record.
+StepPlan plan_steps(const Options& opt, double t_end, double excitation_duration) {
   using plinth::host::given;
+  std::string run_of = " (a run of " + plinth::host::number_text(t_end) + " s";
+  if (!opt.t_end && excitation_duration + 5.0 > 10.0) {
+    const std::string source = !opt.record_path.empty()
+                                   ? "the record " + plinth::host::shown(opt.record_path)
+                                   : "the pulse of " + given("--period", opt.period.value_or(0.0));
+    run_of += ": " + source + " lasts " + plinth::host::number_text(excitation_duration) +
+              " s, and 5 s after it; --t-end shortens it";
+  }
   const std::string subject =
-      given("--dt", opt.dt) + (opt.t_end
-                                   ? " and " + given("--t-end", t_end)
-                                   : " (a run of " + plinth::host::number_text(t_end) + " s)");
+      given("--dt", opt.dt) + (opt.t_end ? " and " + given("--t-end", t_end) : run_of + ")");
   StepPlan plan;
   plan.steps = plinth::host::bounded_count(std::round(t_end / opt.dt), plinth::host::kMaxRunSteps,
                                            subject, "the run would take", "solver steps");
@@ -256,6 +279,14 @@ int run(const Options& opt) {
       throw InputError("--amplitude " + opt.amplitude + ": limit " +
                        plinth::host::number_text(plinth::host::kMaxScaledPeakG) + " g");
     }
+    // A pulse the step cannot follow would be sampled at a few points, or at none: outside
+    // what the integration assumes (docs/model.md, "Other limits of the model").
+    if (*opt.period < kMinStepsPerPulse * opt.dt) {
+      throw InputError(plinth::host::given("--period", *opt.period) + ": a pulse shorter than " +
+                       plinth::host::number_text(kMinStepsPerPulse) + " solver steps (" +
+                       plinth::host::given("--dt", opt.dt) +
+                       ") is not followed by the integration; a smaller --dt or a longer --period");
+    }
     excitation = opt.pulse == "sine" ? plinth::Excitation::sine_pulse(amplitude, *opt.period)
                                      : plinth::Excitation::cosine_pulse(amplitude, *opt.period);
     char text[160];
@@ -276,10 +307,10 @@ int run(const Options& opt) {
   settings.step = opt.dt;
   plinth::Simulator sim;
   plinth::host::throw_if_simulator_error(
-      plinth::Simulator::create(scene, excitation, settings, sim));
+      plinth::Simulator::create(scene, excitation, settings, sim), scene, settings.step);
 
   const double t_end = opt.t_end ? *opt.t_end : std::max(10.0, excitation.duration() + 5.0);
-  const StepPlan plan = plan_steps(opt, t_end);
+  const StepPlan plan = plan_steps(opt, t_end, excitation.duration());
   std::optional<plinth::host::OutputFile> csv_file;
   std::optional<plinth::host::OutputFile> events_file;
   if (!opt.out_path.empty()) csv_file.emplace("--out", opt.out_path);
@@ -326,7 +357,11 @@ int run(const Options& opt) {
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   const plinth::host::Outcome outcome = plinth::host::outcome_of(sim.mode().phase);
-  if (events_file) events_file->stream() << plinth::host::end_json(sim.time(), outcome) << '\n';
+  if (events_file) {
+    events_file->stream() << plinth::host::end_json(sim.time(), outcome,
+                                                     sink.lift_off ? sink.lift_off->t : 0.0)
+                          << '\n';
+  }
   if (csv_file) csv_file->commit();
   if (events_file) events_file->commit();
 
@@ -340,6 +375,15 @@ int run(const Options& opt) {
     std::printf("  %10.4f s  %s\n", entry.t, entry.what.c_str());
   }
   const double alpha = std::min(scene.corner1.critical_angle, scene.corner2.critical_angle);
+  if (sink.lift_off) {
+    std::printf("outside the model: at t = %.6g s the block lost contact with its support (%s; "
+                "g + v_G'' = %.4g m/s2). The model has no free flight: this run ends there, and "
+                "neither survival nor collapse is known after it.\n",
+                sink.lift_off->t,
+                sink.lift_off->before < 0.0 ? "the ground falls faster than gravity"
+                                            : "the rocking unloads its pivot, Eq 12",
+                sink.lift_off->before);
+  }
   std::printf("outcome:    %s at t = %.4f s; peak |theta| %.4g rad (%.3g of alpha), peak |u| %.4g m,"
               " peak |x| %.4g m; %ld impacts, %ld base stop hits\n",
               plinth::host::outcome_name(outcome), sim.time(), peak_theta, peak_theta / alpha,
@@ -377,7 +421,13 @@ int main(int argc, char** argv) {
   app.add_option("--out-interval", opt.out_interval, "time between CSV rows, s (whole steps)")
       ->check(plinth::host::kFinitePositive);
   app.add_option("--events", opt.events_path, "JSON Lines event log");
-  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+  const auto checks = [&] {
+    plinth::host::refuse_without_effect(
+        app, {"--out-interval"}, !opt.out_path.empty(),
+        "sets the time between the rows of --out's CSV; without --out there is no CSV");
+  };
+  if (const std::optional<int> exit_code =
+          plinth::host::parse_command_line(app, argc, argv, checks)) {
     return *exit_code;
   }
   if (!opt.pulse.empty() && (opt.amplitude.empty() || !opt.period)) {

@@ -331,7 +331,27 @@ int main(int argc, char** argv) {
   plot_command->add_option("csv", plot.csv_path, "a plinth-sweep CSV")->required();
   plot_command->add_option("--out", plot.plot_path, "image: map.png writes map.png and map.svg")
       ->required();
-  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+  const auto checks = [&] {
+    using plinth::host::refuse_without_effect;
+    const bool pga_mode = !opt.impulse_map && !opt.impulse_curve;
+    refuse_without_effect(app, {"--event"}, pga_mode && !opt.param2.empty(),
+                          "chooses the one event of a two-parameter map (--param2); a "
+                          "one-parameter sweep has a column for each event, the impulse modes "
+                          "their own");
+    refuse_without_effect(app, {"--from2", "--to2", "--steps2"}, !opt.param2.empty(),
+                          "is part of --param2's range, and --param2 is not given");
+    refuse_without_effect(app, {"--param", "--from", "--to", "--steps"}, !opt.impulse_map,
+                          "the impulse map's axes are mu_s and |I| (--mu-from ... --impulse-steps)");
+    refuse_without_effect(app,
+                          {"--mu-from", "--mu-to", "--mu-steps", "--impulse-from", "--impulse-to",
+                           "--impulse-steps"},
+                          opt.impulse_map, "is an axis of the impulse map, and --impulse-map is "
+                                           "not given");
+    refuse_without_effect(app, {"--impulse-max", "--impulse-tol"}, opt.impulse_curve,
+                          "sets the search of the impulse curve, and --impulse-curve is not given");
+  };
+  if (const std::optional<int> exit_code =
+          plinth::host::parse_command_line(app, argc, argv, checks)) {
     return *exit_code;
   }
   if (opt.compare_ground && opt.impulse_map) {

@@ -21,8 +21,25 @@ using plinth::host::InputError;
 using plinth::host::SweepTable;
 
 
-// Rows of `path` that belong to this sweep, placed by key ("" elsewhere); nothing when the
-// file is absent, from another sweep, or not a sweep CSV (a note says so).
+// Moves `path` aside to the first free name `path`.kept, `path`.kept-2, ... and returns it: rows
+// this run cannot continue are never thrown away.
+std::string set_aside(const std::string& path) {
+  std::string kept = path + ".kept";
+  for (int n = 2; std::filesystem::exists(kept); ++n) kept = path + ".kept-" + std::to_string(n);
+  std::error_code error;
+  std::filesystem::rename(path, kept, error);
+  if (error) {
+    throw InputError(path + ": cannot be resumed, and cannot be moved aside to " + kept + " (" +
+                     error.message() + "); move it, or give another --out");
+  }
+  return kept;
+}
+
+// Rows of `path` that belong to this sweep, placed by key ("" elsewhere); nothing when the file
+// is absent. A file that differs only in line endings or formatting (a spreadsheet's quotes,
+// spaces, padding, number formats) is read as the same rows (read_sweep_table). A file from
+// another sweep, or not a sweep CSV, is moved aside (set_aside), with a note saying why and
+// where its rows are.
 std::vector<std::string> resumable_rows(const std::string& path,
                                         const plinth::host::SweepPlan& plan,
                                         const std::vector<bool>& in_shard) {
@@ -33,17 +50,20 @@ std::vector<std::string> resumable_rows(const std::string& path,
   try {
     table = plinth::host::read_sweep_table(path, &dropped);
   } catch (const InputError& e) {
-    std::fprintf(stderr, "plinth-sweep: note: %s; it will be replaced\n", e.what());
+    const std::string kept = set_aside(path);
+    std::fprintf(stderr, "plinth-sweep: note: %s; not resumed: it is kept as %s\n", e.what(),
+                 kept.c_str());
     return none;
   }
-  if (table.settings != plan.settings || table.header != plan.header) {
-    std::string difference =
-        plinth::host::settings_difference(table.settings, "the file", plan.settings, "this run");
-    if (difference.empty()) difference = "other columns";
+  const std::string difference =
+      plinth::host::settings_difference(table.settings, "the file", plan.settings, "this run");
+  if (!difference.empty() || table.header != plan.header) {
+    const std::string kept = set_aside(path);
     std::fprintf(stderr,
-                 "plinth-sweep: note: %s comes from another sweep (%s); it will be replaced, not "
-                 "resumed\n",
-                 path.c_str(), difference.c_str());
+                 "plinth-sweep: note: %s comes from another sweep (%s); not resumed: its %zu "
+                 "row(s) are kept as %s\n",
+                 path.c_str(), difference.empty() ? "other columns" : difference.c_str(),
+                 table.rows.size(), kept.c_str());
     return none;
   }
   std::vector<std::string> placed =

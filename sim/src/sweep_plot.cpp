@@ -373,8 +373,9 @@ void impulse_map_plot(Script& s, const Columns& c) {
     if (const Field rs = c.at(r, c.index("c_rs")); rs && c_r && *i >= *c_r) c_rs[*i] = *rs;
   }
   const auto starts = plinth::host::kImpulseStartNames.values();
-  const std::array<const char*, 4> colours = {"#b0b0b0", "#1f77b4", "#ff7f0e", "#2ca02c"};
-  const std::array<int, 4> points = {1, 5, 7, 9};
+  const std::array<const char*, 5> colours = {"#b0b0b0", "#1f77b4", "#ff7f0e", "#2ca02c",
+                                              "#d62728"};
+  const std::array<int, 5> points = {1, 5, 7, 9, 3};
   std::string plot = "plot ";
   std::string differ;
   for (std::size_t k = 0; k < starts.size(); ++k) {

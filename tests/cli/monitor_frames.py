@@ -17,12 +17,12 @@ import re
 import sys
 
 LINE = re.compile(r"^\((\d+)\.(\d{6})\) (\S+) ([0-9A-F]{3})#((?:[0-9A-F]{2})*)$")
-PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "fell"]
+PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "fell", "lifted_off"]
 CORNERS = ["none", "left", "right"]
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", None, None, "statue_unexplained"]
+          "collapse_forecast", "not_calibrated", "outside_model", None, "statue_unexplained"]
 STATUS_ID, ALARM_ID = 0x320, 0x330
 
 

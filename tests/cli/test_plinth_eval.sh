@@ -237,7 +237,7 @@ python3 - all.csv old.csv <<'PY'
 import csv, sys
 rows = list(csv.reader(open(sys.argv[1])))
 with open(sys.argv[2], "w", newline="") as out:
-    csv.writer(out, lineterminator="\n").writerows([r[:10] + r[14:] for r in rows])
+    csv.writer(out, lineterminator="\n").writerows([r[:10] + r[15:] for r in rows])  # neither model_valid_until_s nor the grid
 PY
 expect_failure "an earlier file is refused for the margin" "old.csv" "no seed and pga grid" \
   "--false-alarm peak" -- report old.csv

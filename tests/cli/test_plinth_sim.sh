@@ -134,6 +134,36 @@ if expect_success "on the ground, impulse -3 m/s: exit 0" --scene "$GROUND" --im
   check "impulse -3 m/s overturns: CSV header and rows" "$(csv_problem "$TMP/over.csv")"
 fi
 
+# A ground that falls faster than gravity (vertical column to -1.5 g) lifts the block off: the
+# run ends there, outside the model, said in the events, the end line and the summary.
+{
+  echo "t,ag [g],v [g]"
+  for i in $(seq 0 200); do
+    printf '%s,0.05,%s\n' "$(awk "BEGIN{print $i * 0.01}")" "$(awk "BEGIN{v = -1.5 * ($i * 0.01 - 1); print ($i < 100) ? 0 : v}")"
+  done
+} >"$TMP/falling.csv"
+if expect_success "a falling ground: exit 0" --scene "$ISOLATED" --record "$TMP/falling.csv" \
+  --out "$TMP/lift.csv" --events "$TMP/lift.jsonl"; then
+  check "a falling ground: events are JSON Lines" "$(json_lines_problem "$TMP/lift.jsonl")"
+  lift_t=$(grep -oE '^\{"t": [0-9.]+, "event": "lift_off", "from": "[a-z_]+"' "$TMP/lift.jsonl" |
+    grep -oE '[0-9]+\.[0-9]+' | head -n 1)
+  if [[ -n "$lift_t" ]] &&
+    grep -qxE "\\{\"t\": [0-9.]+, \"event\": \"end\", \"outcome\": \"lifted_off\", \"model_valid_until\": $lift_t\\}" \
+      "$TMP/lift.jsonl"; then
+    pass "a falling ground: a lift_off event, and the end line says lifted_off and when"
+  else
+    fail "a falling ground: a lift_off event, and the end line says lifted_off and when" \
+      "events: $(tail -n 2 "$TMP/lift.jsonl" | tr '\n' ' ' | cut -c 1-300)"
+  fi
+  if [[ "$(tail -n 1 "$TMP/lift.csv" | cut -d, -f9)" == lifted_off ]] &&
+    grep -q "^outcome:    lifted_off" "$TMP/stdout" && grep -q "^outside the model: " "$TMP/stdout"; then
+    pass "a falling ground: the CSV's last phase and the summary say lifted_off"
+  else
+    fail "a falling ground: the CSV's last phase and the summary say lifted_off" \
+      "$(tail -n 1 "$TMP/lift.csv"); $(grep -E '^(outcome|outside)' "$TMP/stdout" | cut -c 1-200)"
+  fi
+fi
+
 if expect_success "on the ground, Brienza at 3g: exit 0" --scene "$GROUND" --record "$AT2" \
   --pga 3g --events "$TMP/over3g.jsonl"; then
   if has_event "$TMP/over3g.jsonl" overturned &&

@@ -53,7 +53,7 @@ check "a sweep writes its map" test "$RC" -eq 0 -a -s whole.csv
 check "the first line records the settings" \
   grep -q '^# plinth-sweep thresholds grid=mu_s:0.2:0.5:4 scene=' whole.csv
 check "the header names the parameter and the events" grep -qx \
-  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned' whole.csv
+  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned,lift_off' whole.csv
 check "one row per value" test "$(grep -c '^0\.' whole.csv)" -eq 4
 check "no progress bar when stderr is not a terminal" test ! -s "$TMP/err.txt"
 
@@ -82,6 +82,54 @@ cp whole.csv again.csv
 sweep "${SMALL[@]}" --out again.csv
 check "a finished sweep is resumed, not rerun" grep -q '4 resumed from again.csv), 0 simulations' "$TMP/out.txt"
 check "and its file is unchanged" cmp -s again.csv whole.csv
+
+# A finished file that differs only in line endings or formatting is resumed, and rewritten as
+# plinth-sweep writes it (issue 25). The class walked: CRLF, classic Mac CR, a byte order mark,
+# a spreadsheet's save (every field quoted, spaces after commas, the settings line padded with
+# empty fields, numbers as 2.000000000E-01), blank lines and no final line feed.
+declare -A RESAVED=(
+  [crlf]="sed 's/\$/\r/'"
+  [cr]="tr '\n' '\r'"
+  [bom]="sed '1s/^/\xef\xbb\xbf/'"
+  [spreadsheet]="awk 'NR == 1 { printf \"\\\"%s\\\",,,,,,,,,\r\n\", \$0; next }
+    { n = split(\$0, f, \",\"); out = \"\"
+      for (i = 1; i <= n; i++) { v = f[i]; if (v ~ /^[0-9.]+\$/) v = sprintf(\"%.9E\", v)
+        out = out (i > 1 ? \", \" : \"\") \"\\\"\" v \"\\\"\" }
+      printf \"%s\r\n\", out }'"
+  [blank-lines]="awk '{ print } NR == 3 { print \"\"; print \",,,\" }' | head -c -1"
+)
+for variant in "${!RESAVED[@]}"; do
+  eval "${RESAVED[$variant]}" <whole.csv >"resaved-$variant.csv"
+  if cmp -s "resaved-$variant.csv" whole.csv; then
+    fail "a file resaved ($variant) is resumed" "the variant changed nothing"
+    continue
+  fi
+  sweep "${SMALL[@]}" --out "resaved-$variant.csv"
+  check "a file resaved ($variant) is resumed" \
+    grep -q "4 resumed from resaved-$variant.csv), 0 simulations" "$TMP/out.txt"
+  check "and rewritten as plinth-sweep writes it ($variant)" cmp -s "resaved-$variant.csv" whole.csv
+done
+# A file that cannot be continued says why and keeps its rows beside (never replaced unseen).
+sed 's/tol_g=0.05/tol_g=0.1/' whole.csv >othertol.csv
+cp othertol.csv othertol.orig
+sweep "${SMALL[@]}" --out othertol.csv
+check "a file of another sweep says why it is not resumed" \
+  grep -q "othertol.csv comes from another sweep (tol_g: 0.1 in the file, 0.05 in this run); not resumed: its 4 row(s) are kept as othertol.csv.kept" "$TMP/err.txt"
+check "and its rows are kept" cmp -s othertol.csv.kept othertol.orig
+check "and the run writes its own" cmp -s othertol.csv whole.csv
+cp othertol.orig othertol.csv
+sweep "${SMALL[@]}" --out othertol.csv
+check "a second one is kept beside the first" cmp -s othertol.csv.kept-2 othertol.orig
+printf 'not a sweep\n' >notsweep.csv
+sweep "${SMALL[@]}" --out notsweep.csv
+check "a file that is not a sweep CSV says so and is kept" \
+  grep -q "notsweep.csv:1: not a plinth-sweep CSV.*not resumed: it is kept as notsweep.csv.kept" "$TMP/err.txt"
+check "unchanged" grep -qx 'not a sweep' notsweep.csv.kept
+sed '3s/^0\.2,/0.25,/' whole.csv >offgrid.csv
+cp offgrid.csv offgrid.orig
+refuses "a row off the grid stops the run, naming it" "offgrid.csv: row '0.25' is not a point of this sweep's grid" \
+  "${SMALL[@]}" --out offgrid.csv
+check "and leaves the file as it was" cmp -s offgrid.csv offgrid.orig
 
 # Interrupt: SIGINT once a row is written; the rows so far are kept; a rerun resumes.
 LONG=(--scene "$ISOLATED" --record "$AT2" --param mu_s --from 0.3 --to 1.5 --steps 9
@@ -139,13 +187,13 @@ check "--compare-ground writes its map" test "$RC" -eq 0 -a -s cmp.csv
 check "its settings line says compare=ground" \
   grep -q '^# plinth-sweep thresholds grid=mu_s:0.2:0.5:4 scene=.* compare=ground$' cmp.csv
 check "its header adds the ground's events, suffixed _ground" grep -qx \
-  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned,sliding_ground,rocking_ground,slide_rocking_ground,overturned_ground' cmp.csv
+  'mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned,lift_off,sliding_ground,rocking_ground,slide_rocking_ground,overturned_ground,lift_off_ground' cmp.csv
 check "the scene's own columns are those of the run without it" \
-  cmp -s <(tail -n +3 cmp.csv | cut -d, -f1-9) <(tail -n +3 whole.csv)
+  cmp -s <(tail -n +3 cmp.csv | cut -d, -f1-10) <(tail -n +3 whole.csv)
 sweep --scene "$SCENES/non-isolated.toml" --record "$AT2" --param mu_s --from 0.2 --to 0.5 \
   --steps 4 --pga-max 4g --tol 0.05g --dt 4e-3 --out ground.csv
 check "the ground columns are those of a run of non-isolated.toml" \
-  cmp -s <(tail -n +3 cmp.csv | cut -d, -f10-13) <(tail -n +3 ground.csv | cut -d, -f2-4,9)
+  cmp -s <(tail -n +3 cmp.csv | cut -d, -f11-15) <(tail -n +3 ground.csv | cut -d, -f2-4,9,10)
 check "and the block on the ground rocks there" test -n "$(tail -n +3 ground.csv | cut -d, -f3 | tr -d '\n')"
 PERIOD=(--scene "$ISOLATED" --record "$AT2" --param T --from 1 --to 3 --steps 3 --pga-max 4g
         --tol 0.05g --dt 4e-3 --jobs 2)
@@ -157,8 +205,8 @@ sweep --scene "$SCENES/non-isolated.toml" --record "$AT2" --param epsilon --from
   --steps 1 --pga-max 4g --tol 0.05g --dt 4e-3 --out ground1.csv
 alone=$(simulations)
 check "against T (the ground has none) every row holds the one ground row" test \
-  "$(tail -n +3 cmpT.csv | cut -d, -f10,11 | sort -u)" = "$(tail -n +3 ground1.csv | cut -d, -f3,9)"
-check "its header has only rocking and overturned (no friction)" grep -q ',overturned,rocking_ground,overturned_ground$' cmpT.csv
+  "$(tail -n +3 cmpT.csv | cut -d, -f11-13 | sort -u)" = "$(tail -n +3 ground1.csv | cut -d, -f3,9,10)"
+check "its header has only rocking, overturned and lift_off (no friction)" grep -q ',lift_off,rocking_ground,overturned_ground,lift_off_ground$' cmpT.csv
 check "and the ground was searched once" test "$compared" -eq $((plain + alone))
 # Shards, merge and resume with the ground's columns (on the T sweep: cheap).
 sweep "${PERIOD[@]}" --compare-ground --shard 2/2 --out cmpT2.csv
@@ -179,6 +227,7 @@ cp plainT.csv plainfirst.csv
 sweep "${PERIOD[@]}" --compare-ground --out plainfirst.csv
 check "a map made without --compare-ground is replaced, saying why" \
   grep -q "another sweep (compare: none in the file, ground in this run)" "$TMP/err.txt"
+check "and keeping its rows beside" cmp -s plainfirst.csv.kept plainT.csv
 check "by the compared map" cmp -s plainfirst.csv cmpT.csv
 sweep --scene "$ISOLATED" --record "$AT2" --param lambda --from 3 --to 4 --steps 2 \
   --param2 epsilon --from2 -0.3 --to2 0.3 --steps2 2 --event rocking --pga-max 4g --tol 0.05g \
@@ -188,8 +237,8 @@ check "and keeps the map's own column" cmp -s <(tail -n +3 cmpmap2.csv | cut -d,
 sweep --scene "$ISOLATED" --impulse-curve --param T --from 1.5 --to 2.5 --steps 2 \
   --impulse-max 5 --impulse-tol 0.01 --compare-ground --out cmpicurve.csv
 check "a compared impulse curve adds the ground's overturning" grep -qx \
-  'T,rocking,overturned,rocking_closed_form,overturned_closed_form,overturned_ground,overturned_closed_form_ground' cmpicurve.csv
-check "and keeps the curve's own columns" cmp -s <(tail -n +3 cmpicurve.csv | cut -d, -f1-5) <(tail -n +3 icurve.csv)
+  'T,rocking,overturned,rocking_closed_form,overturned_closed_form,lift_off,overturned_ground,overturned_closed_form_ground,lift_off_ground' cmpicurve.csv
+check "and keeps the curve's own columns" cmp -s <(tail -n +3 cmpicurve.csv | cut -d, -f1-6) <(tail -n +3 icurve.csv)
 refuses "--compare-ground on a scene without a base" "--compare-ground: the scene has no \[base\]" \
   --scene "$SCENES/non-isolated.toml" --record "$AT2" --param mu_s --from 0.2 --to 0.5 --steps 2 \
   --compare-ground --out x.csv

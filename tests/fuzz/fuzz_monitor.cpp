@@ -239,7 +239,7 @@ class Harness {
       const fw::AxisStatus& a = s.axes[static_cast<std::size_t>(i)];
       check(a.state.allFinite(), "finite state");
       const auto phase = static_cast<int>(a.mode.phase);
-      check(phase >= 0 && phase <= static_cast<int>(plinth::Phase::kFell), "a known phase");
+      check(phase >= 0 && phase <= static_cast<int>(plinth::Phase::kLiftedOff), "a known phase");
       check(a.mode.rocking() || a.mode.phase == plinth::Phase::kFullContact ||
                 a.mode.phase == plinth::Phase::kSliding || a.mode.terminal(),
             "phase is one of the model's");

@@ -35,21 +35,21 @@ STATUS_IDS = (0x320, 0x321)
 ALARM_ID = 0x330
 FORECAST_IDS = (0x350, 0x351)  # CollapseForecast, with each status while forecasting
 NO_COLLAPSE_MS = 65535  # CollapseIn: none forecast
-PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "fell"]
+PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "fell", "lifted_off"]
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", None, None, "statue_unexplained"]
+          "collapse_forecast", "not_calibrated", "outside_model", None, "statue_unexplained"]
 SCENARIOS = ("main", "stop", "garbage", "burst")
 # Sent by canplayer in the garbage case, each one refused by the DBC (or not for the monitor).
 GARBAGE = (
     "301#", "301#00", "301#00112233445566",  # SensorAcceleration, lengths 0, 1, 7
     "301#00000000A00F00F0",  # its Status bits 4-7 (reserved)
     "311#00", "311#0000000010F00000",  # SensorHeartbeat: short; Status bits 4-7
-    "320#00F0000000000000", "320#0600000000000000",  # MonitorStatus: bits 12-15; phase 6
+    "320#00F0000000000000", "320#0700000000000000",  # MonitorStatus: bits 12-15; phase 7
     "320#0000112700000000", "320#0000000000000001",  # risk 10001 (> 1); bits 56-63
     "330#0000FE0000000000", "330#0500000000000000",  # AlarmEvent: bits 17-23; level 5
-    "330#000C000000000000", "330#000F000000000000",  # cause 12 (a gap), cause 15
+    "330#000D000000000000", "330#000F000000000000",  # cause 13, cause 15 (gaps)
     "350#1127000100000000", "351#E803050364002800",  # CollapseForecast: probability 10001;
     "350#0000110100000000",  # worst member 5 of 3 members; worst member 17
     "340#F000000000000000", "340#00",  # Acknowledge: bits 4-7; short
@@ -213,7 +213,7 @@ class Dbc:
             raw = (word >> s.start) & mask
             if s.signed and raw >> (s.length - 1):
                 raw -= 1 << s.length
-            # An enumeration's table lies within its range (the causes' has gaps: 12, 13).
+            # an enumeration's names lie in its range (a table may skip reserved values)
             enumeration = s.values is not None and \
                 all(s.raw_min <= v <= s.raw_max for v in s.values)
             if enumeration and raw not in s.values:
@@ -808,7 +808,7 @@ def run_checks(args):
               f"{j['jitter_max_us']:.0f} us over {j['frames_sent']} frames at --speed "
               f"{config['speed']:g} ({config['rate'] * config['speed']:g} frames/s)")
         print(f"  the record run took {figures['main_wall_s']:.2f} s (run "
-              f"{figures['main_attempts']} of at most 3)")
+              f"{figures['main_attempts']} of at most 5)")
         lo, hi = figures["bus_send_time_deviation_us"]
         print(f"  sensor frames on the bus vs k / (rate x speed): {lo:.0f} to {hi:.0f} us")
         print(f"  monitor timeline vs plinth-sim: {figures['timeline_vs_sim_us']:.1f} us "

@@ -69,7 +69,7 @@ status_count() { grep -c '"type": "status"' "$TMP/box.out"; }
 # 1. Writes off: the registers against the status lines after the overturn (a steady state:
 #    alarm latched, risk 1, for the record's last 24 s, 12 s at --speed 2: time for the reads below
 #    even on a loaded machine), three clients polling at once, a coil write refused. A box file
-#    that sets a statue sensor that never sends (registers 86-92: its streams at fault, not
+#    that sets a statue sensor that never sends (registers 102-108: its streams at fault, not
 #    measured): its digest in registers 81-85.
 PORT=$(free_port)
 printf '# monitor_modbus: the Modbus server from the command line\n[statue_sensor]\nnode = 2\n' \

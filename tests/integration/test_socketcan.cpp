@@ -158,13 +158,22 @@ TEST(NoCanKernel, OpenSaysTheKernelHasNoCanAndNamesTheInterface) {
     close(probe);
     GTEST_SKIP() << "this kernel has CAN: the no-CAN error cannot happen here";
   }
-  const SocketCanOpenResult r = SocketCanPort::open("vcan0");
+  // An interface that exists (the loopback): the kernel's lack of CAN is the reason.
+  const SocketCanOpenResult r = SocketCanPort::open("lo");
   EXPECT_FALSE(r.ok());
   EXPECT_FALSE(r.port.has_value());
   EXPECT_EQ(r.error, OpenError::kNoCanSupport);
   EXPECT_EQ(r.error_number, EAFNOSUPPORT);
-  EXPECT_NE(r.message.find("vcan0"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("cannot open CAN interface lo: "), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("this kernel has no CAN support"), std::string::npos) << r.message;
+  // A missing one is reported as missing first, the kernel's lack of CAN after it.
+  const SocketCanOpenResult missing = SocketCanPort::open("vcan0");
+  EXPECT_EQ(missing.error, OpenError::kNoSuchInterface);
+  EXPECT_NE(missing.message.find("cannot open CAN interface vcan0: the interface does not exist"),
+            std::string::npos)
+      << missing.message;
+  EXPECT_NE(missing.message.find("and this kernel has no CAN support"), std::string::npos)
+      << missing.message;
 }
 
 TEST(Open, RefusesEmptyAndTooLongNames) {

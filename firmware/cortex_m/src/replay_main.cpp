@@ -94,7 +94,7 @@ struct Cost {
 };
 
 // Which cost a sample counts to: every axis in full contact, some axis moving on the base, or
-// none moving and some overturned or fallen (the estimator no longer steps).
+// none moving and some overturned, fallen or lifted off (the estimator no longer steps).
 enum class SampleKind { kQuiet, kMoving, kOver };
 SampleKind kind_of(const fw::BoxStatus& s) {
   bool moving = false;
@@ -103,7 +103,7 @@ SampleKind kind_of(const fw::BoxStatus& s) {
     const Phase phase = s.axes[static_cast<std::size_t>(i)].mode.phase;
     moving = moving || phase == Phase::kSliding || phase == Phase::kRocking ||
              phase == Phase::kSlideRocking;
-    over = over || phase == Phase::kOverturned || phase == Phase::kFell;
+    over = over || Mode{phase}.terminal();
   }
   return moving ? SampleKind::kMoving : (over ? SampleKind::kOver : SampleKind::kQuiet);
 }

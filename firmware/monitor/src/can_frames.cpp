@@ -21,6 +21,7 @@ static_assert(same_number(Phase::kRocking, can::Phase::kRocking));
 static_assert(same_number(Phase::kSlideRocking, can::Phase::kSlideRocking));
 static_assert(same_number(Phase::kOverturned, can::Phase::kOverturned));
 static_assert(same_number(Phase::kFell, can::Phase::kFell));
+static_assert(same_number(Phase::kLiftedOff, can::Phase::kLiftedOff));
 static_assert(same_number(Corner::kLeft, can::Corner::kLeft));
 static_assert(same_number(Corner::kRight, can::Corner::kRight));
 
@@ -44,8 +45,9 @@ static_assert(same_number(AlarmCause::kBusError, can::AlarmCause::kBusError));
 static_assert(same_number(AlarmCause::kInternalFault, can::AlarmCause::kInternalFault));
 static_assert(same_number(AlarmCause::kCollapseForecast, can::AlarmCause::kCollapseForecast));
 static_assert(same_number(AlarmCause::kNotCalibrated, can::AlarmCause::kNotCalibrated));
+static_assert(same_number(AlarmCause::kOutsideModel, can::AlarmCause::kOutsideModel));
 static_assert(same_number(AlarmCause::kStatueUnexplained, can::AlarmCause::kStatueUnexplained));
-static_assert(monitor::kAlarmCauseNames.size() == 13);
+static_assert(monitor::kAlarmCauseNames.size() == 14);
 
 // The sensors' status bits (SensorAcceleration.Status): passed through as they are.
 static_assert(monitor::sensor_flags::kSaturated == can::sensor_status::kSaturated);

@@ -57,7 +57,7 @@ constexpr std::array<SignalLayout, 6> kHeartbeatSignals{{
 // MonitorStatus (0x320 + axis)
 enum StatusSignal : std::size_t { kPhase, kCorner, kAlarmLevel, kRisk, kStSequence, kSampleAge };
 constexpr std::array<SignalLayout, 6> kStatusSignals{{
-    {"Phase", 0, 4, false, 1.0, 0.0, 0, 5, "", true, kNoSpecialRaw},
+    {"Phase", 0, 4, false, 1.0, 0.0, 0, 6, "", true, kNoSpecialRaw},
     {"Corner", 4, 4, false, 1.0, 0.0, 0, 2, "", true, kNoSpecialRaw},
     {"AlarmLevel", 8, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"Risk", 16, 16, false, 0.0001, 0.0, 0, 10000, "", false, kNoSpecialRaw},
@@ -233,9 +233,9 @@ class Unpacker {
   CodecResult result_{};
 };
 
-// The AlarmCause VAL_ table has a gap: 12 and 13 are other branches' causes, not on the wire yet.
+// The AlarmCause VAL_ table has a gap: 13 is issue 26's p_wave, not on the wire yet.
 constexpr bool in_cause_table(AlarmCause cause) {
-  return static_cast<unsigned>(cause) <= 11U || cause == AlarmCause::kStatueUnexplained;
+  return static_cast<unsigned>(cause) <= 12U || cause == AlarmCause::kStatueUnexplained;
 }
 
 constexpr bool undefined_status_flags(std::uint8_t status) {

@@ -394,4 +394,61 @@ bool CandumpLogWriter::flush() {
   return true;
 }
 
+namespace {
+
+// "1700000000.250000": a log's timestamp as candump writes it.
+std::string log_time_text(std::int64_t t_ns) {
+  char text[40];
+  const std::int64_t us = t_ns / 1000;
+  std::snprintf(text, sizeof text, "%s%lld.%06lld", us < 0 ? "-" : "",
+                static_cast<long long>((us < 0 ? -us : us) / 1'000'000),
+                static_cast<long long>((us < 0 ? -us : us) % 1'000'000));
+  return text;
+}
+
+// "0.250000 s": a step between timestamps, microseconds.
+std::string log_step_text(std::int64_t step_ns) {
+  return log_time_text(step_ns < 0 ? -step_ns : step_ns) + " s";
+}
+
+}  // namespace
+
+LogTimeCheck::LogTimeCheck() { last_ns_by_id_.fill(-1); }
+
+LogTimeStep LogTimeCheck::check(std::int64_t t_ns, std::uint32_t id) const {
+  if (!started_) return {};
+  const std::int64_t step = t_ns - previous_ns_;
+  if (step < 0) return {LogTimeProblem::kWentBack, step};
+  if (t_ns == last_ns_by_id_[id & kStandardIdMask]) return {LogTimeProblem::kStoodStill, step};
+  if (static_cast<double>(step) > kMaxLogGapS * 1e9) return {LogTimeProblem::kJumped, step};
+  return {LogTimeProblem::kNone, step};
+}
+
+void LogTimeCheck::take(std::int64_t t_ns, std::uint32_t id) {
+  started_ = true;
+  previous_ns_ = t_ns;
+  last_ns_by_id_[id & kStandardIdMask] = t_ns;
+}
+
+std::string LogTimeCheck::describe(const LogTimeStep& step, std::int64_t t_ns) const {
+  switch (step.problem) {
+    case LogTimeProblem::kNone:
+      return "";
+    case LogTimeProblem::kWentBack:
+      return "timestamp goes back by " + log_step_text(step.step_ns) + " (" + log_time_text(t_ns) +
+             " after " + log_time_text(previous_ns_) + ")";
+    case LogTimeProblem::kStoodStill:
+      return "timestamp stands still (" + log_time_text(t_ns) +
+             ", the previous frame's of this identifier)";
+    case LogTimeProblem::kJumped: {
+      char limit[32];
+      std::snprintf(limit, sizeof limit, "%g", kMaxLogGapS);
+      return "timestamp jumps forward by " + log_step_text(step.step_ns) + " (" +
+             log_time_text(t_ns) + " after " + log_time_text(previous_ns_) + "; more than the " +
+             limit + " s a log's frames may be apart)";
+    }
+  }
+  return "";
+}
+
 }  // namespace plinth::hal

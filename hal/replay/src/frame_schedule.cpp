@@ -133,13 +133,17 @@ bool RecordSchedule::next(ScheduledFrame& out) {
   return true;
 }
 
-LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s) {
+LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s,
+                                       hal::LogTimePolicy policy) {
   hal::CandumpLogReaderOpenResult opened = hal::CandumpLogReader::open(path);
   if (!opened.ok()) throw host::InputError(opened.message);
   hal::CandumpLogReader& reader = *opened.reader;
   LoggedFrames out;
   std::int64_t first_ns = 0;
   std::int64_t previous_ns = 0;
+  std::int64_t cut_ns = 0;  // of the jumps shortened so far
+  const auto max_gap_ns = static_cast<std::int64_t>(hal::kMaxLogGapS * kNsPerSecond);
+  hal::LogTimeCheck time_check;
   hal::TimedFrame timed;
   for (;;) {
     const hal::IoStatus status = reader.receive(timed, 0);
@@ -161,7 +165,26 @@ LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s) 
       continue;
     }
     if (out.frames.empty()) first_ns = timed.timestamp_ns;
-    const std::int64_t relative_ns = std::max(previous_ns, timed.timestamp_ns - first_ns);
+    const hal::LogTimeStep step = time_check.check(timed.timestamp_ns, timed.frame.id);
+    if (step.problem == hal::LogTimeProblem::kWentBack ||
+        step.problem == hal::LogTimeProblem::kJumped) {
+      const bool back = step.problem == hal::LogTimeProblem::kWentBack;
+      std::string what = path + ":" + std::to_string(reader.line_number()) + ": " +
+                         time_check.describe(step, timed.timestamp_ns);
+      if (policy == hal::LogTimePolicy::kRefuse) {
+        throw host::InputError(what + " (--log-time refuse)");
+      }
+      ++(back ? out.went_back : out.jumps);
+      if (!back) cut_ns += step.step_ns - max_gap_ns;
+      if (out.time_warnings.size() < kLogTimeWarnings) {
+        char gap[48];
+        std::snprintf(gap, sizeof gap, ": replayed as a %g s gap", hal::kMaxLogGapS);
+        out.time_warnings.push_back(what + (back ? ": sent at the previous frame's time" : gap));
+      }
+    }
+    time_check.take(std::max(timed.timestamp_ns, time_check.previous_ns()), timed.frame.id);
+    const std::int64_t relative_ns =
+        std::max(previous_ns, timed.timestamp_ns - first_ns - cut_ns);
     if (t_end_s >= 0.0 && static_cast<double>(relative_ns) > t_end_s * kNsPerSecond) break;
     previous_ns = relative_ns;
     ScheduledFrame frame;

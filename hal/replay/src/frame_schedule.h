@@ -9,6 +9,7 @@
 
 #include "plinth/core/excitation.h"
 #include "plinth/hal/can_codec.h"
+#include "plinth/hal/candump_log.h"
 
 namespace plinth::hal::replay {
 
@@ -78,17 +79,27 @@ class RecordSchedule final : public FrameSchedule {
 };
 
 // The sensor frames (SensorAcceleration, SensorHeartbeat and StatueRotation of any node: the
-// ground sensors' and the statue sensor's) of a candump log, sent
-// again as logged, at their logged times relative to the first of them (times that go backwards
-// are held at the previous one). Other lines are skipped and counted.
+// ground sensors' and the statue sensor's) of a candump log, sent again as logged, at their
+// logged times relative to the first of them. Other lines are skipped and counted. Their time is
+// checked (hal::LogTimeCheck): with LogTimePolicy::kWarn a frame stamped before the previous one
+// is sent at the previous one's time, and a jump forward beyond hal::kMaxLogGapS is shortened to
+// that gap (the replay does not sit through a logger's pause or a clock step), each one named in
+// `time_warnings` (the first kLogTimeWarnings) and counted; with kRefuse the first one throws.
+// Frames of an identifier at the same microsecond are sent as logged.
+inline constexpr std::size_t kLogTimeWarnings = 10;
 struct LoggedFrames {
   std::vector<ScheduledFrame> frames;  // virtual_ns relative to the first
   std::int64_t skipped = 0;            // non-sensor, non-plinth, error-frame lines
+  std::int64_t went_back = 0;          // frames stamped before the previous one
+  std::int64_t jumps = 0;              // jumps forward beyond hal::kMaxLogGapS
+  std::vector<std::string> time_warnings;  // "file:line: what, by how much: what was done"
 };
 
-// Reads the log; throws host::InputError "file:line: what" for a malformed line, and when the
-// log holds no sensor frame. Frames later than `t_end_s` (relative, s; <0: no limit) are left out.
-[[nodiscard]] LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s);
+// Reads the log; throws host::InputError "file:line: what" for a malformed line, for a time the
+// policy refuses, and when the log holds no sensor frame. Frames later than `t_end_s`
+// (relative, s; <0: no limit) are left out.
+[[nodiscard]] LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s,
+                                                     hal::LogTimePolicy policy);
 
 // `loops` times over the logged frames; each loop starts one mean frame interval after the
 // previous loop's last frame (1 s when the log holds a single frame).

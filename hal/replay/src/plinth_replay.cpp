@@ -29,6 +29,7 @@
 #include "plinth/host/input_error.h"
 #include "plinth/host/limits.h"
 #include "plinth/host/output_file.h"
+#include "plinth/host/parse_name.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/record_sampling.h"
 
@@ -61,6 +62,7 @@ struct Options {
   std::string can_interface;
   std::string log_path;
   std::string log_interface = "vcan0";
+  std::string log_time;  // --log-time: warn or refuse; empty: not given (warn)
   bool report_json = false;
 };
 
@@ -90,19 +92,21 @@ bool is_record(const std::string& path) {
   return ext == "at2" || ext == "csv" || ext == "asc";  // PEER, CSV, ESM/ITACA
 }
 
-// "NODE:AXIS:PATH" or "NODE:PATH" (axis x).
+// "NODE:AXIS:PATH" or "NODE:PATH" (axis x), split at the colons as documented: with two colons
+// or more the field between the first two is the axis (a file whose name holds a colon is given
+// with its axis, "1:x:a:b.AT2"); each field that is not what it must be is named.
 Component parse_node_record(const std::string& text) {
-  const std::string usage =
-      "--node-record: expected NODE:AXIS:FILE or NODE:FILE (NODE 1-15, "
-      "AXIS x, y or z), got '" +
-      text + "'";
+  const std::string usage = "--node-record: expected NODE:AXIS:FILE or NODE:FILE (NODE 1-15, "
+                            "AXIS x, y or z), got " + plinth::host::shown(text);
   const std::size_t colon = text.find(':');
-  if (colon == std::string::npos || colon == 0) throw InputError(usage);
+  if (colon == std::string::npos) throw InputError(usage);
   Component component;
   component.given_as = "--node-record " + text;
   const std::string node_text = text.substr(0, colon);
-  if (node_text.size() > 2 || node_text.find_first_not_of("0123456789") != std::string::npos) {
-    throw InputError(usage);
+  if (node_text.empty() || node_text.size() > 2 ||
+      node_text.find_first_not_of("0123456789") != std::string::npos) {
+    throw InputError("--node-record: the node " + plinth::host::shown(node_text) + " in " +
+                     plinth::host::shown(text) + " is not a number from 1 to 15 (NODE:AXIS:FILE)");
   }
   component.node = std::stoi(node_text);
   if (component.node < plinth::hal::can::kFirstSensorNode ||
@@ -110,11 +114,19 @@ Component parse_node_record(const std::string& text) {
     throw InputError("--node-record: node " + node_text + " is not 1-15 in '" + text + "'");
   }
   std::string rest = text.substr(colon + 1);
-  if (rest.size() > 2 && rest[1] == ':' && (rest[0] == 'x' || rest[0] == 'y' || rest[0] == 'z')) {
-    component.axis = static_cast<Axis>(rest[0] - 'x');
-    rest = rest.substr(2);
+  if (const std::size_t second = rest.find(':'); second != std::string::npos) {
+    const std::string axis = rest.substr(0, second);
+    if (axis != "x" && axis != "y" && axis != "z") {
+      throw InputError("--node-record: unknown axis " + plinth::host::shown(axis) + " in " +
+                       plinth::host::shown(text) + " (one of x, y, z; NODE:AXIS:FILE)");
+    }
+    component.axis = static_cast<Axis>(axis[0] - 'x');
+    rest = rest.substr(second + 1);
   }
-  if (rest.empty()) throw InputError(usage);
+  if (rest.empty()) {
+    throw InputError("--node-record: no file in " + plinth::host::shown(text) +
+                     " (NODE:AXIS:FILE or NODE:FILE)");
+  }
   component.path = rest;
   return component;
 }
@@ -397,6 +409,10 @@ struct Input {
 Input open_input(const Options& opt, const CLI::App& app) {
   Input input;
   if (!is_candump_log(opt.record_path)) {
+    if (app.count("--log-time") > 0) {
+      throw InputError("--log-time: applies to a candump log input only (" + opt.record_path +
+                       " is a record: its samples' time is its sampling interval)");
+    }
     RecordPlan plan = plan_records(opt);
     input.description = plan.description;
     input.clipped_samples = plan.clipped;
@@ -411,8 +427,22 @@ Input open_input(const Options& opt, const CLI::App& app) {
                        opt.record_path + "): its sensor frames are sent again as logged");
     }
   }
-  plinth::hal::replay::LoggedFrames logged =
-      plinth::hal::replay::read_logged_sensor_frames(opt.record_path, opt.t_end_s.value_or(-1.0));
+  const plinth::hal::LogTimePolicy policy =
+      opt.log_time.empty() ? plinth::hal::LogTimePolicy::kWarn
+                           : plinth::host::parse_name<plinth::hal::kLogTimePolicyNames>(
+                                 opt.log_time, "--log-time", "policy");
+  plinth::hal::replay::LoggedFrames logged = plinth::hal::replay::read_logged_sensor_frames(
+      opt.record_path, opt.t_end_s.value_or(-1.0), policy);
+  for (const std::string& warning : logged.time_warnings) {
+    std::fprintf(stderr, "plinth-replay: warning: %s\n", warning.c_str());
+  }
+  if (logged.went_back + logged.jumps > 0) {
+    std::fprintf(stderr,
+                 "plinth-replay: warning: %s: %lld timestamps went back, %lld jumped forward "
+                 "beyond %g s (--log-time refuse stops at the first)\n",
+                 opt.record_path.c_str(), static_cast<long long>(logged.went_back),
+                 static_cast<long long>(logged.jumps), plinth::hal::kMaxLogGapS);
+  }
   input.skipped_log_lines = logged.skipped;
   char text[200];
   std::snprintf(text, sizeof text, "%s: %zu sensor frames over %.4g s", opt.record_path.c_str(),
@@ -568,6 +598,9 @@ int main(int argc, char** argv) {
   app.add_option("--log-interface", opt.log_interface,
                  "interface name written in the log (default vcan0)")
       ->needs(log);
+  app.add_option("--log-time", opt.log_time,
+                 "a candump log's timestamps that go back or jump beyond 10 s: warn (default: "
+                 "named on stderr, sent at the previous time / as a 10 s gap) or refuse");
   app.add_flag("--report-json", opt.report_json,
                "also print the report as one JSON line on stdout");
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {

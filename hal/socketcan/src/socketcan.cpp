@@ -293,8 +293,24 @@ SocketCanOpenResult SocketCanPort::open(std::string_view interface_name,
   const std::string name(interface_name);
 
   FdGuard fd(socket(PF_CAN, SOCK_RAW | SOCK_NONBLOCK | SOCK_CLOEXEC, CAN_RAW));
-  if (fd.get() < 0) {
+  const int socket_error = fd.get() < 0 ? errno : 0;
+  // A missing interface is said first, whatever else is wrong (a mistyped name on a machine
+  // without CAN is still a mistyped name); the kernel's lack of CAN follows it.
+  const unsigned index = if_nametoindex(name.c_str());
+  if (index == 0) {
     const int e = errno;
+    return open_failure(OpenError::kNoSuchInterface, e == 0 ? ENODEV : e, name,
+                        "the interface does not exist (ip link add dev " + name +
+                            " type vcan, for a virtual bus" +
+                            (socket_error == EAFNOSUPPORT
+                                 ? std::string("; and this kernel has no CAN support: a kernel "
+                                               "built with CONFIG_CAN, or a guest kernel: "
+                                               "tools/vcan-bus.sh")
+                                 : std::string()) +
+                            ")");
+  }
+  if (fd.get() < 0) {
+    const int e = socket_error;
     if (e == EAFNOSUPPORT) {
       return open_failure(OpenError::kNoCanSupport, e, name,
                           "this kernel has no CAN support (socket(AF_CAN) refused; a kernel "
@@ -308,14 +324,6 @@ SocketCanOpenResult SocketCanPort::open(std::string_view interface_name,
       return open_failure(OpenError::kPermissionDenied, e, name, "socket(AF_CAN) not permitted");
     }
     return open_failure(OpenError::kSystemError, e, name, "socket(AF_CAN) failed");
-  }
-
-  const unsigned index = if_nametoindex(name.c_str());
-  if (index == 0) {
-    const int e = errno;
-    return open_failure(OpenError::kNoSuchInterface, e == 0 ? ENODEV : e, name,
-                        "the interface does not exist (ip link add dev " + name +
-                            " type vcan, for a virtual bus)");
   }
 
   ifreq request{};

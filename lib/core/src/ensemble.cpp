@@ -50,8 +50,10 @@ bool Ensemble::in_full_contact() const {
 void Ensemble::risk(EnsembleRisk& out) const {
   out.risk = Risk{};
   out.worst_member = 0;
+  out.outside_model = false;
   for (std::size_t m = 0; m < scenes_.size(); ++m) {
     const PlanarEstimator& e = members_[m];
+    out.outside_model = out.outside_model || e.mode().phase == Phase::kLiftedOff;
     const Risk member = overturning_risk(scenes_[m], e.mode(), e.state(), risk_);
     if (m == 0) out.nominal_risk = member;
     if (m == 0 || member.total > out.risk.total) {

@@ -20,10 +20,11 @@ Error validate(const EstimatorSettings& st, const Scene& scene) {
   PLINTH_TRY(validate_feature_set(scene));
   if (const auto limit = static_cast<Time>(largest_stable_step(scene, solver.stepper));
       solver.step > limit) {
+    // The limit: the steps per sample a stable integration needs at this rate (the tools round
+    // it up). Above 64, the most the box takes, the base is the culprit: the tools say so.
     return {ErrorCode::kOutOfRange, "estimator.steps_per_sample",
-            "gives a solver step too large for a stable integration of this scene's base; "
-            "raise it so that 1 / (rate * steps) is below the limit",
-            limit};
+            "too few for this base at this rate (limit: the steps needed)",
+            static_cast<double>(Time(1) / (st.sample_rate_hz * limit))};
   }
   return ok_error();
 }

@@ -53,6 +53,7 @@ struct EventLogic {
         return {};
       case Phase::kOverturned:
       case Phase::kFell:
+      case Phase::kLiftedOff:
         return {};
     }
     return {};
@@ -62,17 +63,7 @@ struct EventLogic {
 
   static void emit_event(Simulator& sim, Time t, EventKind kind, int side = 0,
                          Real before = Real(0), Real after = Real(0)) {
-    Event e;
-    e.t = t;
-    e.kind = kind;
-    e.corner = sim.mode_.corner;
-    e.side = static_cast<std::int8_t>(side);
-    e.before = before;
-    e.after = after;
-    e.phase = sim.mode_.phase;
-    e.overhang = sim.mode_.overhang;
-    e.state = sim.y_;
-    sim.emit_event(e);
+    sim.emit_event(t, kind, side, before, after);
   }
 
   // On entering a mode (at the start or after a reset), the onset conditions that already hold
@@ -84,6 +75,7 @@ struct EventLogic {
   static void start_phases_that_hold(Simulator& sim, Time t) {
     const Scene& s = *sim.scene_;
     const GroundAcceleration ag = sim.excitation_.at(t);
+    if (sim.lift_off(t)) return;
     for (int pass = 0; pass < 2 && !sim.mode_.terminal(); ++pass) {
       const Accelerations acc = accelerations(s, sim.mode_, sim.y_, ag);
       if constexpr (F.sliding) {
@@ -289,6 +281,15 @@ struct EventLogic {
 
   static void apply_reset(Simulator& sim, GuardId id, Time t) {
     ++sim.event_count_;
+    if (id == GuardId::kLiftOff) {
+      (void)sim.lift_off(t, true);
+      return;
+    }
+    apply_mode_reset(sim, id, t);
+    (void)sim.lift_off(t);
+  }
+
+  static void apply_mode_reset(Simulator& sim, GuardId id, Time t) {
     switch (id) {
       case GuardId::kRockingOnsetLeft:
         start_rocking(sim, t, Corner::kLeft);
@@ -405,6 +406,7 @@ struct EventLogic {
         hold_if_pushed(sim, t, sim.y_[kU] > Real(0) ? +1 : -1);
       }
     }
+    (void)sim.lift_off(t);
     ++sim.chatter_steps_;
   }
 
@@ -462,8 +464,11 @@ struct EventLogic {
     }
   }
 
-  static Accelerations current_accelerations(const Simulator& sim, Time t, const State& y) {
-    return accelerations(*sim.scene_, sim.mode_, y, sim.excitation_.at(t));
+  static Accelerations current_accelerations(const Simulator& sim, Time t, const State& y,
+                                             GroundAcceleration* ground) {
+    const GroundAcceleration ag = sim.excitation_.at(t);
+    if (ground != nullptr) *ground = ag;
+    return accelerations(*sim.scene_, sim.mode_, y, ag);
   }
 
   // Binds the logic and the stepper's intervals for each phase to `sim` (Simulator::create).

@@ -190,7 +190,7 @@ void Forecaster::fill_continuation() {
 void Forecaster::start_member() {
   while (member_ < members_) {
     const Snapshot& s = snapshots_[static_cast<std::size_t>(member_)];
-    if (s.mode.terminal()) {  // collapsed already: at the snapshot's time
+    if (s.mode.terminal()) {  // collapsed (or lifted off) already: at the snapshot's time
       finish_member(true, 0.0);
       continue;
     }

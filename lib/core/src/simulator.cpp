@@ -107,6 +107,7 @@ void Simulator::start_with_impulse(Real impulse) {
   e.phase = mode_.phase;
   e.state = y_;
   emit_event(e);
+  (void)lift_off(0.0);  // a spin fast enough to unload the pivot (Eq 12)
 }
 
 // One step by intervals: the stepper in the current mode, then event after event.
@@ -136,6 +137,40 @@ void Simulator::finish_step(Time t0, Time t_end) {
                                    *this, t0, t_end, guards_live, false));
 }
 
-Accelerations Simulator::accelerations() const { return accelerations_fn_(*this, time(), y_); }
+Accelerations Simulator::accelerations() const {
+  return accelerations_fn_(*this, time(), y_, nullptr);
+}
+
+bool Simulator::lift_off(Time t, bool located) {
+  if (mode_.terminal()) return false;
+  GroundAcceleration ag;  // through the bound function: the excitation's code stays there
+  const Accelerations acc = accelerations_fn_(*this, t, y_, &ag);
+  if (!located &&
+      internal::lift_off_guard(*scene_, mode_, y_, ag, acc, internal::sin_cos(y_[kTheta])) <
+          Real(0)) {
+    return false;
+  }
+  const Phase left = mode_.phase;
+  mode_.phase = Phase::kLiftedOff;
+  emit_event(t, EventKind::kLiftOff, 0, scene_->g + ag.vertical, Real(0), left);
+  return true;
+}
+
+void Simulator::emit_event(Time t, EventKind kind, int side, Real before, Real after,
+                           Phase left) {
+  if (sink_ == nullptr) return;
+  Event e;
+  e.t = t;
+  e.kind = kind;
+  e.corner = mode_.corner;
+  e.side = static_cast<std::int8_t>(side);
+  e.before = before;
+  e.after = after;
+  e.phase = mode_.phase;
+  e.overhang = mode_.overhang;
+  e.left = left;
+  e.state = y_;
+  sink_->on_event(e);
+}
 
 }  // namespace plinth

@@ -10,11 +10,16 @@
 #include <system_error>
 #include <tuple>
 
+#include "plinth/host/csv_line.h"
 #include "plinth/host/input_error.h"
 
 namespace plinth::host {
 
 namespace {
+
+// The column after them when a run may have left the model (EvalRun::model_valid_until_s; a
+// runs file without it has none).
+constexpr std::string_view kModelValidColumn = "model_valid_until_s";
 
 // The header's fixed columns, before the crossing grids.
 constexpr std::array<std::string_view, 10> kFixedColumns{
@@ -44,35 +49,6 @@ std::string csv_field(const std::string& text) {
     out += c;
   }
   return out + "\"";
-}
-
-// Splits one CSV line (RFC 4180 quoting); false on an unterminated quote.
-bool split_csv(const std::string& line, std::vector<std::string>& fields) {
-  fields.clear();
-  std::string field;
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        field += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        field += c;
-      }
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      fields.push_back(field);
-      field.clear();
-    } else {
-      field += c;
-    }
-  }
-  fields.push_back(field);
-  return !quoted;
 }
 
 std::string grid_text(double v) {
@@ -439,6 +415,8 @@ void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with
     if (!line.empty()) line += ',';
     line += c;
   }
+  line += ',';
+  line += kModelValidColumn;
   for (std::string_view c : with_grid ? std::span<const std::string_view>(kGridColumns)
                                       : std::span<const std::string_view>()) {
     line += ',';
@@ -472,6 +450,7 @@ void write_eval_csv_row(std::FILE* out, const EvalRun& r) {
   add(format(r.collapse_time_s));
   add(format(r.peak_ratio));
   for (double t : r.first_shown_s) add(format(t));
+  add(format(r.model_valid_until_s));
   if (r.grid.known()) {
     add(std::to_string(r.seed));
     add(grid_text(r.grid.from_g));
@@ -499,11 +478,14 @@ EvalTable read_eval_csv(const std::string& path) {
                        std::string(kFixedColumns[i]) + "\", got \"" + f[i] + "\"");
     }
   }
-  table.has_grid = f.size() >= kFixedColumns.size() + kGridColumns.size() &&
-                   std::equal(kGridColumns.begin(), kGridColumns.end(),
-                              f.begin() + static_cast<std::ptrdiff_t>(kFixedColumns.size()));
-  const std::size_t first_grid = kFixedColumns.size() + (table.has_grid ? kGridColumns.size() : 0);
   std::vector<double> nominal_grid;
+  const bool has_model_valid =
+      f.size() > kFixedColumns.size() && f[kFixedColumns.size()] == kModelValidColumn;
+  const std::size_t first_extra = kFixedColumns.size() + (has_model_valid ? 1 : 0);
+  table.has_grid = f.size() >= first_extra + kGridColumns.size() &&
+                   std::equal(kGridColumns.begin(), kGridColumns.end(),
+                              f.begin() + static_cast<std::ptrdiff_t>(first_extra));
+  const std::size_t first_grid = first_extra + (table.has_grid ? kGridColumns.size() : 0);
   for (std::size_t i = first_grid; i < f.size(); ++i) {
     double v = 0.0;
     if (grid_value(f[i], "risk_ge_", v) && table.grids.probability.empty()) {
@@ -552,6 +534,12 @@ EvalTable read_eval_csv(const std::string& path) {
       r.first_shown_s[i] = parse_time(f[7 + i], where, kFixedColumns[7 + i]);
     }
     std::size_t c = kFixedColumns.size();
+    if (has_model_valid) {
+      r.model_valid_until_s = parse_time(f[c++], where, kModelValidColumn);
+      if (r.outside_model() && r.collapsed) {
+        throw InputError(where + ": model_valid_until_s: a run that left the model has no collapse");
+      }
+    }
     if (table.has_grid) {
       const double seed = parse_number(f[c], where, "seed");
       if (seed < 0.0 || seed != std::floor(seed) || seed > 4294967295.0) {

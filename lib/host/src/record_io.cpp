@@ -25,10 +25,15 @@ namespace {
 
 // ---- small text helpers ------------------------------------------------------------------------
 
-// Walks a file's text line by line, counting lines (1-based) and dropping a trailing '\r'.
+// Walks a file's text line by line, counting lines (1-based) and dropping a trailing '\r'. A
+// carriage return anywhere else (a file with classic Mac line endings, or a corrupted one) is
+// refused where it is: the rest of the line would be read as the same line.
 class LineReader {
  public:
-  LineReader(std::string_view text, const std::string& origin) : text_(text), origin_(origin) {}
+  // `strict` false: a carriage return inside a line is left for the format's reader (format
+  // detection, which must not refuse what the reader then names better).
+  LineReader(std::string_view text, const std::string& origin, bool strict = true)
+      : text_(text), origin_(origin), strict_(strict) {}
 
   bool next(std::string_view& line) {
     if (position_ >= text_.size()) return false;
@@ -37,6 +42,11 @@ class LineReader {
     position_ = end + 1;
     ++line_number_;
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    if (const std::size_t cr = line.find('\r'); strict_ && cr != std::string_view::npos) {
+      fail("column " + std::to_string(cr + 1) +
+           ": a carriage return not followed by a line feed (classic Mac line endings?): " +
+           shown(line.substr(0, std::min<std::size_t>(line.size(), cr + 24))));
+    }
     return true;
   }
 
@@ -55,6 +65,7 @@ class LineReader {
   const std::string& origin_;
   std::size_t position_ = 0;
   std::size_t line_number_ = 0;
+  bool strict_ = true;
 };
 
 // A line of the file a message is about.
@@ -119,10 +130,8 @@ std::vector<std::string_view> split_commas(std::string_view text) {
 
 std::string quote(std::string_view text) {
   constexpr std::size_t kShown = 40;  // characters of a bad token shown in a message
-  std::string result(1, '\'');
-  result.append(text.substr(0, kShown));
-  if (text.size() > kShown) result.append("...");
-  result.push_back('\'');
+  std::string result = shown(text.substr(0, kShown));  // invisible characters escaped
+  if (text.size() > kShown) result.insert(result.size() - 1, "...");
   return result;
 }
 
@@ -310,7 +319,9 @@ std::optional<std::string_view> labelled_value(std::string_view line, std::strin
   return line.substr(i);
 }
 
-std::size_t parse_npts_text(const Where& where, std::string_view text, bool whole) {
+// `key`: the header's name for the count (NPTS, NDATA), for the message.
+std::size_t parse_npts_text(const Where& where, std::string_view text, bool whole,
+                            std::string_view key = "NPTS") {
   std::size_t npts = 0;
   const char* end = text.data() + text.size();
   const auto [stop, error] = std::from_chars(text.data(), end, npts);
@@ -318,24 +329,28 @@ std::size_t parse_npts_text(const Where& where, std::string_view text, bool whol
   const bool complete = !whole || stop == end;
   const bool separated = stop == end || (!is_alnum(*stop) && *stop != '.');
   if (!digits || !complete || !separated) {
-    where.fail("cannot find NPTS= (a positive whole number) in the header line, found " +
-               quote(split_words(text, true).empty() ? "" : split_words(text, true)[0]));
+    where.fail(std::string(key) + " is malformed: expected a positive whole number, found " +
+               shown(split_words(text, true).empty() ? "" : split_words(text, true)[0]));
   }
   if (error != std::errc{})
-    where.fail("NPTS=" + std::string(text.data(), stop) + " is out of range");
+    where.fail(std::string(key) + "=" + std::string(text.data(), stop) + " is out of range");
   return npts;
 }
 
-double parse_dt_text(const Where& where, std::string_view text, bool whole) {
+// `key`: the header's name for the interval (DT, SAMPLING_INTERVAL_S), for the message.
+double parse_dt_text(const Where& where, std::string_view text, bool whole,
+                     std::string_view key = "DT") {
   // The number may have its unit glued on (".00244SEC"): take the longest numeric prefix.
   double dt = 0.0;
   const char* end = text.data() + text.size();
   const auto [stop, error] = std::from_chars(text.data(), end, dt);
-  if (stop == text.data() || (whole && stop != end))
-    where.fail("cannot find DT= in the header line");
+  if (stop == text.data() || (whole && stop != end)) {
+    where.fail(std::string(key) + " is malformed: expected a number of seconds, found " +
+               shown(split_words(text, true).empty() ? "" : split_words(text, true)[0]));
+  }
   const std::string digits(text.data(), stop);
   if (error != std::errc{} || !std::isfinite(dt))
-    where.fail("DT=" + digits + " is not a finite number");
+    where.fail(std::string(key) + "=" + digits + " is not a finite number");
   return dt;
 }
 
@@ -443,8 +458,13 @@ const HeaderValue& required(const LineReader& reader,
                             const std::map<std::string, HeaderValue, std::less<>>& header,
                             std::string_view key) {
   const auto found = header.find(key);
-  if (found == header.end() || found->second.value.empty()) {
+  if (found == header.end()) {
     reader.fail_at(0, "missing header line '" + std::string(key) + ": <value>' (ESM/ITACA format)");
+  }
+  if (found->second.value.empty()) {
+    reader.fail_at(found->second.line,
+                   std::string(key) + " is malformed: the line has no value after '" +
+                       std::string(key) + ":'");
   }
   return found->second;
 }
@@ -487,8 +507,9 @@ Record parse_esm(std::string_view text, const std::string& origin, double gravit
                                    " is not an acceleration (expected cm/s^2, m/s^2 or g)");
   }
   Sampling sampling;
-  sampling.dt = parse_dt_text(Where{reader, interval.line}, interval.value, true);
-  sampling.count = parse_npts_text(Where{reader, ndata.line}, ndata.value, true);
+  sampling.dt =
+      parse_dt_text(Where{reader, interval.line}, interval.value, true, "SAMPLING_INTERVAL_S");
+  sampling.count = parse_npts_text(Where{reader, ndata.line}, ndata.value, true, "NDATA");
   check_sampling(Where{reader, ndata.line}, sampling, "NDATA", "SAMPLING_INTERVAL_S");
 
   Record record;
@@ -660,7 +681,7 @@ const char* record_format_name(RecordFormat format) {
 
 std::optional<RecordFormat> detect_record_format(std::string_view text) {
   const std::string origin;
-  LineReader reader(text, origin);
+  LineReader reader(text, origin, false);
   std::array<std::string, 4> first_upper;
   std::optional<std::string_view> first_content;
   std::string_view line;

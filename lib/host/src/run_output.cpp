@@ -35,6 +35,7 @@ void TimeHistoryCsv::write_row(double t, double ag, const State& y, Phase phase)
 Outcome outcome_of(Phase final_phase) {
   if (final_phase == Phase::kOverturned) return Outcome::kOverturned;
   if (final_phase == Phase::kFell) return Outcome::kFell;  // fell off the base
+  if (final_phase == Phase::kLiftedOff) return Outcome::kLiftedOff;
   return Outcome::kSurvived;
 }
 
@@ -77,6 +78,15 @@ std::string event_json(const Event& e) {
       line += field("x_dot_before", number(e.before));
       line += field("u_dot_after", number(e.after));
       break;
+    case EventKind::kLiftOff:
+      line += field("from", quoted(phase_name(e.left)));
+      if (e.left == Phase::kRocking || e.left == Phase::kSlideRocking) {
+        line += field("corner", quoted(corner_name(e.corner)));
+        line += field("pivot", quoted(pivots_on_support(e.corner, e.overhang) ? "support" : "body"));
+        line += field("theta_dot", number(e.state[kThetaDot]));
+      }
+      line += field("g_plus_vertical", number(e.before));
+      break;
   }
   line += field("u", number(e.state[kU]));
   line += field("x", number(e.state[kX]));
@@ -85,9 +95,11 @@ std::string event_json(const Event& e) {
   return line;
 }
 
-std::string end_json(double t, Outcome outcome) {
-  return "{\"t\": " + number(t) + ", \"event\": \"end\", \"outcome\": " +
-         quoted(outcome_name(outcome)) + "}";
+std::string end_json(double t, Outcome outcome, double lift_off_t) {
+  std::string line = "{\"t\": " + number(t) + ", \"event\": \"end\", \"outcome\": " +
+                     quoted(outcome_name(outcome));
+  if (outcome == Outcome::kLiftedOff) line += field("model_valid_until", number(lift_off_t));
+  return line + "}";
 }
 
 }  // namespace plinth::host

@@ -25,6 +25,7 @@
 #include "plinth/core/name_table.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/text_file.h"
+#include "plinth/host/toml_names.h"
 
 namespace plinth::host {
 namespace {
@@ -37,23 +38,7 @@ std::string format_number(double value) {
   return std::string(buffer.data(), result.ptr);
 }
 
-// What a TOML value is, for messages ("expected a number, got a string").
-constexpr NameTable<toml::node_type, 10> kNodeTypeNames{{{
-    {toml::node_type::none, "nothing"},
-    {toml::node_type::table, "a table"},
-    {toml::node_type::array, "an array"},
-    {toml::node_type::string, "a string"},
-    {toml::node_type::integer, "an integer"},
-    {toml::node_type::floating_point, "a float"},
-    {toml::node_type::boolean, "a boolean"},
-    {toml::node_type::date, "a date"},
-    {toml::node_type::time, "a time"},
-    {toml::node_type::date_time, "a date-time"},
-}}};
-
-std::string_view type_name(toml::node_type type) {
-  return kNodeTypeNames.name(type, "an unknown type");
-}
+std::string_view type_name(toml::node_type type) { return toml_type_name(type); }
 
 std::string join(std::span<const std::string_view> words) {
   std::string out;
@@ -72,6 +57,8 @@ struct Number {
 };
 
 // Where the value the core checks under one of its field names came from in the file.
+using KeyValues = std::vector<std::pair<std::string, double>>;
+
 struct Provenance {
   std::string key;  // the file's dotted key (or table name)
   std::uint32_t line = 0;
@@ -79,6 +66,9 @@ struct Provenance {
   // Set when the core's value was computed from the file's (e.g. eccentricity from
   // eccentricity_ratio): the core's value, shown next to the file's.
   std::optional<double> core_value;
+  // The other keys the core's value was computed from, with their values in the file: a
+  // complaint about the value names every input that made it.
+  KeyValues other_inputs;
 };
 
 // The keys of each table (check_keys below takes the same lists).
@@ -269,15 +259,47 @@ class Loader {
 
   // `core_field` holds the file's number as it is.
   void record(const std::string& core_field, const Number& n) {
-    provenance_[core_field] = Provenance{n.key, n.line, n.value, std::nullopt};
+    provenance_[core_field] = Provenance{n.key, n.line, n.value, std::nullopt, {}};
   }
-  // `core_field` holds `core_value`, computed from the file's number.
-  void record(const std::string& core_field, const Number& n, double core_value) {
-    if (n.key == core_field) {
+  // `core_field` holds `core_value`, computed from the file's number and the core fields
+  // `others` (named in a complaint by the keys that gave them).
+  void record(const std::string& core_field, const Number& n, double core_value,
+              std::initializer_list<std::string_view> others = {}) {
+    if (n.key == core_field && others.size() == 0) {
       record(core_field, n);
-    } else {
-      provenance_[core_field] = Provenance{n.key, n.line, n.value, core_value};
+      return;
     }
+    Provenance p{n.key, n.line, n.value, std::nullopt, inputs_of(others)};
+    if (n.key != core_field) p.core_value = core_value;
+    provenance_[core_field] = std::move(p);
+  }
+
+  // The keys (and their values in the file) that gave the core fields `fields`, each once: a
+  // field computed from other keys brings its own inputs.
+  KeyValues inputs_of(std::initializer_list<std::string_view> fields) const {
+    KeyValues out;
+    const auto add = [&](const std::string& key, double value) {
+      const bool seen = std::any_of(out.begin(), out.end(),
+                                    [&](const auto& kv) { return kv.first == key; });
+      if (!seen) out.emplace_back(key, value);
+    };
+    for (std::string_view field : fields) {
+      const auto it = provenance_.find(field);
+      if (it == provenance_.end()) continue;
+      if (it->second.file_value) add(it->second.key, *it->second.file_value);
+      for (const auto& [key, value] : it->second.other_inputs) add(key, value);
+    }
+    return out;
+  }
+
+  // "block.half_width = 0.3, block.slenderness = 3".
+  static std::string text_of(const KeyValues& inputs) {
+    std::string out;
+    for (const auto& [key, value] : inputs) {
+      if (!out.empty()) out += ", ";
+      out += key + " = " + format_number(value);
+    }
+    return out;
   }
 
   void read_block(const toml::table& tbl, SceneParams& params) {
@@ -290,12 +312,14 @@ class Loader {
 
     const Choice height = *either(tbl, "block", "slenderness", "com_height", true);
     blk.com_height = height.first ? height.number.value * blk.half_width : height.number.value;
-    record("block.com_height", height.number, blk.com_height);
+    record("block.com_height", height.number, blk.com_height,
+           height.first ? std::initializer_list<std::string_view>{"block.half_width"}
+                        : std::initializer_list<std::string_view>{});
 
     if (std::optional<Choice> ecc =
             either(tbl, "block", "eccentricity_ratio", "eccentricity", false)) {
       blk.eccentricity = ecc->first ? ecc->number.value * blk.half_width : ecc->number.value;
-      record("block.eccentricity", ecc->number, blk.eccentricity);
+      record("block.eccentricity", ecc->number, blk.eccentricity, {"block.half_width"});
     }
 
     const Choice mass = *either(tbl, "block", "density", "mass", true);
@@ -308,22 +332,29 @@ class Loader {
                "must be greater than zero (got " + format_number(depth->value) + ")");
         }
         d = depth->value;
+        record("block.depth", *depth);
       }
       blk.mass = mass.number.value * (2.0 * blk.half_width) * (2.0 * blk.com_height) * d;
+      record("block.mass", mass.number, blk.mass,
+             {"block.half_width", "block.com_height", "block.depth"});
     } else {
       if (depth) {
         fail(depth->line, depth->key,
              "is used only with block.density; with block.mass it has no meaning");
       }
       blk.mass = mass.number.value;
+      record("block.mass", mass.number, blk.mass);
     }
-    record("block.mass", mass.number, blk.mass);
 
     if (std::optional<Number> inertia = number(tbl, "block", "inertia")) {
       blk.inertia = inertia->value;
       record("block.inertia", *inertia);
     } else {
       blk.inertia = homogeneous_rectangle_inertia(blk.mass, blk.half_width, blk.com_height);
+      // Not in the file: a complaint about it names the keys it was made from.
+      derived_["block.inertia"] =
+          "not given: m (b^2 + h^2) / 3 = " + format_number(blk.inertia) + " from " +
+          text_of(inputs_of({"block.mass", "block.half_width", "block.com_height"}));
     }
   }
 
@@ -335,7 +366,9 @@ class Loader {
 
     const Choice mass = *either(tbl, "base", "mass_ratio", "mass", true);
     base.mass = mass.first ? mass.number.value * m : mass.number.value;
-    record("base.mass", mass.number, base.mass);
+    record("base.mass", mass.number, base.mass,
+           mass.first ? std::initializer_list<std::string_view>{"block.mass"}
+                      : std::initializer_list<std::string_view>{});
 
     const Choice period = *either(tbl, "base", "period", "stiffness", true);
     if (period.first) {
@@ -348,7 +381,9 @@ class Loader {
       }
       base.period = 2.0 * std::numbers::pi * std::sqrt((m + base.mass) / k);
     }
-    record("base.period", period.number, base.period);
+    record("base.period", period.number, base.period,
+           period.first ? std::initializer_list<std::string_view>{}
+                        : std::initializer_list<std::string_view>{"block.mass", "base.mass"});
 
     const Choice damping = *either(tbl, "base", "damping_ratio", "damping", true);
     if (damping.first) {
@@ -357,7 +392,10 @@ class Loader {
       const double omega = 2.0 * std::numbers::pi / base.period;
       base.damping_ratio = damping.number.value / (2.0 * (m + base.mass) * omega);
     }
-    record("base.damping_ratio", damping.number, base.damping_ratio);
+    record("base.damping_ratio", damping.number, base.damping_ratio,
+           damping.first
+               ? std::initializer_list<std::string_view>{}
+               : std::initializer_list<std::string_view>{"block.mass", "base.mass", "base.period"});
   }
 
   void read_friction(const toml::table& tbl, SceneParams& params) {
@@ -377,7 +415,7 @@ class Loader {
   void read_base_stops(const toml::table& tbl, SceneParams& params) {
     check_keys(tbl, "base_stops", kKnownKeys.at("base_stops"));
     params.has_base_stops = true;
-    provenance_["base_stops"] = Provenance{"base_stops", tbl.source().begin.line, {}, {}};
+    provenance_["base_stops"] = Provenance{"base_stops", tbl.source().begin.line, {}, {}, {}};
     const Number u_max = required(tbl, "base_stops", "max_displacement");
     params.base_stops.max_displacement = u_max.value;
     record("base_stops.max_displacement", u_max);
@@ -389,7 +427,7 @@ class Loader {
   void read_support(const toml::table& tbl, SceneParams& params) {
     check_keys(tbl, "support", kKnownKeys.at("support"));
     params.has_support = true;
-    provenance_["support"] = Provenance{"support", tbl.source().begin.line, {}, {}};
+    provenance_["support"] = Provenance{"support", tbl.source().begin.line, {}, {}, {}};
     const Number clearance = required(tbl, "support", "clearance");
     params.support.clearance = clearance.value;
     record("support.clearance", clearance);
@@ -398,7 +436,7 @@ class Loader {
   void read_sliding_stops(const toml::table& tbl, SceneParams& params) {
     check_keys(tbl, "sliding_stops", kKnownKeys.at("sliding_stops"));
     params.has_sliding_stops = true;
-    provenance_["sliding_stops"] = Provenance{"sliding_stops", tbl.source().begin.line, {}, {}};
+    provenance_["sliding_stops"] = Provenance{"sliding_stops", tbl.source().begin.line, {}, {}, {}};
     const Number eta = required(tbl, "sliding_stops", "restitution");
     params.sliding_stops.restitution = eta.value;
     record("sliding_stops.restitution", eta);
@@ -408,12 +446,17 @@ class Loader {
   [[noreturn]] void report(const Error& error) const {
     const std::string field = error.field;
     const auto it = provenance_.find(field);
+    if (const auto derived = derived_.find(field);
+        it == provenance_.end() && derived != derived_.end()) {
+      fail(0, field, error.reason + std::string(" (") + derived->second + ")");
+    }
     if (it == provenance_.end()) fail(0, field, error.reason);
     const Provenance& p = it->second;
     std::string what = error.reason;
     if (p.file_value) {
       what += " (got " + format_number(*p.file_value);
       if (p.core_value) what += ", giving " + field + " = " + format_number(*p.core_value);
+      if (!p.other_inputs.empty()) what += ", with " + text_of(p.other_inputs);
       what += ")";
     }
     fail(p.line, p.key, what);
@@ -467,6 +510,8 @@ class Loader {
 
   std::string origin_;
   std::map<std::string, Provenance, std::less<>> provenance_;
+  // Core fields computed from several keys, none of them the field's own: how.
+  std::map<std::string, std::string, std::less<>> derived_;
 };
 
 // The document with the uncertain keys set: key i at `value(i)`.

@@ -29,7 +29,8 @@ Simulator impulse_simulator(const Scene& scene, double dt, EventSink* sink) {
   SolverSettings solver;
   solver.step = dt;
   Simulator sim;
-  throw_if_simulator_error(Simulator::create(scene, Excitation::none(), solver, sim));
+  throw_if_simulator_error(Simulator::create(scene, Excitation::none(), solver, sim), scene,
+                           solver.step);
   sim.set_event_sink(sink);
   return sim;
 }
@@ -42,6 +43,10 @@ class StartSink final : public EventSink {
 
   void on_event(const Event& e) override {
     if (settled) return;
+    if (e.kind == EventKind::kLiftOff) {
+      settle(ImpulseStart::kLiftedOff);
+      return;
+    }
     if (!rocking_) {
       if (e.kind == EventKind::kSlidingStart) {
         settle(ImpulseStart::kSliding);
@@ -232,12 +237,14 @@ void validate(const ImpulseSearchSettings& s) {
 
 Occurrences simulate_impulse_occurrences(const Scene& scene, double impulse, double dt,
                                          EventSet events) {
-  // Only rocking and overturning are looked for; the block's own rest ends a run on the ground.
+  // Only rocking, overturning and lift-off are looked for; the block's own rest ends a run on
+  // the ground.
   class Sink final : public EventSink {
    public:
     void on_event(const Event& e) override {
       if (e.kind == EventKind::kRockingStart) mark(SweepEvent::kRocking);
       if (e.kind == EventKind::kOverturned) mark(SweepEvent::kOverturned);
+      if (e.kind == EventKind::kLiftOff) mark(SweepEvent::kLiftOff);
       if (e.kind == EventKind::kRockingStop) at_rest = true;
     }
     void mark(SweepEvent e) {
@@ -254,7 +261,8 @@ Occurrences simulate_impulse_occurrences(const Scene& scene, double impulse, dou
   const double t_end = on_base ? 5.0 * scene.params.base.period : 60.0;
   events &= EventSet{}
                 .set(static_cast<std::size_t>(SweepEvent::kRocking))
-                .set(static_cast<std::size_t>(SweepEvent::kOverturned));
+                .set(static_cast<std::size_t>(SweepEvent::kOverturned))
+                .set(static_cast<std::size_t>(SweepEvent::kLiftOff));
   while (sim.time() < t_end && !sim.mode().terminal() && (sink.seen & events) != events &&
          (on_base || !sink.at_rest)) {
     sim.step();
@@ -284,6 +292,7 @@ ImpulseThresholds impulse_thresholds(const Scene& scene, const ImpulseSearchSett
   grid.tolerance = settings.tolerance;
   EventSet events;
   events.set(static_cast<std::size_t>(SweepEvent::kOverturned));
+  events.set(static_cast<std::size_t>(SweepEvent::kLiftOff));
   if (scene.has_base()) events.set(static_cast<std::size_t>(SweepEvent::kRocking));
   const auto found = first_occurrences(
       [&](double magnitude) {
@@ -293,6 +302,7 @@ ImpulseThresholds impulse_thresholds(const Scene& scene, const ImpulseSearchSett
   ImpulseThresholds out;
   out.rocking = scene.has_base() ? found[static_cast<std::size_t>(SweepEvent::kRocking)] : 0.0;
   out.overturned = found[static_cast<std::size_t>(SweepEvent::kOverturned)];
+  out.lift_off = found[static_cast<std::size_t>(SweepEvent::kLiftOff)];
   return out;
 }
 
@@ -326,11 +336,11 @@ SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,
       .add("scan_points", std::to_string(settings.scan_points))
       .add("dt", settings.dt);
   plan.header = std::string(sweep_parameter_name(parameter)) +
-                ",rocking,overturned,rocking_closed_form,overturned_closed_form";
+                ",rocking,overturned,rocking_closed_form,overturned_closed_form,lift_off";
   if (ground) {
     line.add("compare", "ground");
     plan.header += std::string(",overturned") + kGroundSuffix + ",overturned_closed_form" +
-                   kGroundSuffix;
+                   kGroundSuffix + ",lift_off" + kGroundSuffix;
   }
   plan.settings = line.text();
   plan.keys = grid_keys({axis});
@@ -346,7 +356,8 @@ SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,
         on_base ? std::nullopt : std::optional<double>(ground_overturning_impulse(scene));
     std::string row = keys[i] + "," + format_result(found.rocking) + "," +
                       format_result(found.overturned) + "," + format_result(rocking_closed_form) +
-                      "," + format_result(overturned_closed_form);
+                      "," + format_result(overturned_closed_form) + "," +
+                      format_result(found.lift_off);
     if (ground) {
       const std::size_t k = ground->on_ground.of[i];
       const Scene& on_ground = ground->on_ground.distinct[k];
@@ -361,6 +372,8 @@ SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,
       row += format_result(g.overturned);
       row += ',';
       row += format_result(ground_overturning_impulse(on_ground));
+      row += ',';
+      row += format_result(g.lift_off);
     }
     return row;
   };

@@ -41,6 +41,9 @@ class OccurrenceSink final : public EventSink {
       case EventKind::kOverturned:
         mark(SweepEvent::kOverturned);
         break;
+      case EventKind::kLiftOff:
+        mark(SweepEvent::kLiftOff);
+        break;
       default:
         break;
     }
@@ -74,6 +77,7 @@ EventSet possible_events(const Scene& scene) {
   EventSet events;
   events.set(static_cast<std::size_t>(SweepEvent::kRocking));
   events.set(static_cast<std::size_t>(SweepEvent::kOverturned));
+  events.set(static_cast<std::size_t>(SweepEvent::kLiftOff));
   events.set(static_cast<std::size_t>(SweepEvent::kSliding), f.sliding);
   events.set(static_cast<std::size_t>(SweepEvent::kSlideRocking), f.sliding);
   events.set(static_cast<std::size_t>(SweepEvent::kBaseStopHit), f.base_stops);
@@ -111,7 +115,7 @@ Occurrences simulate_occurrences(const Scene& scene, const Record& record, doubl
   Simulator sim;
   const Excitation excitation =
       Excitation::record(record.horizontal_signal(), {}, pga_mps2 / record.peak_horizontal());
-  throw_if_simulator_error(Simulator::create(scene, excitation, solver, sim));
+  throw_if_simulator_error(Simulator::create(scene, excitation, solver, sim), scene, solver.step);
   OccurrenceSink sink;
   sim.set_event_sink(&sink);
   sim.start_at_rest();

@@ -1,15 +1,18 @@
 #include "plinth/host/sweep_table.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <ostream>
 #include <sstream>
 #include <unordered_map>
 #include <utility>
 
+#include "plinth/host/csv_line.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/limits.h"
 #include "plinth/host/text_file.h"
@@ -54,6 +57,67 @@ std::vector<std::string> split(const std::string& text, char separator) {
   while (std::getline(in, part, separator)) parts.push_back(part);
   if (!text.empty() && text.back() == separator) parts.emplace_back();
   return parts;
+}
+
+// The fields of a CSV line as a spreadsheet may have saved them: quoted (split_csv), with
+// spaces and tabs around them, which are not part of them.
+std::vector<std::string> spreadsheet_fields(const std::string& line) {
+  std::vector<std::string> fields;
+  if (!split_csv(line, fields)) fields = split(line, ',');  // an unterminated quote: as it is
+  for (std::string& field : fields) {
+    const std::size_t first = field.find_first_not_of(" \t");
+    const std::size_t last = field.find_last_not_of(" \t");
+    field = first == std::string::npos ? std::string() : field.substr(first, last - first + 1);
+  }
+  return fields;
+}
+
+std::string join_fields(const std::vector<std::string>& fields, std::size_t count) {
+  std::string out;
+  for (std::size_t i = 0; i < count && i < fields.size(); ++i) {
+    if (i > 0) out += ',';
+    out += fields[i];
+  }
+  return out;
+}
+
+// A line of a sweep file as plinth-sweep writes it, from the line as saved by another program:
+// its fields unquoted and trimmed; the empty fields a spreadsheet pads short lines with
+// dropped (never below `keep` fields); a number in a key column (one of the first
+// `key_columns`) as format_value writes it, in another column as format_result does ("0.50"
+// and "5.0E-01" are 0.5). Other text is kept as it is.
+std::string canonical_line(const std::string& line, std::size_t keep, std::size_t key_columns,
+                           bool numbers) {
+  std::vector<std::string> fields = spreadsheet_fields(line);
+  std::size_t count = fields.size();
+  while (count > std::max<std::size_t>(keep, 1) && fields[count - 1].empty()) --count;
+  if (numbers) {
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::string& field = fields[i];
+      if (field.empty()) continue;
+      char* end = nullptr;
+      const double value = std::strtod(field.c_str(), &end);
+      if (end == field.c_str() || *end != '\0' || !std::isfinite(value)) continue;
+      fields[i] = i < key_columns ? format_value(value) : format_result(value);
+    }
+  }
+  return join_fields(fields, count);
+}
+
+// The file's text with its line endings made '\n' (CRLF, or a lone CR of classic Mac files)
+// and a UTF-8 byte order mark removed.
+std::string unix_text(const std::string& text) {
+  const std::size_t start = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = start; i < text.size(); ++i) {
+    if (text[i] != '\r') {
+      out += text[i];
+    } else if (i + 1 >= text.size() || text[i + 1] != '\n') {
+      out += '\n';
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -280,18 +344,29 @@ std::string result_field_problem(const std::vector<std::string>& header,
 }  // namespace
 
 SweepTable read_sweep_table(const std::string& path, std::size_t* dropped) {
-  std::istringstream in(read_text_file(path, kMaxSweepTableBytes, "sweep CSV"));
+  std::istringstream in(unix_text(read_text_file(path, kMaxSweepTableBytes, "sweep CSV")));
   SweepTable table;
   if (!std::getline(in, table.settings)) throw InputError(path + ": empty file, not a sweep CSV");
-  const std::size_t key_columns = parse_grid(table.settings, path + ":1").size();
-  if (!std::getline(in, table.header) || table.header.empty()) {
-    throw InputError(path + ":2: missing the CSV header");
+  // The settings line as one field (a spreadsheet splits it at the grid's commas, or quotes
+  // it, and pads it with empty fields), its words one space apart.
+  {
+    std::istringstream words(canonical_line(table.settings, 0, 0, false));
+    std::string word;
+    std::string settings;
+    while (words >> word) settings += (settings.empty() ? "" : " ") + word;
+    if (settings.rfind("#plinth-sweep", 0) == 0) settings = "# " + settings.substr(1);
+    table.settings = settings;
   }
+  const std::size_t key_columns = parse_grid(table.settings, path + ":1").size();
+  if (!std::getline(in, table.header)) throw InputError(path + ":2: missing the CSV header");
+  table.header = canonical_line(table.header, 0, 0, false);
+  if (table.header.empty()) throw InputError(path + ":2: missing the CSV header");
   const std::vector<std::string> header = csv_fields(table.header);
   const std::size_t fields = count_fields(table.header);
   std::string line;
   for (int number = 3; std::getline(in, line); ++number) {
-    if (line.empty()) continue;
+    if (line.find_first_not_of(", \t\"") == std::string::npos) continue;  // an empty row
+    line = canonical_line(line, fields, key_columns, true);
     if (count_fields(line) != fields && dropped != nullptr) {
       ++*dropped;
       continue;

@@ -80,6 +80,29 @@ TEST(AlarmInputs, FaultsInTheirOrder) {
   EXPECT_FALSE(alarm_input(s, config, false).fault_active);
 }
 
+// An estimate outside the model (a member lifted off, Phase::kLiftedOff: EnsembleRisk's
+// outside_model) is a fault of any modelled axis while the estimators run, its cause after the
+// others'; a lift-off is no collapse.
+TEST(AlarmInputs, OutsideTheModelIsAFaultAfterTheOthers) {
+  BoxStatus s = healthy();
+  s.axes[1].outside_model = true;
+  EXPECT_FALSE(alarm_input(s, MonitorConfig{}, false).fault_active);  // axis 2 not modelled
+  s.axis_count = 2;
+  const monitor::AlarmInput in = alarm_input(s, MonitorConfig{}, false);
+  EXPECT_TRUE(in.fault_active);
+  EXPECT_EQ(in.fault_cause, AlarmCause::kOutsideModel);
+  s.axes[1].mode.phase = Phase::kLiftedOff;
+  EXPECT_FALSE(alarm_input(s, MonitorConfig{}, false).collapse_detected);
+  EXPECT_EQ(alarm_input(s, MonitorConfig{}, true).fault_cause, AlarmCause::kBusError);
+  s.sensor.state = HealthState::kFault;
+  s.sensor.cause = HealthCause::kTimeout;
+  EXPECT_EQ(alarm_input(s, MonitorConfig{}, false).fault_cause, AlarmCause::kSensorTimeout);
+  s = healthy();
+  s.axes[0].outside_model = true;
+  s.estimating = false;  // stale: the estimators start again from rest
+  EXPECT_FALSE(alarm_input(s, MonitorConfig{}, false).fault_active);
+}
+
 TEST(AlarmInputs, NotCalibratedUntilTheEstimatorsRunOnATrustedStart) {
   BoxStatus s = healthy();
   s.calibrated = false;

@@ -28,8 +28,10 @@ using monitor::AlarmCause;
 using monitor::AlarmLevel;
 
 constexpr std::int64_t kMs = 1'000'000;
-constexpr std::array<Phase, 6> kPhases = {Phase::kFullContact,  Phase::kSliding,    Phase::kRocking,
-                                          Phase::kSlideRocking, Phase::kOverturned, Phase::kFell};
+constexpr std::array<Phase, 7> kPhases = {Phase::kFullContact,  Phase::kSliding,
+                                          Phase::kRocking,      Phase::kSlideRocking,
+                                          Phase::kOverturned,   Phase::kFell,
+                                          Phase::kLiftedOff};
 
 Mode rocking_about(Corner corner) {
   Mode m;

@@ -190,6 +190,55 @@ TEST(Monitor, SensorSilenceIsAFaultAndTheEstimatorRestartsAfterIt) {
   EXPECT_EQ(monitor.status().sensor.counters.timeouts, 1U);
 }
 
+// The ground falling faster than gravity (the sensor's z reads -0.5 g: v_G'' = -1.5 g) lifts the
+// modelled block off: the estimator's model ends (phase lifted_off), which is no collapse; the
+// box says it cannot vouch (fault, cause outside_model) until the estimators start again.
+TEST(Monitor, LiftOffIsOutsideTheModelNotACollapse) {
+  const Scene scene = testing::make(testing::paper_isolated(0.0));
+  fw::Monitor monitor;
+  ASSERT_TRUE(monitor.start(quick_config(), {&scene, nullptr}).ok());
+  fw::FrameDecoder decoder;
+  decoder.start(quick_config());
+  RecordingSink events;
+  monitor.set_event_sink(0, &events);
+  std::uint8_t sequence = 0;
+  std::int64_t t = 0;
+  std::vector<monitor::AlarmEventRecord> alarms;
+  const auto feed_for = [&](double seconds, double az_g) {
+    for (int n = 0; n < std::lround(seconds * 200.0); ++n) {
+      can::SensorAcceleration m;
+      m.node = 1;
+      m.az_g = az_g;
+      m.sequence = sequence++;
+      can::CanFrame f;
+      ASSERT_TRUE(can::encode(m, f).ok());
+      const fw::MonitorUpdate u = fw::on_frame(monitor, decoder, {f, t});
+      for (std::size_t i = 0; i < u.event_count; ++i) alarms.push_back(u.events[i]);
+      t += ns(0.005);
+    }
+  };
+  feed_for(4.0, 1.0);
+  ASSERT_EQ(monitor.status().alarm, monitor::AlarmLevel::kNormal);
+  feed_for(0.1, -0.5);
+  const Event* lift = events.first(EventKind::kLiftOff);
+  ASSERT_NE(lift, nullptr);
+  // As g + v_G'' reaches 0, Eq 16's threshold (b/h)(g + v_G'') vanishes with it: the block may
+  // tip onto a corner at the same instant, within the events' time tolerance.
+  EXPECT_TRUE(lift->left == Phase::kFullContact || lift->left == Phase::kRocking);
+  EXPECT_EQ(monitor.status().axes[0].mode.phase, Phase::kLiftedOff);
+  EXPECT_TRUE(monitor.status().axes[0].outside_model);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kFault);
+  ASSERT_FALSE(alarms.empty());
+  EXPECT_EQ(alarms.back().level, monitor::AlarmLevel::kFault);
+  EXPECT_EQ(alarms.back().cause, monitor::AlarmCause::kOutsideModel);
+  for (const monitor::AlarmEventRecord& a : alarms) {
+    EXPECT_NE(a.cause, monitor::AlarmCause::kOverturnDetected) << "a lift-off is no collapse";
+  }
+  feed_for(5.0, 1.0);  // quiet again: the box still cannot vouch
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kFault);
+  EXPECT_EQ(monitor.status().axes[0].mode.phase, Phase::kLiftedOff);
+}
+
 // A collapse latches the alarm; an Acknowledge frame quoting the latest event releases the
 // latch, the alarm stays (its condition holds), a stale one changes nothing.
 TEST(Monitor, AcknowledgeFrameReleasesTheLatch) {

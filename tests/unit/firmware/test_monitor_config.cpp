@@ -1,7 +1,11 @@
 // The box's configuration file (firmware/linux/monitor_config.h).
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <cctype>
+#include <set>
 #include <string>
+#include <string_view>
 
 #include "box_file_error.h"
 #include "monitor_config.h"
@@ -172,6 +176,80 @@ TEST(MonitorConfigFile, TheStatueSensorsTables) {
   EXPECT_EQ(box_file_error("[statue_filter]\nmemory_s = 3\n"),
             "/etc/plinth/box.toml:1: statue_filter: no [statue_sensor] table (the filter weighs "
             "its measurements)");
+}
+
+// Issue 25: a value of the wrong type is reported as one, never as an unknown key. The walk
+// covers every key the example file shows (commented ones too): each table given a number,
+// each key given a table (or, where a table belongs, a boolean).
+TEST(MonitorConfigFile, EveryKeyOfTheWrongTypeIsSaidToBeOne) {
+  std::ifstream example(kSource + "/firmware/monitor.example.toml");
+  ASSERT_TRUE(example);
+  // By hand, not std::regex (GCC 12 warns falsely inside it under the sanitize preset).
+  // A name: lower case and '_'; a table's may be dotted ("[statue_sensor.health]").
+  const auto word_at = [](const std::string& text, std::size_t at, bool dotted = false) {
+    std::size_t end = at;
+    while (end < text.size() && (std::islower(static_cast<unsigned char>(text[end])) != 0 ||
+                                 text[end] == '_' || (dotted && text[end] == '.'))) {
+      ++end;
+    }
+    return text.substr(at, end - at);
+  };
+  std::string line;
+  std::string table;
+  bool array_of_tables = false;
+  std::set<std::string> tables;
+  int keys = 0;
+  while (std::getline(example, line)) {
+    // An optional "#" and spaces, then "[name]", "[[name]]" or "key = value".
+    std::size_t at = line.rfind('#', 0) == 0 ? 1 : 0;
+    while (at < line.size() && line[at] == ' ') ++at;
+    if (at < line.size() && line[at] == '[') {
+      array_of_tables = line.compare(at, 2, "[[") == 0;
+      const std::size_t name_at = at + (array_of_tables ? 2 : 1);
+      const std::string name = word_at(line, name_at, true);
+      const std::string close = array_of_tables ? "]]" : "]";
+      const std::size_t after = line.find_first_not_of(' ', name_at + name.size() + close.size());
+      if (name.empty() || line.compare(name_at + name.size(), close.size(), close) != 0 ||
+          (after != std::string::npos && line[after] != '#')) {
+        continue;  // prose in a comment ("[uncertainty] table.")
+      }
+      table = name;
+      if (!array_of_tables) tables.insert(table);
+      continue;
+    }
+    const std::string key = word_at(line, at);
+    const std::size_t equals = line.find_first_not_of(' ', at + key.size());
+    if (table.empty() || key.empty() || equals == std::string::npos || line[equals] != '=') {
+      continue;
+    }
+    const std::size_t value_at = line.find_first_not_of(' ', equals + 1);
+    if (value_at == std::string::npos) continue;
+    const char first = line[value_at];
+    const bool value_like = std::string_view("-+.0123456789\"[{").find(first) !=
+                                std::string_view::npos ||
+                            line.compare(value_at, 4, "true") == 0 ||
+                            line.compare(value_at, 5, "false") == 0;
+    if (!value_like) continue;  // prose in a comment ("statue = R sensor")
+    const std::string head = array_of_tables ? "[[" + table + "]]\nnode = 1\n" : "[" + table + "]\n";
+    const std::string name = table + (array_of_tables ? "[0]." : ".") + key;
+    const bool holds_a_table = first == '{';
+    const std::string text = head + key + (holds_a_table ? " = true\n" : " = { x = 1 }\n");
+    const std::string message = box_file_error(text);
+    SCOPED_TRACE(text);
+    EXPECT_EQ(message.find("unknown key"), std::string::npos) << message;
+    if (key == "node" && array_of_tables) continue;  // given twice: the repeat is named
+    EXPECT_NE(message.find(name + ": expected "), std::string::npos) << message;
+    if (!holds_a_table) {
+      EXPECT_NE(message.find("got a table"), std::string::npos) << message;
+    }
+    ++keys;
+  }
+  EXPECT_GT(keys, 60);
+  for (const std::string& t : tables) {
+    const std::string message = box_file_error(t + " = 3\n");
+    EXPECT_NE(message.find(t + ": expected a table"), std::string::npos) << message;
+  }
+  EXPECT_GT(tables.size(), 12U);
 }
 
 // A directory was read as an empty file (the defaults, silently); /dev/zero grew memory.

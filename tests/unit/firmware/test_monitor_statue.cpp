@@ -182,7 +182,7 @@ TEST(MonitorStatue, EachStreamHasItsOwnHealth) {
   EXPECT_TRUE(s.axes[0].statue.measured);
 }
 
-// The fault's place: after the sensors', the disagreement's and the bus's.
+// The fault's place: after the sensors', the disagreement's, the bus's and outside_model's.
 TEST(MonitorStatue, StatueUnexplainedIsTheLastFault) {
   BoxStatus s;
   s.estimating = true;
@@ -193,6 +193,8 @@ TEST(MonitorStatue, StatueUnexplainedIsTheLastFault) {
   EXPECT_TRUE(alarm_input(s, config, false).fault_active);
   EXPECT_EQ(alarm_input(s, config, false).fault_cause, monitor::AlarmCause::kStatueUnexplained);
   EXPECT_EQ(alarm_input(s, config, true).fault_cause, monitor::AlarmCause::kBusError);
+  s.axes[0].outside_model = true;
+  EXPECT_EQ(alarm_input(s, config, false).fault_cause, monitor::AlarmCause::kOutsideModel);
 }
 
 }  // namespace

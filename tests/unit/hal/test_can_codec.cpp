@@ -420,7 +420,7 @@ TEST(CanRoundTrip, SensorHeartbeatEverySmallFieldAndUptimeSweep) {
 
 TEST(CanRoundTrip, MonitorStatusEveryEnumCombinationAndAxis) {
   for (std::uint8_t axis = 0; axis < kMonitorAxisCount; ++axis) {
-    for (unsigned p = 0; p <= 5; ++p) {
+    for (unsigned p = 0; p <= 6; ++p) {
       for (unsigned c = 0; c <= 2; ++c) {
         for (unsigned a = 0; a <= 4; ++a) {
           MonitorStatus m;
@@ -482,7 +482,7 @@ TEST(CanRoundTrip, MonitorStatusEveryRiskSequenceAndAge) {
 TEST(CanRoundTrip, AlarmEventEveryEnumCombinationAndTimeSweep) {
   for (unsigned l = 0; l <= 4; ++l) {
     for (unsigned p = 0; p <= 4; ++p) {
-      for (const unsigned c : {0U, 1U, 2U, 3U, 4U, 5U, 6U, 7U, 8U, 9U, 10U, 11U, 14U}) {
+      for (const unsigned c : {0U, 1U, 2U, 3U, 4U, 5U, 6U, 7U, 8U, 9U, 10U, 11U, 12U, 14U}) {
         for (const bool latched : {false, true}) {
           AlarmEvent m;
           m.level = static_cast<AlarmLevel>(l);
@@ -792,7 +792,7 @@ TEST(CanReject, UndefinedSensorStatusFlags) {
 
 TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   // Decode: every raw value above the VAL_ table.
-  for (unsigned v = 6; v <= 15; ++v) {
+  for (unsigned v = 7; v <= 15; ++v) {
     MonitorStatus d;
     const DecodeResult r = decode(make_frame(0x320, Bytes{static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -819,8 +819,8 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
     EXPECT_STREQ(rk.signal, "Level");
   }
-  for (unsigned v = 12; v <= 255; ++v) {
-    if (v == 14) continue;  // statue_unexplained; 12 and 13 are a gap (other branches' causes)
+  for (unsigned v = 13; v <= 255; ++v) {
+    if (v == 14) continue;  // statue_unexplained; 13 and 15 are a gap (issue 26's causes)
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -829,7 +829,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   // Encode: values no enumerator names.
   CanFrame f;
   MonitorStatus s;
-  s.phase = static_cast<Phase>(6);
+  s.phase = static_cast<Phase>(7);
   EXPECT_EQ(encode(s, f).error, CodecError::kInvalidEnum);
   s = MonitorStatus{};
   s.corner = static_cast<Corner>(3);
@@ -838,7 +838,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  for (const unsigned gap : {12U, 13U, 15U}) {
+  for (const unsigned gap : {13U, 15U}) {
     e.cause = static_cast<AlarmCause>(gap);
     EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum) << gap;
   }
@@ -1062,7 +1062,7 @@ TEST(CanReject, OutputsUntouchedOnFailure) {
   MonitorStatus m;
   m.risk = 0.25;
   m.sequence = 9;
-  Bytes bad{0x06};  // Phase 6: not in the table
+  Bytes bad{0x07};  // Phase 7: not in the table
   ASSERT_FALSE(decode(make_frame(0x320, bad), m).ok());
   EXPECT_EQ(m.risk, 0.25);
   EXPECT_EQ(m.sequence, 9);
@@ -1165,12 +1165,12 @@ TEST(CanDbc, ValueTablesMatchTheCodecsEnumerations) {
       if (!c.has_value_table) continue;
       const auto& table = it->second;
       // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names; the
-      // causes have a gap (12, 13: other branches' causes), which decode refuses as well.
+      // causes have a gap (13: issue 26's p_wave), which decode refuses as well.
       const bool cause_gap = std::string(c.name) == "Cause";
       ASSERT_EQ(table.size(), static_cast<std::size_t>(c.raw_max - c.raw_min + 1) -
-                                  (cause_gap ? 2U : 0U));
+                                  (cause_gap ? 1U : 0U));
       if (cause_gap) {
-        EXPECT_EQ(table.count(12), 0U);
+        EXPECT_EQ(table.count(12), 1U);
         EXPECT_EQ(table.count(13), 0U);
       }
       for (const auto& [value, name] : table) {

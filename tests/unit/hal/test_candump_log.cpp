@@ -517,5 +517,37 @@ TEST(CanUtilsCompatibility, Log2AscThenAsc2LogGivesTheSameFrames) {
   EXPECT_EQ(reader.receive(timed, 0), IoStatus::kEndOfInput);
 }
 
+// The time of a log's frames (LogTimeCheck): back, standing still per identifier, a jump beyond
+// kMaxLogGapS, each described with its size; the first frame has no previous one.
+TEST(LogTime, NamesWhatIsWrongWithTheSize) {
+  constexpr std::int64_t kS = 1'000'000'000;
+  constexpr std::int64_t t0 = 1'700'000'000 * kS;
+  LogTimeCheck check;
+  EXPECT_EQ(check.check(t0, 0x301).problem, LogTimeProblem::kNone);
+  check.take(t0, 0x301);
+  EXPECT_EQ(check.check(t0 + 5'000'000, 0x301).problem, LogTimeProblem::kNone);
+  EXPECT_EQ(check.check(t0, 0x302).problem, LogTimeProblem::kNone) << "another identifier";
+  const LogTimeStep still = check.check(t0, 0x301);
+  EXPECT_EQ(still.problem, LogTimeProblem::kStoodStill);
+  EXPECT_EQ(check.describe(still, t0),
+            "timestamp stands still (1700000000.000000, the previous frame's of this identifier)");
+  const LogTimeStep back = check.check(t0 - 250'000'000, 0x302);
+  EXPECT_EQ(back.problem, LogTimeProblem::kWentBack);
+  EXPECT_EQ(back.step_ns, -250'000'000);
+  EXPECT_EQ(check.describe(back, t0 - 250'000'000),
+            "timestamp goes back by 0.250000 s (1699999999.750000 after 1700000000.000000)");
+  const auto limit = static_cast<std::int64_t>(kMaxLogGapS * 1e9);
+  EXPECT_EQ(check.check(t0 + limit, 0x302).problem, LogTimeProblem::kNone) << "at the limit";
+  const LogTimeStep jump = check.check(t0 + 3600 * kS, 0x302);
+  EXPECT_EQ(jump.problem, LogTimeProblem::kJumped);
+  EXPECT_EQ(check.describe(jump, t0 + 3600 * kS),
+            "timestamp jumps forward by 3600.000000 s (1700003600.000000 after "
+            "1700000000.000000; more than the 10 s a log's frames may be apart)");
+  EXPECT_EQ(check.describe({}, t0), "");
+  check.take(t0 + 3600 * kS, 0x302);
+  EXPECT_EQ(check.previous_ns(), t0 + 3600 * kS);
+  EXPECT_EQ(check.check(t0 + 3600 * kS + 1000, 0x301).problem, LogTimeProblem::kNone);
+}
+
 }  // namespace
 }  // namespace plinth::hal

@@ -346,6 +346,7 @@ TEST(EvalMetrics, RunsFileRoundTrips) {
   b.risk_crossing_s = {-1.0, -1.0};
   b.probability_crossing_s = {-1.0};
   b.nominal_risk_crossing_s = {-1.0, -1.0};
+  b.model_valid_until_s = 7.25;
   const std::string path = temp_path("roundtrip.csv");
   std::FILE* f = std::fopen(path.c_str(), "w");
   ASSERT_NE(f, nullptr);
@@ -365,6 +366,8 @@ TEST(EvalMetrics, RunsFileRoundTrips) {
   EXPECT_EQ(t.runs[1].probability_crossing_s, b.probability_crossing_s);
   EXPECT_EQ(t.runs[0].nominal_risk_crossing_s, a.nominal_risk_crossing_s);
   EXPECT_FALSE(t.runs[1].collapsed);
+  EXPECT_FALSE(t.runs[0].outside_model());
+  EXPECT_EQ(t.runs[1].model_valid_until_s, 7.25);
   EXPECT_FALSE(t.has_grid);  // runs without a grid: the header has no grid columns
   std::filesystem::remove(path);
 }
@@ -399,7 +402,7 @@ TEST(EvalMetrics, RunsFileKeepsTheCaseAndItsGridAndReadsEarlierFiles) {
     for (std::size_t i = 0; i < line.size(); ++i) {
       if (line[i] == ',') commas.push_back(i);
     }
-    text += line.substr(0, commas[9]) + line.substr(commas[13]) + "\n";
+    text += line.substr(0, commas[10]) + line.substr(commas[14]) + "\n";  // after model_valid_until_s
   }
   in.close();
   std::ofstream(path) << text;
@@ -410,6 +413,7 @@ TEST(EvalMetrics, RunsFileKeepsTheCaseAndItsGridAndReadsEarlierFiles) {
   EXPECT_EQ(old.runs[1].risk_crossing_s, runs[1].risk_crossing_s);
   std::filesystem::remove(path);
 }
+
 
 std::string error_reading(const std::string& text) {
   const std::string path = temp_path("bad.csv");
@@ -472,6 +476,32 @@ TEST(EvalMetrics, RunsFileErrorsNameTheLineAndColumn) {
   EXPECT_NE(error_reading("record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,"
                           "first_advisory_s,first_warning_s,first_alarm_s,colour\n")
                 .find(":1: column 11: unknown column \"colour\""),
+            std::string::npos);
+}
+
+// A run whose true statue lifted off has no truth: it counts in no outcome. A runs file
+// written before the column (none left the model) still reads.
+TEST(EvalMetrics, RunsOutsideTheModelCountNowhere) {
+  EvalRun lifted = standing(0.3, 2.0);
+  lifted.model_valid_until_s = 4.0;
+  const std::vector<EvalRun> runs{collapse_at(10.0, 8.0), standing(0.1, -1.0), lifted};
+  const WarningOutcome o = level_outcome(runs, monitor::AlarmLevel::kAlarm);
+  EXPECT_EQ(o.collapses, 1);
+  EXPECT_EQ(o.quiet_runs, 1);
+  EXPECT_EQ(o.false_alarms, 0);
+  EXPECT_EQ(o.near_miss_runs, 0);
+  const std::string path = temp_path("old.csv");
+  std::ofstream(path) << "record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,"
+                         "first_advisory_s,first_warning_s,first_alarm_s,risk_ge_0.5,"
+                         "nominal_risk_ge_0.5\nr,s,0,0.3,0,-1,0.2,-1,-1,-1,-1,-1\n";
+  const EvalTable t = read_eval_csv(path);
+  ASSERT_EQ(t.runs.size(), 1U);
+  EXPECT_FALSE(t.runs[0].outside_model());
+  std::filesystem::remove(path);
+  EXPECT_NE(error_reading("record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,"
+                          "first_advisory_s,first_warning_s,first_alarm_s,model_valid_until_s,"
+                          "risk_ge_0.5,nominal_risk_ge_0.5\nr,s,0,0.3,1,3,1,-1,-1,-1,2,-1,-1\n")
+                .find(":2: model_valid_until_s: a run that left the model has no collapse"),
             std::string::npos);
 }
 

@@ -83,9 +83,9 @@ void expect_complete(const NameTable<Enum, N>& table, Enum first, Enum last) {
 }
 
 TEST(NameTable, CoreTablesNameEveryValueOnce) {
-  expect_complete(kPhaseNames, Phase::kFullContact, Phase::kFell);
+  expect_complete(kPhaseNames, Phase::kFullContact, Phase::kLiftedOff);
   expect_complete(kCornerNames, Corner::kLeft, Corner::kRight);
-  expect_complete(kEventKindNames, EventKind::kRockingStart, EventKind::kFell);
+  expect_complete(kEventKindNames, EventKind::kRockingStart, EventKind::kLiftOff);
   expect_complete(kStepperNames, Stepper::kRk4Located, Stepper::kSemiImplicitEuler);
   EXPECT_STREQ(phase_name(Phase::kSlideRocking), "slide_rocking");
   EXPECT_STREQ(corner_name(Corner::kRight), "right");
@@ -97,11 +97,11 @@ TEST(NameTable, HostTablesNameEveryValueOnce) {
   using host::Outcome;
   using host::SweepEvent;
   using host::SweepParameter;
-  expect_complete(host::kOutcomeNames, Outcome::kSurvived, Outcome::kFell);
-  expect_complete(host::kSweepEventNames, SweepEvent::kSliding, SweepEvent::kOverturned);
+  expect_complete(host::kOutcomeNames, Outcome::kSurvived, Outcome::kLiftedOff);
+  expect_complete(host::kSweepEventNames, SweepEvent::kSliding, SweepEvent::kLiftOff);
   expect_complete(host::kSweepParameterNames, SweepParameter::kMuS, SweepParameter::kMassRatio);
   expect_complete(host::kImpulseStartNames, ImpulseStart::kFullContact,
-                  ImpulseStart::kSlideRocking);
+                  ImpulseStart::kLiftedOff);
 }
 
 // A name read from the command line: the error names the option and every name there is.

@@ -24,6 +24,7 @@ namespace plinth::host {
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 std::string lowercase_for_test(std::string text) {
   for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -299,8 +300,8 @@ TEST_F(At2Test, NegativeNptsIsNotAWholeNumber) {
   const std::string path = write("negnpts.AT2", at2_text("NPTS= -7, DT= .01 SEC", kSevenValues));
   const std::string message = input_error_message([&] { return read_at2(path, kStandardGravity); });
   EXPECT_THAT(message, HasSubstr(path + ":4:"));
-  EXPECT_THAT(message, HasSubstr("cannot find NPTS= (a positive whole number) in the header "
-                                 "line, found '-7'"));
+  EXPECT_THAT(message,
+              HasSubstr("NPTS is malformed: expected a positive whole number, found '-7'"));
 }
 
 TEST_F(At2Test, MissingDt) {
@@ -664,10 +665,11 @@ TEST_F(At2VariantTest, LayoutsThatSayTooLittle) {
       {"7 0.01 0.02 NPTS, DT", "found 3"},
       {"NPTS= 7, DT", "cannot find DT="},
       {"NPTS 7, DT= .01", "cannot find NPTS="},
-      {"NPTS= 7.5, DT= .01", "cannot find NPTS= (a positive whole number)"},
-      {"0.01 7 NPTS, DT",
-       "cannot find NPTS= (a positive whole number) in the header line, "
-       "found '0.01'"},
+      {"NPTS= 7.5, DT= .01", "NPTS is malformed: expected a positive whole number, found '7.5'"},
+      {"0.01 7 NPTS, DT", "NPTS is malformed: expected a positive whole number, found '0.01'"},
+      {"NPTS= 7, DT= abc", "DT is malformed: expected a number of seconds, found 'abc'"},
+      {"NPTS= 7, DT= \xEF\xBB\xBF.01",
+       "DT is malformed: expected a number of seconds, found '\\ufeff.01'"},
       {"NPTS= 99999999999999999999999, DT= .01", "is out of range"},
       {"NPTS= 7, DT= 1e999", "DT=1e999 is not a finite number"},
   };
@@ -722,6 +724,27 @@ TEST_F(EsmErrorTest, HeaderThatLies) {
               HasSubstr(path_ + ":15: more values than NDATA=4"));
 }
 
+// Issue 25: each header field the reader needs is named as missing when its line is absent and
+// as malformed when its line is there with no value or a value that is not one.
+TEST_F(EsmErrorTest, EachRequiredFieldMissingOrMalformed) {
+  const std::vector<std::pair<std::string, std::string>> fields = {
+      {"SAMPLING_INTERVAL_S", "0.005000"}, {"NDATA", "4"}, {"UNITS", "cm/s^2"}};
+  for (const auto& [key, value] : fields) {
+    const std::string line = key + ": " + value + "\n";
+    EXPECT_THAT(error_for(line, ""),
+                HasSubstr(path_ + ": missing header line '" + key + ": <value>'"));
+    const std::string empty = error_for(line, key + ":\n");
+    EXPECT_THAT(empty, HasSubstr(key + " is malformed: the line has no value after '" + key + ":'"));
+    EXPECT_THAT(empty, Not(HasSubstr("missing")));
+    const std::string garbage = error_for(line, key + ": 4\x01x\n");
+    EXPECT_THAT(garbage, HasSubstr("'4\\x01x'")) << key;
+    EXPECT_THAT(garbage, Not(HasSubstr("missing"))) << key;
+    if (key != "UNITS") {
+      EXPECT_THAT(garbage, HasSubstr(key + " is malformed")) << garbage;
+    }
+  }
+}
+
 TEST_F(EsmErrorTest, MissingOrBadKeys) {
   EXPECT_THAT(error_for("NDATA: 4\n", ""),
               HasSubstr(path_ + ": missing header line 'NDATA: <value>'"));
@@ -730,7 +753,8 @@ TEST_F(EsmErrorTest, MissingOrBadKeys) {
   EXPECT_THAT(error_for("DATA_TYPE: ACCELERATION", "DATA_TYPE: VELOCITY"),
               HasSubstr(path_ + ":9: DATA_TYPE is 'VELOCITY', expected ACCELERATION"));
   EXPECT_THAT(error_for("NDATA: 4", "NDATA: four"),
-              HasSubstr(path_ + ":6: cannot find NPTS= (a positive whole number)"));
+              HasSubstr(path_ + ":6: NDATA is malformed: expected a positive whole number, "
+                        "found 'four'"));
   EXPECT_THAT(error_for("SAMPLING_INTERVAL_S: 0.005000", "SAMPLING_INTERVAL_S: 0"),
               HasSubstr(path_ + ":6: SAMPLING_INTERVAL_S must be positive"));
   EXPECT_THAT(error_for("STREAM: HGE", "STREAM: HGE\nNDATA: 5"),

@@ -9,6 +9,7 @@
 #include <functional>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "expect_text.h"
 #include "plinth/core/scene.h"
@@ -384,7 +385,7 @@ TEST(SceneTomlErrors, NegativeDensityIsNamedAsWritten) {
   const std::string msg = error_of_text(
       "[block]\nhalf_width = 0.3\nslenderness = 3.0\ndensity = -2000\n");
   EXPECT_HAS(msg, "test.toml:4: block.density: must be greater than zero (got -2000, giving "
-                  "block.mass = -2160)");
+                  "block.mass = -2160, with block.half_width = 0.3, block.slenderness = 3)");
 }
 
 TEST(SceneTomlErrors, EccentricityRatioOfOne) {
@@ -395,7 +396,7 @@ TEST(SceneTomlErrors, EccentricityRatioOfOne) {
   EXPECT_HAS(msg, "block.eccentricity = 0.3");
   EXPECT_HAS(error_of_text(isolated("eccentricity = -0.4\n")),
              "test.toml:5: block.eccentricity: |e| must be smaller than the half-width b "
-             "(|epsilon| < 1) (got -0.4)");
+             "(|epsilon| < 1) (got -0.4, with block.half_width = 0.3)");
 }
 
 TEST(SceneTomlErrors, DampingRatioOfOne) {
@@ -408,7 +409,7 @@ TEST(SceneTomlErrors, DampingRatioOfOne) {
 TEST(SceneTomlErrors, CoreErrorsAreMappedToTheKeysUsed) {
   EXPECT_HAS(error_of_text("[block]\nhalf_width = 0.5\nslenderness = -2\nmass = 1\n"),
              "test.toml:3: block.slenderness: must be greater than zero (got -2, giving "
-             "block.com_height = -1)");
+             "block.com_height = -1, with block.half_width = 0.5)");
   EXPECT_HAS(error_of_text("[block]\nhalf_width = -0.3\ncom_height = 1\nmass = 1\n"),
              "test.toml:2: block.half_width: must be greater than zero (got -0.3)");
   EXPECT_HAS(error_of_text(isolated("inertia = 0\n")),
@@ -419,7 +420,7 @@ TEST(SceneTomlErrors, CoreErrorsAreMappedToTheKeysUsed) {
                  "[block]\nhalf_width = 0.3\nslenderness = 3\ndensity = 2000\n[base]\nmass_ratio "
                  "= 0\nperiod = 2\ndamping_ratio = 0.2\n"),
              "test.toml:6: base.mass_ratio: must be greater than zero (got 0, giving base.mass "
-             "= 0)");
+             "= 0, with block.density = 2000");
   EXPECT_HAS(error_of_text(
                  "[block]\nhalf_width = 0.3\nslenderness = 3\ndensity = 2000\n[base]\nmass_ratio "
                  "= 1\nperiod = 2\ndamping = -10\n"),
@@ -436,6 +437,49 @@ TEST(SceneTomlErrors, CoreErrorsAreMappedToTheKeysUsed) {
              "test.toml:11: base_stops.restitution: must lie in [0, 1] (got 1.5)");
   EXPECT_HAS(error_of_text(isolated("", "[friction]\nstatic = 0.5\n[support]\nclearance = 0\n")),
              "test.toml:12: support.clearance: must be greater than zero (got 0)");
+}
+
+// Issue 25: a core value computed from several keys, when invalid, is blamed on the key that
+// set it and names every other key it was computed from. The walk covers each derived field
+// of make_scene: com_height, eccentricity, mass, inertia, base mass, period and damping ratio.
+TEST(SceneTomlErrors, EveryDerivedFieldNamesAllItsInputs) {
+  struct Case {
+    std::string text;
+    std::string blamed;               // "test.toml:LINE: KEY: "
+    std::vector<std::string> inputs;  // the other keys, each "KEY = "
+  };
+  const std::vector<Case> cases = {
+      {"[block]\nhalf_width = 1e200\nslenderness = 1e200\nmass = 1\n",
+       "test.toml:3: block.slenderness: must be a finite number", {"block.half_width = "}},
+      {isolated("eccentricity_ratio = 1.0\n"), "test.toml:5: block.eccentricity_ratio: ",
+       {"block.half_width = 0.3"}},
+      {isolated("eccentricity = -0.4\n"), "test.toml:5: block.eccentricity: ",
+       {"block.half_width = 0.3"}},
+      {"[block]\nhalf_width = 1e5\nslenderness = 3\ndensity = 1e300\ndepth = 1e5\n",
+       "test.toml:4: block.density: must be a finite number",
+       {"block.half_width = ", "block.slenderness = 3", "block.depth = "}},
+      {"[block]\nhalf_width = 1e10\nslenderness = 3\nmass = 1e300\n",
+       "test.toml: block.inertia: must be a finite number (not given: m (b^2 + h^2) / 3",
+       {"block.mass = ", "block.half_width = ", "block.slenderness = 3"}},
+      {isolated("", "").replace(isolated("", "").find("mass_ratio = 1.0"), 16,
+                                "mass_ratio = 1e306"),
+       "test.toml:6: base.mass_ratio: must be a finite number",
+       {"block.density = 2000", "block.half_width = 0.3", "block.slenderness = 3"}},
+      {"[block]\nhalf_width = 0.3\nslenderness = 3\nmass = 1e10\n[base]\nmass_ratio = 1\n"
+       "stiffness = 1e-300\ndamping_ratio = 0.2\n",
+       "test.toml:7: base.stiffness: must be a finite number",
+       {"block.mass = ", "base.mass_ratio = 1"}},
+      {isolated("", "").replace(isolated("", "").find("damping_ratio = 0.2"), 19,
+                                "damping = 1e6"),
+       "test.toml:8: base.damping: must lie in [0, 1)",
+       {"block.density = 2000", "block.half_width = 0.3", "block.slenderness = 3",
+        "base.mass_ratio = 1", "base.period = 2"}},
+  };
+  for (const Case& c : cases) {
+    const std::string msg = error_of_text(c.text);
+    EXPECT_HAS(msg, c.blamed);
+    for (const std::string& input : c.inputs) EXPECT_HAS(msg, input);
+  }
 }
 
 TEST(SceneTomlErrors, PartsThatNeedOthers) {

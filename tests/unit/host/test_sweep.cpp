@@ -54,7 +54,8 @@ SweepSettings coarse() {
 
 TEST(Sweep, Names) {
   const char* expected[] = {"sliding",       "rocking",        "slide_rocking", "out_of_base",
-                            "base_stop_hit", "slide_stop_hit", "fell",          "overturned"};
+                            "base_stop_hit", "slide_stop_hit", "fell",          "overturned",
+                            "lift_off"};
   ASSERT_EQ(kSweepEventNames.size(), kSweepEventCount);
   for (std::size_t i = 0; i < kSweepEventCount; ++i) {
     EXPECT_STREQ(sweep_event_name(static_cast<SweepEvent>(i)), expected[i]);
@@ -78,9 +79,10 @@ std::string fields(const Thresholds& thresholds) {
 }
 
 // Each reported threshold: the event occurs there and not one tolerance below.
-Thresholds expect_thresholds_hold(const Scene& scene, std::size_t& found, std::size_t& runs) {
+Thresholds expect_thresholds_hold(const Scene& scene, std::size_t& found, std::size_t& runs,
+                                  const Record& record = brienza()) {
   const SweepSettings settings = coarse();
-  const auto thresholds = first_occurrence_thresholds(scene, brienza(), settings, &runs);
+  const auto thresholds = first_occurrence_thresholds(scene, record, settings, &runs);
   for (std::size_t e = 0; e < kSweepEventCount; ++e) {
     const auto event = static_cast<SweepEvent>(e);
     SCOPED_TRACE(sweep_event_name(event));
@@ -89,9 +91,9 @@ Thresholds expect_thresholds_hold(const Scene& scene, std::size_t& found, std::s
     const double thr = *thresholds[e];
     EXPECT_GT(thr, 0.0);
     EXPECT_LE(thr, settings.pga_max_g);
-    EXPECT_TRUE(simulate_occurrences(scene, brienza(), thr * scene.g, settings)[event]);
+    EXPECT_TRUE(simulate_occurrences(scene, record, thr * scene.g, settings)[event]);
     if (thr - settings.tolerance_g > 0.0) {
-      EXPECT_FALSE(simulate_occurrences(scene, brienza(), (thr - settings.tolerance_g) * scene.g,
+      EXPECT_FALSE(simulate_occurrences(scene, record, (thr - settings.tolerance_g) * scene.g,
                                         settings)[event]);
     }
   }
@@ -120,6 +122,29 @@ TEST(Sweep, ThresholdsHoldWhereBehaviourIsNotMonotonic) {
   std::size_t runs = 0;
   (void)expect_thresholds_hold(scene, found, runs);
   EXPECT_GE(found, 5u);
+}
+
+// Where the model ends is a threshold like the others: the paper's block on its base with
+// stops under Irpinia 1980, Bagnoli 000 lifts off (a stop hit while it rocks spins it until
+// h' theta'^2 beats g, Eq 12) from about 2 g; the runs there end in lift_off, not a collapse.
+TEST(Sweep, LiftOffIsAThresholdWhereTheModelEnds) {
+  SceneParams p = plinth::testing::paper_isolated();
+  p.has_base_stops = true;
+  p.base_stops = {0.2, 0.7};
+  const Scene scene = plinth::testing::make(p);
+  const Record bagnoli =
+      read_at2(plinth::testing::kSource + "/sim/data/records/irpinia1980_bagnoli_000.AT2",
+               kStandardGravity);
+  std::size_t found = 0;
+  std::size_t runs = 0;
+  const Thresholds thresholds = expect_thresholds_hold(scene, found, runs, bagnoli);
+  const std::optional<double> lift_off = thresholds[static_cast<std::size_t>(SweepEvent::kLiftOff)];
+  ASSERT_TRUE(lift_off.has_value());
+  EXPECT_GT(*lift_off, 1.5);
+  EXPECT_LT(*lift_off, 2.5);
+  const Occurrences at = simulate_occurrences(scene, bagnoli, *lift_off * scene.g, coarse());
+  EXPECT_TRUE(at[SweepEvent::kLiftOff]);
+  EXPECT_FALSE(at[SweepEvent::kOverturned]);  // the run ended before anything else
 }
 
 // On the ground without friction, rocking starts as soon as the scaled record reaches
@@ -284,7 +309,8 @@ TEST(Sweep, BadInputsSayWhatIsWrong) {
   const SweepPlan stiff =
       plan_thresholds(iso, brienza(), SweepParameter::kPeriod, {"T", 0.01, 0.01, 1}, big_step);
   EXPECT_THAT(input_error_text([&] { (void)testing::run_whole_plan(stiff); }),
-              HasSubstr("--param T = 0.01: --dt: "));
+              HasSubstr("--param T = 0.01: --dt 0.01: too large for a stable integration of this "
+                        "scene's base (base.period T = 0.01 s"));
   SweepSettings bad = coarse();
   bad.tolerance_g = 0.0;
   EXPECT_THAT(input_error_text([&] { validate(bad); }), HasSubstr("--tol"));
@@ -347,13 +373,13 @@ TEST(Sweep, PossibleEventsFollowTheSceneFeatures) {
     return text;
   };
   EXPECT_EQ(names(possible_events(plinth::testing::make(plinth::testing::paper_isolated()))),
-            "rocking overturned");
+            "rocking overturned lift_off");
   EXPECT_EQ(names(possible_events(plinth::testing::make(isolated_with_friction()))),
-            "sliding rocking slide_rocking out_of_base base_stop_hit fell overturned");
+            "sliding rocking slide_rocking out_of_base base_stop_hit fell overturned lift_off");
   SceneParams stops = isolated_with_friction();
   stops.has_sliding_stops = true;
   EXPECT_EQ(names(possible_events(plinth::testing::make(stops))),
-            "sliding rocking slide_rocking base_stop_hit slide_stop_hit overturned");
+            "sliding rocking slide_rocking base_stop_hit slide_stop_hit overturned lift_off");
   EXPECT_EQ(parse_sweep_event("fell"), SweepEvent::kFell);
   EXPECT_THAT(input_error_text([] { (void)parse_sweep_event("toppled"); }),
               HasSubstr("--event: unknown event 'toppled' (one of sliding, rocking,"));
@@ -430,7 +456,7 @@ TEST(Sweep, ThresholdPlanRowsAreTheCsvMap) {
                                          {"mu_s", 0.2, 0.6, 2}, settings);
   EXPECT_EQ(plan.header,
             "mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,"
-            "overturned");
+            "overturned,lift_off");
   EXPECT_THAT(plan.settings,
               ::testing::StartsWith("# plinth-sweep thresholds grid=mu_s:0.2:0.6:2 "));
   JobRun run;
@@ -482,7 +508,8 @@ TEST(SweepGround, CounterpartIsTheSameBlockOnTheGround) {
                         .set(static_cast<std::size_t>(SweepEvent::kSliding))
                         .set(static_cast<std::size_t>(SweepEvent::kRocking))
                         .set(static_cast<std::size_t>(SweepEvent::kSlideRocking))
-                        .set(static_cast<std::size_t>(SweepEvent::kOverturned)));
+                        .set(static_cast<std::size_t>(SweepEvent::kOverturned))
+                        .set(static_cast<std::size_t>(SweepEvent::kLiftOff)));
   EXPECT_EQ(fingerprint(ground_counterpart(bundled("paper-isolated.toml"))),
             fingerprint(bundled("non-isolated.toml")));
   for (const char* name : {"T", "xi", "u_max", "mass_ratio"}) {
@@ -506,7 +533,8 @@ TEST(SweepGround, ColumnsEqualARunOfTheBlockOnTheGround) {
       plan_thresholds(bundled("non-isolated.toml"), brienza(), SweepParameter::kMuS, mu, settings);
   EXPECT_EQ(compared.settings, own.settings + " compare=ground");
   EXPECT_EQ(compared.header,
-            own.header + ",sliding_ground,rocking_ground,slide_rocking_ground,overturned_ground");
+            own.header +
+                ",sliding_ground,rocking_ground,slide_rocking_ground,overturned_ground,lift_off_ground");
   const std::vector<std::string> rows = testing::run_whole_plan(compared);
   const std::vector<std::string> own_rows = testing::run_whole_plan(own);
   const std::vector<std::string> ground_rows = testing::run_whole_plan(ground);
@@ -515,11 +543,12 @@ TEST(SweepGround, ColumnsEqualARunOfTheBlockOnTheGround) {
     SCOPED_TRACE(rows[i]);
     const std::vector<std::string> f = csv_fields(rows[i]);
     const std::vector<std::string> g = csv_fields(ground_rows[i]);
-    ASSERT_EQ(f.size(), 1 + kSweepEventCount + 4);
+    ASSERT_EQ(f.size(), 1 + kSweepEventCount + 5);
     EXPECT_EQ(rows[i].substr(0, own_rows[i].size() + 1), own_rows[i] + ",");
     std::size_t column = 1 + kSweepEventCount;
     for (const SweepEvent e : {SweepEvent::kSliding, SweepEvent::kRocking,
-                               SweepEvent::kSlideRocking, SweepEvent::kOverturned}) {
+                               SweepEvent::kSlideRocking, SweepEvent::kOverturned,
+                               SweepEvent::kLiftOff}) {
       const std::string& expected = g[1 + static_cast<std::size_t>(e)];
       EXPECT_EQ(f[column++], expected) << sweep_event_name(e);
       found += expected.empty() ? 0U : 1U;
@@ -537,7 +566,7 @@ TEST(SweepGround, BaseParameterGivesOneGroundRowSearchedOnce) {
   const SweepPlan compared =
       plan_thresholds(base, brienza(), SweepParameter::kPeriod, period, settings, true);
   const SweepPlan own = plan_thresholds(base, brienza(), SweepParameter::kPeriod, period, settings);
-  EXPECT_EQ(compared.header, own.header + ",rocking_ground,overturned_ground");
+  EXPECT_EQ(compared.header, own.header + ",rocking_ground,overturned_ground,lift_off_ground");
   std::size_t compared_runs = 0;
   std::size_t own_runs = 0;
   JobRun run;
@@ -552,8 +581,9 @@ TEST(SweepGround, BaseParameterGivesOneGroundRowSearchedOnce) {
   EXPECT_EQ(compared_runs, own_runs + ground_runs);
   const std::string fields =
       "," + format_result(ground[static_cast<std::size_t>(SweepEvent::kRocking)]) + "," +
-      format_result(ground[static_cast<std::size_t>(SweepEvent::kOverturned)]);
-  EXPECT_NE(fields, ",,");
+      format_result(ground[static_cast<std::size_t>(SweepEvent::kOverturned)]) + "," +
+      format_result(ground[static_cast<std::size_t>(SweepEvent::kLiftOff)]);
+  EXPECT_NE(fields, ",,,");
   for (std::size_t i = 0; i < rows.size(); ++i) EXPECT_EQ(rows[i], own_rows[i] + fields);
 }
 

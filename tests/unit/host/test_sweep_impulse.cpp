@@ -139,7 +139,8 @@ TEST(SweepImpulse, CurveOnTheGroundMatchesTheEnergyBound) {
   }
   const SweepPlan plan = plan_impulse_curve(plinth::testing::paper_block(), SweepParameter::kLambda,
                                             {"lambda", 3, 3, 1}, settings);
-  EXPECT_EQ(plan.header, "lambda,rocking,overturned,rocking_closed_form,overturned_closed_form");
+  EXPECT_EQ(plan.header,
+            "lambda,rocking,overturned,rocking_closed_form,overturned_closed_form,lift_off");
   EXPECT_THAT(testing::input_error_text([&] {
                 ImpulseSearchSettings bad = settings;
                 bad.impulse_max = 0.0;
@@ -161,17 +162,18 @@ TEST(SweepImpulse, CurveComparesTheBlockOnTheGround) {
                                            SweepParameter::kLambda, lambda, settings);
   const SweepPlan ground =
       plan_impulse_curve(plinth::testing::paper_block(), SweepParameter::kLambda, lambda, settings);
-  EXPECT_EQ(compared.header, own.header + ",overturned_ground,overturned_closed_form_ground");
+  EXPECT_EQ(compared.header,
+            own.header + ",overturned_ground,overturned_closed_form_ground,lift_off_ground");
   EXPECT_EQ(compared.settings, own.settings + " compare=ground");
   const std::vector<std::string> rows = testing::run_whole_plan(compared);
   const std::vector<std::string> own_rows = testing::run_whole_plan(own);
   const std::vector<std::string> ground_rows = testing::run_whole_plan(ground);
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    // The ground's row: lambda, rocking (0), overturned, 0, the energy bound.
+    // The ground's row: lambda, rocking (0), overturned, 0, the energy bound, lift-off.
     const std::vector<std::string> g = csv_fields(ground_rows[i]);
-    ASSERT_EQ(g.size(), 5u);
+    ASSERT_EQ(g.size(), 6u);
     EXPECT_FALSE(g[2].empty());
-    EXPECT_EQ(rows[i], own_rows[i] + "," + g[2] + "," + g[4]);
+    EXPECT_EQ(rows[i], own_rows[i] + "," + g[2] + "," + g[4] + "," + g[5]);
   }
 
   const GridAxis period{"T", 1.0, 3.0, 3};
@@ -193,7 +195,8 @@ TEST(SweepImpulse, CurveComparesTheBlockOnTheGround) {
   EXPECT_EQ(runs, own_runs + ground_runs);
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_EQ(period_rows[i], own_period_rows[i] + "," + format_result(found.overturned) + "," +
-                                  format_result(ground_overturning_impulse(on_ground)));
+                                  format_result(ground_overturning_impulse(on_ground)) + "," +
+                                  format_result(found.lift_off));
   }
   EXPECT_THAT(testing::input_error_text([&] {
                 (void)plan_impulse_curve(plinth::testing::paper_block(), SweepParameter::kLambda,

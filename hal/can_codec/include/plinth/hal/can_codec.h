@@ -82,6 +82,7 @@ enum class Phase : std::uint8_t {
   kSlideRocking = 3,
   kOverturned = 4,
   kFell = 5,
+  kLiftedOff = 6,
 };
 // The corner the block rocks about; kNone when it does not rock.
 enum class Corner : std::uint8_t { kNone = 0, kLeft = 1, kRight = 2 };
@@ -105,10 +106,11 @@ enum class AlarmCause : std::uint8_t {
   kInternalFault = 9,       // the monitor's own self-check failed
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet
+  kOutsideModel = 12,       // the estimate left the model's validity (lift-off)
   kStatueUnexplained = 14,  // no member of the ensemble explains the statue sensor's motion
 };
-// 12 (outside_model) and 13 (p_wave) are other branches' causes: gaps in the VAL_ table, refused
-// on encode and decode until they land.
+// 13 (p_wave) and 15 (regional_alert) are issue 26's causes: gaps in the VAL_ table, refused on
+// encode and decode until they land.
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.
 namespace sensor_status {

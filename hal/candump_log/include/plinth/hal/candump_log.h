@@ -158,6 +158,58 @@ class CandumpLogWriter final : public FrameSink {
   std::string error_;
 };
 
+// ---------------------------------------------------------------------------------------------
+// Time in a log (docs/record-formats.md, "Time in candump logs")
+//
+// A log's frames are meant to follow one another in time: a frame stamped before the previous
+// one (the log was merged, or the logging clock was stepped back), at the same microsecond as
+// the previous frame of its identifier (a duplicate), or long after the previous one (the
+// logger paused, or the clock was stepped forward) cannot be replayed as logged.
+// plinth-replay and plinth-monitor check every frame with LogTimeCheck and apply the policy
+// --log-time chooses: warn (the default: name each, go on) or refuse (stop at the first).
+
+enum class LogTimeProblem : std::uint8_t {
+  kNone,
+  kWentBack,    // stamped before the previous frame
+  kStoodStill,  // stamped at the previous time of its identifier
+  kJumped,      // stamped more than the gap limit after the previous frame
+};
+
+enum class LogTimePolicy : std::uint8_t { kWarn, kRefuse };
+inline constexpr NameTable<LogTimePolicy, 2> kLogTimePolicyNames{{{
+    {LogTimePolicy::kWarn, "warn"},
+    {LogTimePolicy::kRefuse, "refuse"},
+}}};
+
+// A log's frames longer apart than this are a jump: s.
+inline constexpr double kMaxLogGapS = 10.0;
+
+struct LogTimeStep {
+  LogTimeProblem problem = LogTimeProblem::kNone;
+  std::int64_t step_ns = 0;  // the frame's time minus the previous frame's (< 0: back)
+};
+
+class LogTimeCheck {
+ public:
+  LogTimeCheck();
+  // The frame stamped t_ns (standard identifier `id`) against the latest frame taken; kNone for
+  // the first one.
+  [[nodiscard]] LogTimeStep check(std::int64_t t_ns, std::uint32_t id) const;
+  // Takes the frame as the latest (its time then becomes the previous frame's).
+  void take(std::int64_t t_ns, std::uint32_t id);
+  [[nodiscard]] bool started() const { return started_; }
+  [[nodiscard]] std::int64_t previous_ns() const { return previous_ns_; }
+  // What is wrong, with the size: "timestamp goes back by 0.250000 s (1700000000.250000 after
+  // 1700000000.500000)", "timestamp jumps forward by 3600.000000 s (more than the 10 s a log's
+  // frames may be apart)", "timestamp stands still (...)". "" for kNone.
+  [[nodiscard]] std::string describe(const LogTimeStep& step, std::int64_t t_ns) const;
+
+ private:
+  bool started_ = false;
+  std::int64_t previous_ns_ = 0;
+  std::array<std::int64_t, kStandardIdMask + 1> last_ns_by_id_{};  // -1: none yet
+};
+
 struct CandumpLogReaderOpenResult {
   std::optional<CandumpLogReader> reader;  // set on success
   std::string message;                     // names the file and the cause; empty on success

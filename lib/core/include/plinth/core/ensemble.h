@@ -26,6 +26,9 @@ struct EnsembleRisk {
   Risk risk;             // the worst member's: the highest total (the first of equals)
   Risk nominal_risk;     // member 0's: the scene file's statue alone
   int worst_member = 0;  // whose `risk` that is
+  // A member's estimate ended outside the model (Phase::kLiftedOff): the box cannot vouch for
+  // this axis until its estimators start again (the alarm policy's outside_model).
+  bool outside_model = false;
 };
 
 class Ensemble {

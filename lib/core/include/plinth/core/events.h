@@ -24,6 +24,8 @@ enum class EventKind : std::uint8_t {
   kOutOfBase,         // |x| passed x_hat: the block overhangs the support's `side` edge
   kBackOnBase,        // the overhanging block slid back onto the support
   kFell,              // C passed the support's `side` edge: the block fell off the base
+  kLiftOff,           // the support's normal force on the block reached 0 (guards.h, kLiftOff):
+                      // `left` is the phase it left, `before` g + v_G'' (m/s2) then
 };
 
 struct Event {
@@ -35,11 +37,12 @@ struct Event {
   Real after = 0.0;
   Phase phase = Phase::kFullContact;  // the phase just after the event
   std::int8_t overhang = 0;           // Mode::overhang just after the event
+  Phase left = Phase::kFullContact;   // kLiftOff: the phase the block was in
   State state = State::Zero();        // just after the reset
 };
 
 // Names used in plinth-sim's JSON Lines event log.
-inline constexpr NameTable<EventKind, 13> kEventKindNames{{{
+inline constexpr NameTable<EventKind, 14> kEventKindNames{{{
     {EventKind::kRockingStart, "rocking_start"},
     {EventKind::kImpact, "impact"},
     {EventKind::kRockingStop, "rocking_stop"},
@@ -53,6 +56,7 @@ inline constexpr NameTable<EventKind, 13> kEventKindNames{{{
     {EventKind::kOutOfBase, "out_of_base"},
     {EventKind::kBackOnBase, "back_on_base"},
     {EventKind::kFell, "fell"},
+    {EventKind::kLiftOff, "lift_off"},
 }}};
 [[nodiscard]] constexpr const char* event_name(EventKind kind) {
   return kEventKindNames.name(kind);

@@ -80,7 +80,9 @@ struct ForecastOutcome {
   bool valid = false;          // a forecast has completed since the start
   double start_time_s = 0.0;   // estimator time of the snapshot it started from, s
   int members = 0;
-  int collapsing = 0;          // members that overturn or fall within the horizon
+  // Members that overturn or fall within the horizon, or lift off (the model ends there and
+  // cannot say they stand: counted as collapsing, the safe side).
+  int collapsing = 0;
   double probability = 0.0;    // collapsing / members
   int worst_member = -1;       // the member that collapses first; -1: none does
   std::uint32_t collapsing_members = 0;  // bit m: member m collapses within the horizon

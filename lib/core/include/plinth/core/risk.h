@@ -12,7 +12,8 @@
 //  - base stops: the amplitude the base's free oscillation would reach from (u, u'),
 //    sqrt(u^2 + (u'/omega)^2), against u_max, times base_stop_weight (hitting the stops is not
 //    a collapse, but it kicks the block: the paper's Fig. 8).
-// The total is the worst part. Overturned or fell: 1.
+// The total is the worst part. Overturned or fell: 1. Lifted off (outside the model): 0, no
+// margin being known; the box reports the state itself (alarm policy, outside_model).
 #pragma once
 
 #include "plinth/core/error.h"

@@ -117,9 +117,19 @@ class Simulator {
   void emit_event(const Event& event) {
     if (sink_ != nullptr) sink_->on_event(event);
   }
+  // The event `kind` at t, of the current mode and state: one copy out of line for every
+  // feature set's event logic (the Cortex-M image's flash), built only when a sink listens.
+  void emit_event(Time t, EventKind kind, int side, Real before, Real after,
+                  Phase left = Phase::kFullContact);
   // The guards of the current mode, after it changed.
   void refresh_guards() { active_guards_ = guards_fn_(mode_); }
   void step_intervals(Time t_end);
+  // Lift-off (guards.h, kLiftOff): the run ends in Phase::kLiftedOff at t, the state that of the
+  // lift-off, with the event. `located`: the guard's crossing was located at t; otherwise (after
+  // a reset or at a start, where a guard already past 0 would never cross) only when the mode
+  // has no normal force left there (the ground already falling faster than gravity, a jump of
+  // theta' that unloads the pivot). True when it lifted off. One copy for every feature set.
+  bool lift_off(Time t, bool located = false);
   [[gnu::noinline]] void finish_step(Time t0, Time t_end);
 
   // Advances in the current mode from t0 towards t_end (one interval of a step, StepInterval in
@@ -139,7 +149,9 @@ class Simulator {
   void (*settle_chatter_fn_)(Simulator&, Time t) = nullptr;
   internal::ActiveGuards (*guards_fn_)(const Mode&) = nullptr;
   void (*start_phases_fn_)(Simulator&, Time t) = nullptr;  // whose onset already holds
-  Accelerations (*accelerations_fn_)(const Simulator&, Time t, const State&) = nullptr;
+  // The current mode's accelerations at (t, y); the ground's there into *ground when given.
+  Accelerations (*accelerations_fn_)(const Simulator&, Time t, const State&,
+                                     GroundAcceleration* ground) = nullptr;
   // exact_full_contact: a quiet whole step of full contact, from time() to t_end (false: take
   // the interval).
   bool (*quiet_full_contact_step_fn_)(Simulator&, Time t_end) = nullptr;

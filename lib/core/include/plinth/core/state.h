@@ -24,6 +24,7 @@ struct Accelerations {
   Real theta = 0.0;  // rad/s2
 };
 
+// The terminal phases come last (Mode::terminal compares once).
 enum class Phase : std::uint8_t {
   kFullContact,
   kSliding,
@@ -31,16 +32,20 @@ enum class Phase : std::uint8_t {
   kSlideRocking,
   kOverturned,
   kFell,
+  // The block lost contact with its support (its normal force fell to zero, guards.h kLiftOff):
+  // the model has no free flight, so the run ends here, outside the model.
+  kLiftedOff,
 };
 
 // The names used in plinth-sim's CSV and in the monitor's status lines.
-inline constexpr NameTable<Phase, 6> kPhaseNames{{{
+inline constexpr NameTable<Phase, 7> kPhaseNames{{{
     {Phase::kFullContact, "full_contact"},
     {Phase::kSliding, "sliding"},
     {Phase::kRocking, "rocking"},
     {Phase::kSlideRocking, "slide_rocking"},
     {Phase::kOverturned, "overturned"},
     {Phase::kFell, "fell"},
+    {Phase::kLiftedOff, "lifted_off"},
 }}};
 [[nodiscard]] constexpr const char* phase_name(Phase phase) { return kPhaseNames.name(phase); }
 
@@ -64,9 +69,12 @@ struct Mode {
   [[nodiscard]] bool rocking() const {
     return phase == Phase::kRocking || phase == Phase::kSlideRocking;
   }
-  [[nodiscard]] bool terminal() const {
+  // The block overturned or fell off the base.
+  [[nodiscard]] bool collapsed() const {
     return phase == Phase::kOverturned || phase == Phase::kFell;
   }
+  // The run has ended: a collapse, or the model's validity (kLiftedOff).
+  [[nodiscard]] bool terminal() const { return phase >= Phase::kOverturned; }
 };
 
 }  // namespace plinth

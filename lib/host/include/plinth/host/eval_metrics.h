@@ -79,6 +79,9 @@ struct EvalRun {
   bool collapsed = false;
   double collapse_time_s = -1.0;  // -1: none
   double peak_ratio = 0.0;        // max |theta| / alpha over the run (1 at a collapse)
+  // >= 0: the true statue lifted off then (Phase::kLiftedOff): the model ends, so the truth is
+  // unknown and the run counts in no outcome (outcome_of skips it); -1: the model held.
+  double model_valid_until_s = -1.0;
   // When the true statue first left full contact (-1: never). Not a column of the runs file:
   // plinth-eval run --motion-out writes it beside the levels' times.
   double first_motion_s = -1.0;
@@ -90,6 +93,7 @@ struct EvalRun {
   // The nominal statue's reactive risk alone (today's box), on the risk grid.
   std::vector<double> nominal_risk_crossing_s;
 
+  [[nodiscard]] bool outside_model() const { return model_valid_until_s >= 0.0; }
   [[nodiscard]] bool quiet() const { return !collapsed && peak_ratio < kQuietPeakRatio; }
   [[nodiscard]] bool near_miss() const { return !collapsed && peak_ratio >= kQuietPeakRatio; }
   // The collapse margin: case_collapse_g / scale_g; when the case never collapsed, the lower bound
@@ -147,6 +151,7 @@ template <class FirstTime>
 [[nodiscard]] WarningOutcome outcome_of(const std::vector<EvalRun>& runs, FirstTime first_time) {
   WarningOutcome o;
   for (const EvalRun& r : runs) {
+    if (r.outside_model()) continue;  // no truth to judge the warning against
     const double t = first_time(r);
     if (r.collapsed) {
       ++o.collapses;

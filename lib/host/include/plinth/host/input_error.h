@@ -4,8 +4,10 @@
 #include <cstdio>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "plinth/core/error.h"
+#include "plinth/core/scene.h"
 
 namespace plinth::host {
 
@@ -16,18 +18,22 @@ class InputError : public std::runtime_error {
   explicit InputError(const std::string& message) : std::runtime_error(message) {}
 };
 
-// Throws the InputError a command-line tool shows for a failed Simulator::create: the solver's
-// step is the tools' --dt, and a largest stable step is quoted.
-inline void throw_if_simulator_error(const Error& e) {
-  if (e.ok()) return;
-  std::string message = std::string(std::string(e.field) == "solver.step" ? "--dt" : e.field) +
-                        ": " + e.reason;
-  if (e.limit > 0.0) {
-    char limit[64];
-    std::snprintf(limit, sizeof limit, "; the largest stable step is %.3g s", e.limit);
-    message += limit;
-  }
-  throw InputError(message);
-}
+// A text shown in a message with its invisible characters escaped (a tab as \t, a carriage
+// return as \r, a line feed as \n, a UTF-8 byte order mark as \ufeff, any other control byte
+// as \xNN, a backslash as \\) and quoted: what the user typed or the file held, as it is.
+[[nodiscard]] std::string shown(std::string_view text);
+
+// A whole message made printable the same way, its own line breaks kept: every tool prints its
+// errors (run_tool, parse_command_line) and warnings through it, so whatever text of the user's
+// a message quotes, a stray tab, carriage return or byte order mark shows as what it is.
+[[nodiscard]] std::string printable(std::string_view message);
+
+// Throws the InputError a command-line tool shows for a failed Simulator::create of `scene` at
+// the step `step` (s, the tools' --dt). A step too large for the scene's base names --dt with
+// its value and the largest stable step, and the base's keys that set that limit (its period,
+// mass and damping: a stiff or light base); when no step a tool can take would do (the limit
+// below kSmallestUsableStep), the base alone is blamed.
+inline constexpr double kSmallestUsableStep = 1e-9;  // s
+void throw_if_simulator_error(const Error& e, const Scene& scene, double step);
 
 }  // namespace plinth::host

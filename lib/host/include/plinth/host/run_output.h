@@ -23,12 +23,15 @@ class TimeHistoryCsv {
   std::ostream& out_;
 };
 
-enum class Outcome { kSurvived, kOverturned, kFell };
+// kLiftedOff: the block lost contact with its support at the end time; the model has no free
+// flight, so nothing after it is known (neither survival nor collapse).
+enum class Outcome { kSurvived, kOverturned, kFell, kLiftedOff };
 
-inline constexpr NameTable<Outcome, 3> kOutcomeNames{{{
+inline constexpr NameTable<Outcome, 4> kOutcomeNames{{{
     {Outcome::kSurvived, "survived"},
     {Outcome::kOverturned, "overturned"},
     {Outcome::kFell, "fell"},
+    {Outcome::kLiftedOff, "lifted_off"},
 }}};
 [[nodiscard]] constexpr const char* outcome_name(Outcome outcome) {
   return kOutcomeNames.name(outcome);
@@ -37,7 +40,8 @@ inline constexpr NameTable<Outcome, 3> kOutcomeNames{{{
 
 // One JSON object per line: {"t": s, "event": name, ...details}.
 [[nodiscard]] std::string event_json(const Event& event);
-// The last line: {"t": s, "event": "end", "outcome": "survived" | "overturned" | "fell"}.
-[[nodiscard]] std::string end_json(double t, Outcome outcome);
+// The last line: {"t": s, "event": "end", "outcome": "survived" | "overturned" | "fell" |
+// "lifted_off"}; with lifted_off also "model_valid_until": s, the lift-off event's time.
+[[nodiscard]] std::string end_json(double t, Outcome outcome, double lift_off_t = 0.0);
 
 }  // namespace plinth::host

@@ -26,14 +26,16 @@ enum class ImpulseStart : unsigned char {
   kSliding,       // sliding starts first
   kRocking,       // rocking starts first and its first phase ends without sliding
   kSlideRocking,  // rocking first, then sliding within the first rocking phase
+  kLiftedOff,     // the block lifted off before the start was settled: outside the model
 };
 
 // The names in the impulse map's CSV.
-inline constexpr NameTable<ImpulseStart, 4> kImpulseStartNames{{{
+inline constexpr NameTable<ImpulseStart, 5> kImpulseStartNames{{{
     {ImpulseStart::kFullContact, "full_contact"},
     {ImpulseStart::kSliding, "sliding"},
     {ImpulseStart::kRocking, "rocking"},
     {ImpulseStart::kSlideRocking, "slide_rocking"},
+    {ImpulseStart::kLiftedOff, "lifted_off"},
 }}};
 [[nodiscard]] constexpr const char* impulse_start_name(ImpulseStart start) {
   return kImpulseStartNames.name(start);
@@ -111,6 +113,7 @@ void validate(const ImpulseSearchSettings& settings);
 struct ImpulseThresholds {
   std::optional<double> rocking;
   std::optional<double> overturned;
+  std::optional<double> lift_off;  // the smallest |I| after which the model ends (lift-off)
 };
 [[nodiscard]] ImpulseThresholds impulse_thresholds(const Scene& scene,
                                                    const ImpulseSearchSettings& settings,
@@ -118,10 +121,11 @@ struct ImpulseThresholds {
                                                    const std::atomic<bool>* stop = nullptr);
 
 // Fig. 7 kind (mode "impulse_curve"): a row per value,
-// "<param>,rocking,overturned,rocking_closed_form,overturned_closed_form": the simulated
-// thresholds and Eq 37 (on a base) or 0 and ground_overturning_impulse (on the ground).
+// "<param>,rocking,overturned,rocking_closed_form,overturned_closed_form,lift_off": the
+// simulated thresholds and Eq 37 (on a base) or 0 and ground_overturning_impulse (on the
+// ground), and the simulated lift-off threshold (above it the model ends before the others).
 // With `compare_ground` (the scene must have a base), also the value's ground_counterpart's
-// "overturned_ground,overturned_closed_form_ground" (its rocking impulse is 0 for every
+// "overturned_ground,overturned_closed_form_ground,lift_off_ground" (its rocking impulse is 0 for every
 // value, so it has no column); the same ground scene is searched once, and the
 // settings line says "compare=ground".
 [[nodiscard]] SweepPlan plan_impulse_curve(const SceneParams& base, SweepParameter parameter,

@@ -27,8 +27,9 @@ enum class SweepEvent : unsigned char {
   kSlideStopHit,  // kSlideStopHit
   kFell,          // kFell
   kOverturned,    // kOverturned
+  kLiftOff,       // kLiftOff: the model ends (its threshold bounds where the others are valid)
 };
-inline constexpr std::size_t kSweepEventCount = 8;
+inline constexpr std::size_t kSweepEventCount = 9;
 
 // The CSV columns' names, in the order above.
 inline constexpr NameTable<SweepEvent, kSweepEventCount> kSweepEventNames{{{
@@ -40,6 +41,7 @@ inline constexpr NameTable<SweepEvent, kSweepEventCount> kSweepEventNames{{{
     {SweepEvent::kSlideStopHit, "slide_stop_hit"},
     {SweepEvent::kFell, "fell"},
     {SweepEvent::kOverturned, "overturned"},
+    {SweepEvent::kLiftOff, "lift_off"},
 }}};
 [[nodiscard]] constexpr const char* sweep_event_name(SweepEvent event) {
   return kSweepEventNames.name(event);
@@ -54,7 +56,7 @@ inline const EventSet kAllEvents = EventSet{}.set();
 
 // The events the scene's features allow (features_of, scene.h): sliding and slide_rocking need
 // friction, base stop hits base stops, leaving the support and falling a support without
-// sliding stops, sliding stop hits sliding stops.
+// sliding stops, sliding stop hits sliding stops. Every scene can lift off.
 [[nodiscard]] EventSet possible_events(const Scene& scene);
 
 // Which events occurred in one simulation; indexed by SweepEvent.

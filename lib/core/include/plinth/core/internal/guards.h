@@ -33,6 +33,7 @@ enum class GuardId : std::uint8_t {
   kBaseStopRight,        // Eq 28, u = +u_max
   kBaseStopLeft,         // Eq 28, u = -u_max
   kBaseStopRelease,      // the held base's stop would have to pull: it leaves the stop
+  kLiftOff,              // the support's normal force on the block reaches 0: outside the model
 };
 
 inline constexpr int kMaxActiveGuards = 13;
@@ -50,6 +51,7 @@ template <Features F>
 [[nodiscard]] constexpr ActiveGuards active_guards(const Mode& mode) {
   ActiveGuards g;
   if (mode.terminal()) return g;
+  g.add(GuardId::kLiftOff);  // first: at a tie the model's validity ends before anything else
   if (mode.rocking()) {
     g.add(GuardId::kRockingImpact);
     g.add(GuardId::kOverturning);
@@ -146,6 +148,22 @@ template <Features F>
   return sticking_contact_force(s, mode, y, ag, acc, sin_cos(y[kTheta]));
 }
 
+// Lift-off: the witness is minus the support's normal force on the block per unit mass, Y / m
+// (m/s2); the model has no free flight, so where Y reaches 0 its validity ends. Y per phase:
+//  - full contact and sliding (Fig. 4(a), Eqs 5 and 15): Y = m (g + v_G''), so the block lifts
+//    off when the ground falls faster than gravity, v_G'' <= -g;
+//  - rocking and slide-rocking about a body corner, Eq 12 (pure rocking: x'' = 0):
+//    Y = m (g + v_G'') + m b'_i theta'' - m h'_i theta'^2: besides the ground's fall, the
+//    pivot unloads when the rotation accelerates the wrong way or spins fast (centripetal term);
+//  - about the support's corner, Eq 14 (x' = 0 in pure rocking), with its Coriolis term.
+// Computed by sticking_contact_force (one copy of the contact's equations: the Cortex-M image's
+// flash); tests/unit/core/test_lift_off.cpp checks it against each printed form above.
+[[nodiscard]] inline Real lift_off_guard(const Scene& s, const Mode& mode, const State& y,
+                                         GroundAcceleration ag, const Accelerations& acc,
+                                         const SinCos& trig) {
+  return -sticking_contact_force(s, mode, y, ag, acc, trig).normal / s.m;
+}
+
 // det(with friction) / det(frictionless) of slide-rocking about the mode's pivot in `direction`
 // (flows.h, sliding_consistency).
 [[nodiscard]] inline Real sliding_consistency(const Scene& s, const Mode& mode, int direction,
@@ -222,6 +240,8 @@ template <Features F>
       return -y[kU] - s.params.base_stops.max_displacement;
     case GuardId::kBaseStopRelease:
       return static_cast<Real>(mode.held_stop) * base_stop_reaction(s, mode, y, ag, acc, trig);
+    case GuardId::kLiftOff:
+      return lift_off_guard(s, mode, y, ag, acc, trig);
   }
   return -Real(1);
 }
@@ -263,6 +283,9 @@ template <Features F>
       return -y[kU] - s.params.base_stops.max_displacement;
     case GuardId::kSlidingInconsistent:
       return kPainleveMargin - p.consistency;
+    case GuardId::kLiftOff:
+      if (!mode.rocking()) return -(s.g + ag.vertical);
+      break;
     default:
       break;
   }
