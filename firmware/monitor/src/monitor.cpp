@@ -51,8 +51,8 @@ Error Monitor::start(const MonitorConfig& config,
     note_statue_health();
   }
   if (statue_present()) {
-    measured_.fill(false);
-    statue_restarts_ = 0;
+    room().measured.fill(false);
+    room().restarts = 0;
   }
   last_ground_.setZero();
   frames_not_encoded_ = 0;
@@ -129,14 +129,14 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
 // again).
 void Monitor::push_ensembles(const Vector3r& g, std::int64_t receive_time_ns) {
   const bool measuring = statue_present() && room().sensor.usable(receive_time_ns);
-  if (measuring && room().sensor.restarts() != statue_restarts_) {
-    statue_restarts_ = room().sensor.restarts();
+  if (measuring && room().sensor.restarts() != room().restarts) {
+    room().restarts = room().sensor.restarts();
     for (StatueFilter& f : room().filters) f.reset();
   }
   for (int i = 0; i < status_.axis_count; ++i) {
     const auto k = static_cast<std::size_t>(i);
     ensembles_[k].push({g[i], g.z()});
-    if (statue_present()) measured_[k] = measuring;
+    if (statue_present()) room().measured[k] = measuring;
     if (measuring) {
       room().filters[k].on_sample(ensembles_[k], {g[i], g.z()}, {room().sensor.axis_rate(i)});
     }
@@ -152,7 +152,7 @@ void Monitor::feed_estimators() {
         ensembles_[static_cast<std::size_t>(i)].restart({g[i], g.z()});
         if (statue_present()) {
           room().filters[static_cast<std::size_t>(i)].reset();
-          measured_[static_cast<std::size_t>(i)] = false;
+          room().measured[static_cast<std::size_t>(i)] = false;
         }
       }
       ++status_.estimator_restarts;
@@ -188,9 +188,10 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   axis.state = statues.nominal().state();
   statues.risk(axis);
   axis.forecast = statues.forecaster().latest();
-  if (!statue_present()) return;
-  axis.statue = StatueAxisStatus{};
-  if (!measured_[k]) return;
+  StatueAxisStatus* statue = statue_part<StatueAxisStatus>(axis.statue);
+  if (statue == nullptr || !statue_present()) return;
+  *statue = StatueAxisStatus{};
+  if (!room().measured[k]) return;
   const StatueEstimate& e = room().filters[k].estimate();
   axis.mode = e.mode;
   axis.state[kTheta] = e.tilt;
@@ -198,8 +199,8 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   axis.risk = e.risk;
   axis.worst_member = e.risk_member;
   axis.forecast.probability = weighted_collapse_probability(axis.forecast, e);
-  axis.statue = {true,          e.informative, !e.explained, e.weighted, e.effective_members,
-                 e.best_score,  e.best_member, e.ruled_out};
+  *statue = {true,         e.informative, !e.explained, e.weighted, e.effective_members,
+             e.best_score, e.best_member, e.ruled_out};
 }
 
 // The axes' part of the status: mode, state, risk, the forecast.
@@ -213,8 +214,9 @@ void Monitor::update_axes_status() {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
     if (status_.estimating) update_axis(i, axis);
-    if (statue_present()) {
-      status_.statue_unexplained = status_.statue_unexplained || axis.statue.unexplained;
+    if (const StatueAxisStatus* statue = statue_part<StatueAxisStatus>(axis.statue);
+        statue != nullptr && statue_present()) {
+      status_.statue_unexplained = status_.statue_unexplained || statue->unexplained;
     }
     risk = axis.risk.total > risk ? axis.risk.total : risk;
     const ForecastOutcome& f = axis.forecast;

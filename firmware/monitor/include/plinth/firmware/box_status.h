@@ -41,6 +41,9 @@ struct StatueSensorStatus {
 struct NoStatueSensorStatus {};
 using StatueSensorStatusField =
     std::conditional_t<kStatueSensorBuiltIn, StatueSensorStatus, NoStatueSensorStatus>;
+struct NoStatueAxisStatus {};
+using StatueAxisStatusField =
+    std::conditional_t<kStatueSensorBuiltIn, StatueAxisStatus, NoStatueAxisStatus>;
 
 // One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box
 // without ensemble) and the rest.
@@ -49,7 +52,8 @@ struct AxisStatus : EnsembleRisk {
   // tilt and rotation rate.
   Mode mode;
   State state = State::Zero();
-  StatueAxisStatus statue;
+  // The statue sensor's view (nothing in a build without it: statue_part).
+  [[no_unique_address]] StatueAxisStatusField statue;
   int members = 1;       // the ensemble's size
   ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
   // Monitor time, s, of that forecast's first collapse (its worst member's); -1: none forecast.
@@ -118,7 +122,7 @@ struct BoxStatus : SensorSetStatus {
   // statue_part), and unexplained: on some axis no member explains its motion (fault,
   // kStatueUnexplained).
   bool has_statue_sensor = false;
-  StatueSensorStatusField statue_sensor;
+  [[no_unique_address]] StatueSensorStatusField statue_sensor;
   bool statue_unexplained = false;
 };
 

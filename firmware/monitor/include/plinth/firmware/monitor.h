@@ -161,12 +161,12 @@ class Monitor {
   struct StatueRoom {
     StatueSensor sensor;
     std::array<StatueFilter, kMaxAxes> filters{};
+    std::array<bool, kMaxAxes> measured{};  // each filter took the newest estimator sample
+    std::uint64_t restarts = 0;             // the statue stream's restarts the filters know
   };
   std::array<StatueRoom, kStatueSensorBuiltIn ? 1 : 0> statue_room_{};
   [[nodiscard]] StatueRoom& room() { return statue_room_[0]; }
   [[nodiscard]] const StatueRoom& room() const { return statue_room_[0]; }
-  std::array<bool, kMaxAxes> measured_{};  // each filter took the newest estimator sample
-  std::uint64_t statue_restarts_ = 0;      // the statue stream's restarts the filters know
   monitor::AlarmPolicy alarm_;
   BoxStatus status_;
   std::uint64_t frames_not_encoded_ = 0;
