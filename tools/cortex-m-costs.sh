@@ -18,6 +18,8 @@ run() {  # IMAGE
     -semihosting-config enable=on,target=native -icount shift=0 -kernel "$1"
 }
 names=$(cut -f 1 "$images/replay_cases.txt")
+# Images that no plinth-monitor replay compares with (the statue sensor's load case).
+if [ -s "$images/cost_cases.txt" ]; then names="$names $(cat "$images/cost_cases.txt")"; fi
 for name in $names step-bench; do
   echo "== $name"
   run "$images/$name.elf" | grep -E '^# (cost|step|stack|end)' | sed 's/^# /   /'

@@ -87,7 +87,7 @@ constexpr std::array<Point, kPointCount> kPoints = {{
     word(reg::kCommands, "commands", "",
          "operator commands carried out (acknowledge and reset), modulo 65536"),
     word(reg::kAlarmEvents, "alarm_events", "", "alarm events so far, modulo 65536"),
-    word(reg::kMapVersion, "map_version", "", "the version of this map: 3"),
+    word(reg::kMapVersion, "map_version", "", "the version of this map: 5"),
     scaled(reg::kProbability, "probability", "0.0001", "", false, "status.probability",
            "the forecast's probability of a collapse within its horizon, 0 .. 1"),
     word(reg::kForecastAxis, "forecast_axis", "",
@@ -122,6 +122,29 @@ constexpr std::array<Point, kPointCount> kPoints = {{
     file_digest(reg::kConfigSha256, "config_sha256", "first_status.config_sha256",
                 "the box's configuration file's SHA-256 (--config), its leading 64 bits, high "
                 "word first; 65535 in each register without one"),
+    word(reg::kStatueRateHealth, "statue_rate_health", "status.statue_sensor.rate.health",
+         "health of the statue sensor's gyroscope; 65535: no statue sensor", Codes::kHealthState,
+         true),
+    word(reg::kStatueAccelerationHealth, "statue_acceleration_health",
+         "status.statue_sensor.acceleration.health",
+         "health of the statue sensor's accelerometer; 65535: no statue sensor",
+         Codes::kHealthState, true),
+    word(reg::kStatueReady, "statue_ready", "status.statue_sensor.ready",
+         "1 once the statue sensor's rate offset is known; 65535: no statue sensor",
+         Codes::kPlain, true),
+    word(reg::kStatueWeightsX, "statue_weights_x", "status.statue_sensor.weights",
+         "what the statue sensor's weights say of axis x (weighted: the risk is the weighted "
+         "members'); 65535: no statue sensor",
+         Codes::kStatueWeights, true),
+    word(reg::kStatueWeightsY, "statue_weights_y", "",
+         "the same of axis y; 65535 with one axis or no statue sensor", Codes::kStatueWeights,
+         true),
+    scaled(reg::kStatueEffectiveMembersX, "statue_effective_members_x", "0.01", "", true,
+           "status.statue_sensor.weights",
+           "effective ensemble members of axis x, 1 / sum of the squared weights (all members: "
+           "nothing learned); 65535: no statue sensor"),
+    scaled(reg::kStatueEffectiveMembersY, "statue_effective_members_y", "0.01", "", true, "",
+           "the same of axis y; 65535 with one axis or no statue sensor"),
     level_bit(monitor::AlarmLevel::kNormal, "level_normal"),
     level_bit(monitor::AlarmLevel::kAdvisory, "level_advisory"),
     level_bit(monitor::AlarmLevel::kWarning, "level_warning"),
@@ -134,13 +157,14 @@ constexpr std::array<Point, kPointCount> kPoints = {{
                "write 1: the monitor starts again as at power-up; needs modbus.writes"),
 }};
 
-// The registers follow each other without gaps up to reg::kCount, the discrete inputs are the
-// level codes 0 .. discrete::kCount - 1.
+// The registers follow each other without gaps up to reg::kCount but the reserved ones, the
+// discrete inputs are the level codes 0 .. discrete::kCount - 1.
 constexpr bool contiguous() {
   int next = 0;
   int bits = 0;
   for (const Point& p : kPoints) {
     if (p.table == Table::kRegister) {
+      if (next == reg::kRegionalReserved) next += reg::kRegionalReservedWords;
       if (p.address != next) return false;
       next += p.words;
     } else if (p.table == Table::kDiscreteInput) {
@@ -150,7 +174,7 @@ constexpr bool contiguous() {
   return next == reg::kCount && bits == discrete::kCount;
 }
 static_assert(contiguous());
-static_assert(kMapVersion == 3, "the map_version row says 3");
+static_assert(kMapVersion == 5, "the map_version row says 5");
 
 void put16(std::uint16_t* r, int address, std::uint64_t value) {
   r[address] = static_cast<std::uint16_t>(value & 0xFFFFU);
@@ -227,6 +251,8 @@ std::string codes_text(const Point& p) {
       return codes_text(kAckOutcomeCodes, monitor::kAckOutcomeNames);
     case Codes::kAxis:
       return "0=x;1=y";
+    case Codes::kStatueWeights:
+      return "0=not_measured;1=uninformative;2=weighted;3=unexplained";
   }
   return "";
 }
@@ -265,6 +291,12 @@ std::string field(const std::string& text) {
 
 const std::array<Point, kPointCount>& points() { return kPoints; }
 
+StatueWeights statue_weights(const StatueAxisStatus& axis) {
+  if (!axis.measured) return StatueWeights::kNotMeasured;
+  if (axis.unexplained) return StatueWeights::kUnexplained;
+  return axis.weighted ? StatueWeights::kWeighted : StatueWeights::kUninformative;
+}
+
 void fill(const StatusSnapshot& s, std::uint64_t alarm_events, Image& out) {
   std::uint16_t* r = out.registers.data();
   put16(r, reg::kAlarmLevel, kAlarmLevelCodes.code(s.level));
@@ -301,6 +333,22 @@ void fill(const StatusSnapshot& s, std::uint64_t alarm_events, Image& out) {
                              : static_cast<std::uint16_t>(std::clamp(collapse_in_ms, 0.0,
                                                                      kNone - 1.0)));
   put16(r, reg::kForecastWorstMember, index_or_none(s.forecast_worst_member));
+  for (int i = 0; i < reg::kRegionalReservedWords; ++i) put16(r, reg::kRegionalReserved + i, kNone);
+  const bool statue = s.has_statue_sensor;
+  put16(r, reg::kStatueRateHealth, statue ? kHealthStateCodes.code(s.statue_rate) : kNone);
+  put16(r, reg::kStatueAccelerationHealth,
+        statue ? kHealthStateCodes.code(s.statue_acceleration) : kNone);
+  put16(r, reg::kStatueReady, statue ? (s.statue_ready ? 1 : 0) : kNone);
+  for (int i = 0; i < kMaxAxes; ++i) {
+    const StatueAxisStatus& a = s.statue_axes[static_cast<std::size_t>(i)];
+    const bool shown = statue && i < s.axis_count;
+    put16(r, reg::kStatueWeightsX + i,
+          shown ? static_cast<std::uint16_t>(statue_weights(a)) : kNone);
+    put16(r, reg::kStatueEffectiveMembersX + i,
+          shown ? static_cast<std::uint16_t>(std::lround(
+                      std::clamp(static_cast<double>(a.effective_members), 0.0, 655.0) * 100.0))
+                : kNone);
+  }
   for (int i = 0; i < discrete::kCount; ++i) {
     out.discrete_inputs[static_cast<std::size_t>(i)] = kAlarmLevelCodes.code(s.level) == i ? 1 : 0;
   }

@@ -22,9 +22,10 @@
 namespace plinth::firmware::modbus {
 
 inline constexpr std::uint16_t kNone = 0xFFFF;  // a register with no value (yet)
-inline constexpr std::uint16_t kMapVersion = 3;  // register 31; 2: holding registers, discrete
+inline constexpr std::uint16_t kMapVersion = 5;  // register 31; 2: holding registers, discrete
                                                  // inputs, causes 10-11, forecast, version;
-                                                 // 3: the files' digests
+                                                 // 3: the files' digests; 4: issue 26's regional
+                                                 // alert (86-101); 5: the statue sensor
 
 template <class Enum>
 struct Code {
@@ -52,7 +53,7 @@ inline constexpr CodeTable<monitor::AlarmLevel, 5> kAlarmLevelCodes{{{
     {monitor::AlarmLevel::kAlarm, 3},
     {monitor::AlarmLevel::kFault, 4},
 }}};
-inline constexpr CodeTable<monitor::AlarmCause, 13> kAlarmCauseCodes{{{
+inline constexpr CodeTable<monitor::AlarmCause, 14> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kNone, 0},
     {monitor::AlarmCause::kRiskThreshold, 1},
     {monitor::AlarmCause::kPhaseChange, 2},
@@ -66,6 +67,7 @@ inline constexpr CodeTable<monitor::AlarmCause, 13> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kCollapseForecast, 10},
     {monitor::AlarmCause::kNotCalibrated, 11},
     {monitor::AlarmCause::kOutsideModel, 12},
+    {monitor::AlarmCause::kStatueUnexplained, 14},
 }}};
 inline constexpr CodeTable<Phase, 7> kPhaseCodes{{{
     {Phase::kFullContact, 0},
@@ -159,7 +161,20 @@ inline constexpr int kSceneYSha256 = 77;
 inline constexpr int kConfigGiven = 81;
 inline constexpr int kConfigSha256 = 82;
 inline constexpr int kDigestWords = 4;
-inline constexpr int kCount = 86;
+// Reserved for the regional alert (issue 26, map 4): no point of this map; they read kNone.
+inline constexpr int kRegionalReserved = 86;
+inline constexpr int kRegionalReservedWords = 16;  // 86-101
+// The statue sensor (kNone in each without one): its gyroscope's and accelerometer's health
+// (kHealthStateCodes), 1 once its rate offset is known, and per axis what its weights say
+// (kStatueWeightsCodes; y kNone with one axis) and the effective members x 100.
+inline constexpr int kStatueRateHealth = 102;
+inline constexpr int kStatueAccelerationHealth = 103;
+inline constexpr int kStatueReady = 104;
+inline constexpr int kStatueWeightsX = 105;
+inline constexpr int kStatueWeightsY = 106;
+inline constexpr int kStatueEffectiveMembersX = 107;
+inline constexpr int kStatueEffectiveMembersY = 108;
+inline constexpr int kCount = 109;
 }  // namespace reg
 
 // Discrete inputs (function 02): one per alarm level, 1 while that level is shown (exactly one
@@ -185,7 +200,17 @@ enum class Codes : std::uint8_t {
   kHealthState,
   kAckOutcome,
   kAxis,
+  kStatueWeights,
 };
+
+// What the statue sensor's weights say of an axis (StatueAxisStatus), pinned like the others.
+enum class StatueWeights : std::uint8_t {
+  kNotMeasured = 0,    // no fresh rate (no sensor, silent, at fault, offset not known yet)
+  kUninformative = 1,  // measured, the weights do not yet tell the members apart: worst member
+  kWeighted = 2,       // informative and explained: the risk is the weighted members'
+  kUnexplained = 3,    // no member explains the motion (cause statue_unexplained)
+};
+[[nodiscard]] StatueWeights statue_weights(const StatueAxisStatus& axis);
 
 // One row of the map (one line of modbus-map.csv).
 struct Point {
@@ -204,7 +229,7 @@ struct Point {
 };
 
 // The rows, in the CSV's order: registers, discrete inputs, coils, each by address.
-inline constexpr std::size_t kPointCount = 45;
+inline constexpr std::size_t kPointCount = 52;
 [[nodiscard]] const std::array<Point, kPointCount>& points();
 
 // The values the server answers with.

@@ -150,6 +150,50 @@ void sensor_bindings(std::vector<Binding>& b, const std::string& mounting,
   }
 }
 
+// [statue_sensor] (its mounting, its streams' health) and [statue_filter] (the gyroscope's noise
+// and the weighing of the members): statue_sensor.h, statue_filter.h. The table's presence
+// configures the sensor (load_monitor_text).
+void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int& node) {
+  b.push_back({"statue_sensor.node", integer_into(node), "an integer"});
+  b.push_back({"statue_sensor.sensor_to_statue", rotation_into(statue.sensor_to_statue),
+               kRotationExpected});
+  StatueSensorHealthSettings& h = statue.health;
+  StatueFilterSettings& f = statue.filter;
+  const std::pair<const char*, double*> numbers[] = {
+      {"statue_sensor.height_m", &statue.height_m},
+      {"statue_sensor.offset_x_m", &statue.offset_x_m},
+      {"statue_sensor.offset_y_m", &statue.offset_y_m},
+      {"statue_sensor.offset_window_s", &statue.offset_window_s},
+      {"statue_sensor.max_age_s", &statue.max_age_s},
+      {"statue_sensor.health.timeout_s", &h.timeout_s},
+      {"statue_sensor.health.rate_full_scale_rad_s", &h.rate_full_scale_rad_s},
+      {"statue_sensor.health.rate_max_valid_rad_s", &h.rate_max_valid_rad_s},
+      {"statue_sensor.health.acceleration_full_scale_g", &h.acceleration_full_scale_g},
+      {"statue_sensor.health.acceleration_max_valid_g", &h.acceleration_max_valid_g},
+      {"statue_filter.rate_noise_rad_s", &f.rate_noise_rad_s},
+      {"statue_filter.model_tolerance", &f.model_tolerance},
+      {"statue_filter.rest_rate_rad_s", &f.rest_rate_rad_s},
+      {"statue_filter.rest_tilt_rad", &f.rest_tilt_rad},
+      {"statue_filter.rest_time_s", &f.rest_time_s},
+      {"statue_filter.interval_s", &f.interval_s},
+      {"statue_filter.memory_s", &f.memory_s},
+      {"statue_filter.score_memory_s", &f.score_memory_s},
+      {"statue_filter.informative_fraction", &f.informative_fraction},
+      {"statue_filter.credible_weight", &f.credible_weight},
+      {"statue_filter.unexplained_score", &f.unexplained_score},
+      {"statue_filter.ruled_out_fraction", &f.ruled_out_fraction},
+  };
+  for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
+  const std::pair<const char*, int*> integers[] = {
+      {"statue_sensor.health.max_bridge_samples", &h.max_bridge_samples},
+      {"statue_sensor.health.recovery_samples", &h.recovery_samples},
+      {"statue_sensor.health.stuck_samples", &h.stuck_samples},
+  };
+  for (const auto& [key, target] : integers) {
+    b.push_back({key, integer_into(*target), "an integer"});
+  }
+}
+
 // [relays]: the chip, every line's default polarity, and per relay its offset, either
 // `warning = 5` or `warning = { line = 5, active_low = true }`.
 void relay_bindings(std::vector<Binding>& b, RelaySettings& relays,
@@ -194,7 +238,7 @@ void output_bindings(std::vector<Binding>& b, ModbusSettings& modbus, MqttSettin
                "a string (topic levels)"});
 }
 
-std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
+std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::string& unit,
                               std::array<bool, kRelayCount>& relay_active_low) {
   MonitorConfig& c = f.config;
   monitor::AlarmPolicySettings& alarm = c.alarm;
@@ -233,6 +277,7 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
       {"alarm_policy.heartbeat_period_s", number_into(alarm.heartbeat_period_s), "a number"},
   };
   sensor_bindings(b, "conditioning.", c.conditioning, c.sensor_health, unit);
+  statue_bindings(b, c.statue_sensor, statue_node);
   relay_bindings(b, f.relays, relay_active_low);
   b.push_back({"watchdog.notify", flag_into(f.watchdog.notify), "true or false"});
   b.push_back({"watchdog.test_stall_after_s", number_into(f.watchdog.test_stall_after_s),
@@ -402,6 +447,30 @@ void read_sensors(const toml::node& list, MonitorConfig& config, KeyLines& lines
   }
 }
 
+// [statue_sensor] configures the statue sensor, which needs its node; [statue_filter] alone
+// tunes a sensor the file does not have.
+void read_statue_sensor(const toml::table& doc, int node, StatueSensorSettings& statue,
+                        KeyLines& lines) {
+  for (const char* name : {"statue_sensor", "statue_filter"}) {
+    if (const toml::node* t = doc.get(name)) lines.note(name, t->source().begin.line);
+  }
+  const bool table = doc.get("statue_sensor") != nullptr;
+  if (!table && doc.get("statue_filter") != nullptr) {
+    lines.fail("statue_filter",
+               "statue_filter: no [statue_sensor] table (the filter weighs its measurements)");
+  }
+  if (!table) return;
+  if (!lines.has("statue_sensor.node")) {
+    lines.fail("statue_sensor",
+               "statue_sensor: no node (statue_sensor.node gives the IMU's CAN node)");
+  }
+  if (node < 1 || node > 15) {
+    lines.fail("statue_sensor.node", "statue_sensor.node: must lie in [1, 15]");
+  }
+  statue.present = true;
+  statue.node = static_cast<std::uint8_t>(node);
+}
+
 // The file's key of a field validate() reports for sensor `index` of a [[sensor]] list.
 std::string sensor_key(int index, const std::string& field) {
   const std::string head = cat("sensor[", std::to_string(index), "].");
@@ -534,9 +603,10 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   MonitorFile file;
   file.config = defaults;
   int node = defaults.ground_node;
+  int statue_node = defaults.statue_sensor.node;
   std::string unit;
   std::array<bool, kRelayCount> relay_active_low{};  // [0]: relays.active_low
-  std::vector<Binding> known = bindings(file, node, unit, relay_active_low);
+  std::vector<Binding> known = bindings(file, node, statue_node, unit, relay_active_low);
   const toml::node* sensor_list = doc.get("sensor");
   const bool sensor_tables = sensor_list != nullptr && sensor_list->is_array();
   std::vector<std::pair<std::string, const toml::node*>> leaves;
@@ -551,6 +621,7 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     lines.fail("monitor.ground_node", "monitor.ground_node: must lie in [1, 15]");
   }
   file.config.ground_node = static_cast<std::uint8_t>(node);
+  read_statue_sensor(doc, statue_node, file.config.statue_sensor, lines);
   store_unit(unit, lines, "conditioning.unit", file.config.conditioning.unit);
   if (sensor_list != nullptr) read_sensors(*sensor_list, file.config, lines);
   if (!file.second_scene_path.empty()) {

@@ -100,6 +100,23 @@ extern "C" void log_callback(mosquitto*, void* self, int level, const char* text
   if ((level & MOSQ_LOG_ERR) != 0) static_cast<MqttPublisher*>(self)->on_error_log(text);
 }
 
+// The state's statue sensor: null without one; its streams' health, its offset known, and per
+// axis whether the weights tell the members apart (weighted: the risk is theirs).
+std::string statue_sensor_state(const StatusSnapshot& s, const char* const* axes) {
+  if (!s.has_statue_sensor) return "null";
+  JsonObject weights;
+  for (int i = 0; i < s.axis_count && i < kMaxAxes; ++i) {
+    weights.raw(axes[i], statue_weights_json(s.statue_axes[static_cast<std::size_t>(i)]));
+  }
+  return JsonObject()
+      .text("rate", monitor::health_state_name(s.statue_rate))
+      .text("acceleration", monitor::health_state_name(s.statue_acceleration))
+      .flag("ready", s.statue_ready)
+      .flag("unexplained", s.statue_unexplained)
+      .raw("weights", weights.close())
+      .close();
+}
+
 }  // namespace
 
 MqttPublisher::MqttPublisher(const MqttSettings& settings, const RunIdentity& identity)
@@ -556,6 +573,7 @@ std::string MqttPublisher::state_json() const {
       .text("sensor", monitor::health_state_name(s.sensor))
       .text("sensors_state", monitor::health_state_name(s.sensors_state))
       .raw("sensor_counters", counters)
+      .raw("statue_sensor", statue_sensor_state(s, axes))
       .count("estimator_restarts", s.estimator_restarts)
       .count("heartbeat", s.statuses)
       .count("events_dropped", events_dropped_ + mailbox_.events_dropped())

@@ -85,6 +85,25 @@ std::string status_sensors(const BoxStatus& s) {
   return json_array(sensors);
 }
 
+// The statue sensor of a status line: each stream's health, the offset known, and per axis
+// what its filter makes of the members (AxisStatus::statue).
+std::string status_statue_sensor(const BoxStatus& s) {
+  const auto stream = [](const monitor::SensorHealth& h) {
+    return JsonObject()
+        .text("health", monitor::health_state_name(h.state))
+        .text("cause", monitor::health_cause_name(h.cause))
+        .close();
+  };
+  return JsonObject()
+      .raw("rate", stream(s.statue_sensor.rate))
+      .raw("acceleration", stream(s.statue_sensor.acceleration))
+      .flag("ready", s.statue_sensor.ready)
+      .flag("unexplained", s.statue_unexplained)
+      .raw("weights",
+           per_axis(s, [](const AxisStatus& a) { return statue_weights_json(a.statue); }))
+      .close();
+}
+
 std::uint64_t rejected(const monitor::SensorCounters& c) {
   return c.non_finite + c.out_of_range + c.undefined_status;
 }
@@ -102,6 +121,8 @@ std::string frame_counters(const FrameCounters& f, std::uint64_t not_encoded) {
   return JsonObject()
       .count("received", f.received)
       .count("sensor_samples", f.sensor_samples)
+      .count("statue_rates", f.statue_rates)
+      .count("statue_accelerations", f.statue_accelerations)
       .count("other_nodes", f.other_nodes)
       .count("heartbeats", f.heartbeats)
       .count("acknowledgements", f.acknowledgements)
@@ -229,8 +250,22 @@ std::string status_json(const BoxStatus& s, double t_origin) {
         .flag("plate_mismatch", s.plate_mismatch);
   }
   line.raw("sensors", status_sensors(s));
+  if (s.has_statue_sensor) line.raw("statue_sensor", status_statue_sensor(s));
   line.raw("state", per_axis(s, axis_state));
   return line.close();
+}
+
+std::string statue_weights_json(const StatueAxisStatus& a) {
+  return JsonObject()
+      .flag("measured", a.measured)
+      .flag("informative", a.informative)
+      .flag("explained", !a.unexplained)
+      .flag("weighted", a.weighted)
+      .general("effective_members", a.effective_members, 4)
+      .count("best_member", static_cast<std::uint64_t>(a.best_member))
+      .general("best_score", a.best_score, 4)
+      .count("ruled_out", static_cast<std::uint64_t>(a.ruled_out))
+      .close();
 }
 
 std::string alarm_json(const monitor::AlarmEventRecord& e, double t_origin) {
@@ -283,6 +318,14 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
       .count("failovers", s.failovers)
       .count("failovers_continued", s.failovers_continued)
       .raw("sensors", summary_sensors(s));
+  if (s.has_statue_sensor) {
+    const StatueSensorStatus& statue = s.statue_sensor;
+    line.raw("statue_sensor", JsonObject()
+                                  .raw("rate", sensor_counters(statue.rate))
+                                  .raw("acceleration", sensor_counters(statue.acceleration))
+                                  .flag("ready", statue.ready)
+                                  .close());
+  }
   if (totals.recorder) {
     line.raw("recorder", JsonObject()
                              .count("captures_written", totals.captures_written)

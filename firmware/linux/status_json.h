@@ -39,6 +39,8 @@ class JsonObject {
 // {"type": "status", "t": .., "phase": .., "risk": .., "alarm": .., ...}: the monitor's status;
 // t in s of monitor time less `t_origin` (a record replay's lead-in).
 [[nodiscard]] std::string status_json(const BoxStatus& status, double t_origin);
+// What the statue sensor's weights say of one axis (the status line's and the MQTT state's).
+[[nodiscard]] std::string statue_weights_json(const StatueAxisStatus& axis);
 
 // {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
 [[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);

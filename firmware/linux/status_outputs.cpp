@@ -42,6 +42,14 @@ void copy_status(const BoxStatus& s, double t_origin, StatusSnapshot& snapshot) 
   snapshot.sensors_state = s.sensors_state;
   snapshot.sensor_counters = s.sensor.counters;
   snapshot.estimator_restarts = s.estimator_restarts;
+  snapshot.has_statue_sensor = s.has_statue_sensor;
+  snapshot.statue_rate = s.statue_sensor.rate.state;
+  snapshot.statue_acceleration = s.statue_sensor.acceleration.state;
+  snapshot.statue_ready = s.statue_sensor.ready;
+  snapshot.statue_unexplained = s.statue_unexplained;
+  for (std::size_t i = 0; i < snapshot.statue_axes.size(); ++i) {
+    snapshot.statue_axes[i] = s.axes[i].statue;
+  }
 }
 
 std::string Endpoint::text() const {

@@ -49,6 +49,14 @@ struct StatusSnapshot {
   monitor::HealthState sensors_state = monitor::HealthState::kFault;
   monitor::SensorCounters sensor_counters;  // the primary's
   std::uint64_t estimator_restarts = 0;
+  // The statue sensor (BoxStatus): its streams' health, its offset known, per axis what the
+  // filter makes of the members (StatueAxisStatus).
+  bool has_statue_sensor = false;
+  monitor::HealthState statue_rate = monitor::HealthState::kFault;
+  monitor::HealthState statue_acceleration = monitor::HealthState::kFault;
+  bool statue_ready = false;
+  bool statue_unexplained = false;
+  std::array<StatueAxisStatus, kMaxAxes> statue_axes{};
   monitor::AckOutcome last_ack = monitor::AckOutcome::kNone;  // of the latest command
   std::uint64_t commands = 0;  // operator commands the loop carried out
   std::uint64_t resets = 0;

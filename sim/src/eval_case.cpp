@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <numbers>
+#include <optional>
+#include <random>
 #include <span>
 #include <string>
 
@@ -29,6 +32,20 @@ struct Truth {
   double collapse_time_s = -1.0;
   double lift_off_s = -1.0;  // the statue lifted off then: the model, and the truth, end
   double peak_ratio = 0.0;  // max |theta| / alpha of the corner it rocks on
+  double first_motion_s = -1.0;  // s: first out of full contact; -1: never
+  double step_s = 0.0;
+  std::vector<double> rotation_rate;  // theta' at each step's end, rad/s ([0]: t = 0)
+
+  // theta' at time t (s from the record's start), linear between steps; 0 before the start,
+  // the last one after the end.
+  [[nodiscard]] double rate_at(double t) const {
+    if (t <= 0.0 || rotation_rate.empty()) return 0.0;
+    const double x = t / step_s;
+    const auto i = static_cast<std::size_t>(x);
+    if (i + 1 >= rotation_rate.size()) return rotation_rate.back();
+    const double w = x - static_cast<double>(i);
+    return (1.0 - w) * rotation_rate[i] + w * rotation_rate[i + 1];
+  }
 };
 
 Excitation scaled(const host::Record& record, double gamma) {
@@ -50,8 +67,14 @@ Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& setti
   const Scene& s = *c.true_statue;
   const double t_end = c.record->duration() + kFreeRockingTailS;
   Truth truth;
+  truth.step_s = solver.step;
+  truth.rotation_rate.push_back(0.0);
   while (sim.time() < t_end - 0.5 * solver.step && !sim.mode().terminal()) {
     sim.step();
+    truth.rotation_rate.push_back(sim.state()[kThetaDot]);
+    if (truth.first_motion_s < 0.0 && sim.mode().phase != Phase::kFullContact) {
+      truth.first_motion_s = sim.time();
+    }
     const double theta = sim.state()[kTheta];
     const double ratio = theta >= 0.0 ? theta / s.corner1.critical_angle
                                       : -theta / s.corner2.critical_angle;
@@ -76,8 +99,49 @@ fw::MonitorConfig box_config(const BoxSettings& box) {
   config.alarm.raise_hold_s = box.raise_hold_s;
   config.conditioning.startup_window_s = box.startup_window_s;
   fw::configure_record_replay(config, box.rate_hz);
+  if (box.statue_sensor) fw::configure_replay_statue_sensor(config);
   return config;
 }
+
+// The statue sensor's samples of one run: the truth's theta' through StatueImuModel's noise,
+// offset and delay, as a gyroscope whose y axis points along the statue's y (theta'_0 =
+// -omega_y, statue_sensor.h). Seeded by the case, so a run is the same in every shard.
+class StatueImu {
+ public:
+  StatueImu(const EvalCase& c, double rate_hz, const StatueImuModel& model)
+      : model_(model), random_(seed_of(c)) {
+    const double to_rad = std::numbers::pi / 180.0;
+    std::uniform_real_distribution<double> offset(-model.zero_rate_offset_deg_s,
+                                                  model.zero_rate_offset_deg_s);
+    for (double& o : offset_rad_s_) o = offset(random_) * to_rad;
+    // White noise of the density over the output's band (half the rate).
+    noise_rad_s_ = model.noise_density_deg_s_rthz * std::sqrt(rate_hz / 2.0) * to_rad;
+  }
+  fw::StatueSample sample(const fw::MonitorConfig& config, std::int64_t n, double rate_rad_s) {
+    fw::StatueSample s = fw::replay_statue_sample(config, n, static_cast<Real>(rate_rad_s), 0);
+    for (int i = 0; i < 3; ++i) {
+      s.rotation_rate_rad_s[i] += static_cast<Real>(offset_rad_s_[static_cast<std::size_t>(i)] +
+                                                    noise_rad_s_ * gauss_(random_));
+    }
+    return s;
+  }
+  [[nodiscard]] double delay_s() const { return model_.delay_s; }
+
+ private:
+  static std::uint64_t seed_of(const EvalCase& c) {
+    std::uint64_t h = 1469598103934665603ULL;  // FNV-1a
+    const std::string key =
+        c.record_name + "|" + c.scene_name + "|" + std::to_string(c.statue) + "|" +
+        std::to_string(c.scale_g);
+    for (const char ch : key) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ULL;
+    return h;
+  }
+  StatueImuModel model_;
+  std::mt19937_64 random_;
+  std::normal_distribution<double> gauss_;
+  std::array<double, 3> offset_rad_s_{};
+  double noise_rad_s_ = 0.0;
+};
 
 // First time each threshold of `grid` was reached by `value`.
 void note_crossings(const std::vector<double>& grid, double value, double t,
@@ -96,11 +160,12 @@ void note_level(monitor::AlarmLevel shown, double t,
   }
 }
 
-// The box on the case's motion; stops at `stop_s` (the true collapse: what comes after cannot
-// make a hit; or the true statue's lift-off: nothing after it is known), else at the end of the
-// record and its tail.
+// The box on the case's motion; stops at the true collapse (what comes after cannot make a hit)
+// or the true statue's lift-off (nothing after it is known), else at the end of the record and
+// its tail.
 void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
-             const host::CrossingGrids& grids, double stop_s, EvalRun& run) {
+             const host::CrossingGrids& grids, const Truth& truth, EvalRun& run) {
+  const double stop_s = truth.collapsed ? truth.collapse_time_s : truth.lift_off_s;
   const fw::MonitorConfig config = box_config(box);
   auto monitor = std::make_unique<fw::Monitor>();  // an ensemble is too big for the stack
   const std::span<const Scene> members = box.knows_true_statue
@@ -120,15 +185,21 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
   run.risk_crossing_s.assign(grids.risk.size(), -1.0);
   run.probability_crossing_s.assign(grids.probability.size(), -1.0);
   run.nominal_risk_crossing_s.assign(grids.risk.size(), -1.0);
+  std::optional<StatueImu> imu;
+  if (box.statue_sensor) imu.emplace(c, rate, StatueImuModel{});
   for (std::size_t n = 0; n < lead_in + count; ++n) {
     const std::size_t k = n < lead_in ? 0 : n - lead_in;
     const Eigen::Vector3d ground(gamma * h[k], 0.0,
                                  kStandardGravity + (v.empty() ? 0.0 : gamma * v[k]));
     const monitor::SensorSample s =
         fw::record_replay_sample(config, static_cast<std::int64_t>(n), ground, kStandardGravity);
+    const double t = static_cast<double>(k) / rate;
+    if (imu) {
+      const double rate_now = n < lead_in ? 0.0 : truth.rate_at(t - imu->delay_s());
+      (void)monitor->on_statue_sample(imu->sample(config, static_cast<std::int64_t>(n), rate_now));
+    }
     const fw::MonitorUpdate update = monitor->on_sample(s);
     if (n < lead_in) continue;
-    const double t = static_cast<double>(k) / rate;
     if (stop_s >= 0.0 && t >= stop_s) break;
     const fw::BoxStatus& status = *update.status;
     note_level(status.alarm, t, run.first_shown_s);
@@ -158,7 +229,8 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.collapse_time_s = truth.collapse_time_s;
   run.peak_ratio = truth.peak_ratio;
   run.model_valid_until_s = truth.lift_off_s;
-  run_box(c, gamma, box, grids, truth.collapsed ? truth.collapse_time_s : truth.lift_off_s, run);
+  run.first_motion_s = truth.first_motion_s;
+  run_box(c, gamma, box, grids, truth, run);
   return run;
 }
 

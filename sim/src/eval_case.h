@@ -27,6 +27,20 @@ struct BoxSettings {
   // A box given the true statue (one member, no uncertainty) instead of the scene file: what
   // knowing the statue exactly would buy, against the same truth (docs/forecast.md).
   bool knows_true_statue = false;
+  // A statue sensor (firmware statue_sensor.h) simulated from the truth: its gyroscope as
+  // StatueImuModel says, at the box's rate.
+  bool statue_sensor = false;
+};
+
+// A MEMS gyroscope a museum would mount on a statue: a Bosch BMI088's as usually quoted from its
+// data sheet (BST-BMI088-DS001 rev. 1.3; not verified here, docs/forecast.md): rate noise
+// density 0.014 deg/s/sqrt(Hz), zero-rate offset +-1 deg/s (each run draws one per axis,
+// uniformly), and a delay of one 200 Hz sample (its output filter's group delay at 200 Hz ODR
+// and the CAN frame's transit).
+struct StatueImuModel {
+  double noise_density_deg_s_rthz = 0.014;  // deg/s/sqrt(Hz)
+  double zero_rate_offset_deg_s = 1.0;      // deg/s, the offset's bound
+  double delay_s = 0.005;                   // s, behind the ground sensor's sample
 };
 
 struct TruthSettings {

@@ -51,6 +51,8 @@ struct RunOptions {
   double rate_hz = 200.0;
   int steps_per_sample = 4;
   bool box_knows_statue = false;
+  bool statue_sensor = false;
+  std::string motion_path;  // --motion-out
   // The box's own continuation unless told (plinth::ForecastSettings, docs/forecast.md).
   std::string forecast = plinth::kContinuationNames.name(plinth::ForecastSettings{}.continuation);
   double horizon_s = 4.0;
@@ -120,6 +122,7 @@ plinth::sim::BoxSettings box_settings(const RunOptions& opt) {
   box.rate_hz = opt.rate_hz;
   box.steps_per_sample = opt.steps_per_sample;
   box.knows_true_statue = opt.box_knows_statue;
+  box.statue_sensor = opt.statue_sensor;
   if (opt.forecast == "off") {
     box.forecast.enabled = false;
   } else if (!plinth::kContinuationNames.parse(opt.forecast, box.forecast.continuation)) {
@@ -164,6 +167,24 @@ void write_runs(const std::string& path, const plinth::host::CrossingGrids& grid
     std::filesystem::remove(temporary, ec);
     throw InputError(path + ": cannot write");
   }
+}
+
+// --motion-out: per run, when the true statue first left full contact beside when each level
+// was first shown (docs/forecast.md: the alarms a statue sensor cannot take away).
+void write_motion(const std::string& path, const std::vector<std::vector<EvalRun>>& results) {
+  std::FILE* out = std::fopen(path.c_str(), "w");
+  if (out == nullptr) throw InputError(path + ": cannot write (does its folder exist?)");
+  std::fprintf(out, "record,scene,statue,seed,scale_g,collapsed,first_motion_s,"
+                    "first_advisory_s,first_warning_s,first_alarm_s\n");
+  for (const std::vector<EvalRun>& job : results) {
+    for (const EvalRun& r : job) {
+      std::fprintf(out, "%s,%s,%d,%u,%.6g,%d,%.6g,%.6g,%.6g,%.6g\n", r.record.c_str(),
+                   r.scene.c_str(), r.statue, r.seed, r.scale_g, r.collapsed ? 1 : 0,
+                   r.first_motion_s, r.first_shown_s[0], r.first_shown_s[1], r.first_shown_s[2]);
+    }
+  }
+  const bool ok = std::fflush(out) == 0 && std::ferror(out) == 0;
+  if (std::fclose(out) != 0 || !ok) throw InputError(path + ": cannot write");
 }
 
 int run_eval(const RunOptions& opt) {
@@ -233,6 +254,7 @@ int run_eval(const RunOptions& opt) {
     return kInterruptedExit;
   }
   write_runs(opt.out_path, grids, results);
+  if (!opt.motion_path.empty()) write_motion(opt.motion_path, results);
   std::size_t runs = 0;
   std::size_t outside_model = 0;
   for (const auto& job : results) {
@@ -355,6 +377,12 @@ int main(int argc, char** argv) {
   run->add_option("--steps", opt.steps_per_sample, "the box's solver steps per sample (default 4)");
   run->add_flag("--box-knows-statue", opt.box_knows_statue,
                 "give the box the true statue, not the scene file: what knowing it would buy");
+  run->add_option("--motion-out", opt.motion_path,
+                  "also write, per run, when the true statue first left full contact and when "
+                  "each level was first shown (CSV)");
+  run->add_flag("--statue-sensor", opt.statue_sensor,
+                "give the box a gyroscope on the statue (a BMI088's noise, offset and delay, "
+                "simulated from the truth: docs/forecast.md)");
   run->add_option("--forecast", opt.forecast,
                   "strongest_window, recent_window or off (default the box's, " + opt.forecast +
                       ")");

@@ -114,6 +114,26 @@ def main():
             if value != expected:
                 fail(row, "reads %016x, the first status line says %s" % (value, digest))
             continue
+        elif name.startswith("statue_"):
+            # The statue sensor's: none without one; else its streams' health, ready, and per
+            # axis the weights' code and effective members (one axis here: y is none).
+            sensor = status.get("statue_sensor")
+            axis = name[-1] if name[-2:] in ("_x", "_y") else ""
+            if sensor is None or axis == "y":
+                expected = int(row["none"])
+            elif name.startswith("statue_weights_"):
+                w = sensor["weights"]
+                code = ("not_measured" if not w["measured"] else "unexplained"
+                        if not w["explained"] else "weighted" if w["weighted"] else
+                        "uninformative")
+                expected = codes(row)[code]
+            elif name.startswith("statue_effective_members_"):
+                expected = round(sensor["weights"]["effective_members"] * 100)
+            elif name == "statue_ready":
+                expected = int(sensor["ready"])
+            else:  # statue_rate_health, statue_acceleration_health
+                stream = name[len("statue_"):-len("_health")]
+                expected = codes(row)[sensor[stream]["health"]]
         elif name.endswith("_given"):  # 1 while the digest that follows is the file's
             expected = 1 if name[:-len("given")] + "sha256" in first_status else 0
         elif name == "collapse_in":
@@ -145,7 +165,7 @@ def main():
         elif name == "alarm_events":
             expected = len(alarms)
         elif name == "map_version":
-            expected = 3
+            expected = 5
         elif name == "forecast_axis":  # one axis: x once a forecast ran
             expected = 0 if status["collapse_forecast_t"] is not None else value
         elif name == "forecast_worst_member":  # one member: member 0 is the first to collapse

@@ -69,9 +69,11 @@ status_count() { grep -c '"type": "status"' "$TMP/box.out"; }
 # 1. Writes off: the registers against the status lines after the overturn (a steady state:
 #    alarm latched, risk 1, for the record's last 24 s, 12 s at --speed 2: time for the reads below
 #    even on a loaded machine), three clients polling at once, a coil write refused. A box file
-#    that sets nothing: its digest in registers 81-85.
+#    that sets a statue sensor that never sends (registers 102-108: its streams at fault, not
+#    measured): its digest in registers 81-85.
 PORT=$(free_port)
-echo "# monitor_modbus: the Modbus server from the command line" >"$TMP/run1.toml"
+printf '# monitor_modbus: the Modbus server from the command line\n[statue_sensor]\nnode = 2\n' \
+  >"$TMP/run1.toml"
 STARTED=$(date +%s.%N)
 "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
   --modbus "127.0.0.1:$PORT" --config "$TMP/run1.toml" >"$TMP/box.out" 2>"$TMP/box.err" &

@@ -60,4 +60,23 @@ monitor::SensorSample record_replay_sample(const MonitorConfig& config, std::int
   return sample;
 }
 
+void configure_replay_statue_sensor(MonitorConfig& config) {
+  config.statue_sensor.present = true;  // refused by a build without the statue sensor
+  if (StatueSensorSettings* statue = statue_settings(config.statue_sensor)) {
+    statue->node = 2;
+    statue->offset_window_s = config.conditioning.startup_window_s;
+    statue->health.stuck_samples = 0;
+  }
+}
+
+StatueSample replay_statue_sample(const MonitorConfig& config, std::int64_t n, Real theta_dot_x,
+                                  Real theta_dot_y) {
+  const monitor::SensorSample ground = record_replay_sample(config, n, Eigen::Vector3d::Zero(), 0);
+  StatueSample sample;
+  sample.receive_time_ns = ground.receive_time_ns;
+  sample.sequence = ground.sequence;
+  sample.rotation_rate_rad_s = Vector3r(theta_dot_y, -theta_dot_x, 0);
+  return sample;
+}
+
 }  // namespace plinth::firmware

@@ -35,6 +35,7 @@ struct Options {
   fw::RecordReplayOptions input;
   std::optional<int> steps;
   bool no_forecast = false;
+  bool statue_sensor = false;
   std::string out_path;
 };
 
@@ -147,6 +148,7 @@ int run(const Options& opt) {
   if (opt.steps) config.estimator.steps_per_sample = *opt.steps;
   if (opt.no_forecast) config.forecast.enabled = false;
   fw::configure_record_replay(config, record.rate_hz);
+  if (opt.statue_sensor) fw::configure_replay_statue_sensor(config);
   const auto monitor = std::make_unique<fw::Monitor>();
   if (const plinth::Error e = monitor->start(
           config, {std::span<const plinth::Scene>(scene_x.members),
@@ -183,6 +185,7 @@ int run(const Options& opt) {
          << "    .y = " << (scene_y ? "kMembersY" : "{}") << ",\n"
          << "    .steps_per_sample = " << (opt.steps ? *opt.steps : 0) << ",\n"
          << "    .forecast = " << boolean(!opt.no_forecast) << ",\n"
+         << "    .statue_sensor = " << boolean(opt.statue_sensor) << ",\n"
          << "    .record = {.description = " << literal(opt.input.path) << ",\n"
          << "               .sample_rate_hz = " << hex_double(record.rate_hz) << ",\n"
          << "               .count = " << record.samples.size() << ",\n"
@@ -219,6 +222,9 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 64));
   app.add_flag("--no-forecast", opt.no_forecast,
                "the box without the forecast (in a build that has it), as plinth-monitor's");
+  app.add_flag("--statue-sensor", opt.statue_sensor,
+               "the image feeds a statue sensor the nominal statue's rotation (its update's "
+               "load; no plinth-monitor replay compares with it)");
   app.add_option("--out", opt.out_path, "the C++ source to write")->required();
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
     return *exit_code;

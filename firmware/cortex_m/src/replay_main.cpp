@@ -156,6 +156,7 @@ extern "C" int plinth_board_main() {
   if (replay.steps_per_sample > 0) config.estimator.steps_per_sample = replay.steps_per_sample;
   if (!replay.forecast) config.forecast.enabled = false;
   fw::configure_record_replay(config, record.sample_rate_hz);
+  if (kStatueSensorBuiltIn && replay.statue_sensor) fw::configure_replay_statue_sensor(config);
   if constexpr (fw::kMaxSensors == 1) {
     // This build holds one sensor: no cross-check runs, and their windows, never filled, are
     // set within the build's window capacity.
@@ -186,6 +187,19 @@ extern "C" int plinth_board_main() {
     now_ns = sample.receive_time_ns;
     g_untimed_ticks = 0;
     const std::uint32_t start = board::ticks();
+    if (kStatueSensorBuiltIn && replay.statue_sensor) {
+      // The statue sensor reads the nominal statue's rotation (its newest state): its update's
+      // cost is in the sample's.
+      const auto rate = [](const fw::Monitor& m, int axis) {
+        return axis < m.status().axis_count ? m.ensemble(axis).nominal().state()[kThetaDot]
+                                            : Real(0);
+      };
+      const fw::MonitorUpdate statue = g_monitor.on_statue_sample(
+          fw::replay_statue_sample(config, n, rate(g_monitor, 0), rate(g_monitor, 1)));
+      for (std::size_t i = 0; i < statue.frame_count; ++i) {
+        if (can.send(statue.frames[i]) != hal::IoStatus::kOk) ++send_errors;
+      }
+    }
     const fw::MonitorUpdate update = g_monitor.on_sample(sample);
     const std::uint32_t ticks = board::ticks() - start - g_untimed_ticks;
     if (n >= lead_in) {

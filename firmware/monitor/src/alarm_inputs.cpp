@@ -19,11 +19,14 @@ monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& co
   const bool sensor_fault = status.sensor.state == monitor::HealthState::kFault;
   const bool disagreement = status.disagreement;
   const bool mismatch_fault = status.plate_mismatch && config.plate.raises_fault;
-  input.fault_active = sensor_fault || disagreement || mismatch_fault || bus_fault || outside_model;
+  const bool unexplained = kStatueSensorBuiltIn && status.statue_unexplained;
+  input.fault_active =
+      sensor_fault || disagreement || mismatch_fault || bus_fault || outside_model || unexplained;
   input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status.sensor.cause)
                       : (disagreement || mismatch_fault) ? monitor::AlarmCause::kSensorDisagreement
                       : bus_fault                        ? monitor::AlarmCause::kBusError
-                                                         : monitor::AlarmCause::kOutsideModel;
+                      : outside_model                    ? monitor::AlarmCause::kOutsideModel
+                                                         : monitor::AlarmCause::kStatueUnexplained;
   input.not_calibrated = !status.estimating || !status.calibrated;
   return input;
 }

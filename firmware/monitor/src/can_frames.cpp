@@ -46,7 +46,8 @@ static_assert(same_number(AlarmCause::kInternalFault, can::AlarmCause::kInternal
 static_assert(same_number(AlarmCause::kCollapseForecast, can::AlarmCause::kCollapseForecast));
 static_assert(same_number(AlarmCause::kNotCalibrated, can::AlarmCause::kNotCalibrated));
 static_assert(same_number(AlarmCause::kOutsideModel, can::AlarmCause::kOutsideModel));
-static_assert(monitor::kAlarmCauseNames.size() == 13);
+static_assert(same_number(AlarmCause::kStatueUnexplained, can::AlarmCause::kStatueUnexplained));
+static_assert(monitor::kAlarmCauseNames.size() == 14);
 
 // The sensors' status bits (SensorAcceleration.Status): passed through as they are.
 static_assert(monitor::sensor_flags::kSaturated == can::sensor_status::kSaturated);
@@ -142,6 +143,17 @@ can::SensorAcceleration sensor_message(std::uint8_t node, const monitor::SensorS
   return m;
 }
 
+can::StatueRotation rotation_message(std::uint8_t node, const StatueSample& sample) {
+  can::StatueRotation m;
+  m.node = node;
+  m.wx_rad_s = static_cast<double>(sample.rotation_rate_rad_s.x());
+  m.wy_rad_s = static_cast<double>(sample.rotation_rate_rad_s.y());
+  m.wz_rad_s = static_cast<double>(sample.rotation_rate_rad_s.z());
+  m.sequence = sample.sequence;
+  m.status = sample.status;
+  return m;
+}
+
 monitor::Acknowledgement acknowledgement_of(const can::Acknowledge& message) {
   return {from_wire(message.level), message.event_sequence};
 }
@@ -155,6 +167,17 @@ monitor::SensorSample sample_of(const can::SensorAcceleration& message,
   // The codec's physical values are double; the monitor's arithmetic is Real (plinth/core/real.h).
   sample.acceleration_g = Vector3r(static_cast<Real>(message.ax_g), static_cast<Real>(message.ay_g),
                                    static_cast<Real>(message.az_g));
+  return sample;
+}
+
+StatueSample sample_of(const can::StatueRotation& message, std::int64_t receive_time_ns) {
+  StatueSample sample;
+  sample.receive_time_ns = receive_time_ns;
+  sample.sequence = message.sequence;
+  sample.status = message.status;
+  sample.rotation_rate_rad_s =
+      Vector3r(static_cast<Real>(message.wx_rad_s), static_cast<Real>(message.wy_rad_s),
+               static_cast<Real>(message.wz_rad_s));
   return sample;
 }
 

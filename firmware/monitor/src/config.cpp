@@ -117,6 +117,29 @@ Error validate_sensors(const MonitorConfig& c, int* sensor_index) {
   return ok_error();
 }
 
+// The statue sensor's settings, its node apart from the accelerometers'. A build without it
+// refuses one; its checks are left out at compile time (if constexpr), so that the Cortex-M4F
+// image's validate() stays small enough to be inlined and folded on its constant settings.
+Error validate_statue_sensor(const MonitorConfig& c) {
+  if (!c.statue_sensor.present) return ok_error();
+  if constexpr (!kStatueSensorBuiltIn) {
+    return {ErrorCode::kOutOfRange, "statue_sensor",
+            "this build has no statue sensor (PLINTH_STATUE_SENSOR=OFF)"};
+  } else {
+    const StatueSensorSettings& statue = *statue_settings(c.statue_sensor);
+    PLINTH_TRY(validate(statue, c.estimator.sample_period()));
+    std::array<SensorConfig, kMaxSensors> sensors{};
+    const int count = resolved_sensors(c, sensors);
+    for (int i = 0; i < count; ++i) {
+      if (sensors[static_cast<std::size_t>(i)].node == statue.node) {
+        return {ErrorCode::kInconsistent, "statue_sensor.node",
+                "is an accelerometer's node; each sensor has its own"};
+      }
+    }
+    return ok_error();
+  }
+}
+
 }  // namespace
 
 Error validate(const MonitorConfig& c, int* sensor_index) {
@@ -135,7 +158,8 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
                             "redundancy.tolerance_m_s2"));
   PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
                             "plate.window_s", "plate.threshold_m_s2"));
-  return validate_sensors(c, sensor_index);
+  PLINTH_TRY(validate_sensors(c, sensor_index));
+  return validate_statue_sensor(c);
 }
 
 }  // namespace plinth::firmware

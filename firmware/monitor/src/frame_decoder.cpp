@@ -13,6 +13,8 @@ void FrameDecoder::start(const MonitorConfig& config) {
   for (int i = 0; i < count_; ++i) {
     nodes_[static_cast<std::size_t>(i)] = sensors[static_cast<std::size_t>(i)].node;
   }
+  const StatueSensorSettings* statue = statue_settings(config.statue_sensor);
+  statue_node_ = statue != nullptr && statue->present ? statue->node : -1;
   counters_ = FrameCounters{};
 }
 
@@ -42,6 +44,12 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
       can::SensorAcceleration message;
       if (!decoded(frame, message)) break;
       input.sensor = sensor_of_node(message.node);
+      if (input.sensor < 0 && message.node == statue_node_) {
+        ++counters_.statue_accelerations;
+        input.kind = FrameInput::Kind::kStatueAcceleration;
+        input.sample = sample_of(message, timed.timestamp_ns);
+        break;
+      }
       if (input.sensor < 0) {
         ++counters_.other_nodes;
         break;
@@ -79,6 +87,18 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
       if (decoded(frame, message)) ++counters_.monitor_frames;
       break;
     }
+    case can::MessageKind::kStatueRotation: {
+      can::StatueRotation message;
+      if (!decoded(frame, message)) break;
+      if (message.node != statue_node_) {
+        ++counters_.other_nodes;
+        break;
+      }
+      ++counters_.statue_rates;
+      input.kind = FrameInput::Kind::kStatueRate;
+      input.statue = sample_of(message, timed.timestamp_ns);
+      break;
+    }
     case can::MessageKind::kUnknown:
       ++counters_.unknown_identifiers;
       break;
@@ -93,6 +113,10 @@ MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::Timed
       return monitor.on_sensor_sample(input.sensor, input.sample);
     case FrameInput::Kind::kAcknowledgement:
       return monitor.acknowledge(input.acknowledgement);
+    case FrameInput::Kind::kStatueRate:
+      return monitor.on_statue_sample(input.statue);
+    case FrameInput::Kind::kStatueAcceleration:
+      return monitor.on_statue_acceleration(input.sample);
     case FrameInput::Kind::kNone:
       break;
   }

@@ -40,6 +40,20 @@ Error Monitor::start(const MonitorConfig& config,
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
+  const StatueSensorSettings* statue = statue_settings(config.statue_sensor);
+  status_.has_statue_sensor = statue != nullptr && statue->present;
+  if (status_.has_statue_sensor) {
+    PLINTH_TRY(room().sensor.start(*statue, config.estimator.sample_period()));
+    for (int i = 0; i < config.axis_count; ++i) {
+      PLINTH_TRY(room().filters[static_cast<std::size_t>(i)].start(
+          statue->filter, config.estimator, config.risk, ensemble(i).size()));
+    }
+    note_statue_health();
+  }
+  if (statue_present()) {
+    room().measured.fill(false);
+    room().restarts = 0;
+  }
   last_ground_.setZero();
   frames_not_encoded_ = 0;
   have_epoch_ = false;
@@ -93,6 +107,10 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
   sensors_.tick(sample.receive_time_ns, sensor);
+  if (statue_present()) {  // its timeout, on the ground sensors' clock
+    room().sensor.tick(sample.receive_time_ns);
+    note_statue_health();
+  }
   const monitor::SensorUpdate fed = sensors_.receive(sensor, sample);
   // Each fed sample in turn: the primary's goes on to the estimators at once (the next one's
   // conditioning is told whether they are quiet).
@@ -106,9 +124,22 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
   evaluate(update);
 }
 
-void Monitor::push_ensembles(const Vector3r& g) {
+// Each axis's members take the sample; with the statue sensor's newest rate fresh, the axis's
+// filter weighs them on it (a restart of the statue's stream loses the tilt: the filters start
+// again).
+void Monitor::push_ensembles(const Vector3r& g, std::int64_t receive_time_ns) {
+  const bool measuring = statue_present() && room().sensor.usable(receive_time_ns);
+  if (measuring && room().sensor.restarts() != room().restarts) {
+    room().restarts = room().sensor.restarts();
+    for (StatueFilter& f : room().filters) f.reset();
+  }
   for (int i = 0; i < status_.axis_count; ++i) {
-    ensembles_[static_cast<std::size_t>(i)].push({g[i], g.z()});
+    const auto k = static_cast<std::size_t>(i);
+    ensembles_[k].push({g[i], g.z()});
+    if (statue_present()) room().measured[k] = measuring;
+    if (measuring) {
+      room().filters[k].on_sample(ensembles_[k], {g[i], g.z()}, {room().sensor.axis_rate(i)});
+    }
   }
 }
 
@@ -119,6 +150,10 @@ void Monitor::feed_estimators() {
     if (in.start) {
       for (int i = 0; i < status_.axis_count; ++i) {
         ensembles_[static_cast<std::size_t>(i)].restart({g[i], g.z()});
+        if (statue_present()) {
+          room().filters[static_cast<std::size_t>(i)].reset();
+          room().measured[static_cast<std::size_t>(i)] = false;
+        }
       }
       ++status_.estimator_restarts;
       status_.estimator_start_ns = in.time_ns - epoch_ns_;
@@ -128,9 +163,9 @@ void Monitor::feed_estimators() {
       const long n = in.bridged + 1;
       for (long j = 1; j < n; ++j) {
         const auto w = static_cast<Real>(static_cast<double>(j) / static_cast<double>(n));
-        push_ensembles(last_ground_ + w * (g - last_ground_));
+        push_ensembles(last_ground_ + w * (g - last_ground_), in.time_ns);
       }
-      push_ensembles(g);
+      push_ensembles(g, in.time_ns);
     }
     status_.estimating = true;
     status_.newest_sample_time_ns = in.time_ns - epoch_ns_;
@@ -143,18 +178,35 @@ void Monitor::feed_estimators() {
   }
 }
 
-// One axis: the nominal statue's mode and state, the worst member's risk, the forecast.
+// One axis: the nominal statue's mode and state, the worst member's risk, the forecast; with
+// the statue sensor measuring, the measured phase, tilt and rate, the filter's risk (weighted
+// once informative, else the worst member's) and the forecast's probability weighted alike.
 void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
+  const auto k = static_cast<std::size_t>(axis_index);
   const Ensemble& statues = ensemble(axis_index);
   axis.mode = statues.nominal().mode();
   axis.state = statues.nominal().state();
   statues.risk(axis);
   axis.forecast = statues.forecaster().latest();
+  StatueAxisStatus* statue = statue_part<StatueAxisStatus>(axis.statue);
+  if (statue == nullptr || !statue_present()) return;
+  *statue = StatueAxisStatus{};
+  if (!room().measured[k]) return;
+  const StatueEstimate& e = room().filters[k].estimate();
+  axis.mode = e.mode;
+  axis.state[kTheta] = e.tilt;
+  axis.state[kThetaDot] = e.rotation_rate;
+  axis.risk = e.risk;
+  axis.worst_member = e.risk_member;
+  axis.forecast.probability = weighted_collapse_probability(axis.forecast, e);
+  *statue = {true,         e.informative, !e.explained, e.weighted, e.effective_members,
+             e.best_score, e.best_member, e.ruled_out};
 }
 
 // The axes' part of the status: mode, state, risk, the forecast.
 void Monitor::update_axes_status() {
   Real risk = 0;
+  if (statue_present()) status_.statue_unexplained = false;
   status_.probability = 0.0;
   status_.forecast_axis = -1;
   status_.collapse_forecast_s = -1.0;
@@ -162,6 +214,10 @@ void Monitor::update_axes_status() {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
     if (status_.estimating) update_axis(i, axis);
+    if (const StatueAxisStatus* statue = statue_part<StatueAxisStatus>(axis.statue);
+        statue != nullptr && statue_present()) {
+      status_.statue_unexplained = status_.statue_unexplained || statue->unexplained;
+    }
     risk = axis.risk.total > risk ? axis.risk.total : risk;
     const ForecastOutcome& f = axis.forecast;
     axis.collapse_forecast_s = -1.0;
@@ -248,8 +304,44 @@ void Monitor::report(MonitorUpdate& update) {
   }
 }
 
+void Monitor::note_statue_health() {
+  if (StatueSensorStatus* s = statue_part<StatueSensorStatus>(status_.statue_sensor)) {
+    *s = {room().sensor.rate_health(), room().sensor.acceleration_health(), room().sensor.ready()};
+  }
+}
+
+MonitorUpdate Monitor::on_statue_sample(const StatueSample& sample) {
+  MonitorUpdate update = new_update();
+  if (!statue_present()) {
+    report_state(update);
+    return update;
+  }
+  status_.time_ns = monitor_time(sample.receive_time_ns);
+  room().sensor.on_sample(sample, !status_.estimating || quiet());
+  note_statue_health();
+  evaluate(update);
+  return update;
+}
+
+MonitorUpdate Monitor::on_statue_acceleration(const monitor::SensorSample& sample) {
+  MonitorUpdate update = new_update();
+  if (!statue_present()) {
+    report_state(update);
+    return update;
+  }
+  status_.time_ns = monitor_time(sample.receive_time_ns);
+  room().sensor.on_acceleration(sample);
+  note_statue_health();
+  evaluate(update);
+  return update;
+}
+
 MonitorUpdate Monitor::on_tick(std::int64_t receive_time_ns) {
   MonitorUpdate update = new_update();
+  if (have_epoch_ && statue_present()) {
+    room().sensor.tick(receive_time_ns);
+    note_statue_health();
+  }
   if (have_epoch_) {
     sensors_.tick(receive_time_ns);
     status_.time_ns = monitor_time(receive_time_ns);

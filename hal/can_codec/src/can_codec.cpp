@@ -26,6 +26,16 @@ constexpr std::array<SignalLayout, 5> kAccelerationSignals{{
     {"Status", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
 }};
 
+// StatueRotation (0x370 + node): SensorAcceleration's layout, rates for accelerations.
+enum RotationSignal : std::size_t { kWx, kWy, kWz, kRotSequence, kRotStatus };
+constexpr std::array<SignalLayout, 5> kRotationSignals{{
+    {"Wx", 0, 16, true, 0.0005, 0.0, -32768, 32767, "rad/s", false, kNoSpecialRaw},
+    {"Wy", 16, 16, true, 0.0005, 0.0, -32768, 32767, "rad/s", false, kNoSpecialRaw},
+    {"Wz", 32, 16, true, 0.0005, 0.0, -32768, 32767, "rad/s", false, kNoSpecialRaw},
+    {"Sequence", 48, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"Status", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+}};
+
 // SensorHeartbeat (0x310 + node)
 enum HeartbeatSignal : std::size_t {
   kUptime,
@@ -60,7 +70,7 @@ enum EventSignal : std::size_t { kLevel, kPreviousLevel, kCause, kLatched, kTime
 constexpr std::array<SignalLayout, 6> kEventSignals{{
     {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
-    {"Cause", 8, 8, false, 1.0, 0.0, 0, 12, "", true, kNoSpecialRaw},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 14, "", true, kNoSpecialRaw},
     {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true, kNoSpecialRaw},
     {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false, kNoSpecialRaw},
     {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
@@ -223,18 +233,24 @@ class Unpacker {
   CodecResult result_{};
 };
 
+// The AlarmCause VAL_ table has a gap: 13 is issue 26's p_wave, not on the wire yet.
+constexpr bool in_cause_table(AlarmCause cause) {
+  return static_cast<unsigned>(cause) <= 12U || cause == AlarmCause::kStatueUnexplained;
+}
+
 constexpr bool undefined_status_flags(std::uint8_t status) {
   return (status & static_cast<std::uint8_t>(~sensor_status::kDefinedMask)) != 0;
 }
 
 // The DBC message names, without node or axis suffix.
-constexpr NameTable<MessageKind, 6> kMessageKindNames{{{
+constexpr NameTable<MessageKind, 7> kMessageKindNames{{{
     {MessageKind::kSensorAcceleration, "SensorAcceleration"},
     {MessageKind::kSensorHeartbeat, "SensorHeartbeat"},
     {MessageKind::kMonitorStatus, "MonitorStatus"},
     {MessageKind::kAlarmEvent, "AlarmEvent"},
     {MessageKind::kAcknowledge, "Acknowledge"},
     {MessageKind::kCollapseForecast, "CollapseForecast"},
+    {MessageKind::kStatueRotation, "StatueRotation"},
 }}};
 
 constexpr NameTable<CodecError, 8> kCodecErrorTexts{{{
@@ -270,6 +286,8 @@ MessageKind classify(std::uint32_t id) {
       return index == 0 ? MessageKind::kAcknowledge : MessageKind::kUnknown;
     case kCollapseForecastBaseId:
       return index < kMonitorAxisCount ? MessageKind::kCollapseForecast : MessageKind::kUnknown;
+    case kStatueRotationBaseId:
+      return index >= kFirstSensorNode ? MessageKind::kStatueRotation : MessageKind::kUnknown;
     default:
       return MessageKind::kUnknown;
   }
@@ -289,6 +307,7 @@ std::span<const SignalLayout> signal_layouts(MessageKind kind) {
     case MessageKind::kAlarmEvent: return kEventSignals;
     case MessageKind::kAcknowledge: return kAcknowledgeSignals;
     case MessageKind::kCollapseForecast: return kForecastSignals;
+    case MessageKind::kStatueRotation: return kRotationSignals;
     case MessageKind::kUnknown: break;
   }
   return {};
@@ -340,34 +359,75 @@ std::int64_t sign_extend(std::uint64_t raw, unsigned length) {
 // ---------------------------------------------------------------------------------------------
 // Messages
 
-EncodeResult encode(const SensorAcceleration& message, CanFrame& frame) {
-  const auto& s = kAccelerationSignals;
+namespace {
+
+// A node's sample (SensorAcceleration, StatueRotation): three signed values, the sequence and
+// the status flags, in the signals' order.
+struct NodeSample {
+  std::uint8_t node = kFirstSensorNode;
+  std::array<double, 3> values{};
+  std::uint8_t sequence = 0;
+  std::uint8_t status = 0;
+};
+
+EncodeResult encode_node_sample(const NodeSample& m, std::span<const SignalLayout> s,
+                                std::uint32_t base_id, CanFrame& frame) {
   Packer packer;
-  if (message.node < kFirstSensorNode || message.node > kLastSensorNode) {
+  if (m.node < kFirstSensorNode || m.node > kLastSensorNode) {
     packer.fail(CodecError::kOutOfRange, "node");
   }
-  packer.physical(message.ax_g, s[kAx]);
-  packer.physical(message.ay_g, s[kAy]);
-  packer.physical(message.az_g, s[kAz]);
-  packer.integer(message.sequence, s[kAccSequence]);
-  if (undefined_status_flags(message.status)) packer.fail(CodecError::kReservedBitsSet, "Status");
-  packer.integer(message.status, s[kAccStatus]);
-  return packer.finish(kSensorAccelerationBaseId + message.node, frame);
+  for (std::size_t i = 0; i < 3; ++i) packer.physical(m.values[i], s[i]);
+  packer.integer(m.sequence, s[3]);
+  if (undefined_status_flags(m.status)) packer.fail(CodecError::kReservedBitsSet, "Status");
+  packer.integer(m.status, s[4]);
+  return packer.finish(base_id + m.node, frame);
+}
+
+DecodeResult decode_node_sample(const CanFrame& frame, MessageKind kind,
+                                std::span<const SignalLayout> s, std::uint32_t base_id,
+                                NodeSample& m) {
+  Unpacker unpacker(frame, kind, s);
+  m.node = static_cast<std::uint8_t>(frame.id - base_id);
+  for (std::size_t i = 0; i < 3; ++i) m.values[i] = unpacker.physical(s[i]);
+  m.sequence = unpacker.integer<std::uint8_t>(s[3]);
+  m.status = unpacker.integer<std::uint8_t>(s[4]);
+  if (undefined_status_flags(m.status)) unpacker.fail(CodecError::kReservedBitsSet, "Status");
+  return unpacker.result();
+}
+
+static_assert(kAx == 0 && kAy == 1 && kAz == 2 && kAccSequence == 3 && kAccStatus == 4);
+static_assert(kWx == 0 && kWy == 1 && kWz == 2 && kRotSequence == 3 && kRotStatus == 4);
+
+}  // namespace
+
+EncodeResult encode(const SensorAcceleration& message, CanFrame& frame) {
+  return encode_node_sample(
+      {message.node, {message.ax_g, message.ay_g, message.az_g}, message.sequence, message.status},
+      kAccelerationSignals, kSensorAccelerationBaseId, frame);
 }
 
 DecodeResult decode(const CanFrame& frame, SensorAcceleration& message) {
-  const auto& s = kAccelerationSignals;
-  Unpacker unpacker(frame, MessageKind::kSensorAcceleration, s);
-  SensorAcceleration m;
-  m.node = static_cast<std::uint8_t>(frame.id - kSensorAccelerationBaseId);
-  m.ax_g = unpacker.physical(s[kAx]);
-  m.ay_g = unpacker.physical(s[kAy]);
-  m.az_g = unpacker.physical(s[kAz]);
-  m.sequence = unpacker.integer<std::uint8_t>(s[kAccSequence]);
-  m.status = unpacker.integer<std::uint8_t>(s[kAccStatus]);
-  if (undefined_status_flags(m.status)) unpacker.fail(CodecError::kReservedBitsSet, "Status");
-  if (unpacker.result().ok()) message = m;
-  return unpacker.result();
+  NodeSample m;
+  const DecodeResult r = decode_node_sample(frame, MessageKind::kSensorAcceleration,
+                                            kAccelerationSignals, kSensorAccelerationBaseId, m);
+  if (r.ok()) message = {m.node, m.values[0], m.values[1], m.values[2], m.sequence, m.status};
+  return r;
+}
+
+EncodeResult encode(const StatueRotation& message, CanFrame& frame) {
+  return encode_node_sample({message.node,
+                             {message.wx_rad_s, message.wy_rad_s, message.wz_rad_s},
+                             message.sequence,
+                             message.status},
+                            kRotationSignals, kStatueRotationBaseId, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, StatueRotation& message) {
+  NodeSample m;
+  const DecodeResult r = decode_node_sample(frame, MessageKind::kStatueRotation, kRotationSignals,
+                                            kStatueRotationBaseId, m);
+  if (r.ok()) message = {m.node, m.values[0], m.values[1], m.values[2], m.sequence, m.status};
+  return r;
 }
 
 EncodeResult encode(const SensorHeartbeat& message, CanFrame& frame) {
@@ -436,6 +496,7 @@ EncodeResult encode(const AlarmEvent& message, CanFrame& frame) {
   packer.enumeration(message.level, s[kLevel]);
   packer.enumeration(message.previous_level, s[kPreviousLevel]);
   packer.enumeration(message.cause, s[kCause]);
+  if (!in_cause_table(message.cause)) packer.fail(CodecError::kInvalidEnum, "Cause");
   packer.integer(message.latched ? 1U : 0U, s[kLatched]);
   packer.integer(message.time_since_start_ms, s[kTime]);
   packer.integer(message.sequence, s[kEvSequence]);
@@ -449,6 +510,7 @@ DecodeResult decode(const CanFrame& frame, AlarmEvent& message) {
   m.level = unpacker.enumeration<AlarmLevel>(s[kLevel]);
   m.previous_level = unpacker.enumeration<AlarmLevel>(s[kPreviousLevel]);
   m.cause = unpacker.enumeration<AlarmCause>(s[kCause]);
+  if (!in_cause_table(m.cause)) unpacker.fail(CodecError::kInvalidEnum, "Cause");
   m.latched = unpacker.integer<std::uint8_t>(s[kLatched]) != 0;
   m.time_since_start_ms = unpacker.integer<std::uint32_t>(s[kTime]);
   m.sequence = unpacker.integer<std::uint8_t>(s[kEvSequence]);

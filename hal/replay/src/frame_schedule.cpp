@@ -160,7 +160,7 @@ LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s,
     const can::MessageKind kind =
         status == hal::IoStatus::kOk ? can::classify(timed.frame.id) : can::MessageKind::kUnknown;
     if (kind != can::MessageKind::kSensorAcceleration &&
-        kind != can::MessageKind::kSensorHeartbeat) {
+        kind != can::MessageKind::kSensorHeartbeat && kind != can::MessageKind::kStatueRotation) {
       ++out.skipped;
       continue;
     }
@@ -189,15 +189,17 @@ LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s,
     previous_ns = relative_ns;
     ScheduledFrame frame;
     frame.virtual_ns = relative_ns;
-    frame.kind = kind == can::MessageKind::kSensorHeartbeat ? FrameKind::kHeartbeat
-                                                            : FrameKind::kAcceleration;
+    frame.kind = kind == can::MessageKind::kSensorHeartbeat  ? FrameKind::kHeartbeat
+                 : kind == can::MessageKind::kStatueRotation ? FrameKind::kRotation
+                                                             : FrameKind::kAcceleration;
     frame.frame = timed.frame;
     out.frames.push_back(frame);
   }
   if (out.frames.empty()) {
     throw host::InputError(path +
-                           ": no sensor frames (SensorAcceleration 0x301-0x30F or "
-                           "SensorHeartbeat 0x311-0x31F) in the log");
+                           ": no sensor frames (SensorAcceleration 0x301-0x30F, "
+                           "SensorHeartbeat 0x311-0x31F or StatueRotation 0x371-0x37F) in the "
+                           "log");
   }
   return out;
 }

@@ -13,7 +13,7 @@
 
 namespace plinth::hal::replay {
 
-enum class FrameKind : std::uint8_t { kAcceleration, kHeartbeat };
+enum class FrameKind : std::uint8_t { kAcceleration, kHeartbeat, kRotation };
 
 struct ScheduledFrame {
   std::int64_t virtual_ns = 0;  // since the replay started, at speed 1
@@ -78,14 +78,14 @@ class RecordSchedule final : public FrameSchedule {
   std::vector<std::uint8_t> status_since_;  // per node: flags since its last heartbeat
 };
 
-// The sensor frames (SensorAcceleration and SensorHeartbeat of any node) of a candump log, sent
-// again as logged, at their logged times relative to the first of them. Other lines are skipped
-// and counted. Their time is checked (hal::LogTimeCheck): with LogTimePolicy::kWarn a frame
-// stamped before the previous one is sent at the previous one's time, and a jump forward beyond
-// hal::kMaxLogGapS is shortened to that gap (the replay does not sit through a logger's pause
-// or a clock step), each one named in `time_warnings` (the first kLogTimeWarnings) and counted;
-// with kRefuse the first one throws. Frames of an identifier at the same microsecond are sent
-// as logged.
+// The sensor frames (SensorAcceleration, SensorHeartbeat and StatueRotation of any node: the
+// ground sensors' and the statue sensor's) of a candump log, sent again as logged, at their
+// logged times relative to the first of them. Other lines are skipped and counted. Their time is
+// checked (hal::LogTimeCheck): with LogTimePolicy::kWarn a frame stamped before the previous one
+// is sent at the previous one's time, and a jump forward beyond hal::kMaxLogGapS is shortened to
+// that gap (the replay does not sit through a logger's pause or a clock step), each one named in
+// `time_warnings` (the first kLogTimeWarnings) and counted; with kRefuse the first one throws.
+// Frames of an identifier at the same microsecond are sent as logged.
 inline constexpr std::size_t kLogTimeWarnings = 10;
 struct LoggedFrames {
   std::vector<ScheduledFrame> frames;  // virtual_ns relative to the first

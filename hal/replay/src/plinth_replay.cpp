@@ -297,6 +297,7 @@ struct Report {
   std::int64_t frames_sent = 0;
   std::int64_t acceleration_frames = 0;
   std::int64_t heartbeat_frames = 0;
+  std::int64_t rotation_frames = 0;  // StatueRotation, from a log
   std::int64_t send_errors = 0;
   std::int64_t skipped_log_lines = 0;
   std::size_t clipped_samples = 0;
@@ -311,11 +312,12 @@ void print_report(const Options& opt, const Report& r, const plinth::hal::Pacer&
   std::fprintf(
       stderr,
       "plinth-replay: %lld frames sent to %s (%lld SensorAcceleration, %lld "
-      "SensorHeartbeat), %lld send errors; %.3f s of virtual time in %.3f s (speed %s)%s\n",
+      "SensorHeartbeat, %lld StatueRotation), %lld send errors; %.3f s of virtual time in %.3f s "
+      "(speed %s)%s\n",
       static_cast<long long>(r.frames_sent), destination.c_str(),
       static_cast<long long>(r.acceleration_frames), static_cast<long long>(r.heartbeat_frames),
-      static_cast<long long>(r.send_errors), r.virtual_time_s, r.wall_time_s, opt.speed.c_str(),
-      r.interrupted ? "; interrupted" : "");
+      static_cast<long long>(r.rotation_frames), static_cast<long long>(r.send_errors),
+      r.virtual_time_s, r.wall_time_s, opt.speed.c_str(), r.interrupted ? "; interrupted" : "");
   if (r.skipped_log_lines > 0) {
     std::fprintf(stderr, "plinth-replay: %lld log lines skipped (not sensor frames)\n",
                  static_cast<long long>(r.skipped_log_lines));
@@ -342,14 +344,15 @@ void print_report(const Options& opt, const Report& r, const plinth::hal::Pacer&
   }
   std::printf(
       "{\"frames_sent\": %lld, \"acceleration_frames\": %lld, \"heartbeat_frames\": %lld, "
-      "\"send_errors\": %lld, \"skipped_log_lines\": %lld, \"clipped_samples\": %zu, "
-      "\"virtual_time_s\": %.6f, "
+      "\"rotation_frames\": %lld, \"send_errors\": %lld, \"skipped_log_lines\": %lld, "
+      "\"clipped_samples\": %zu, \"virtual_time_s\": %.6f, "
       "\"wall_time_s\": %.6f, \"speed\": %s, \"loops\": %lld, \"interrupted\": %s, %s}\n",
       static_cast<long long>(r.frames_sent), static_cast<long long>(r.acceleration_frames),
-      static_cast<long long>(r.heartbeat_frames), static_cast<long long>(r.send_errors),
-      static_cast<long long>(r.skipped_log_lines), r.clipped_samples, r.virtual_time_s,
-      r.wall_time_s, opt.speed == "max" ? "\"max\"" : opt.speed.c_str(),
-      static_cast<long long>(opt.loops), r.interrupted ? "true" : "false", jitter);
+      static_cast<long long>(r.heartbeat_frames), static_cast<long long>(r.rotation_frames),
+      static_cast<long long>(r.send_errors), static_cast<long long>(r.skipped_log_lines),
+      r.clipped_samples, r.virtual_time_s, r.wall_time_s,
+      opt.speed == "max" ? "\"max\"" : opt.speed.c_str(), static_cast<long long>(opt.loops),
+      r.interrupted ? "true" : "false", jitter);
   std::fflush(stdout);
 }
 
@@ -511,8 +514,10 @@ void send_all(plinth::hal::replay::FrameSchedule& schedule, const Destination& d
       continue;
     }
     ++report.frames_sent;
-    ++(next.kind == plinth::hal::replay::FrameKind::kHeartbeat ? report.heartbeat_frames
-                                                          : report.acceleration_frames);
+    using plinth::hal::replay::FrameKind;
+    ++(next.kind == FrameKind::kHeartbeat  ? report.heartbeat_frames
+       : next.kind == FrameKind::kRotation ? report.rotation_frames
+                                           : report.acceleration_frames);
   }
 }
 

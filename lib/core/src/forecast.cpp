@@ -216,6 +216,7 @@ void Forecaster::start_member() {
 void Forecaster::finish_member(bool collapsed, double time_s) {
   if (collapsed) {
     ++building_.collapsing;
+    building_.collapsing_members |= std::uint32_t{1} << static_cast<unsigned>(member_);
     if (building_.worst_member < 0 || time_s < building_.collapse_in_s) {
       building_.worst_member = member_;
       building_.collapse_in_s = time_s;

@@ -16,28 +16,10 @@ namespace {
 
 using testing::make;
 using testing::paper_block;
+using testing::wide_block;
+using testing::ensemble_estimator_settings;
+using testing::no_forecast;
 using testing::paper_isolated;
-
-EstimatorSettings ensemble_estimator_settings() {
-  EstimatorSettings e;
-  e.sample_rate_hz = 200.0;
-  e.steps_per_sample = 4;
-  return e;
-}
-
-ForecastSettings no_forecast() {
-  ForecastSettings f;
-  f.enabled = false;
-  return f;
-}
-
-// A block twice as wide as the paper's (uplift at 2g/3): it stands where the paper's rocks.
-Scene wide_block() {
-  SceneParams wide = paper_block();
-  wide.block.half_width = 0.6;
-  wide.block.inertia = homogeneous_rectangle_inertia(wide.block.mass, 0.6, 0.9);
-  return make(wide);
-}
 
 // The ensemble with the scenes it refers to (on the heap: 17 estimators and a forecaster).
 struct EnsembleRun {

@@ -2,6 +2,7 @@
 // to its sensor's index, an Acknowledge is an acknowledgement, anything else is no input.
 #include <gtest/gtest.h>
 
+#include "plinth/firmware/can_frames.h"
 #include "plinth/firmware/frame_decoder.h"
 
 namespace plinth::firmware {
@@ -45,6 +46,53 @@ TEST(FrameDecoder, ASensorFrameIsItsSensorsSample) {
   m.node = 5;  // not configured
   EXPECT_EQ(decoder.decode({encoded(m), 0}).kind, FrameInput::Kind::kNone);
   EXPECT_EQ(decoder.counters().sensor_samples, 1U);
+  EXPECT_EQ(decoder.counters().other_nodes, 1U);
+}
+
+// The statue sensor's node: its StatueRotation is the gyroscope's sample, its
+// SensorAcceleration the accelerometer's; another node's StatueRotation, or one without a
+// statue sensor configured, is no input; a garbled one is refused and counted.
+TEST(FrameDecoder, TheStatueSensorsFramesAreItsSamples) {
+  MonitorConfig config = two_sensors();
+  config.statue_sensor.present = true;
+  config.statue_sensor.node = 6;
+  FrameDecoder decoder;
+  decoder.start(config);
+  can::StatueRotation r;
+  r.node = 6;
+  r.wx_rad_s = 0.5;
+  r.wy_rad_s = -1.25;
+  r.wz_rad_s = 0.0005;
+  r.sequence = 200;
+  r.status = monitor::sensor_flags::kSaturated;
+  FrameInput in = decoder.decode({encoded(r), 5'000});
+  ASSERT_EQ(in.kind, FrameInput::Kind::kStatueRate);
+  EXPECT_EQ(in.statue.receive_time_ns, 5'000);
+  EXPECT_EQ(in.statue.sequence, 200);
+  EXPECT_EQ(in.statue.status, monitor::sensor_flags::kSaturated);
+  EXPECT_EQ(in.statue.rotation_rate_rad_s, Vector3r(Real(0.5), Real(-1.25), Real(0.0005)));
+  EXPECT_EQ(can::decode(encoded(rotation_message(6, in.statue)), r).error, can::CodecError::kOk);
+  EXPECT_EQ(r.wy_rad_s, -1.25);
+  can::SensorAcceleration a;
+  a.node = 6;
+  a.az_g = 1.0;
+  in = decoder.decode({encoded(a), 6'000});
+  ASSERT_EQ(in.kind, FrameInput::Kind::kStatueAcceleration);
+  EXPECT_EQ(in.sample.acceleration_g, Vector3r(0, 0, 1));
+  r.node = 7;
+  EXPECT_EQ(decoder.decode({encoded(r), 0}).kind, FrameInput::Kind::kNone);
+  can::CanFrame garbled = encoded(r);
+  garbled.id = 0x376;
+  garbled.length = 7;
+  EXPECT_EQ(decoder.decode({garbled, 0}).kind, FrameInput::Kind::kNone);
+  EXPECT_EQ(decoder.counters().statue_rates, 1U);
+  EXPECT_EQ(decoder.counters().statue_accelerations, 1U);
+  EXPECT_EQ(decoder.counters().other_nodes, 1U);
+  EXPECT_EQ(decoder.counters().rejected, 1U);
+  EXPECT_EQ(decoder.counters().last_error, can::CodecError::kWrongLength);
+  decoder.start(two_sensors());  // no statue sensor: its frames are another node's
+  r.node = 6;
+  EXPECT_EQ(decoder.decode({encoded(r), 0}).kind, FrameInput::Kind::kNone);
   EXPECT_EQ(decoder.counters().other_nodes, 1U);
 }
 

@@ -27,7 +27,8 @@ TEST(ModbusMap, TheShippedCsvIsTheCodesMap) {
 
 TEST(ModbusMap, EveryCauseHasItsCodeInTheCsv) {
   const std::string csv = map_csv();
-  EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model\""),
+  EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model;"
+                     "14=statue_unexplained\""),
             std::string::npos);
   EXPECT_NE(csv.find("4=overturned;5=fell;6=lifted_off\""), std::string::npos);
   EXPECT_NE(csv.find("\"0=normal;1=advisory;2=warning;3=alarm;4=fault\""), std::string::npos);
@@ -39,6 +40,7 @@ TEST(ModbusMap, CodesArePinned) {
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kCollapseForecast), 10);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kNotCalibrated), 11);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kOutsideModel), 12);
+  EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kStatueUnexplained), 14);
   EXPECT_EQ(kAlarmLevelCodes.code(monitor::AlarmLevel::kFault), 4);
   EXPECT_EQ(kPhaseCodes.code(Phase::kFell), 5);
   EXPECT_EQ(kPhaseCodes.code(Phase::kLiftedOff), 6);
@@ -90,13 +92,62 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 3);
+  EXPECT_EQ(at(reg::kMapVersion), 5);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";
   EXPECT_EQ(at(reg::kForecastWorstMember), 3);
   for (int level = 0; level < discrete::kCount; ++level) {
     EXPECT_EQ(image.discrete_inputs[static_cast<std::size_t>(level)], level == 2 ? 1 : 0) << level;
+  }
+}
+
+// The statue sensor's registers: kNone without one; with one, its streams' health, its offset,
+// and per axis the weights' code (pinned: 0 not measured .. 3 unexplained) and effective members.
+TEST(ModbusMap, TheStatueSensorsRegisters) {
+  StatusSnapshot s;
+  Image image;
+  fill(s, 0, image);
+  const auto at = [&](int address) { return image.registers[static_cast<std::size_t>(address)]; };
+  for (int r = reg::kStatueRateHealth; r <= reg::kStatueEffectiveMembersY; ++r) {
+    EXPECT_EQ(at(r), kNone) << r;
+  }
+  EXPECT_EQ(reg::kStatueRateHealth, 102) << "after 86-101, the regional alert's (issue 26)";
+  EXPECT_EQ(reg::kCount, 109);
+  s.has_statue_sensor = true;
+  s.axis_count = 1;
+  s.statue_rate = monitor::HealthState::kOk;
+  s.statue_acceleration = monitor::HealthState::kDegraded;
+  s.statue_ready = true;
+  s.statue_axes[0] = {true, true, false, true, Real(2.345), Real(1.1), 4};
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kStatueRateHealth), 0);
+  EXPECT_EQ(at(reg::kStatueAccelerationHealth), 1);
+  EXPECT_EQ(at(reg::kStatueReady), 1);
+  EXPECT_EQ(at(reg::kStatueWeightsX), 2) << "weighted";
+  EXPECT_EQ(at(reg::kStatueEffectiveMembersX), 235);
+  EXPECT_EQ(at(reg::kStatueWeightsY), kNone) << "one axis";
+  EXPECT_EQ(at(reg::kStatueEffectiveMembersY), kNone);
+  s.axis_count = 2;
+  s.statue_axes[0].unexplained = true;
+  s.statue_axes[0].weighted = false;
+  s.statue_axes[1] = {true, false, false, false, Real(17), Real(0), 0};
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kStatueWeightsX), 3) << "unexplained";
+  EXPECT_EQ(at(reg::kStatueWeightsY), 1) << "uninformative";
+  EXPECT_EQ(at(reg::kStatueEffectiveMembersY), 1700);
+  s.statue_axes[1].measured = false;
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kStatueWeightsY), 0) << "not measured";
+  // The registers reserved for the regional alert read kNone, and no point of the map is there.
+  for (int r = reg::kRegionalReserved; r < reg::kStatueRateHealth; ++r) {
+    EXPECT_EQ(at(r), kNone) << r;
+  }
+  for (const Point& p : points()) {
+    if (p.table != Table::kRegister) continue;
+    EXPECT_TRUE(p.address + p.words <= reg::kRegionalReserved ||
+                p.address >= reg::kRegionalReserved + reg::kRegionalReservedWords)
+        << p.name;
   }
 }
 

@@ -115,6 +115,69 @@ TEST(MonitorConfigFile, BadInputNamesFileLineAndKey) {
   }
 }
 
+// [statue_sensor]: its presence configures the IMU; its mounting, health and the filter's keys.
+TEST(MonitorConfigFile, TheStatueSensorsTables) {
+  const MonitorFile f = load_monitor_text(
+      "[statue_sensor]\nnode = 5\nheight_m = 1.2\noffset_x_m = -0.05\n"
+      "sensor_to_statue = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]\n"
+      "health = { timeout_s = 0.04, stuck_samples = 0, rate_full_scale_rad_s = 8.0, "
+      "rate_max_valid_rad_s = 8.5, acceleration_max_valid_g = 8.1 }\n"
+      "[statue_filter]\nrate_noise_rad_s = 0.004\nmemory_s = 5\n",
+      "/etc/plinth/box.toml", MonitorConfig{});
+  const StatueSensorSettings& s = f.config.statue_sensor;
+  EXPECT_TRUE(s.present);
+  EXPECT_EQ(s.node, 5);
+  EXPECT_EQ(s.height_m, 1.2);
+  EXPECT_EQ(s.offset_x_m, -0.05);
+  EXPECT_EQ(s.sensor_to_statue(0, 1), -1.0);
+  EXPECT_EQ(s.health.timeout_s, 0.04);
+  EXPECT_EQ(s.health.stuck_samples, 0);
+  EXPECT_EQ(s.health.rate_full_scale_rad_s, 8.0);
+  EXPECT_EQ(s.health.rate_max_valid_rad_s, 8.5);
+  EXPECT_EQ(s.health.acceleration_max_valid_g, 8.1);
+  EXPECT_EQ(s.filter.rate_noise_rad_s, 0.004);
+  EXPECT_EQ(s.filter.memory_s, 5.0);
+  EXPECT_FALSE(load_monitor_text("[monitor]\nground_node = 2\n", "/etc/plinth/box.toml",
+                                 MonitorConfig{})
+                   .config.statue_sensor.present);
+
+  // Errors name the file, the line and the key.
+  EXPECT_EQ(box_file_error("[statue_sensor]\nheight_m = 1\n"),
+            "/etc/plinth/box.toml:1: statue_sensor: no node (statue_sensor.node gives the IMU's "
+            "CAN node)");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 0\n"),
+            "/etc/plinth/box.toml:2: statue_sensor.node: must lie in [1, 15]");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 1\n"),
+            "/etc/plinth/box.toml:2: statue_sensor.node: is an accelerometer's node; each "
+            "sensor has its own");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\nnoise = 3\n"),
+            "/etc/plinth/box.toml:3: statue_sensor.noise: unknown key (docs/monitor.md lists "
+            "them)");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\nheight_m = \"tall\"\n"),
+            "/etc/plinth/box.toml:3: statue_sensor.height_m: expected a number");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\nheight_m = -1\n"),
+            "/etc/plinth/box.toml:3: statue_sensor.height_m: must be finite and >= 0");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n"
+                           "sensor_to_statue = [[1, 0, 0], [0, 1, 0], [0, 0, -1]]\n")
+                .rfind("/etc/plinth/box.toml:3: statue_sensor.sensor_to_statue: ", 0),
+            0U);
+  // A key the file leaves at its default: the file named without a line.
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_sensor.health]\n"
+                           "rate_full_scale_rad_s = 20\n"),
+            "/etc/plinth/box.toml: statue_sensor.health.rate_max_valid_rad_s: must not be below "
+            "rate_full_scale_rad_s");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\nhealth.max_bridge_samples = 1.5\n"),
+            "/etc/plinth/box.toml:3: statue_sensor.health.max_bridge_samples: expected an "
+            "integer");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\nmemory_s = 0\n")
+                .rfind("/etc/plinth/box.toml:4: statue_filter.memory_s: must be finite and > 0",
+                       0),
+            0U);
+  EXPECT_EQ(box_file_error("[statue_filter]\nmemory_s = 3\n"),
+            "/etc/plinth/box.toml:1: statue_filter: no [statue_sensor] table (the filter weighs "
+            "its measurements)");
+}
+
 // Issue 25: a value of the wrong type is reported as one, never as an unknown key. The walk
 // covers every key the example file shows (commented ones too): each table given a number,
 // each key given a table (or, where a table belongs, a boolean).
@@ -122,10 +185,11 @@ TEST(MonitorConfigFile, EveryKeyOfTheWrongTypeIsSaidToBeOne) {
   std::ifstream example(kSource + "/firmware/monitor.example.toml");
   ASSERT_TRUE(example);
   // By hand, not std::regex (GCC 12 warns falsely inside it under the sanitize preset).
-  const auto word_at = [](const std::string& text, std::size_t at) {
+  // A name: lower case and '_'; a table's may be dotted ("[statue_sensor.health]").
+  const auto word_at = [](const std::string& text, std::size_t at, bool dotted = false) {
     std::size_t end = at;
     while (end < text.size() && (std::islower(static_cast<unsigned char>(text[end])) != 0 ||
-                                 text[end] == '_')) {
+                                 text[end] == '_' || (dotted && text[end] == '.'))) {
       ++end;
     }
     return text.substr(at, end - at);
@@ -142,7 +206,7 @@ TEST(MonitorConfigFile, EveryKeyOfTheWrongTypeIsSaidToBeOne) {
     if (at < line.size() && line[at] == '[') {
       array_of_tables = line.compare(at, 2, "[[") == 0;
       const std::size_t name_at = at + (array_of_tables ? 2 : 1);
-      const std::string name = word_at(line, name_at);
+      const std::string name = word_at(line, name_at, true);
       const std::string close = array_of_tables ? "]]" : "]";
       const std::size_t after = line.find_first_not_of(' ', name_at + name.size() + close.size());
       if (name.empty() || line.compare(name_at + name.size(), close.size(), close) != 0 ||

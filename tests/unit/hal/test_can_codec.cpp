@@ -55,6 +55,7 @@ std::uint64_t raw_at(const CanFrame& f, unsigned start, unsigned length) {
 }
 
 constexpr double kG = 0.00025;  // SensorAcceleration factor, g/bit
+constexpr double kRadS = 0.0005;  // StatueRotation factor, rad/s/bit
 constexpr double kRiskStep = 0.0001;
 
 // ---------------------------------------------------------------------------------------------
@@ -241,8 +242,76 @@ TEST(CanGolden, CollapseForecast) {
   EXPECT_DOUBLE_EQ(d.horizon_s, 10.0);
 }
 
+// StatueRotation of node 2 (0x372): Wx = +1 rad/s (raw 2000 = 0x07D0), Wy = -0.5 rad/s (raw
+// -1000 = 0xFC18), Wz = the most negative raw (0x8000, -16.384 rad/s), Sequence 0x81, Status
+// saturated + over-temperature (0x05).
+TEST(CanGolden, StatueRotation) {
+  const Bytes golden{0xD0, 0x07, 0x18, 0xFC, 0x00, 0x80, 0x81, 0x05};
+  StatueRotation m;
+  m.node = 2;
+  m.wx_rad_s = 1.0;
+  m.wy_rad_s = -0.5;
+  m.wz_rad_s = -16.384;
+  m.sequence = 0x81;
+  m.status = sensor_status::kSaturated | sensor_status::kOverTemperature;
+  StatueRotation d;
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x372, golden, d));
+  EXPECT_EQ(d.node, 2);
+  EXPECT_DOUBLE_EQ(d.wx_rad_s, 1.0);
+  EXPECT_DOUBLE_EQ(d.wy_rad_s, -0.5);
+  EXPECT_DOUBLE_EQ(d.wz_rad_s, -16.384);
+  EXPECT_EQ(d.sequence, 0x81);
+  EXPECT_EQ(d.status, m.status);
+  EXPECT_STREQ(message_kind_name(classify(0x372)), "StatueRotation");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Round trips over every signal's range
+
+TEST(CanRoundTrip, StatueRotationEveryRawValueOfEveryAxisAndNode) {
+  for (std::uint8_t node = kFirstSensorNode; node <= kLastSensorNode; ++node) {
+    StatueRotation m;
+    m.node = node;
+    m.sequence = static_cast<std::uint8_t>(node * 17);
+    CanFrame f;
+    ASSERT_TRUE(encode(m, f).ok());
+    EXPECT_EQ(f.id, 0x370U + node);
+    EXPECT_EQ(classify(f.id), MessageKind::kStatueRotation);
+    StatueRotation d;
+    ASSERT_TRUE(decode(f, d).ok());
+    EXPECT_EQ(d.node, node);
+    EXPECT_EQ(d.sequence, m.sequence);
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    for (std::int32_t raw = -32768; raw <= 32767; ++raw) {
+      StatueRotation m;
+      const double w = raw * kRadS;
+      (axis == 0 ? m.wx_rad_s : axis == 1 ? m.wy_rad_s : m.wz_rad_s) = w;
+      CanFrame f;
+      ASSERT_TRUE(encode(m, f).ok()) << w;
+      ASSERT_EQ(sign_extend(raw_at(f, 16U * static_cast<unsigned>(axis), 16), 16), raw);
+      StatueRotation d;
+      ASSERT_TRUE(decode(f, d).ok());
+      ASSERT_EQ(axis == 0 ? d.wx_rad_s : axis == 1 ? d.wy_rad_s : d.wz_rad_s, w);
+    }
+  }
+  // Beyond the range (half a step past either end), not finite, an undefined flag, node 0/16.
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (const double w : {16.38375 + 1e-9, -16.38425, 100.0, nan}) {
+    StatueRotation m;
+    m.wy_rad_s = w;
+    CanFrame f;
+    const EncodeResult r = encode(m, f);
+    EXPECT_EQ(r.error, std::isnan(w) ? CodecError::kNotFinite : CodecError::kOutOfRange) << w;
+    EXPECT_STREQ(r.signal, "Wy");
+  }
+  for (const int node : {0, 16}) {
+    StatueRotation m;
+    m.node = static_cast<std::uint8_t>(node);
+    CanFrame f;
+    EXPECT_STREQ(encode(m, f).signal, "node");
+  }
+}
 
 TEST(CanRoundTrip, SensorAccelerationEveryRawValueOfEveryAxis) {
   for (std::uint8_t node = kFirstSensorNode; node <= kLastSensorNode; ++node) {
@@ -413,7 +482,7 @@ TEST(CanRoundTrip, MonitorStatusEveryRiskSequenceAndAge) {
 TEST(CanRoundTrip, AlarmEventEveryEnumCombinationAndTimeSweep) {
   for (unsigned l = 0; l <= 4; ++l) {
     for (unsigned p = 0; p <= 4; ++p) {
-      for (unsigned c = 0; c <= 12; ++c) {
+      for (const unsigned c : {0U, 1U, 2U, 3U, 4U, 5U, 6U, 7U, 8U, 9U, 10U, 11U, 12U, 14U}) {
         for (const bool latched : {false, true}) {
           AlarmEvent m;
           m.level = static_cast<AlarmLevel>(l);
@@ -555,7 +624,7 @@ TEST(CanRoundTrip, CollapseForecastEveryProbabilityCollapseInHorizonAndSequence)
 
 // A valid frame of every message kind.
 std::vector<CanFrame> valid_frames() {
-  std::vector<CanFrame> frames(6);
+  std::vector<CanFrame> frames(7);
   SensorAcceleration a;
   a.ax_g = 0.1;
   EXPECT_TRUE(encode(a, frames[0]).ok());
@@ -572,12 +641,16 @@ std::vector<CanFrame> valid_frames() {
   k.level = AlarmLevel::kAlarm;
   EXPECT_TRUE(encode(k, frames[4]).ok());
   EXPECT_TRUE(encode(forecast_of(9, 2, 1500), frames[5]).ok());
+  StatueRotation r;
+  r.node = 3;
+  r.wy_rad_s = -0.25;
+  EXPECT_TRUE(encode(r, frames[6]).ok());
   return frames;
 }
 
 // Decodes `f` as every message type; the result of the one `f.id` classifies as, or of all.
 struct AllDecodes {
-  DecodeResult acceleration, heartbeat, status, event, acknowledge, forecast;
+  DecodeResult acceleration, heartbeat, status, event, acknowledge, forecast, rotation;
 };
 AllDecodes decode_all(const CanFrame& f) {
   SensorAcceleration a;
@@ -586,7 +659,9 @@ AllDecodes decode_all(const CanFrame& f) {
   AlarmEvent e;
   Acknowledge k;
   CollapseForecast c;
-  return {decode(f, a), decode(f, h), decode(f, s), decode(f, e), decode(f, k), decode(f, c)};
+  StatueRotation r;
+  return {decode(f, a), decode(f, h), decode(f, s), decode(f, e),
+          decode(f, k), decode(f, c), decode(f, r)};
 }
 DecodeResult decode_as_own_kind(const CanFrame& f) {
   const AllDecodes all = decode_all(f);
@@ -597,6 +672,7 @@ DecodeResult decode_as_own_kind(const CanFrame& f) {
     case MessageKind::kAlarmEvent: return all.event;
     case MessageKind::kAcknowledge: return all.acknowledge;
     case MessageKind::kCollapseForecast: return all.forecast;
+    case MessageKind::kStatueRotation: return all.rotation;
     case MessageKind::kUnknown: break;
   }
   ADD_FAILURE() << "unknown identifier " << f.id;
@@ -619,7 +695,7 @@ TEST(CanReject, EveryLengthButEight) {
 
 TEST(CanReject, UnknownIdentifiers) {
   std::set<std::uint32_t> known;
-  for (std::uint32_t n = 1; n <= 15; ++n) known.insert({0x300 + n, 0x310 + n});
+  for (std::uint32_t n = 1; n <= 15; ++n) known.insert({0x300 + n, 0x310 + n, 0x370 + n});
   known.insert({0x320, 0x321, 0x330, 0x340, 0x350, 0x351});
   std::vector<std::uint32_t> ids;
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) ids.push_back(id);
@@ -639,8 +715,9 @@ TEST(CanReject, UnknownIdentifiers) {
     EXPECT_EQ(all.event.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.acknowledge.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.forecast.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.rotation.error, CodecError::kUnknownIdentifier) << id;
   }
-  EXPECT_EQ(known.size(), 36U);
+  EXPECT_EQ(known.size(), 51U);
 }
 
 TEST(CanReject, AnotherMessagesIdentifier) {
@@ -657,6 +734,8 @@ TEST(CanReject, AnotherMessagesIdentifier) {
               kind != MessageKind::kAcknowledge);
     EXPECT_EQ(all.forecast.error == CodecError::kWrongMessage,
               kind != MessageKind::kCollapseForecast);
+    EXPECT_EQ(all.rotation.error == CodecError::kWrongMessage,
+              kind != MessageKind::kStatueRotation);
   }
 }
 
@@ -699,6 +778,15 @@ TEST(CanReject, UndefinedSensorStatusFlags) {
     bytes = Bytes{};
     bytes[5] = status;  // Status 40|8
     EXPECT_EQ(decode(make_frame(0x311, bytes), dh).error, CodecError::kReservedBitsSet);
+    StatueRotation r;
+    r.status = status;
+    EXPECT_STREQ(encode(r, f).signal, "Status");
+    StatueRotation dr;
+    bytes = Bytes{};
+    bytes[7] = status;  // Status 56|8
+    const DecodeResult rr = decode(make_frame(0x37F, bytes), dr);
+    EXPECT_EQ(rr.error, CodecError::kReservedBitsSet);
+    EXPECT_STREQ(rr.signal, "Status");
   }
 }
 
@@ -732,6 +820,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_STREQ(rk.signal, "Level");
   }
   for (unsigned v = 13; v <= 255; ++v) {
+    if (v == 14) continue;  // statue_unexplained; 13 and 15 are a gap (issue 26's causes)
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -749,8 +838,10 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  e.cause = static_cast<AlarmCause>(13);
-  EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
+  for (const unsigned gap : {13U, 15U}) {
+    e.cause = static_cast<AlarmCause>(gap);
+    EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum) << gap;
+  }
   e = AlarmEvent{};
   e.previous_level = static_cast<AlarmLevel>(255);
   EXPECT_STREQ(encode(e, f).signal, "PreviousLevel");
@@ -991,7 +1082,7 @@ TEST(CanReject, ErrorTexts) {
 
 TEST(CanDbc, EveryIdentifierTheCodecKnowsIsAMessageAndNoOther) {
   const Dbc& dbc = plinth_dbc();
-  ASSERT_EQ(dbc.messages.size(), 36U);
+  ASSERT_EQ(dbc.messages.size(), 51U);
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) {
     const MessageKind kind = classify(id);
     const auto it = dbc.messages.find(id);
@@ -1073,8 +1164,15 @@ TEST(CanDbc, ValueTablesMatchTheCodecsEnumerations) {
       }
       if (!c.has_value_table) continue;
       const auto& table = it->second;
-      // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names.
-      ASSERT_EQ(table.size(), static_cast<std::size_t>(c.raw_max - c.raw_min + 1));
+      // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names; the
+      // causes have a gap (13: issue 26's p_wave), which decode refuses as well.
+      const bool cause_gap = std::string(c.name) == "Cause";
+      ASSERT_EQ(table.size(), static_cast<std::size_t>(c.raw_max - c.raw_min + 1) -
+                                  (cause_gap ? 1U : 0U));
+      if (cause_gap) {
+        EXPECT_EQ(table.count(12), 1U);
+        EXPECT_EQ(table.count(13), 0U);
+      }
       for (const auto& [value, name] : table) {
         EXPECT_GE(static_cast<std::int64_t>(value), c.raw_min);
         EXPECT_LE(static_cast<std::int64_t>(value), c.raw_max);

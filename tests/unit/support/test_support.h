@@ -3,6 +3,8 @@
 
 #include <vector>
 
+#include "plinth/core/estimator.h"
+#include "plinth/core/forecast.h"
 #include "plinth/core/scene.h"
 #include "plinth/core/simulator.h"
 
@@ -35,6 +37,28 @@ inline Scene make(const SceneParams& p) {
   const Error e = make_scene(p, s);
   if (!e.ok()) __builtin_trap();
   return s;
+}
+
+// A block twice as wide as the paper's (uplift at 2g/3): it stands where the paper's rocks.
+inline Scene wide_block() {
+  SceneParams wide = paper_block();
+  wide.block.half_width = 0.6;
+  wide.block.inertia = homogeneous_rectangle_inertia(wide.block.mass, 0.6, 0.9);
+  return make(wide);
+}
+
+// The ensembles' tests' estimator (200 Hz, 4 steps a sample) and no forecast.
+inline EstimatorSettings ensemble_estimator_settings() {
+  EstimatorSettings e;
+  e.sample_rate_hz = 200.0;
+  e.steps_per_sample = 4;
+  return e;
+}
+
+inline ForecastSettings no_forecast() {
+  ForecastSettings f;
+  f.enabled = false;
+  return f;
 }
 
 class RecordingSink final : public EventSink {

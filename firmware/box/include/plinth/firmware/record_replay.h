@@ -41,4 +41,15 @@ void configure_record_replay(MonitorConfig& config, double sample_rate_hz);
                                                          const Eigen::Vector3d& ground_m_s2,
                                                          double gravity);
 
+// A statue sensor on a replay (the microcontroller image's load case, plinth-eval run
+// --statue-sensor): node 2, its offset estimated over the start-up window, no stuck-value check
+// (a replay's rates may be exact: zero at rest).
+void configure_replay_statue_sensor(MonitorConfig& config);
+
+// The statue sensor's gyroscope sample n, received with the ground's: rotation rates about the
+// sensor axes from each axis's theta' (statue_sensor.h: theta'_0 = -omega_y, theta'_1 =
+// omega_x; the sensor mounted in the statue frame).
+[[nodiscard]] StatueSample replay_statue_sample(const MonitorConfig& config, std::int64_t n,
+                                                Real theta_dot_x, Real theta_dot_y);
+
 }  // namespace plinth::firmware

@@ -20,6 +20,9 @@ struct ReplayCase {
   std::span<const SceneParams> y;  // empty: one axis
   int steps_per_sample = 0;  // 0: the estimator's default
   bool forecast = true;      // false: off (plinth-monitor --no-forecast) in a build that has it
+  // A statue sensor (record_replay.h: configure_replay_statue_sensor) fed the nominal statue's
+  // own rotation each sample: what the statue sensor's update costs.
+  bool statue_sensor = false;
   hal::CompiledRecord record;
 };
 

@@ -17,7 +17,8 @@ namespace plinth::firmware {
 //    sensor_fault), a ground sensor that disagrees with the primary or, with
 //    config.plate.raises_fault, a plate mismatch (sensor_disagreement), `bus_fault` (bus_error),
 //    an estimate outside the model (outside_model: a member of an axis's ensemble lifted off,
-//    while the estimators run: the box cannot vouch for what it no longer models);
+//    while the estimators run: the box cannot vouch for what it no longer models), no member
+//    explaining the statue sensor's motion (statue_unexplained);
 //  - not calibrated: the estimators do not run, or run on an untrusted start (the start-up rule).
 [[nodiscard]] monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& config,
                                               bool bus_fault);

@@ -6,22 +6,54 @@
 
 #include <array>
 #include <cstdint>
+#include <type_traits>
 
 #include "plinth/core/ensemble.h"
 #include "plinth/core/forecast.h"
 #include "plinth/core/risk.h"
 #include "plinth/core/state.h"
+#include "plinth/core/statue_filter.h"
 #include "plinth/firmware/config.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
 
+// What the statue sensor makes of an axis (StatueFilter's estimate, statue_filter.h).
+struct StatueAxisStatus {
+  bool measured = false;     // the filter took the statue sensor's newest sample
+  bool informative = false;  // the weights tell the members apart
+  bool unexplained = false;  // no member explains the measured motion
+  bool weighted = false;     // the risk is the weighted members' (informative and explained)
+  Real effective_members = 0.0;
+  Real best_score = 0.0;     // the best member's mean normalised innovation
+  int best_member = 0;
+  int ruled_out = 0;         // members the measured motion ruled out (their risk not counted)
+};
+
+// The statue sensor's streams: its gyroscope's and accelerometer's health, its rate offset
+// known.
+struct StatueSensorStatus {
+  monitor::SensorHealth rate;
+  monitor::SensorHealth acceleration;
+  bool ready = false;
+};
+struct NoStatueSensorStatus {};
+using StatueSensorStatusField =
+    std::conditional_t<kStatueSensorBuiltIn, StatueSensorStatus, NoStatueSensorStatus>;
+struct NoStatueAxisStatus {};
+using StatueAxisStatusField =
+    std::conditional_t<kStatueSensorBuiltIn, StatueAxisStatus, NoStatueAxisStatus>;
+
 // One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box
 // without ensemble) and the rest.
 struct AxisStatus : EnsembleRisk {
-  Mode mode;  // the nominal statue's (member 0)
+  // The nominal statue's (member 0); with the statue sensor measuring, the measured phase,
+  // tilt and rotation rate.
+  Mode mode;
   State state = State::Zero();
+  // The statue sensor's view (nothing in a build without it: statue_part).
+  [[no_unique_address]] StatueAxisStatusField statue;
   int members = 1;       // the ensemble's size
   ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
   // Monitor time, s, of that forecast's first collapse (its worst member's); -1: none forecast.
@@ -86,6 +118,12 @@ struct BoxStatus : SensorSetStatus {
   std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
   std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
   std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
+  // The statue sensor (statue_sensor.h): configured, its streams (none in a build without it:
+  // statue_part), and unexplained: on some axis no member explains its motion (fault,
+  // kStatueUnexplained).
+  bool has_statue_sensor = false;
+  [[no_unique_address]] StatueSensorStatusField statue_sensor;
+  bool statue_unexplained = false;
 };
 
 }  // namespace plinth::firmware

@@ -9,6 +9,7 @@
 
 #include "plinth/core/state.h"
 #include "plinth/firmware/box_status.h"
+#include "plinth/firmware/statue_sensor.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
@@ -44,10 +45,17 @@ namespace plinth::firmware {
 [[nodiscard]] hal::can::SensorAcceleration sensor_message(std::uint8_t node,
                                                      const monitor::SensorSample& sample_g);
 
+// A StatueRotation of node `node` from a gyroscope sample (the statue sensor's, rad/s).
+[[nodiscard]] hal::can::StatueRotation rotation_message(std::uint8_t node,
+                                                        const StatueSample& sample);
+
 // An operator's Acknowledge as the alarm policy takes it (without its source id).
 [[nodiscard]] monitor::Acknowledgement acknowledgement_of(const hal::can::Acknowledge& message);
 // A decoded SensorAcceleration as the sensor's health tracker takes it.
 [[nodiscard]] monitor::SensorSample sample_of(const hal::can::SensorAcceleration& message,
                                               std::int64_t receive_time_ns);
+// A StatueRotation frame as the statue sensor's gyroscope sample (statue_sensor.h).
+[[nodiscard]] StatueSample sample_of(const hal::can::StatueRotation& message,
+                                     std::int64_t receive_time_ns);
 
 }  // namespace plinth::firmware

@@ -12,6 +12,7 @@
 #include "plinth/core/forecast.h"
 #include "plinth/core/name_table.h"
 #include "plinth/core/risk.h"
+#include "plinth/firmware/statue_sensor.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/conditioning.h"
 #include "plinth/monitor/sensor_health.h"
@@ -102,6 +103,9 @@ struct MonitorConfig {
   std::array<SensorConfig, kMaxSensors> sensors{};
   RedundancySettings redundancy;
   PlateCheckSettings plate;
+  // The IMU on the statue (statue_sensor.h): absent unless `present`; a build without the
+  // statue sensor holds `present` alone (statue_settings() gives the rest when built).
+  StatueSensorConfig statue_sensor;
 };
 
 // Checks every part; the Error names the field ("monitor.axis_count", "estimator....", ...).

@@ -1,6 +1,8 @@
 // The bus's frames (hal/can_codec) as the monitor's inputs: a configured sensor's
-// SensorAcceleration is its sample, an Acknowledge an operator's acknowledgement; every other
-// frame, and every frame the codec refuses, is counted and is no input. Freestanding.
+// SensorAcceleration is its sample, the statue sensor's StatueRotation and SensorAcceleration
+// its gyroscope's and accelerometer's samples, an Acknowledge an operator's acknowledgement;
+// every other frame, and every frame the codec refuses, is counted and is no input.
+// Freestanding.
 #pragma once
 
 #include <array>
@@ -19,7 +21,9 @@ namespace plinth::firmware {
 struct FrameCounters {
   std::uint64_t received = 0;
   std::uint64_t sensor_samples = 0;       // SensorAcceleration of a configured node, decoded
-  std::uint64_t other_nodes = 0;          // SensorAcceleration of other nodes (not used)
+  std::uint64_t statue_rates = 0;         // StatueRotation of the statue sensor's node
+  std::uint64_t statue_accelerations = 0;  // SensorAcceleration of the statue sensor's node
+  std::uint64_t other_nodes = 0;  // SensorAcceleration / StatueRotation of other nodes (not used)
   std::uint64_t heartbeats = 0;           // SensorHeartbeat of any node
   std::uint64_t acknowledgements = 0;     // Acknowledge frames, decoded
   std::uint64_t monitor_frames = 0;  // MonitorStatus / AlarmEvent / CollapseForecast (any box's)
@@ -35,17 +39,20 @@ struct FrameInput {
     kNone,             // no input (another message, another node, refused)
     kSensorSample,     // `sample` of sensor `sensor` (Monitor::on_sensor_sample)
     kAcknowledgement,  // `acknowledgement` (Monitor::acknowledge)
+    kStatueRate,          // `statue` (Monitor::on_statue_sample)
+    kStatueAcceleration,  // `sample` of the statue sensor (Monitor::on_statue_acceleration)
   };
   Kind kind = Kind::kNone;
   int sensor = -1;  // its index in the configured order
   monitor::SensorSample sample;
+  StatueSample statue;
   monitor::Acknowledgement acknowledgement;
 };
 
 class FrameDecoder {
  public:
-  // The sensors' nodes of `config` (resolved_sensors()), in configured order; the counters
-  // start at zero.
+  // The sensors' nodes of `config` (resolved_sensors()), in configured order, and the statue
+  // sensor's node if it has one; the counters start at zero.
   void start(const MonitorConfig& config);
   [[nodiscard]] FrameInput decode(const hal::TimedFrame& frame);
   [[nodiscard]] const FrameCounters& counters() const { return counters_; }
@@ -58,6 +65,7 @@ class FrameDecoder {
 
   std::array<std::uint8_t, kMaxSensors> nodes_{};
   int count_ = 0;
+  int statue_node_ = -1;  // -1: no statue sensor
   FrameCounters counters_;
 };
 

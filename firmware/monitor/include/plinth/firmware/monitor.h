@@ -20,6 +20,7 @@
 #include "plinth/firmware/box_status.h"
 #include "plinth/firmware/config.h"
 #include "plinth/firmware/sensor_set.h"
+#include "plinth/firmware/statue_sensor.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/conditioning.h"
@@ -85,6 +86,12 @@ class Monitor {
   }
   // One decoded sample of sensor `sensor` (its index in the configured order).
   [[nodiscard]] MonitorUpdate on_sensor_sample(int sensor, const monitor::SensorSample& sample);
+  // One gyroscope sample of the statue sensor (statue_sensor.h): its health and offset; the
+  // estimators' next samples take it to each axis's StatueFilter. Ignored (a status, if due)
+  // without a statue sensor configured.
+  [[nodiscard]] MonitorUpdate on_statue_sample(const StatueSample& sample);
+  // One accelerometer sample of the statue sensor (g, sensor frame): its stream's health.
+  [[nodiscard]] MonitorUpdate on_statue_acceleration(const monitor::SensorSample& sample);
   // Call periodically with the receive clock's time: sensor timeouts, heartbeats.
   [[nodiscard]] MonitorUpdate on_tick(std::int64_t receive_time_ns);
   // An operator acknowledges the latched level, quoting the latest alarm event (from the bus,
@@ -118,12 +125,22 @@ class Monitor {
     return sensors_.config(sensor);
   }
   [[nodiscard]] const MonitorConfig& config() const { return config_; }
+  // The statue sensor's filter of `axis` (started only with a statue sensor; a build without
+  // one has none: kStatueSensorBuiltIn).
+  [[nodiscard]] const StatueFilter& statue_filter(int axis) const {
+    return statue_room_[0].filters[static_cast<std::size_t>(axis)];
+  }
 
  private:
   // The estimators take the inputs the sensors have for them (SensorSet::next_input).
   void feed_estimators();
-  void push_ensembles(const Vector3r& ground_m_s2);
+  void push_ensembles(const Vector3r& ground_m_s2, std::int64_t receive_time_ns);
   [[nodiscard]] bool quiet() const;
+  // A statue sensor configured, in a build that has it (kStatueSensorBuiltIn).
+  [[nodiscard]] bool statue_present() const {
+    return kStatueSensorBuiltIn && config_.statue_sensor.present;
+  }
+  void note_statue_health();
   [[nodiscard]] MonitorUpdate new_update() const;
   void take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update);
   void update_axis(int axis_index, AxisStatus& axis) const;
@@ -139,6 +156,17 @@ class Monitor {
   SensorSet sensors_;
   Vector3r last_ground_ = Vector3r::Zero();  // the estimators' newest input, m/s2
   std::array<Ensemble, kMaxAxes> ensembles_{};
+  // The statue sensor and each axis's filter: none in a build without it, so that neither its
+  // code nor its data take a microcontroller's room (statue_present() guards every use).
+  struct StatueRoom {
+    StatueSensor sensor;
+    std::array<StatueFilter, kMaxAxes> filters{};
+    std::array<bool, kMaxAxes> measured{};  // each filter took the newest estimator sample
+    std::uint64_t restarts = 0;             // the statue stream's restarts the filters know
+  };
+  std::array<StatueRoom, kStatueSensorBuiltIn ? 1 : 0> statue_room_{};
+  [[nodiscard]] StatueRoom& room() { return statue_room_[0]; }
+  [[nodiscard]] const StatueRoom& room() const { return statue_room_[0]; }
   monitor::AlarmPolicy alarm_;
   BoxStatus status_;
   std::uint64_t frames_not_encoded_ = 0;

@@ -45,6 +45,7 @@ inline constexpr std::uint32_t kMonitorStatusBaseId = 0x320;       // + axis (0.
 inline constexpr std::uint32_t kAlarmEventId = 0x330;
 inline constexpr std::uint32_t kAcknowledgeId = 0x340;
 inline constexpr std::uint32_t kCollapseForecastBaseId = 0x350;  // + axis (0..1)
+inline constexpr std::uint32_t kStatueRotationBaseId = 0x370;    // + node (1..15)
 
 inline constexpr std::uint8_t kFirstSensorNode = 1;
 inline constexpr std::uint8_t kLastSensorNode = 15;
@@ -58,6 +59,7 @@ enum class MessageKind : std::uint8_t {
   kAlarmEvent,
   kAcknowledge,
   kCollapseForecast,
+  kStatueRotation,
 };
 
 // Which plinth message an identifier carries; kUnknown outside the table (node 0, axis 2, ...).
@@ -105,7 +107,10 @@ enum class AlarmCause : std::uint8_t {
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet
   kOutsideModel = 12,       // the estimate left the model's validity (lift-off)
+  kStatueUnexplained = 14,  // no member of the ensemble explains the statue sensor's motion
 };
+// 13 (p_wave) and 15 (regional_alert) are issue 26's causes: gaps in the VAL_ table, refused on
+// encode and decode until they land.
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.
 namespace sensor_status {
@@ -125,6 +130,18 @@ struct SensorAcceleration {
   double ax_g = 0.0;
   double ay_g = 0.0;
   double az_g = 0.0;
+  std::uint8_t sequence = 0;  // increments by one per frame, wraps 255 -> 0
+  std::uint8_t status = 0;    // sensor_status flags
+};
+
+// 0x370 + node. The rotation rate of an IMU's gyroscope (the statue sensor) in rad/s,
+// right-handed about the sensor axes, +-16.384 rad/s at 0.5 mrad/s. Its accelerometer sends
+// SensorAcceleration on the same node, the same sample under the same sequence.
+struct StatueRotation {
+  std::uint8_t node = kFirstSensorNode;  // 1..15
+  double wx_rad_s = 0.0;
+  double wy_rad_s = 0.0;
+  double wz_rad_s = 0.0;
   std::uint8_t sequence = 0;  // increments by one per frame, wraps 255 -> 0
   std::uint8_t status = 0;    // sensor_status flags
 };
@@ -220,6 +237,7 @@ using DecodeResult = CodecResult;
 [[nodiscard]] EncodeResult encode(const AlarmEvent& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const Acknowledge& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const CollapseForecast& message, CanFrame& frame);
+[[nodiscard]] EncodeResult encode(const StatueRotation& message, CanFrame& frame);
 
 // On success `message` holds the decoded values (node / axis from the identifier); on failure
 // it is left untouched.
@@ -229,6 +247,7 @@ using DecodeResult = CodecResult;
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, AlarmEvent& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, Acknowledge& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, CollapseForecast& message);
+[[nodiscard]] DecodeResult decode(const CanFrame& frame, StatueRotation& message);
 
 // ---------------------------------------------------------------------------------------------
 // Signal layouts (as in the DBC) and Intel bit packing

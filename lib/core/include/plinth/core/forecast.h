@@ -85,6 +85,7 @@ struct ForecastOutcome {
   int collapsing = 0;
   double probability = 0.0;    // collapsing / members
   int worst_member = -1;       // the member that collapses first; -1: none does
+  std::uint32_t collapsing_members = 0;  // bit m: member m collapses within the horizon
   double collapse_in_s = -1.0;  // s from start_time_s to that collapse; -1: none
 };
 

@@ -82,6 +82,9 @@ struct EvalRun {
   // >= 0: the true statue lifted off then (Phase::kLiftedOff): the model ends, so the truth is
   // unknown and the run counts in no outcome (outcome_of skips it); -1: the model held.
   double model_valid_until_s = -1.0;
+  // When the true statue first left full contact (-1: never). Not a column of the runs file:
+  // plinth-eval run --motion-out writes it beside the levels' times.
+  double first_motion_s = -1.0;
   // The box: first time each risk level was shown (-1: never), in monitor::kRiskLevels' order.
   std::array<double, monitor::kRiskLevels.size()> first_shown_s{-1.0, -1.0, -1.0};
   // First time each grid threshold was reached (-1: never), same order as the grids.

@@ -1,0 +1,134 @@
+// The statue sensor's room: an IMU on the statue (a CAN node like the ground sensors) whose
+// gyroscope measures the block's rotation (StatueRotation frames) and whose accelerometer
+// (SensorAcceleration frames of the same node) the block's specific force. Each stream has its
+// own health (gaps, stuck, saturation), the gyroscope's offset is estimated over a quiet window
+// at start-up, its axes turned into the statue frame; each axis's rotation rate then goes to
+// that axis's StatueFilter (lib/core statue_filter.h) beside the ensemble. The accelerometer's
+// samples are checked and counted; no estimate uses them yet.
+//
+// Axes: the statue frame is x, y the first and second principal horizontal axes, z up. Axis 0's
+// plane is x-z, its theta (> 0 about corner 1, the -x side: counter-clockwise with x right, z
+// up) is a rotation about -y: theta'_0 = -omega_y. Axis 1's plane is y-z: theta'_1 = omega_x.
+// Freestanding.
+#pragma once
+
+#include <cstdint>
+#include <type_traits>
+
+#include "plinth/core/error.h"
+#include "plinth/core/real.h"
+#include "plinth/core/statue_filter.h"
+#include "plinth/monitor/sensor_health.h"
+
+namespace plinth::firmware {
+
+// One sample of the statue sensor's gyroscope (a StatueRotation frame), sensor frame.
+struct StatueSample {
+  std::int64_t receive_time_ns = 0;
+  std::uint8_t sequence = 0;
+  std::uint8_t status = 0;                          // sensor_flags (alarm_level.h)
+  Vector3r rotation_rate_rad_s = Vector3r::Zero();  // rad/s, right-handed about x, y, z
+};
+
+// The health of the statue sensor's two streams, each checked as a ground sensor's is
+// (sensor_health.h: gaps bridged up to max_bridge_samples, timeouts, stuck values, saturation
+// at full scale, values beyond the valid range rejected), at the estimator's sample rate.
+struct StatueSensorHealthSettings {
+  Time timeout_s = 0.05;     // s without an accepted sample: a timeout fault
+  int max_bridge_samples = 3;  // samples: longest gap bridged
+  int recovery_samples = 10;   // samples: consecutive clean ones that clear a condition
+  int stuck_samples = 50;      // samples bit-identical on all axes: stuck (0: off)
+  // The gyroscope: a BMI088 at its +-1000 deg/s range (17.45 rad/s) sends StatueRotation's
+  // +-16.384 rad/s; full scale is where the frame clamps.
+  Real rate_full_scale_rad_s = Real(16.38);
+  Real rate_max_valid_rad_s = Real(16.384);
+  Real acceleration_full_scale_g = Real(8.0);  // the accelerometer, as a ground sensor's
+  Real acceleration_max_valid_g = Real(8.192);
+};
+
+struct StatueSensorSettings {
+  bool present = false;
+  std::uint8_t node = 2;  // CAN node id, 1..15, not a ground sensor's
+  // Its mounting: the rotation from the sensor frame to the statue frame (orthonormal, det +1),
+  // and where it sits: height above the block's base and horizontal offsets from its vertical
+  // axis, m (the accelerometer's lever arm; the gyroscope reads the same anywhere on the block).
+  Matrix3r sensor_to_statue = Matrix3r::Identity();
+  Real height_m = 1.0;
+  Real offset_x_m = 0.0;
+  Real offset_y_m = 0.0;
+  StatueSensorHealthSettings health;
+  double offset_window_s = 2.0;  // s: the quiet start-up window that estimates the rate offset
+  double max_age_s = 0.01;       // s: a rate older than this is not the statue's now
+  StatueFilterSettings filter;   // its rate_noise_rad_s is the gyroscope's noise
+};
+
+// A build without the statue sensor (kStatueSensorBuiltIn false) keeps only whether one is
+// configured (it refuses it); MonitorConfig holds StatueSensorConfig.
+struct NoStatueSensorSettings {
+  bool present = false;
+};
+using StatueSensorConfig =
+    std::conditional_t<kStatueSensorBuiltIn, StatueSensorSettings, NoStatueSensorSettings>;
+// The statue sensor's settings in a build that has it; nullptr in one that has not.
+template <class Held>
+[[nodiscard]] constexpr auto* statue_settings(Held& config) {
+  return statue_part<StatueSensorSettings>(config);
+}
+
+// Checks the settings; the Error names the field ("statue_sensor.node", ...). The first
+// leaves out the streams' health, which the second checks at the estimator's sample period.
+[[nodiscard]] Error validate(const StatueSensorSettings& settings);
+[[nodiscard]] Error validate(const StatueSensorSettings& settings, double sample_period_s);
+
+class StatueSensor {
+ public:
+  [[nodiscard]] Error start(const StatueSensorSettings& settings, double sample_period_s);
+  // One gyroscope sample. `quiet`: the monitor's quiet (the statue at rest, the ground quiet;
+  // true before the estimators run): the offset is estimated only then, over a window whose
+  // rates spread by at most 0.05 rad/s.
+  void on_sample(const StatueSample& sample, bool quiet);
+  // One accelerometer sample (g, sensor frame): its stream's health and counters.
+  void on_acceleration(const monitor::SensorSample& sample);
+  void tick(std::int64_t now_ns) {
+    rate_health_ = rate_tracker_.tick(now_ns);
+    acceleration_health_ = acceleration_tracker_.tick(now_ns);
+  }
+
+  // Offset known, the gyroscope's stream not in fault, and a sample within max_age_s of
+  // `now_ns` (receive clock).
+  [[nodiscard]] bool usable(std::int64_t now_ns) const;
+  // theta' of axis `axis` (0 or 1), rad/s: the newest rate, offset removed, statue frame.
+  [[nodiscard]] Real axis_rate(int axis) const {
+    return axis == 0 ? -rate_.y() : rate_.x();
+  }
+  // The gyroscope's stream (its counters count rate samples) and the accelerometer's.
+  [[nodiscard]] const monitor::SensorHealth& rate_health() const { return rate_health_; }
+  [[nodiscard]] const monitor::SensorHealth& acceleration_health() const {
+    return acceleration_health_;
+  }
+  [[nodiscard]] bool ready() const { return ready_; }
+  [[nodiscard]] const Vector3r& offset_rad_s() const { return offset_; }
+  // Samples fed since the stream last restarted (a restart loses the tilt: the filter resets).
+  [[nodiscard]] std::uint64_t restarts() const { return restarts_; }
+
+ private:
+  Matrix3r sensor_to_statue_;  // set by start()
+  double max_age_ns_ = 0.0;
+  monitor::SensorHealthTracker rate_tracker_;
+  monitor::SensorHealthTracker acceleration_tracker_;
+  monitor::SensorHealth rate_health_;
+  monitor::SensorHealth acceleration_health_;
+  int window_samples_ = 1;
+  int summed_ = 0;
+  Vector3r sum_ = Vector3r::Zero();
+  Vector3r low_ = Vector3r::Zero();  // the window's smallest and largest rates
+  Vector3r high_ = Vector3r::Zero();
+  Vector3r offset_ = Vector3r::Zero();
+  Vector3r rate_ = Vector3r::Zero();  // statue frame, rad/s
+  bool ready_ = false;
+  bool have_sample_ = false;
+  std::int64_t newest_ns_ = 0;
+  std::uint64_t restarts_ = 0;
+};
+
+}  // namespace plinth::firmware

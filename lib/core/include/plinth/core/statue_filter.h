@@ -1,0 +1,185 @@
+// The statue sensor's use: the members of an ensemble (ensemble.h) weighted by how well each
+// explains the statue's measured rotation, the phase taken from the measurement, and the risk
+// of the weighted members.
+//
+// The measurement is the rotation rate theta' of one axis (a gyroscope on the block, in the
+// statue frame; its offset removed by the conditioning). The filter integrates it to the tilt
+// theta (set back to 0 once the block has sat still: full contact is theta = 0), and takes the
+// phase from the two: rocking about corner 1 or 2, full contact, overturned past every member's
+// critical angle.
+//
+// Each member is judged on its equations at the *measured* state, not on its own simulated
+// trajectory (which rocking's sensitivity to impacts soon separates from the statue's, right
+// member or not): over every interval of interval_s, the member's theta'' of Eq 8 (rocking_flow;
+// at rest, the rotation Eq 16's onset would start, or none) is integrated at the measured
+// theta, theta' and ground, with the member's own base (u, u'), and the predicted change of
+// theta' is compared with the measured one. An interval with an impact (the tilt changes sign)
+// says nothing about the flow and is skipped. The innovation's variance is the gyroscope's noise
+// at both ends plus the model's tolerance, a fraction of the larger change:
+//   nu = d_meas - d_pred,  s^2 = 2 rate_noise^2 + (model_tolerance * max(|d_pred|, |d_meas|))^2
+// and each member's evidence, a log likelihood with forgetting (memory_s), is
+//   L <- L exp(-interval / memory_s) - nu^2 / (2 s^2) - ln s.
+// The weights are exp(L - max L), normalised: a bank of fixed members with forgetting rather
+// than a particle filter that resamples and jitters them (the members are the corners of the
+// declared uncertainty, so the extremes are never lost; forgetting keeps the weights from
+// collapsing onto one member for good, as resampling would).
+//
+// Informative: the effective number of members 1 / sum w^2 is at most informative_fraction of
+// the members (uniform weights give all of them: nothing has been learned while the statue and
+// every member sit still). The risk is then the highest member risk that members holding at
+// least credible_weight of the weight reach (each member's overturning_risk at the measured
+// phase and state). Before, the worst member's over the members not ruled out, of the measured
+// state and of its own simulation, the latter only while the member's own theta' agrees with
+// the measured one (within 3 standard deviations of the innovation: a member its base's stops
+// just kicked into rocking while the statue stands is contradicted at once, before its next
+// interval's evidence); the forecast's probability likewise counts the others. A member is
+// ruled out once its weight is below ruled_out_fraction of the uniform 1 / members. Besides the
+// flow's innovations, an interval through which the statue stood in full contact weighs
+// against a member whose own simulation rocks (its theta' against the measured one): the
+// evidence that the members' own trajectories give while they still follow the statue's.
+//
+// Explained: the smallest member's mean normalised innovation nu^2 / s^2 (forgetting over
+// score_memory_s, over the intervals whose measured or predicted change is beyond 4 times the
+// rate's noise; near 1 for the right member) stays below unexplained_score. Above it (an
+// anchored, cracked or toppled statue, a loose sensor) no member explains the measurement: the
+// filter says so and its risk is the worst member's, never less. Freestanding: no heap.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <type_traits>
+
+#include "plinth/core/ensemble.h"
+#include "plinth/core/error.h"
+#include "plinth/core/excitation.h"
+#include "plinth/core/forecast.h"
+#include "plinth/core/real.h"
+#include "plinth/core/risk.h"
+#include "plinth/core/state.h"
+
+#ifndef PLINTH_STATUE_SENSOR
+#define PLINTH_STATUE_SENSOR 1
+#endif
+
+namespace plinth {
+
+// A build without the statue sensor (a microcontroller's with 64 KB of flash: its filter takes
+// about 10 KB) refuses one in its settings; the monitor's code for it is left out.
+inline constexpr bool kStatueSensorBuiltIn = PLINTH_STATUE_SENSOR != 0;
+
+// A field that only a build with the statue sensor fills holds `Full` there and an empty
+// stand-in elsewhere: statue_part gives the Full object, or nullptr in a build without, so that
+// its uses compile in both and vanish from the latter.
+template <class Full, class Held>
+[[nodiscard]] constexpr auto* statue_part(Held& held) {
+  using Target = std::conditional_t<std::is_const_v<Held>, const Full, Full>;
+  if constexpr (std::is_same_v<std::remove_const_t<Held>, Full>) {
+    return static_cast<Target*>(&held);
+  } else {
+    return static_cast<Target*>(nullptr);
+  }
+}
+
+struct StatueFilterSettings {
+  Real rate_noise_rad_s = Real(0.003);  // rad/s: one measured rate's noise (gyro noise, bias left)
+  Real model_tolerance = Real(0.25);   // the members' theta'' holds to this fraction, (0, 2]
+  Real rest_rate_rad_s = Real(0.02);   // rad/s: |theta'| below this (and the tilt below
+  Real rest_tilt_rad = Real(0.002);    // rad: this) is at rest
+  double rest_time_s = 0.1;            // s: at rest this long with a small tilt sets theta to 0
+  double interval_s = 0.05;            // s: the innovations' interval, [1 sample, 1 s]
+  double memory_s = 10.0;              // s: the evidence's forgetting time constant
+  double score_memory_s = 1.0;         // s: the innovations' mean score's time constant
+  Real informative_fraction = Real(0.5);  // informative: effective members <= this * members
+  Real credible_weight = Real(0.2);       // the risk: reached by members holding this weight
+  Real unexplained_score = Real(6);       // mean nu^2 / s^2 of the best member above: unexplained
+  Real ruled_out_fraction = Real(0.1);    // weight below this x 1 / members: ruled out, (0, 1]
+};
+
+// Checks the settings; the Error names the field ("statue_filter.memory_s", ...).
+[[nodiscard]] Error validate(const StatueFilterSettings& settings);
+
+// One measured sample of an axis, in the statue frame.
+struct StatueMeasurement {
+  Real rotation_rate = 0.0;  // theta', rad/s (> 0 turns about corner 1)
+};
+
+struct StatueEstimate {
+  bool measuring = false;     // started and fed a sample since
+  Mode mode;                  // the measured phase and corner
+  Real tilt = 0.0;            // theta, rad
+  Real rotation_rate = 0.0;   // theta', rad/s
+  Real effective_members = 0.0;  // 1 / sum w^2
+  bool informative = false;
+  bool explained = true;
+  Real best_score = 0.0;      // the smallest member mean score
+  int best_member = 0;        // whose
+  int intervals = 0;          // innovations taken since the start
+  Risk risk;                  // the filter's risk (as above)
+  int risk_member = 0;        // whose risk that is
+  bool weighted = false;      // the risk is the weighted members' (informative and explained)
+  int ruled_out = 0;          // members ruled out (explained only; 0 while unexplained)
+  std::uint32_t ruled_out_members = 0;  // bit m: member m ruled out
+  // bit m: member m's own theta' disagrees with the measured one now (not weighted only): its
+  // own simulation's risk and forecast do not count.
+  std::uint32_t disagreeing_members = 0;
+  std::array<Real, kMaxEnsembleMembers> weights{};  // weights[0 .. members)
+};
+
+// The forecast's probability of a collapse with the members weighted: the weight of the members
+// that collapse within the horizon when the estimate is weighted; else, with members ruled out
+// or disagreeing, the collapsing members among the others over their number; else (or none
+// left) the forecast's own (collapsing / members).
+[[nodiscard]] double weighted_collapse_probability(const ForecastOutcome& forecast,
+                                                   const StatueEstimate& estimate);
+
+class StatueFilter {
+ public:
+  // Refuses invalid settings and an interval shorter than one sample.
+  [[nodiscard]] Error start(const StatueFilterSettings& settings, const EstimatorSettings& rate,
+                            const RiskSettings& risk, int members);
+  // Forgets everything (the ensemble restarted): uniform weights, at rest.
+  void reset();
+  // The sample the ensemble's members just took (Ensemble::push(ground)) and the statue's
+  // measured motion at the same time.
+  void on_sample(const Ensemble& members, GroundAcceleration ground,
+                 const StatueMeasurement& measured);
+
+  [[nodiscard]] const StatueEstimate& estimate() const { return estimate_; }
+  [[nodiscard]] const StatueFilterSettings& settings() const { return settings_; }
+
+ private:
+  void measure(const Ensemble& members, const StatueMeasurement& measured);
+  [[nodiscard]] Real predicted_rate_change(const Ensemble& members, int m,
+                                           GroundAcceleration ground) const;
+  void finish_interval(const Ensemble& members);
+  void weigh(const Ensemble& members);
+  [[nodiscard]] State measured_state(const PlanarEstimator& member) const;
+
+  StatueFilterSettings settings_;
+  RiskSettings risk_;
+  Real period_ = 0.0;  // s, a sample period
+  int members_ = 0;
+  int interval_samples_ = 1;
+  Real evidence_decay_ = 1.0;  // per interval
+  Real score_decay_ = 1.0;
+  int rest_samples_ = 1;
+
+  StatueEstimate estimate_;
+  Real previous_rate_ = 0.0;
+  int still_samples_ = 0;
+  // The interval in progress.
+  int interval_count_ = 0;
+  Real interval_start_rate_ = 0.0;
+  Real interval_start_tilt_ = 0.0;
+  bool interval_impact_ = false;
+  bool interval_terminal_ = false;
+  bool interval_moved_ = false;  // the measured statue left full contact in the interval
+  std::array<Real, kMaxEnsembleMembers> previous_acceleration_{};  // theta'' rad/s2
+  std::array<Real, kMaxEnsembleMembers> predicted_change_{};       // rad/s
+  std::array<Real, kMaxEnsembleMembers> evidence_{};
+  std::array<Real, kMaxEnsembleMembers> score_{};
+  std::array<Real, kMaxEnsembleMembers> score_norm_{};
+  bool have_previous_ = false;
+};
+
+}  // namespace plinth
