@@ -8,6 +8,8 @@
 #include <fstream>
 #include <string>
 
+#include <unistd.h>
+
 #include "plinth/host/eval_metrics.h"
 #include "plinth/host/input_error.h"
 
@@ -326,8 +328,12 @@ TEST(EvalMetrics, ACasesRowsMustRunUpItsGrid) {
   EXPECT_EQ(level_outcome(all_scales, monitor::AlarmLevel::kAlarm).margins.below_one.runs, 2);
 }
 
+// The process id keeps two runs of the suite at once (ctest -j, the release and sanitize builds)
+// off each other's files.
 std::string temp_path(const std::string& name) {
-  return (std::filesystem::temp_directory_path() / ("plinth_eval_" + name)).string();
+  return (std::filesystem::temp_directory_path() /
+          ("plinth_eval_" + std::to_string(getpid()) + "_" + name))
+      .string();
 }
 
 TEST(EvalMetrics, RunsFileRoundTrips) {
