@@ -189,6 +189,8 @@ void output_bindings(std::vector<Binding>& b, ModbusSettings& modbus, MqttSettin
   b.push_back({"mqtt.reconnect_min_s", number_into(mqtt.reconnect_min_s), "a number"});
   b.push_back({"mqtt.reconnect_max_s", number_into(mqtt.reconnect_max_s), "a number"});
   b.push_back({"mqtt.commands", flag_into(mqtt.commands), "true or false"});
+  b.push_back({"mqtt.regional_alerts", flag_into(mqtt.regional_alerts), "true or false"});
+  b.push_back({"mqtt.regional_topic", string_into(mqtt.regional_topic), "a string (a topic)"});
   b.push_back({"mqtt.discovery", flag_into(mqtt.discovery), "true or false"});
   b.push_back({"mqtt.discovery_prefix", string_into(mqtt.discovery_prefix),
                "a string (topic levels)"});
@@ -231,6 +233,15 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
       {"alarm_policy.latch_warning", flag_into(alarm.latch_warning), "true or false"},
       {"alarm_policy.latch_alarm", flag_into(alarm.latch_alarm), "true or false"},
       {"alarm_policy.heartbeat_period_s", number_into(alarm.heartbeat_period_s), "a number"},
+      {"regional_alert.max_origin_age_s", number_into(c.regional.max_origin_age_s), "a number"},
+      {"regional_alert.future_tolerance_s", number_into(c.regional.future_tolerance_s),
+       "a number"},
+      {"regional_alert.expiry_margin_s", number_into(c.regional.expiry_margin_s), "a number"},
+      {"regional_alert.stress_drop_bar", number_into(c.regional.stress_drop_bar), "a number"},
+      {"regional_alert.shear_wave_speed_km_s", number_into(c.regional.shear_wave_speed_km_s),
+       "a number"},
+      {"regional_alert.path_duration_s_per_km", number_into(c.regional.path_duration_s_per_km),
+       "a number"},
   };
   sensor_bindings(b, "conditioning.", c.conditioning, c.sensor_health, unit);
   relay_bindings(b, f.relays, relay_active_low);
@@ -249,7 +260,8 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
                                   {"alarm", &alarm.alarm},
                                   {"advisory_forecast", &alarm.advisory_forecast},
                                   {"warning_forecast", &alarm.warning_forecast},
-                                  {"alarm_forecast", &alarm.alarm_forecast}}) {
+                                  {"alarm_forecast", &alarm.alarm_forecast},
+                                  {"warning_regional", &alarm.warning_regional}}) {
     b.push_back({cat("alarm_policy.", name, ".on"), number_into(thresholds->on), "a number"});
     b.push_back({cat("alarm_policy.", name, ".off"), number_into(thresholds->off), "a number"});
   }

@@ -230,7 +230,53 @@ std::string status_json(const BoxStatus& s, double t_origin) {
   }
   line.raw("sensors", status_sensors(s));
   line.raw("state", per_axis(s, axis_state));
+  if (s.regional.received > 0) line.raw("regional", regional_status_json(s.regional, t_origin));
   return line.close();
+}
+
+std::string regional_status_json(const monitor::RegionalAlertStatus& r, double t_origin) {
+  JsonObject refused;
+  for (const NamedValue<monitor::RegionalRefusal>& named : monitor::kRegionalRefusalNames) {
+    if (named.value == monitor::RegionalRefusal::kNone) continue;
+    refused.count(named.name, r.refused[static_cast<std::size_t>(named.value)]);
+  }
+  JsonObject out;
+  out.count("held", static_cast<std::uint64_t>(r.held));
+  if (r.held > 0) {
+    const monitor::RegionalAlert& a = r.worst.alert;
+    out.count("event_id", a.event_id)
+        .count("version", a.version)
+        .fixed("magnitude", static_cast<double>(a.magnitude), 2)
+        .fixed("distance_km", static_cast<double>(a.distance_km), 1)
+        .fixed("pga_g", static_cast<double>(a.pga_g), 4)
+        .fixed("sigma_ln", static_cast<double>(a.sigma_ln), 2)
+        .fixed("probability", static_cast<double>(r.probability), 4)
+        .fixed("time_to_s_arrival_s", static_cast<double>(r.time_to_s_arrival_s), 3)
+        .fixed("s_arrival_t", seconds(r.worst.s_arrival_ns, t_origin), 3)
+        .fixed("expires_t", seconds(r.worst.expires_ns, t_origin), 3);
+  }
+  return out.count("received", r.received)
+      .count("accepted", r.accepted)
+      .count("replaced", r.replaced)
+      .count("cancelled", r.cancelled)
+      .count("expired", r.expired)
+      .raw("refused", refused.close())
+      .text("last_refusal", monitor::regional_refusal_name(r.last_refusal))
+      .text("last_refusal_field", r.last_refusal_field)
+      .close();
+}
+
+std::string regional_json(const monitor::RegionalOutcome& o, const BoxStatus& s) {
+  JsonObject line;
+  line.text("type", "regional").text("result", o.accepted() ? "accepted" : "refused");
+  if (!o.accepted()) {
+    line.text("reason", monitor::regional_refusal_name(o.refusal)).text("field", o.field);
+  } else {
+    line.flag("replaced", o.replaced).flag("cancelled", o.cancelled);
+  }
+  return line.count("held", static_cast<std::uint64_t>(s.regional.held))
+      .fixed("probability", static_cast<double>(s.regional.probability), 4)
+      .close();
 }
 
 std::string alarm_json(const monitor::AlarmEventRecord& e, double t_origin) {

@@ -39,7 +39,7 @@ PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", "outside_model"]
+          "collapse_forecast", "not_calibrated", "outside_model", None, None, "regional_alert"]
 SCENARIOS = ("main", "stop", "garbage", "burst")
 # Sent by canplayer in the garbage case, each one refused by the DBC (or not for the monitor).
 GARBAGE = (

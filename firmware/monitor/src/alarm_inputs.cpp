@@ -9,6 +9,7 @@ monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& co
   input.time_ns = status.time_ns;
   input.risk = static_cast<Real>(status.risk);
   input.probability = static_cast<Real>(status.probability);
+  input.regional_probability = status.regional.probability;
   for (int i = 0; i < status.axis_count; ++i) {
     const AxisStatus& axis = status.axes[static_cast<std::size_t>(i)];
     const Mode& mode = axis.mode;

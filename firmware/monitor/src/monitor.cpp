@@ -37,6 +37,7 @@ Error Monitor::start(const MonitorConfig& config,
   status_.axis_count = config.axis_count;
   PLINTH_TRY(sensors_.start(config_, status_));
   PLINTH_TRY(monitor::AlarmPolicy::create(config_.alarm, alarm_));
+  PLINTH_TRY(monitor::RegionalAlertState::create(config_.regional, regional_));
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
@@ -185,6 +186,8 @@ void Monitor::update_axes_status() {
 void Monitor::evaluate(MonitorUpdate& update) {
   sensors_.update_status();
   update_axes_status();
+  regional_.tick(status_.time_ns);
+  status_.regional = regional_.status();
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
@@ -264,6 +267,29 @@ MonitorUpdate Monitor::acknowledge(const monitor::Acknowledgement& acknowledgeme
   MonitorUpdate update = new_update();
   pending_ack_ = true;
   ack_ = acknowledgement;
+  evaluate(update);
+  return update;
+}
+
+MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert,
+                                         std::int64_t receive_time_ns) {
+  status_.time_ns = monitor_time(receive_time_ns);
+  return on_regional_alert(alert);
+}
+
+MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert) {
+  MonitorUpdate update = new_update();
+  update.regional_received = true;
+  update.regional = regional_.receive(alert, status_.time_ns);
+  evaluate(update);
+  return update;
+}
+
+MonitorUpdate Monitor::regional_alert_malformed(const char* field) {
+  MonitorUpdate update = new_update();
+  regional_.refuse_malformed(field);
+  update.regional_received = true;
+  update.regional = {monitor::RegionalRefusal::kMalformed, field};
   evaluate(update);
   return update;
 }

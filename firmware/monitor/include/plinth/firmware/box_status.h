@@ -13,6 +13,7 @@
 #include "plinth/core/state.h"
 #include "plinth/firmware/config.h"
 #include "plinth/monitor/alarm_level.h"
+#include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
@@ -86,6 +87,9 @@ struct BoxStatus : SensorSetStatus {
   std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
   std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
   std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
+  // Regional alerts: the worst held, its probability of collapse and time to the S arrival,
+  // the counters (times in monitor time).
+  monitor::RegionalAlertStatus regional;
 };
 
 }  // namespace plinth::firmware

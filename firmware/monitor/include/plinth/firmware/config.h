@@ -14,6 +14,7 @@
 #include "plinth/core/risk.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/conditioning.h"
+#include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
@@ -102,6 +103,9 @@ struct MonitorConfig {
   std::array<SensorConfig, kMaxSensors> sensors{};
   RedundancySettings redundancy;
   PlateCheckSettings plate;
+  // Regional early-warning alerts (regional_alert.h): their checks and expiry, and the statue's
+  // fragility (plinth-monitor takes it from the scene file's [fragility]).
+  monitor::RegionalAlertSettings regional;
 };
 
 // Checks every part; the Error names the field ("monitor.axis_count", "estimator....", ...).

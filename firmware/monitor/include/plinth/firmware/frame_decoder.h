@@ -1,6 +1,7 @@
 // The bus's frames (hal/can_codec) as the monitor's inputs: a configured sensor's
-// SensorAcceleration is its sample, an Acknowledge an operator's acknowledgement; every other
-// frame, and every frame the codec refuses, is counted and is no input. Freestanding.
+// SensorAcceleration is its sample, an Acknowledge an operator's acknowledgement, a
+// RegionalAlert after its RegionalAlertOrigin a regional alert; every other frame, and every
+// frame the codec refuses, is counted and is no input. Freestanding.
 #pragma once
 
 #include <array>
@@ -23,6 +24,10 @@ struct FrameCounters {
   std::uint64_t heartbeats = 0;           // SensorHeartbeat of any node
   std::uint64_t acknowledgements = 0;     // Acknowledge frames, decoded
   std::uint64_t monitor_frames = 0;  // MonitorStatus / AlarmEvent / CollapseForecast (any box's)
+  std::uint64_t regional_alerts = 0;  // RegionalAlert frames taken with their origin frame
+  // RegionalAlert frames without their RegionalAlertOrigin (same event and version, within
+  // kRegionalPairWindowNs before), or refused by the codec: malformed alerts
+  std::uint64_t regional_malformed = 0;
   std::uint64_t rejected = 0;             // failed to decode (length, range, reserved bits)
   std::uint64_t unknown_identifiers = 0;  // not a plinth identifier
   hal::can::CodecError last_error = hal::can::CodecError::kOk;  // of the latest rejected frame
@@ -35,12 +40,20 @@ struct FrameInput {
     kNone,             // no input (another message, another node, refused)
     kSensorSample,     // `sample` of sensor `sensor` (Monitor::on_sensor_sample)
     kAcknowledgement,  // `acknowledgement` (Monitor::acknowledge)
+    kRegionalAlert,    // `regional` (Monitor::on_regional_alert at the frame's time)
+    kRegionalMalformed,  // a regional alert that cannot be read (`malformed_field` says why)
   };
   Kind kind = Kind::kNone;
   int sensor = -1;  // its index in the configured order
   monitor::SensorSample sample;
   monitor::Acknowledgement acknowledgement;
+  monitor::RegionalAlert regional;
+  const char* malformed_field = "";
 };
+
+// The longest time from a RegionalAlertOrigin to its RegionalAlert frame (the bridge sends them
+// back to back).
+inline constexpr std::int64_t kRegionalPairWindowNs = 100'000'000;
 
 class FrameDecoder {
  public:
@@ -56,9 +69,15 @@ class FrameDecoder {
   [[nodiscard]] bool decoded(const hal::can::CanFrame& frame, Message& message);
   [[nodiscard]] int sensor_of_node(std::uint8_t node) const;  // -1: not configured
 
+  // A regional alert's two frames into one input.
+  void decode_regional(const hal::TimedFrame& timed, FrameInput& input);
+
   std::array<std::uint8_t, kMaxSensors> nodes_{};
   int count_ = 0;
   FrameCounters counters_;
+  bool have_origin_ = false;  // origin_ is the latest RegionalAlertOrigin, not yet used
+  hal::can::RegionalAlertOrigin origin_;
+  std::int64_t origin_time_ns_ = 0;
 };
 
 // One frame from the bus (or a candump log) into `monitor`: its input, or, for a frame that

@@ -23,6 +23,7 @@
 #include "plinth/hal/can_codec.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/conditioning.h"
+#include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
@@ -45,6 +46,10 @@ struct MonitorUpdate {
   bool status_due = false;
   // What came of an acknowledgement (Monitor::acknowledge); kNone for other inputs.
   monitor::AckOutcome acknowledgement = monitor::AckOutcome::kNone;
+  // What came of a regional alert (Monitor::on_regional_alert, regional_alert_malformed), when
+  // the input was one (regional_received).
+  bool regional_received = false;
+  monitor::RegionalOutcome regional;
   std::array<hal::can::CanFrame, kMaxFramesPerUpdate> frames{};  // frames[0 .. frame_count)
   std::size_t frame_count = 0;
 };
@@ -91,6 +96,14 @@ class Monitor {
   // Modbus or MQTT): evaluated at once, at the current monitor time; the update says what came
   // of it (MonitorUpdate::acknowledgement).
   [[nodiscard]] MonitorUpdate acknowledge(const monitor::Acknowledgement& acknowledgement);
+  // A regional alert (docs/regional.md), its times relative to its receipt at
+  // `receive_time_ns` (the bus's frames) or, without one, now (the newest input's time: an alert
+  // from MQTT); the update says what came of it (MonitorUpdate::regional).
+  [[nodiscard]] MonitorUpdate on_regional_alert(const monitor::RegionalAlert& alert,
+                                                std::int64_t receive_time_ns);
+  [[nodiscard]] MonitorUpdate on_regional_alert(const monitor::RegionalAlert& alert);
+  // A regional alert the host could not read (counted as malformed; `field` names what).
+  [[nodiscard]] MonitorUpdate regional_alert_malformed(const char* field);
   // No input (a frame that is none of the monitor's): the status, if one is due; the alarm
   // policy's first evaluation if none happened since start() (so that no status says the
   // policy's initial `normal`).
@@ -140,6 +153,7 @@ class Monitor {
   Vector3r last_ground_ = Vector3r::Zero();  // the estimators' newest input, m/s2
   std::array<Ensemble, kMaxAxes> ensembles_{};
   monitor::AlarmPolicy alarm_;
+  monitor::RegionalAlertState regional_;
   BoxStatus status_;
   std::uint64_t frames_not_encoded_ = 0;
   bool have_epoch_ = false;

@@ -34,6 +34,8 @@ enum class AlarmCause : std::uint8_t {
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet: nothing to vouch for
   kOutsideModel = 12,       // the estimate left the model (the block lifted off): nothing to vouch for
+  // 13-14: other branches' causes (p_wave, the statue's sensor).
+  kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
 };
 
 // The names in status and alarm lines (also the DBC's VAL_ names).
@@ -45,7 +47,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 13> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 14> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -59,6 +61,7 @@ inline constexpr NameTable<AlarmCause, 13> kAlarmCauseNames{{{
     {AlarmCause::kCollapseForecast, "collapse_forecast"},
     {AlarmCause::kNotCalibrated, "not_calibrated"},
     {AlarmCause::kOutsideModel, "outside_model"},
+    {AlarmCause::kRegionalAlert, "regional_alert"},
 }}};
 
 // The levels the risk raises, lowest first (neither normal nor fault): the ones plinth-eval
