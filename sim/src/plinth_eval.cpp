@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "eval_case.h"
+#include "eval_pwave.h"
 #include "eval_report.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/eval_metrics.h"
@@ -300,12 +301,14 @@ int main(int argc, char** argv) {
   CLI::App* merge_command = app.add_subcommand("merge", "join the runs CSVs of shards");
   merge_command->add_option("--out", merge.out_path, "merged CSV")->required();
   merge_command->add_option("inputs", merge.inputs, "the shards' CSV files")->required();
+  const plinth::eval::Subcommand pwave_fit = plinth::eval::add_pwave_fit(app);
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
     return *exit_code;
   }
   return plinth::host::run_tool("plinth-eval", [&] {
     if (report_command->parsed()) return run_report(report);
     if (merge_command->parsed()) return run_merge(merge);
+    if (pwave_fit.command->parsed()) return pwave_fit.run();
     return run_eval(opt);
   });
 }

@@ -86,19 +86,40 @@ struct PWavePredictorPoint {
 
 inline constexpr std::size_t kMaxPWavePredictorPoints = 8;
 
-// The table fitted by plinth-eval pwave-fit on the bundled calibration records
-// (sim/data/records/pwave/, docs/pwave.md), vertical channel.
+// The tables fitted by plinth-eval pwave-fit on the bundled calibration records
+// (sim/data/records/pwave/, each station's two horizontals with its vertical, scaled to 0.3,
+// 0.6 and 1.2 g, at 200 Hz; docs/pwave.md), c1 = 0 (tau_c's exponent, fitted, changed sign
+// from window to window: not resolved by five earthquakes):
+//   plinth-eval pwave-fit $(tools/pwave-records.sh sim/data/records/pwave) [--channel horizontal]
 inline constexpr std::array<PWavePredictorPoint, kMaxPWavePredictorPoints>
     kDefaultVerticalPredictor{{
-        {0.5, 3.70, 0.0, 0.70},
-        {1.0, 3.70, 0.0, 0.75},
-        {1.5, 3.70, 0.0, 0.80},
-        {2.0, 3.70, 0.0, 0.85},
-        {2.5, 3.70, 0.0, 0.85},
-        {3.0, 3.70, 0.0, 0.90},
-        {3.5, 3.70, 0.0, 0.90},
-        {4.0, 3.70, 0.0, 0.95},
+        {0.5, 3.059, 0.0, 0.650},
+        {1.0, 2.701, 0.0, 0.786},
+        {1.5, 2.529, 0.0, 0.735},
+        {2.0, 2.435, 0.0, 0.723},
+        {2.5, 2.231, 0.0, 0.938},
+        {3.0, 2.030, 0.0, 0.937},
+        {3.5, 1.877, 0.0, 1.003},
+        {4.0, 1.758, 0.0, 1.023},
     }};
+inline constexpr std::array<PWavePredictorPoint, kMaxPWavePredictorPoints>
+    kDefaultHorizontalPredictor{{
+        {0.5, 3.344, 0.0, 0.829},
+        {1.0, 3.066, 0.0, 0.855},
+        {1.5, 2.749, 0.0, 0.944},
+        {2.0, 2.376, 0.0, 1.090},
+        {2.5, 1.985, 0.0, 1.050},
+        {3.0, 1.550, 0.0, 0.977},
+        {3.5, 1.190, 0.0, 0.815},
+        {4.0, 1.029, 0.0, 0.754},
+    }};
+
+// The table fitted for a channel.
+[[nodiscard]] constexpr const std::array<PWavePredictorPoint, kMaxPWavePredictorPoints>&
+default_predictor(PWaveChannel channel) {
+  return channel == PWaveChannel::kHorizontal ? kDefaultHorizontalPredictor
+                                              : kDefaultVerticalPredictor;
+}
 
 struct PWaveSettings {
   bool enabled = true;
@@ -120,6 +141,8 @@ struct PWaveSettings {
   Real s_wave_ratio = Real(1.5);        // vertical channel: peak |a_h| / peak |a_z| closing it
   Time max_window_s = 4.0;      // s: the longest window
   Time hold_s = 30.0;           // s: the probability is held this long after the window
+  // The channel's own table (default_predictor(channel)): a horizontal channel's Pa is not a
+  // vertical one's.
   std::array<PWavePredictorPoint, kMaxPWavePredictorPoints> predictor = kDefaultVerticalPredictor;
   std::size_t predictor_points = kDefaultVerticalPredictor.size();  // 1..kMaxPWavePredictorPoints
   bool fragility_known = false;  // the scene file's [fragility] was given
