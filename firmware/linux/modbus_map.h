@@ -50,7 +50,7 @@ inline constexpr CodeTable<monitor::AlarmLevel, 5> kAlarmLevelCodes{{{
     {monitor::AlarmLevel::kAlarm, 3},
     {monitor::AlarmLevel::kFault, 4},
 }}};
-inline constexpr CodeTable<monitor::AlarmCause, 12> kAlarmCauseCodes{{{
+inline constexpr CodeTable<monitor::AlarmCause, 13> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kNone, 0},
     {monitor::AlarmCause::kRiskThreshold, 1},
     {monitor::AlarmCause::kPhaseChange, 2},
@@ -63,6 +63,7 @@ inline constexpr CodeTable<monitor::AlarmCause, 12> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kInternalFault, 9},
     {monitor::AlarmCause::kCollapseForecast, 10},
     {monitor::AlarmCause::kNotCalibrated, 11},
+    {monitor::AlarmCause::kPWave, 12},
 }}};
 inline constexpr CodeTable<Phase, 6> kPhaseCodes{{{
     {Phase::kFullContact, 0},

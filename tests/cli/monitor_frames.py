@@ -22,7 +22,7 @@ CORNERS = ["none", "left", "right"]
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated"]
+          "collapse_forecast", "not_calibrated", "p_wave"]
 STATUS_ID, ALARM_ID = 0x320, 0x330
 
 

@@ -41,7 +41,8 @@ static_assert(same_number(AlarmCause::kBusError, can::AlarmCause::kBusError));
 static_assert(same_number(AlarmCause::kInternalFault, can::AlarmCause::kInternalFault));
 static_assert(same_number(AlarmCause::kCollapseForecast, can::AlarmCause::kCollapseForecast));
 static_assert(same_number(AlarmCause::kNotCalibrated, can::AlarmCause::kNotCalibrated));
-static_assert(monitor::kAlarmCauseNames.size() == 12);
+static_assert(same_number(AlarmCause::kPWave, can::AlarmCause::kPWave));
+static_assert(monitor::kAlarmCauseNames.size() == 13);
 
 // The sensors' status bits (SensorAcceleration.Status): passed through as they are.
 static_assert(monitor::sensor_flags::kSaturated == can::sensor_status::kSaturated);

@@ -83,6 +83,8 @@ Error validate(const AlarmPolicySettings& s) {
                   "alarm_policy.warning_forecast.off"),
       check_order(s.warning_forecast, s.alarm_forecast, "alarm_policy.alarm_forecast.on",
                   "alarm_policy.alarm_forecast.off"),
+      check_thresholds(s.warning_pwave, "alarm_policy.warning_pwave.on",
+                       "alarm_policy.warning_pwave.off"),
       detail::check_duration(s.raise_hold_s, "alarm_policy.raise_hold_s", true),
       detail::check_duration(s.lower_hold_s, "alarm_policy.lower_hold_s", true),
       detail::check_duration(s.heartbeat_period_s, "alarm_policy.heartbeat_period_s", false),
@@ -124,9 +126,11 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
     const bool warning_forecast = above(warning_, settings_.warning_forecast, in.probability);
     const bool alarm_risk = above(alarm_, settings_.alarm, in.risk);
     const bool alarm_forecast = above(alarm_, settings_.alarm_forecast, in.probability);
-    const bool warning = warning_risk || warning_forecast;
+    const bool warning_pwave = above(warning_, settings_.warning_pwave, in.pwave_probability);
+    const bool warning = warning_risk || warning_forecast || warning_pwave;
     const bool alarm = alarm_risk || alarm_forecast;
     warning_by_forecast_ = warning_forecast && !warning_risk;
+    warning_by_pwave_ = warning_pwave && !warning_risk && !warning_forecast;
     alarm_by_forecast_ = alarm_forecast && !alarm_risk;
     advisory_.update(advisory, in.time_ns, raise_hold_ns_, lower_hold_ns_);
     warning_.update(warning, in.time_ns, raise_hold_ns_, lower_hold_ns_);
@@ -164,10 +168,7 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   }
   if (latch != AlarmLevel::kNormal && rank(latch) >= rank(latched_level_)) {
     latched_level_ = latch;
-    const bool by_forecast = latch == AlarmLevel::kAlarm ? alarm_by_forecast_ : warning_by_forecast_;
-    latched_cause_ = collapse_began ? AlarmCause::kOverturnDetected
-                     : by_forecast  ? AlarmCause::kCollapseForecast
-                                    : AlarmCause::kRiskThreshold;
+    latched_cause_ = collapse_began ? AlarmCause::kOverturnDetected : condition_cause(latch);
   }
 }
 
@@ -192,11 +193,19 @@ AlarmCause AlarmPolicy::cause_of(AlarmLevel level) const {
       if (collapse_) return AlarmCause::kOverturnDetected;
       // Held by its latch alone: the cause it latched with.
       if (rank(condition_level_) < rank(level) && latched_level_ == level) return latched_cause_;
-      return (level == AlarmLevel::kAlarm ? alarm_by_forecast_ : warning_by_forecast_)
-                 ? AlarmCause::kCollapseForecast
-                 : AlarmCause::kRiskThreshold;
+      return condition_cause(level);
   }
   return AlarmCause::kNone;
+}
+
+// Which signal holds the warning or alarm condition: the risk, else the forecast, else (warning
+// only) the P wave.
+AlarmCause AlarmPolicy::condition_cause(AlarmLevel level) const {
+  if (level == AlarmLevel::kAlarm) {
+    return alarm_by_forecast_ ? AlarmCause::kCollapseForecast : AlarmCause::kRiskThreshold;
+  }
+  if (warning_by_forecast_) return AlarmCause::kCollapseForecast;
+  return warning_by_pwave_ ? AlarmCause::kPWave : AlarmCause::kRiskThreshold;
 }
 
 void AlarmPolicy::emit_if_changed(AlarmOutput& out, std::int64_t time_ns,
@@ -238,7 +247,8 @@ AlarmOutput AlarmPolicy::update(const AlarmInput& in) {
       out.acknowledgement = acknowledge(in.acknowledgement);
       emit_if_changed(out, in.time_ns, true);
     }
-    const bool risk_valid = valid_fraction(in.risk) && valid_fraction(in.probability);
+    const bool risk_valid = valid_fraction(in.risk) && valid_fraction(in.probability) &&
+                            valid_fraction(in.pwave_probability);
     if (!risk_valid) out.input_problem = InputProblem::kRiskInvalid;
     evaluate_conditions(in, risk_valid);
     emit_if_changed(out, in.time_ns, false);

@@ -731,7 +731,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
     EXPECT_STREQ(rk.signal, "Level");
   }
-  for (unsigned v = 12; v <= 255; ++v) {
+  for (unsigned v = 13; v <= 255; ++v) {
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -749,7 +749,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  e.cause = static_cast<AlarmCause>(12);
+  e.cause = static_cast<AlarmCause>(13);
   EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
   e = AlarmEvent{};
   e.previous_level = static_cast<AlarmLevel>(255);

@@ -25,6 +25,7 @@ AlarmPolicySettings immediate() {
   s.advisory_forecast = {0.2, 0.1};
   s.warning_forecast = {0.5, 0.4};
   s.alarm_forecast = {0.9, 0.8};
+  s.warning_pwave = {0.6, 0.3};
   s.raise_hold_s = 0.0;
   s.lower_hold_s = 0.0;
   s.latch_warning = false;
@@ -120,6 +121,13 @@ TEST(AlarmPolicySettings, DefaultsAreValidAndThresholdsAreChecked) {
   s = {};
   s.advisory_forecast.off = 0.2;  // equal to its on
   expect_refused(s, "alarm_policy.advisory_forecast.off", ErrorCode::kInconsistent);
+  s = {};
+  s.warning_pwave = {0.3, 0.3};
+  expect_refused(s, "alarm_policy.warning_pwave.off", ErrorCode::kInconsistent);
+  s.warning_pwave = {1.2, 0.3};
+  expect_refused(s, "alarm_policy.warning_pwave.on", ErrorCode::kOutOfRange);
+  s.warning_pwave = {0.05, 0.01};  // below the other warnings: a level of its own, not ordered
+  EXPECT_TRUE(validate(s).ok());
   s = {};
   s.alarm.on = 1.0;  // the edges of [0, 1] are allowed
   s.advisory.off = 0.0;
@@ -426,6 +434,45 @@ TEST(AlarmPolicy, ALevelLatchedByTheForecastKeepsItsCause) {
   const AlarmOutput held = p.at(10, 0.0);
   EXPECT_EQ(held.level, AlarmLevel::kAlarm);
   EXPECT_EQ(held.latched_level, AlarmLevel::kAlarm);
+}
+
+// The P-wave stage's probability raises `warning`, never `alarm`, with its own cause; the risk
+// and the forecast name the cause when they hold the level too.
+TEST(AlarmPolicy, ThePWaveRaisesTheWarningAloneWithItsOwnCause) {
+  Policy p(immediate());
+  const auto at = [&p](std::int64_t ms, double risk, double pwave) {
+    p.base.pwave_probability = pwave;
+    return p.at(ms, risk);
+  };
+  EXPECT_EQ(at(0, 0.0, 0.5999).level, AlarmLevel::kNormal);
+  expect_change(at(1, 0.0, 0.6), AlarmLevel::kWarning, AlarmLevel::kNormal, AlarmCause::kPWave,
+                false);
+  EXPECT_EQ(at(2, 0.0, 1.0).level, AlarmLevel::kWarning);  // never alarm
+  EXPECT_EQ(at(3, 0.0, 0.3).level, AlarmLevel::kWarning);  // at off: still on
+  EXPECT_EQ(at(4, 0.0, 0.2999).level, AlarmLevel::kNormal);
+  // With the risk at warning too, the risk is the cause; the P wave holds it once the risk falls.
+  expect_change(at(5, 0.55, 0.9), AlarmLevel::kWarning, AlarmLevel::kNormal,
+                AlarmCause::kRiskThreshold, false);
+  expect_change(at(6, 0.85, 0.9), AlarmLevel::kAlarm, AlarmLevel::kWarning,
+                AlarmCause::kRiskThreshold, false);
+  expect_change(at(7, 0.0, 0.9), AlarmLevel::kWarning, AlarmLevel::kAlarm, AlarmCause::kPWave,
+                false);
+  // An invalid P-wave probability is an internal fault, as an invalid risk is.
+  EXPECT_EQ(at(8, 0.0, std::numeric_limits<double>::quiet_NaN()).input_problem,
+            InputProblem::kRiskInvalid);
+  EXPECT_EQ(at(9, 0.0, -0.1).input_problem, InputProblem::kRiskInvalid);
+}
+
+TEST(AlarmPolicy, AWarningLatchedByThePWaveKeepsItsCause) {
+  Policy p(latching(true, true));
+  p.base.pwave_probability = 0.7;
+  expect_change(p.at(0, 0.0), AlarmLevel::kWarning, AlarmLevel::kNormal, AlarmCause::kPWave,
+                true);
+  p.base.pwave_probability = 0.0;
+  const AlarmOutput held = p.at(10, 0.0);
+  EXPECT_EQ(held.level, AlarmLevel::kWarning);
+  EXPECT_EQ(held.latched_level, AlarmLevel::kWarning);
+  EXPECT_EQ(held.event_count, 0U);
 }
 
 TEST(AlarmPolicy, AnUpdateFromThePastIsRefused) {

@@ -31,6 +31,7 @@ enum class AlarmCause : std::uint8_t {
   kInternalFault = 9,       // the monitor's own self-check failed
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet: nothing to vouch for
+  kPWave = 12,              // the P-wave stage's probability of collapse crossed its threshold
 };
 
 // The names in status and alarm lines (also the DBC's VAL_ names).
@@ -42,7 +43,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 12> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 13> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -55,6 +56,7 @@ inline constexpr NameTable<AlarmCause, 12> kAlarmCauseNames{{{
     {AlarmCause::kInternalFault, "internal_fault"},
     {AlarmCause::kCollapseForecast, "collapse_forecast"},
     {AlarmCause::kNotCalibrated, "not_calibrated"},
+    {AlarmCause::kPWave, "p_wave"},
 }}};
 
 [[nodiscard]] constexpr const char* alarm_level_name(AlarmLevel level) {

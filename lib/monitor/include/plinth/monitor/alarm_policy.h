@@ -8,11 +8,14 @@
 // raise_hold_s before its level is raised, and be absent for lower_hold_s before it is lowered):
 //   advisory  risk >= advisory.on, probability >= advisory_forecast.on, or the block is out of
 //             full contact (motion started)
-//   warning   risk >= warning.on, or probability >= warning_forecast.on
+//   warning   risk >= warning.on, or probability >= warning_forecast.on, or the P-wave
+//             stage's probability of collapse >= warning_pwave.on
 //   alarm     risk >= alarm.on, or probability >= alarm_forecast.on; or a collapse (overturned,
 //             fell): alarm at once, no hold, latched
 // The risk is the margin used up now (risk.h), the probability what the forecast says of the
 // next seconds (forecast.h); today's margins running out raise the level whatever the forecast.
+// The P-wave stage (p_wave.h) forecasts the shaking still to come from its first seconds: a
+// guess about the ground, not the statue's physics, so it raises `warning` and never `alarm`.
 // The condition level is the highest level whose condition is active.
 //
 // Latching: when the condition level rises to warning (latch_warning) or alarm (latch_alarm,
@@ -42,7 +45,8 @@
 // Sequence numbers start at 0 and increment by one per event, wrapping 255 -> 0. Cause: why the
 // new level holds (kRiskThreshold; kCollapseForecast when the forecast alone holds it;
 // kPhaseChange, kOverturnDetected, the fault's cause), kNone
-// back to normal, kAcknowledged for a change an acknowledgement made.
+// back to normal, kAcknowledged for a change an acknowledgement made. kPWave when the P-wave
+// stage alone holds the warning.
 //
 // Heartbeat: a status is due every heartbeat_period_s, and at once after an event;
 // next_heartbeat_ns() says when, heartbeat_sent() records that one went out.
@@ -81,6 +85,8 @@ struct AlarmPolicySettings {
   RiskThresholds advisory_forecast{Real(0.125), Real(0.0625)};
   RiskThresholds warning_forecast{Real(0.25), Real(0.1875)};
   RiskThresholds alarm_forecast{Real(0.375), Real(0.3125)};
+  // On the P-wave stage's probability of collapse (warning only; docs/pwave.md calibrated it).
+  RiskThresholds warning_pwave{Real(0.5), Real(0.4)};
   // s, >= 0: a condition holds this long before its level rises. 0: the sample it starts (a
   // margin run out is news at once), so plinth-eval's rules are exactly what the box applies;
   // 0.1 s missed a collapse they caught and cost 0.1-0.2 s of lead (docs/forecast.md).
@@ -92,8 +98,9 @@ struct AlarmPolicySettings {
 };
 
 // Checks the settings; the Error names the field at fault ("alarm_policy.warning.off", ...).
-// Thresholds (risk and forecast alike): finite, in [0, 1], off < on per level, and ordered across
-// levels (advisory <= warning <= alarm, for on and for off).
+// Thresholds (risk, forecast and P wave alike): finite, in [0, 1], off < on per level, and ordered
+// across levels (advisory <= warning <= alarm, for on and for off; warning_pwave has no other
+// level to be ordered with).
 [[nodiscard]] Error validate(const AlarmPolicySettings& settings);
 
 // An operator's acknowledgement (on the bus: the Acknowledge frame, without its source id).
@@ -106,6 +113,7 @@ struct AlarmInput {
   std::int64_t time_ns = 0;          // monitor time since start, ns
   Real risk = 0.0;                   // overturning risk, dimensionless, [0, 1]
   Real probability = 0.0;            // forecast probability of a collapse, [0, 1]
+  Real pwave_probability = 0.0;      // the P-wave stage's probability of collapse, [0, 1]
   bool out_of_full_contact = false;  // the block slides or rocks (motion started)
   bool collapse_detected = false;    // the block overturned or fell
   bool fault_active = false;         // sensor or bus trouble
@@ -126,7 +134,7 @@ enum class AckOutcome : std::uint8_t {
 
 enum class InputProblem : std::uint8_t {
   kNone = 0,
-  kRiskInvalid,   // risk or probability not finite or outside [0, 1]: an internal fault
+  kRiskInvalid,   // risk or a probability not finite or outside [0, 1]: an internal fault
   kTimeWentBack,  // time earlier than the last update's: the update was refused
 };
 
@@ -208,6 +216,7 @@ class AlarmPolicy {
   void evaluate_conditions(const AlarmInput& input, bool risk_valid);
   [[nodiscard]] AlarmLevel shown_level() const;
   [[nodiscard]] AlarmCause cause_of(AlarmLevel level) const;
+  [[nodiscard]] AlarmCause condition_cause(AlarmLevel level) const;
   void emit_if_changed(AlarmOutput& out, std::int64_t time_ns, bool by_acknowledgement);
 
   AlarmPolicySettings settings_;
@@ -220,8 +229,10 @@ class AlarmPolicy {
   detail::HeldCondition alarm_;
   detail::HeldCondition fault_;
   bool collapse_ = false;      // the latest input's collapse_detected
-  // The forecast alone holds the warning / alarm condition (for the cause).
+  // The forecast alone holds the warning / alarm condition, the P wave alone the warning (for
+  // the cause).
   bool warning_by_forecast_ = false;
+  bool warning_by_pwave_ = false;
   bool alarm_by_forecast_ = false;
   bool out_of_contact_ = false;  // the latest input's out_of_full_contact
   bool not_calibrated_ = false;  // the latest input's not_calibrated
