@@ -191,6 +191,8 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.record = c.record_name;
   run.scene = c.scene_name;
   run.statue = c.statue;
+  run.seed = c.seed;
+  run.grid = c.grid;
   run.scale_g = c.scale_g;
   const Truth truth = simulate_truth(c, gamma, truth_settings);
   run.collapsed = truth.collapsed;

@@ -5,6 +5,7 @@
 // feeds it.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,8 @@ struct EvalCase {
   const host::UncertainScene* scene = nullptr;
   std::string scene_name;
   int statue = 0;
+  std::uint32_t seed = 0;  // the statues' draw (plinth-eval run --seed): with the above, the case
+  host::PgaGrid grid;      // the grid the case runs up
   const Scene* true_statue = nullptr;
   double scale_g = 0.0;  // the record's PGA in this run, g
   host::RecordPhases phases;  // the record's (the same at every scale)

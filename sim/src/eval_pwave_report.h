@@ -5,6 +5,7 @@
 // so every threshold of the grid is scored from the same runs.
 #pragma once
 
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,22 +19,12 @@ namespace plinth::eval {
 enum class PWaveClass { kLeadAtLeast3s = 0, kLeadBelow3s, kNoPWave };
 inline constexpr std::size_t kPWaveClasses = 3;
 
-struct PWaveOutcome {
-  int collapses = 0;
-  int missed = 0;               // no warning before the collapse
-  double median_lead_s = 0.0;   // over the collapses, a miss counting 0
-  double p10_lead_s = 0.0;
-  int unneeded_runs = 0;        // runs that stood with a collapse margin >= 2
-  int unneeded_warnings = 0;    // ... with a warning
-  [[nodiscard]] double unneeded_rate() const {
-    return unneeded_runs > 0 ? static_cast<double>(unneeded_warnings) / unneeded_runs : 0.0;
-  }
-};
-
+// The warning's outcome (host::outcome_of: leads with misses as 0, unneeded warnings at a
+// collapse margin >= 2) over every run and per class.
 struct PWaveThresholdRow {
   double threshold = 0.0;  // -1: without the stage
-  PWaveOutcome all;
-  std::array<PWaveOutcome, kPWaveClasses> by_class;
+  host::WarningOutcome all;
+  std::array<host::WarningOutcome, kPWaveClasses> by_class;
 };
 
 struct PWaveReport {

@@ -1,6 +1,7 @@
 #include "gnuplot.h"
 
 #include <fcntl.h>
+#include <stdlib.h>  // mkdtemp
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -69,6 +70,37 @@ void run_gnuplot(const std::string& script_path, const std::vector<std::string>&
   std::filesystem::remove(error_path);
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     throw InputError("gnuplot failed on " + script_path + ":\n" + errors);
+  }
+}
+
+PlotFolder::PlotFolder() {
+  // Not TMPDIR: the folder's name goes into the script as text, so it is only letters we chose.
+  std::string name = "/tmp/plinth-plot-XXXXXX";
+  if (::mkdtemp(name.data()) == nullptr) throw InputError("--plot: cannot make a temporary folder");
+  folder_ = name;
+}
+
+PlotFolder::~PlotFolder() {
+  std::error_code ec;
+  std::filesystem::remove_all(folder_, ec);
+}
+
+std::string PlotFolder::path(const std::string& name) const {
+  return (std::filesystem::path(folder_) / name).string();
+}
+
+void PlotFolder::draw(const std::string& script, const std::string& image,
+                      const std::string& to) const {
+  run_gnuplot(path(script), {});
+  const std::string temporary = to + ".tmp";
+  std::error_code ec;
+  std::filesystem::copy_file(path(image), temporary,
+                             std::filesystem::copy_options::overwrite_existing, ec);
+  if (!ec) std::filesystem::rename(temporary, to, ec);
+  if (ec) {
+    std::error_code ignored;
+    std::filesystem::remove(temporary, ignored);
+    throw InputError(to + ": cannot write the plot: " + ec.message());
   }
 }
 

@@ -19,4 +19,23 @@ void run_gnuplot(const std::string& script_path, const std::vector<std::string>&
 // comment) become '?'.
 [[nodiscard]] std::string comment_text(std::string text);
 
+// A private temporary folder (mkdtemp) for one plot: its data, its script and its image under
+// fixed names, so that gnuplot reads and writes no name of the user's; the image is then copied
+// to the user's path. Removed with everything in it when destroyed. Throws InputError when it
+// cannot be made.
+class PlotFolder {
+ public:
+  PlotFolder();
+  ~PlotFolder();
+  PlotFolder(const PlotFolder&) = delete;
+  PlotFolder& operator=(const PlotFolder&) = delete;
+
+  [[nodiscard]] std::string path(const std::string& name) const;  // folder/name
+  // Runs gnuplot on the folder's `script`, then copies its `image` to `to` (through to.tmp).
+  void draw(const std::string& script, const std::string& image, const std::string& to) const;
+
+ private:
+  std::string folder_;
+};
+
 }  // namespace plinth::cli

@@ -2,18 +2,21 @@
 // scenes x true statues drawn inside each scene's declared [uncertainty], the truth from the
 // solver on the true statue against the box's timeline (the scene file's ensemble, nominal
 // first) on the same motion; per alarm level hits, misses, false alarms, near misses, the lead
-// and the ROC; thresholds calibrated on half of the records and reported on the other half.
+// and the ROC; thresholds calibrated on half of the records and reported on the other half; the
+// alarms by collapse margin, and the statues' fragility curves.
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <random>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
 
 #include "eval_case.h"
+#include "eval_fragility.h"
 #include "eval_pwave.h"
 #include "eval_pwave_report.h"
 #include "eval_report.h"
@@ -67,6 +70,16 @@ struct ReportOptions {
   std::string plot_path;
   bool frontier = false;  // also the frontier of the rules (make_report)
   std::string pwave_calibrate_on;  // choose the P-wave threshold on this runs file
+  std::string calibration_path;  // choose the rules on this other runs file
+  std::string false_alarm =
+      plinth::host::false_alarm_name(plinth::eval::CalibrationTargets{}.false_alarm);
+};
+
+struct FragilityOptions {
+  std::string runs_path;
+  std::string json_path;
+  std::string plot_path;
+  std::string collapse_intensity = "interval";
 };
 
 struct MergeOptions {
@@ -78,7 +91,7 @@ std::string file_name(const std::string& path) {
   return std::filesystem::path(path).filename().string();
 }
 
-std::vector<double> pga_grid(const RunOptions& opt) {
+plinth::host::PgaGrid pga_grid(const RunOptions& opt) {
   const double g = plinth::kStandardGravity;
   const double from = plinth::host::parse_acceleration(opt.pga_from, g, "--pga-from") / g;
   const double to = plinth::host::parse_acceleration(opt.pga_to, g, "--pga-to") / g;
@@ -89,11 +102,22 @@ std::vector<double> pga_grid(const RunOptions& opt) {
     throw InputError("--pga-steps: expected 1 to " + std::to_string(kMaxPgaSteps) + ", got " +
                      std::to_string(opt.pga_steps));
   }
-  std::vector<double> grid;
-  for (int i = 0; i < opt.pga_steps; ++i) {
-    grid.push_back(opt.pga_steps == 1 ? from : from + (to - from) * i / (opt.pga_steps - 1));
+  if (to == from && opt.pga_steps > 1) {
+    throw InputError("--pga-steps: a grid from " + opt.pga_from + " to " + opt.pga_to +
+                     " has one point, got " + std::to_string(opt.pga_steps));
   }
-  return grid;
+  return {from, to, opt.pga_steps};
+}
+
+// The runs file names a case by its files' names: two paths of one name would be one case.
+void refuse_repeated_names(const std::vector<std::string>& paths, const char* option) {
+  std::set<std::string> names;
+  for (const std::string& path : paths) {
+    if (!names.insert(file_name(path)).second) {
+      throw InputError(std::string(option) + ": two files named " + file_name(path) +
+                       " (the runs file names them by file name; rename one)");
+    }
+  }
 }
 
 plinth::eval::BoxSettings box_settings(const RunOptions& opt) {
@@ -133,11 +157,11 @@ std::vector<plinth::Scene> draw_statues(const plinth::host::UncertainScene& scen
 }
 
 void write_runs(const std::string& path, const plinth::host::CrossingGrids& grids,
-                const std::vector<std::vector<EvalRun>>& results) {
+                const std::vector<std::vector<EvalRun>>& results, bool with_grid = true) {
   const std::string temporary = path + ".tmp";
   std::FILE* out = std::fopen(temporary.c_str(), "w");
   if (out == nullptr) throw InputError(path + ": cannot write (does its folder exist?)");
-  plinth::host::write_eval_csv_header(out, grids);
+  plinth::host::write_eval_csv_header(out, grids, with_grid);
   for (const std::vector<EvalRun>& job : results) {
     for (const EvalRun& run : job) plinth::host::write_eval_csv_row(out, run);
   }
@@ -152,7 +176,9 @@ void write_runs(const std::string& path, const plinth::host::CrossingGrids& grid
 }
 
 int run_eval(const RunOptions& opt) {
-  const std::vector<double> pgas = pga_grid(opt);
+  const plinth::host::PgaGrid grid = pga_grid(opt);
+  refuse_repeated_names(opt.scene_paths, "--scene");
+  refuse_repeated_names(opt.record_paths, "--record");
   if (opt.statues < 1 || opt.statues > kMaxStatues) {
     throw InputError("--statues: expected 1 to " + std::to_string(kMaxStatues) + ", got " +
                      std::to_string(opt.statues));
@@ -185,14 +211,11 @@ int run_eval(const RunOptions& opt) {
     const std::size_t r = index / per_record;
     const std::size_t s = index % per_record / static_cast<std::size_t>(opt.statues);
     const auto j = static_cast<int>(index % static_cast<std::size_t>(opt.statues));
-    return plinth::eval::EvalCase{&records[r],
-                                  file_name(opt.record_paths[r]),
-                                  &scenes[s],
-                                  file_name(opt.scene_paths[s]),
-                                  j,
-                                  &statues[s][static_cast<std::size_t>(j)],
-                                  pga,
-                                  phases[r]};
+    return plinth::eval::EvalCase{&records[r],   file_name(opt.record_paths[r]),
+                                  &scenes[s],    file_name(opt.scene_paths[s]),
+                                  j,             opt.seed,
+                                  grid,          &statues[s][static_cast<std::size_t>(j)],
+                                  pga,           phases[r]};
   };
   run.stop = plinth::host::install_stop_handlers("plinth-eval");
   plinth::host::ProgressBar progress(indices.size(), 0, "cases");
@@ -203,9 +226,9 @@ int run_eval(const RunOptions& opt) {
       indices, run,
       [&](std::size_t index) {
         std::vector<EvalRun> job;
-        for (const double pga : pgas) {
+        for (int i = 0; i < grid.steps; ++i) {
           if (run.stop->load()) throw plinth::host::JobCancelled();
-          job.push_back(plinth::eval::run_case(case_of(index, pga), box, truth, grids));
+          job.push_back(plinth::eval::run_case(case_of(index, grid.at(i)), box, truth, grids));
           if (job.back().collapsed && !opt.all_scales) break;
         }
         results[index] = std::move(job);
@@ -229,10 +252,34 @@ int run_eval(const RunOptions& opt) {
   return 0;
 }
 
+// `text` into `path` through path.tmp.
+void write_text(const std::string& path, const std::string& text) {
+  const std::string temporary = path + ".tmp";
+  std::FILE* out = std::fopen(temporary.c_str(), "w");
+  if (out == nullptr) throw InputError(path + ": cannot write (does its folder exist?)");
+  std::fputs(text.c_str(), out);
+  const bool ok = std::fclose(out) == 0;
+  std::error_code ec;
+  if (ok) std::filesystem::rename(temporary, path, ec);
+  if (!ok || ec) throw InputError(path + ": cannot write");
+}
+
 int run_report(const ReportOptions& opt) {
+  plinth::eval::CalibrationTargets targets;
+  if (!plinth::host::parse_false_alarm(opt.false_alarm, targets.false_alarm)) {
+    throw InputError("--false-alarm: expected margin or peak, got '" + opt.false_alarm + "'");
+  }
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
-  const plinth::eval::Report report = plinth::eval::make_report(table, {}, opt.frontier);
+  plinth::eval::require_margins(table, targets, opt.runs_path);
+  EvalTable calibration;
+  if (!opt.calibration_path.empty()) {
+    calibration = plinth::host::read_eval_csv(opt.calibration_path);
+    if (calibration.runs.empty()) throw InputError(opt.calibration_path + ": no runs");
+    plinth::eval::require_margins(calibration, targets, opt.calibration_path + " (--calibrate-on)");
+  }
+  const plinth::eval::Report report = plinth::eval::make_report(
+      table, targets, opt.frontier, opt.calibration_path.empty() ? nullptr : &calibration);
   std::fputs(plinth::eval::report_text(report, table.grids).c_str(), stdout);
   if (!table.grids.pwave.empty()) {
     std::optional<EvalTable> other;
@@ -243,16 +290,25 @@ int run_report(const ReportOptions& opt) {
                stdout);
   }
   if (!opt.json_path.empty()) {
-    const std::string temporary = opt.json_path + ".tmp";
-    std::FILE* out = std::fopen(temporary.c_str(), "w");
-    if (out == nullptr) throw InputError(opt.json_path + ": cannot write (does its folder exist?)");
-    std::fputs(plinth::eval::report_json(report, table.grids).c_str(), out);
-    const bool ok = std::fclose(out) == 0;
-    std::error_code ec;
-    if (ok) std::filesystem::rename(temporary, opt.json_path, ec);
-    if (!ok || ec) throw InputError(opt.json_path + ": cannot write");
+    write_text(opt.json_path, plinth::eval::report_json(report, table.grids));
   }
   if (!opt.plot_path.empty()) plinth::eval::plot_roc(table, opt.plot_path);
+  return 0;
+}
+
+int run_fragility(const FragilityOptions& opt) {
+  plinth::eval::CollapseIntensityRule rule{};
+  if (!plinth::eval::parse_collapse_intensity(opt.collapse_intensity, rule)) {
+    throw InputError("--collapse-intensity: expected interval or grid, got '" +
+                     opt.collapse_intensity + "'");
+  }
+  const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
+  if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
+  const std::vector<plinth::eval::SceneFragility> scenes =
+      plinth::eval::scene_fragilities(table, opt.runs_path, rule);
+  std::fputs(plinth::eval::fragility_text(scenes, rule).c_str(), stdout);
+  if (!opt.json_path.empty()) write_text(opt.json_path, plinth::eval::fragility_json(scenes, rule));
+  if (!opt.plot_path.empty()) plinth::eval::plot_fragility(scenes, opt.plot_path);
   return 0;
 }
 
@@ -262,14 +318,24 @@ int run_merge(const MergeOptions& opt) {
     EvalTable part = plinth::host::read_eval_csv(opt.inputs[i]);
     if (i == 0) {
       merged.grids = part.grids;
+      merged.has_grid = part.has_grid;
     } else if (part.grids.risk != merged.grids.risk ||
                part.grids.probability != merged.grids.probability) {
       throw InputError(opt.inputs[i] + ": its threshold columns differ from " + opt.inputs[0] +
                        "'s (another plinth-eval version)");
+    } else if (part.has_grid != merged.has_grid) {
+      throw InputError(opt.inputs[i] + ": " + (part.has_grid ? "has" : "has no") +
+                       " seed and pga grid columns, " + opt.inputs[0] + " " +
+                       (part.has_grid ? "has none" : "has them") +
+                       " (a plinth-eval before the collapse margin wrote one of them)");
     }
     for (EvalRun& r : part.runs) merged.runs.push_back(std::move(r));
   }
-  write_runs(opt.out_path, merged.grids, {merged.runs});
+  // A case in two inputs (shards of one run never share one) would not be one case.
+  if (merged.has_grid) {
+    (void)plinth::host::eval_cases(merged.runs, "merge (a case in two inputs?)");
+  }
+  write_runs(opt.out_path, merged.grids, {merged.runs}, merged.has_grid);
   std::printf("plinth-eval merge: %zu runs from %zu files -> %s\n", merged.runs.size(),
               opt.inputs.size(), opt.out_path.c_str());
   return 0;
@@ -327,6 +393,23 @@ int main(int argc, char** argv) {
   report_command->add_flag("--frontier", report.frontier,
                            "also the rule with the fewest false alarms under each of the alarm's "
                            "targets, on the worst member's and on the nominal statue's risk");
+  report_command->add_option("--calibrate-on", report.calibration_path,
+                             "also choose each level's rule on this other runs CSV and report it "
+                             "on these runs");
+  report_command->add_option("--false-alarm", report.false_alarm,
+                             "what calibration and frontier count as false: margin (alarms in runs "
+                             "whose collapse margin is >= 2) or peak (in runs below half the "
+                             "overturning angle); default margin");
+  FragilityOptions fragility;
+  CLI::App* fragility_command = app.add_subcommand(
+      "fragility", "per scene, the lognormal fragility P(collapse | PGA) of a runs CSV's statues");
+  fragility_command->add_option("runs", fragility.runs_path, "a plinth-eval runs CSV")->required();
+  fragility_command->add_option("--json", fragility.json_path, "also write the fits as JSON");
+  fragility_command->add_option("--plot", fragility.plot_path,
+                                "also draw the curves and the empirical points as a PNG");
+  fragility_command->add_option("--collapse-intensity", fragility.collapse_intensity,
+                                "interval (between the grid point below the lowest collapsing PGA "
+                                "and it; default) or grid (the lowest collapsing PGA itself)");
   MergeOptions merge;
   CLI::App* merge_command = app.add_subcommand("merge", "join the runs CSVs of shards");
   merge_command->add_option("--out", merge.out_path, "merged CSV")->required();
@@ -337,6 +420,7 @@ int main(int argc, char** argv) {
   }
   return plinth::host::run_tool("plinth-eval", [&] {
     if (report_command->parsed()) return run_report(report);
+    if (fragility_command->parsed()) return run_fragility(fragility);
     if (merge_command->parsed()) return run_merge(merge);
     if (pwave_fit.command->parsed()) return pwave_fit.run();
     return run_eval(opt);

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # plinth-eval run as a user would (docs/forecast.md), kept short: a small run writes one row
 # per case and scale up to each case's first collapse, shards merged hold the same rows, the
-# report counts what the rows say (recounted here from the CSV), its JSON parses, the ROC is
-# drawn (or a missing gnuplot is named), and bad inputs end with exit code 1 or 2 and a
+# report counts what the rows say (recounted here from the CSV, collapse margins too), the
+# fragility's fits are maxima of the likelihood (recomputed here), files of an earlier
+# plinth-eval are read or refused with what to do, the ROC and the fragility are drawn (or a
+# missing gnuplot is named), and bad inputs end with exit code 1 or 2 and a
 # message naming the problem. Prints "ok - <name>" or "not ok - <name>: <why>" per check, then
 # "N passed, M failed".
 #
@@ -144,6 +146,174 @@ if not alarm["meets_target"]:
 PY
 ok_if "the report names the two folds" grep -q "fold 2: chosen" report.txt
 
+# The collapse margin (docs/forecast.md): each row names its case's seed and grid, and the report's
+# unneeded alarms and margin bands are recounted here from the rows: a case's lowest collapsing
+# PGA over the run's PGA, or the grid's top over it (a bound from below) when the case stood.
+ok_if "each row names its case's seed and grid" python3 - all.csv <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+columns = ("seed", "pga_from_g", "pga_to_g", "pga_steps")
+assert all(tuple(r[c] for c in columns) == ("2026", "0.3", "1.5", "4") for r in rows), rows[0]
+PY
+ok_if "the report's margins are the rows'" python3 - all.csv report.json <<'PY'
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+report = json.load(open(sys.argv[2]))
+assert report["false_alarm"] == "margin" and report["margins_known"]
+collapse = {}
+for r in rows:
+    key = (r["record"], r["scene"], r["statue"], r["seed"])
+    if r["collapsed"] == "1":
+        collapse[key] = min(collapse.get(key, 9.0), float(r["scale_g"]))
+floors = [1.0, 1.25, 1.5, 2.0, 3.0]
+known = [[0, 0, 0] for _ in floors]
+lower = [[0, 0, 0] for _ in floors[:-1]]
+for r in rows:
+    if r["collapsed"] == "1":
+        continue
+    key = (r["record"], r["scene"], r["statue"], r["seed"])
+    bounded = key not in collapse
+    margin = (float(r["pga_to_g"]) if bounded else collapse[key]) / float(r["scale_g"])
+    band = max(i for i, f in enumerate(floors) if margin >= f * (1 - 1e-9))
+    count = lower[band] if bounded and band < 4 else known[band]
+    count[0] += 1
+    count[1] += float(r["first_alarm_s"]) >= 0
+    count[2] += float(r["peak_ratio"]) < 0.5
+alarm = [l for l in report["levels"] if l["level"] == "alarm"][0]
+bands = alarm["shown_by_margin"]
+assert [[b["runs"], b["alarms"], b["quiet"]] for b in bands["bands"]] == known, (bands, known)
+assert [[b["runs"], b["alarms"], b["quiet"]] for b in bands["lower_bound_only"]] == lower, lower
+unneeded = [known[3][i] + known[4][i] + lower[3][i] for i in (0, 1)]
+shown = alarm["shown"]
+assert [shown["unneeded_runs"], shown["unneeded_alarms"]] == unneeded, (shown, unneeded)
+assert shown["margin_unknown_runs"] == sum(c[0] for c in lower[:3])
+assert sum(c[0] for c in known) + sum(c[0] for c in lower) == \
+    sum(1 for r in rows if r["collapsed"] == "0")  # every run that stood, counted once
+PY
+ok_if "the text names the bands" grep -q "by collapse margin (runs that stood): 1-1.25: " report.txt
+expect_success "report counting alarms in quiet runs" report all.csv --false-alarm peak \
+  --json peak.json
+ok_if "the peak report says so" python3 -c '
+import json, sys
+r = json.load(open("peak.json"))
+assert r["false_alarm"] == "peak" and r["margins_known"], r["false_alarm"]'
+expect_failure "an unknown false alarm" "--false-alarm: expected margin or peak" -- report \
+  all.csv --false-alarm loud
+
+# report --calibrate-on: each level's rule chosen on another file (here shard 1, as its own report
+# chooses it on all its records), and that rule on this file's rows (shard 2, recounted here).
+expect_success "report on shard 1" report s1.csv --json s1.json
+expect_success "report on shard 2 calibrated on shard 1" report s2.csv --calibrate-on s1.csv \
+  --json s2-cal.json
+ok_if "the rule chosen on one file is scored on the other" \
+  python3 - s1.json s2-cal.json s2.csv <<'PY'
+import csv, json, sys
+own = json.load(open(sys.argv[1]))
+report = json.load(open(sys.argv[2]))
+rows = list(csv.DictReader(open(sys.argv[3])))
+for mine, theirs in zip(own["levels"], report["levels"]):
+    elsewhere = theirs["calibrated_elsewhere"]
+    assert elsewhere["rule"] == mine["all_records"]["rule"], (elsewhere, mine["all_records"])
+    assert elsewhere["calibration"] == mine["all_records"]["outcome"]
+columns = []
+for part in report["levels"][2]["calibrated_elsewhere"]["rule"].split(" or "):
+    signal, value = part.split(" >= ")
+    columns += [c for c in rows[0] if c.startswith(signal + "_ge_")
+                and abs(float(c.split("_ge_")[1]) - float(value)) < 1e-3]
+def first(r):
+    ts = [float(r[c]) for c in columns if float(r[c]) >= 0]
+    return min(ts) if ts else -1.0
+held_out = report["levels"][2]["calibrated_elsewhere"]["held_out"]
+collapses = [r for r in rows if r["collapsed"] == "1"]
+assert held_out["misses"] == sum(1 for r in collapses
+                                 if not 0 <= first(r) < float(r["collapse_time_s"]))
+quiet = [r for r in rows if r["collapsed"] == "0" and float(r["peak_ratio"]) < 0.5]
+assert held_out["false_alarms"] == sum(1 for r in quiet if first(r) >= 0)
+PY
+
+# A runs file of a plinth-eval before the margin (no seed and grid columns): reported with the
+# peak alone, refused for the margin and the fragility with what to do.
+python3 - all.csv old.csv <<'PY'
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+with open(sys.argv[2], "w", newline="") as out:
+    csv.writer(out, lineterminator="\n").writerows([r[:10] + r[14:] for r in rows])
+PY
+expect_failure "an earlier file is refused for the margin" "old.csv" "no seed and pga grid" \
+  "--false-alarm peak" -- report old.csv
+expect_success "an earlier file reported with the peak" report old.csv --false-alarm peak
+ok_if "without margins, says so" grep -q "collapse margins: not in this file" "$TMP/stdout"
+expect_failure "an earlier file has no fragility" "old.csv" "no seed and pga grid" -- \
+  fragility old.csv
+expect_failure "merging an earlier file with a new one" "pga grid columns" -- merge --out m.csv \
+  all.csv old.csv
+expect_failure "calibrating on an earlier file" \
+  "old.csv \\(--calibrate-on\\): no seed and pga grid" -- \
+  report all.csv --calibrate-on old.csv
+# A case with a row missing: its rows must run up the grid from its first point.
+python3 - all.csv short.csv <<'PY'
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+standing = [i for i, r in enumerate(rows[1:], 1) if r[4] == "0" and r[3] == "0.3"]
+del rows[standing[0]]
+with open(sys.argv[2], "w", newline="") as out:
+    csv.writer(out, lineterminator="\n").writerows(rows)
+PY
+expect_failure "a case with a row missing" \
+  "short.csv: case .*no row at 0.3 g, below its rows at higher PGA" -- report short.csv
+mkdir -p a b
+cp "$AT2" a/r.AT2
+cp "$SRC/sim/data/records/eval/RSN1605_DUZCE_DZC270.AT2" b/r.AT2
+expect_failure "two records of one name" "--record: two files named r.AT2" -- run \
+  --scene "$EVAL_SCENES/isolated.toml" --record a/r.AT2 --record b/r.AT2 --out x.csv
+
+# plinth-eval fragility: per scene its cases and collapses, as the rows count them, and each
+# fitted curve a maximum of the likelihood (recomputed here, interval-censored on the grid).
+expect_success "fragility" fragility all.csv --json fragility.json
+ok_if "the fragility's counts are the rows', its fits maxima" \
+  python3 - all.csv fragility.json <<'PY'
+import csv, json, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+fits = json.load(open(sys.argv[2]))
+cases = {}
+for r in rows:
+    key = (r["record"], r["scene"], r["statue"], r["seed"])
+    c = cases.setdefault(key, [r["scene"], None, float(r["pga_from_g"]), float(r["pga_to_g"]),
+                               int(r["pga_steps"])])
+    if r["collapsed"] == "1" and (c[1] is None or float(r["scale_g"]) < c[1]):
+        c[1] = float(r["scale_g"])
+assert sorted(f["scene"] for f in fits) == sorted({c[0] for c in cases.values()})
+assert any(f["median_g"] is not None for f in fits)  # these runs allow a fit (else no check)
+def cdf(z): return 0.5 * math.erfc(-z / math.sqrt(2))
+for f in fits:
+    mine = [c for c in cases.values() if c[0] == f["scene"]]
+    assert f["cases"] == len(mine) and f["collapsed"] == sum(c[1] is not None for c in mine), f
+    assert f["censored_at_g"] == 1.5
+    if f["median_g"] is None:
+        assert f["no_fit"], f
+        continue
+    def ll(median, beta):
+        total = 0.0
+        for _, at, lo, top, steps in mine:
+            step = (top - lo) / (steps - 1)
+            if at is None:
+                total += math.log(1 - cdf(math.log(top / median) / beta))
+            else:
+                below = at - step
+                p = cdf(math.log(at / median) / beta) - (
+                    cdf(math.log(below / median) / beta) if below > 1e-9 else 0.0)
+                total += math.log(p)
+        return total
+    best = ll(f["median_g"], f["beta"])
+    assert abs(best - f["log_likelihood"]) < 1e-3, (best, f)
+    for dm, db in ((1.02, 1), (0.98, 1), (1, 1.02), (1, 0.98)):
+        assert ll(f["median_g"] * dm, f["beta"] * db) < best, (f, dm, db)
+PY
+ok_if "the fragility text names every scene" bash -c \
+  'grep -q "^isolated.toml: " "$0" && grep -q "^ground-slender.toml: " "$0"' "$TMP/stdout"
+expect_failure "an unknown collapse intensity" "--collapse-intensity: expected interval or grid" \
+  -- fragility all.csv --collapse-intensity midpoint
+
 if command -v gnuplot >/dev/null 2>&1; then
   expect_success "the ROC as a PNG" report all.csv --plot roc.png
   ok_if "the PNG is a PNG" bash -c '[[ "$(head -c 4 roc.png | tail -c 3)" == PNG ]]'
@@ -152,6 +322,20 @@ if command -v gnuplot >/dev/null 2>&1; then
   expect_success "a hostile plot name is only a name" report all.csv --plot "$hostile"
   ok_if "no command ran" test ! -e pwned
   ok_if "the hostile name holds the PNG" test -s "$hostile"
+  expect_success "the fragility as a PNG" fragility all.csv --plot fragility.png
+  ok_if "the fragility PNG is a PNG" bash -c '[[ "$(head -c 4 fragility.png | tail -c 3)" == PNG ]]'
+  # A scene whose file name would be gnuplot code reaches the legend as plain characters.
+  python3 - all.csv hostile.csv <<'PY'
+import csv, sys
+rows = list(csv.reader(open(sys.argv[1])))
+for r in rows[1:]:
+    r[1] = r[1].replace("isolated.toml", "x'; system \"touch pwned2\"; print '.toml")
+with open(sys.argv[2], "w", newline="") as out:
+    csv.writer(out, lineterminator="\n").writerows(rows)
+PY
+  expect_success "a hostile scene name in the fragility plot" fragility hostile.csv \
+    --plot hostile.png
+  ok_if "no command ran from the scene name" test ! -e pwned2
 else
   expect_failure "a missing gnuplot is named" "gnuplot" -- report all.csv --plot roc.png
 fi
@@ -163,6 +347,10 @@ expect_failure "a PGA grid upside down" "--pga-to.*below --pga-from" -- run "${C
   --statues 2 --pga-from 1g --pga-to 0.5g --out x.csv
 expect_failure "a PGA of zero" "--pga-from: must be above 0" -- run "${CASES[@]}" \
   --statues 2 --pga-from 0g --out x.csv
+expect_failure "a grid of one point in steps" "--pga-steps: a grid from 1g to 1g has one point" \
+  -- run "${CASES[@]}" --statues 2 --pga-from 1g --pga-to 1g --out x.csv
+expect_failure "merging a file with itself" "merge \\(a case in two inputs\\?\\): case .*two rows" \
+  -- merge --out m.csv all.csv all.csv
 expect_failure "a PGA without a unit" "--pga-from" -- run "${CASES[@]}" --statues 2 \
   --pga-from 0.3 --out x.csv
 expect_failure "too many statues" "--statues: expected 1 to 1000" -- run "${CASES[@]}" \

@@ -4,8 +4,11 @@
 #include <charconv>
 #include <cmath>
 #include <fstream>
+#include <span>
+#include <map>
 #include <string_view>
 #include <system_error>
+#include <tuple>
 
 #include "plinth/host/input_error.h"
 
@@ -19,6 +22,14 @@ constexpr std::array<const char*, kEvalLevels> kLevelNames{"advisory", "warning"
 constexpr std::array<std::string_view, 10> kFixedColumns{
     "record",          "scene",      "statue",           "scale_g",         "collapsed",
     "collapse_time_s", "peak_ratio", "first_advisory_s", "first_warning_s", "first_alarm_s"};
+// Then the case's draw and grid (since the collapse margin; absent from earlier files).
+constexpr std::array<std::string_view, 4> kGridColumns{"seed", "pga_from_g", "pga_to_g",
+                                                       "pga_steps"};
+constexpr int kMaxGridSteps = 1000;
+// A margin within this fraction below a band's floor is on the floor (the grid's divisions).
+constexpr double kMarginRounding = 1e-9;
+// Grid points and scale_g agree within the runs file's 6 significant digits.
+constexpr double kGridMatch = 1e-5;
 
 std::string format(double v) {
   char buffer[48];
@@ -64,6 +75,12 @@ bool split_csv(const std::string& line, std::vector<std::string>& fields) {
   }
   fields.push_back(field);
   return !quoted;
+}
+
+std::string grid_text(double v) {
+  char buffer[48];
+  std::snprintf(buffer, sizeof buffer, "%.10g", v);
+  return buffer;
 }
 
 double parse_number(const std::string& text, const std::string& where, std::string_view column) {
@@ -115,8 +132,91 @@ std::vector<double> default_pwave_grid() {
           0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95, 0.99};
 }
 
+const char* false_alarm_name(FalseAlarm definition) {
+  return definition == FalseAlarm::kPeak ? "peak" : "margin";
+}
+
+bool parse_false_alarm(const std::string& text, FalseAlarm& definition) {
+  if (text == "margin" || text == "peak") {
+    definition = text == "peak" ? FalseAlarm::kPeak : FalseAlarm::kMargin;
+    return true;
+  }
+  return false;
+}
+
+double PgaGrid::at(int i) const {
+  return steps == 1 ? from_g : from_g + (to_g - from_g) * i / (steps - 1);
+}
+
+int PgaGrid::index_of(double pga_g) const {
+  if (!known()) return -1;
+  const double span = to_g - from_g;
+  const long i =
+      steps == 1 || !(span > 0.0) ? 0 : std::lround((pga_g - from_g) / span * (steps - 1));
+  if (i < 0 || i >= steps) return -1;
+  const double point = at(static_cast<int>(i));
+  return std::abs(point - pga_g) <= kGridMatch * std::max(std::abs(point), std::abs(pga_g))
+             ? static_cast<int>(i)
+             : -1;
+}
+
+double EvalRun::collapse_margin() const {
+  if (!grid.known() || !(scale_g > 0.0)) return 0.0;
+  return (margin_is_lower_bound() ? grid.top_g() : case_collapse_g) / scale_g;
+}
+
+double BandCount::rate() const { return runs > 0 ? static_cast<double>(alarms) / runs : 0.0; }
+
+void count_margin(const EvalRun& run, bool raised, MarginBands& bands) {
+  if (!run.grid.known() || run.collapsed) return;
+  const double margin = run.collapse_margin();
+  std::size_t band = kMarginBands;  // none: below 1
+  for (std::size_t i = kMarginBands; i-- > 0 && band == kMarginBands;) {
+    if (margin >= kMarginBandFloors[i] * (1.0 - kMarginRounding)) band = i;
+  }
+  const bool top = band == kMarginBands - 1;
+  BandCount& count = band == kMarginBands                  ? bands.below_one
+                     : run.margin_is_lower_bound() && !top ? bands.lower_bound[band]
+                                                           : bands.known[band];
+  ++count.runs;
+  count.alarms += raised ? 1 : 0;
+  count.quiet += run.quiet() ? 1 : 0;
+}
+
+BandCount WarningOutcome::unneeded() const {
+  BandCount c;
+  const auto add = [&c](const BandCount& b) {
+    c.runs += b.runs;
+    c.alarms += b.alarms;
+    c.quiet += b.quiet;
+  };
+  for (std::size_t i = 0; i < kMarginBands; ++i) {
+    if (kMarginBandFloors[i] >= kUnneededMargin) add(margins.known[i]);
+    if (i < margins.lower_bound.size() && kMarginBandFloors[i] >= kUnneededMargin) {
+      add(margins.lower_bound[i]);
+    }
+  }
+  return c;
+}
+
+BandCount WarningOutcome::margin_unknown() const {
+  BandCount c;
+  for (std::size_t i = 0; i < margins.lower_bound.size(); ++i) {
+    if (kMarginBandFloors[i] < kUnneededMargin) {
+      c.runs += margins.lower_bound[i].runs;
+      c.alarms += margins.lower_bound[i].alarms;
+      c.quiet += margins.lower_bound[i].quiet;
+    }
+  }
+  return c;
+}
+
 double WarningOutcome::false_alarm_rate() const {
   return quiet_runs > 0 ? static_cast<double>(false_alarms) / quiet_runs : 0.0;
+}
+
+double WarningOutcome::false_alarm_rate(FalseAlarm definition) const {
+  return definition == FalseAlarm::kPeak ? false_alarm_rate() : unneeded_rate();
 }
 
 double WarningOutcome::lead_quantile(double q) const {
@@ -175,9 +275,12 @@ std::vector<RocPoint> roc(const std::vector<EvalRun>& runs, const CrossingGrids&
 Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& target) {
   // Safety first: 0 meets both; 1 misses no more than allowed, too many false alarms; 2 within
   // the rate, more misses; 3 neither.
+  const auto rate = [&target](const WarningOutcome& o) {
+    return o.false_alarm_rate(target.false_alarm);
+  };
   const auto rank = [&](const WarningOutcome& o) {
     const bool misses_ok = o.misses <= target.max_misses;
-    const bool rate_ok = o.false_alarm_rate() <= target.max_false_alarm_rate;
+    const bool rate_ok = rate(o) <= target.max_false_alarm_rate;
     return misses_ok ? (rate_ok ? 0 : 1) : (rate_ok ? 2 : 3);
   };
   const auto lead = [](const WarningOutcome& o) { return o.lead_quantile(0.5); };
@@ -195,48 +298,52 @@ Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& targe
     if (ra != rb) {
       better = ra < rb;
     } else if (ra == 0) {
-      better = lead(a) > lead(b) ||
-               (lead(a) == lead(b) && a.false_alarm_rate() < b.false_alarm_rate());
+      better = lead(a) > lead(b) || (lead(a) == lead(b) && rate(a) < rate(b));
     } else if (ra == 1) {
-      better = a.false_alarm_rate() < b.false_alarm_rate() ||
-               (a.false_alarm_rate() == b.false_alarm_rate() && lead(a) > lead(b));
+      better = rate(a) < rate(b) || (rate(a) == rate(b) && lead(a) > lead(b));
     } else if (ra == 2) {
       better = a.misses < b.misses || (a.misses == b.misses && lead(a) > lead(b));
     } else {
-      better = a.misses < b.misses ||
-               (a.misses == b.misses && a.false_alarm_rate() < b.false_alarm_rate());
+      better = a.misses < b.misses || (a.misses == b.misses && rate(a) < rate(b));
     }
     if (better) best = {true, ra == 0, p};
   }
   return best;
 }
 
-std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points) {
-  using Allowed = bool (*)(const WarningOutcome&);
+std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points, FalseAlarm false_alarm) {
+  using Allowed = bool (*)(const WarningOutcome&, FalseAlarm);
   struct Constraint {
     const char* name;
     Allowed allowed;
     bool fewest_misses_first;
   };
   static constexpr Constraint kConstraints[] = {
-      {"no miss", [](const WarningOutcome& o) { return o.misses == 0; }, false},
+      {"no miss", [](const WarningOutcome& o, FalseAlarm) { return o.misses == 0; }, false},
       {"no miss, median lead >= 1.5 s",
-       [](const WarningOutcome& o) { return o.misses == 0 && o.lead_quantile(0.5) >= 1.5; },
+       [](const WarningOutcome& o, FalseAlarm) {
+         return o.misses == 0 && o.lead_quantile(0.5) >= 1.5;
+       },
        false},
       {"no miss, 10th pct lead >= 0.5 s",
-       [](const WarningOutcome& o) { return o.misses == 0 && o.lead_quantile(0.1) >= 0.5; },
+       [](const WarningOutcome& o, FalseAlarm) {
+         return o.misses == 0 && o.lead_quantile(0.1) >= 0.5;
+       },
        false},
       {"no miss, median lead >= 3 s",
-       [](const WarningOutcome& o) { return o.misses == 0 && o.lead_quantile(0.5) >= 3.0; },
+       [](const WarningOutcome& o, FalseAlarm) {
+         return o.misses == 0 && o.lead_quantile(0.5) >= 3.0;
+       },
        false},
-      {"false alarms <= 5 %", [](const WarningOutcome& o) { return o.false_alarm_rate() <= 0.05; },
-       true},
-      {"fewest false alarms", [](const WarningOutcome&) { return true; }, false},
+      {"false alarms <= 5 %",
+       [](const WarningOutcome& o, FalseAlarm f) { return o.false_alarm_rate(f) <= 0.05; }, true},
+      {"fewest false alarms", [](const WarningOutcome&, FalseAlarm) { return true; }, false},
   };
   // Lexicographic: (false alarms, misses, -median lead), or (misses, false alarms, -median).
-  const auto better = [](const WarningOutcome& a, const WarningOutcome& b, bool misses_first) {
-    const double fa = a.false_alarm_rate();
-    const double fb = b.false_alarm_rate();
+  const auto better = [false_alarm](const WarningOutcome& a, const WarningOutcome& b,
+                                    bool misses_first) {
+    const double fa = a.false_alarm_rate(false_alarm);
+    const double fb = b.false_alarm_rate(false_alarm);
     if (misses_first && a.misses != b.misses) return a.misses < b.misses;
     if (fa != fb) return fa < fb;
     if (a.misses != b.misses) return a.misses < b.misses;
@@ -247,7 +354,7 @@ std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points) {
     FrontierRow row;
     row.constraint = c.name;
     for (const RocPoint& p : points) {
-      if (!c.allowed(p.outcome)) continue;
+      if (!c.allowed(p.outcome, false_alarm)) continue;
       if (!row.found || better(p.outcome, row.point.outcome, c.fewest_misses_first)) {
         row.found = true;
         row.point = p;
@@ -258,10 +365,95 @@ std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points) {
   return rows;
 }
 
-void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids) {
+namespace {
+
+std::string case_name(const EvalRun& r) {
+  return r.record + ", " + r.scene + ", statue " + std::to_string(r.statue) + ", seed " +
+         std::to_string(r.seed);
+}
+
+std::string grid_name(const PgaGrid& g) {
+  return grid_text(g.from_g) + " to " + grid_text(g.to_g) + " g in " + std::to_string(g.steps) +
+         " steps";
+}
+
+}  // namespace
+
+std::vector<EvalCaseRows> eval_cases(const std::vector<EvalRun>& runs, const std::string& where) {
+  using Key = std::tuple<std::string, std::string, int, std::uint32_t>;
+  std::map<Key, std::size_t> index;
+  std::vector<EvalCaseRows> cases;
+  std::vector<std::vector<int>> points;  // each case's grid indices, as its rows come
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const EvalRun& r = runs[i];
+    if (!r.grid.known()) continue;
+    const Key key{r.record, r.scene, r.statue, r.seed};
+    auto [it, added] = index.emplace(key, cases.size());
+    if (added) {
+      cases.push_back({r.record, r.scene, r.statue, r.seed, r.grid, -1, {}});
+      points.emplace_back();
+    }
+    EvalCaseRows& c = cases[it->second];
+    if (!(r.grid == c.grid)) {
+      throw InputError(where + ": case " + case_name(r) + ": rows of two grids (" +
+                       grid_name(c.grid) + ", " + grid_name(r.grid) + ")");
+    }
+    const int point = c.grid.index_of(r.scale_g);
+    if (point < 0) {
+      throw InputError(where + ": case " + case_name(r) + ": scale_g " + grid_text(r.scale_g) +
+                       " g is not a point of its grid (" + grid_name(c.grid) + ")");
+    }
+    c.runs.push_back(i);
+    points[it->second].push_back(point);
+  }
+  for (std::size_t k = 0; k < cases.size(); ++k) {
+    EvalCaseRows& c = cases[k];
+    std::vector<std::size_t> order(c.runs.size());
+    for (std::size_t j = 0; j < order.size(); ++j) order[j] = j;
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return points[k][a] < points[k][b]; });
+    std::vector<std::size_t> sorted;
+    for (std::size_t j = 0; j < order.size(); ++j) {
+      const int point = points[k][order[j]];
+      const EvalRun& r = runs[c.runs[order[j]]];
+      if (point != static_cast<int>(j)) {
+        throw InputError(where + ": case " + case_name(r) + ": " +
+                         (point < static_cast<int>(j)
+                              ? "two rows at " + grid_text(c.grid.at(point)) + " g"
+                              : "no row at " + grid_text(c.grid.at(static_cast<int>(j))) +
+                                    " g, below its rows at higher PGA") +
+                         " (its rows run up the grid from " + grid_text(c.grid.from_g) + " g)");
+      }
+      if (c.first_collapse < 0 && r.collapsed) c.first_collapse = point;
+      sorted.push_back(c.runs[order[j]]);
+    }
+    c.runs = std::move(sorted);
+    if (c.first_collapse < 0 && static_cast<int>(c.runs.size()) < c.grid.steps) {
+      throw InputError(where + ": case " + case_name(runs[c.runs.front()]) + ": its rows stop at " +
+                       grid_text(c.grid.at(static_cast<int>(c.runs.size()) - 1)) +
+                       " g without a collapse, below its grid's top " + grid_text(c.grid.top_g()) +
+                       " g (a file cut short, or part of a shard?)");
+    }
+  }
+  return cases;
+}
+
+void assign_case_collapses(std::vector<EvalRun>& runs, const std::string& where) {
+  for (const EvalCaseRows& c : eval_cases(runs, where)) {
+    const double collapse_g = c.first_collapse >= 0 ? c.grid.at(c.first_collapse) : -1.0;
+    for (std::size_t i : c.runs) runs[i].case_collapse_g = collapse_g;
+  }
+}
+
+void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with_grid) {
   std::string line;
   for (std::string_view c : kFixedColumns) {
     if (!line.empty()) line += ',';
+    line += c;
+  }
+  for (std::string_view c : with_grid ? std::span<const std::string_view>(kGridColumns)
+                                      : std::span<const std::string_view>()) {
+    line += ',';
     line += c;
   }
   for (double v : grids.risk) {
@@ -297,6 +489,12 @@ void write_eval_csv_row(std::FILE* out, const EvalRun& r) {
   add(format(r.collapse_time_s));
   add(format(r.peak_ratio));
   for (double t : r.first_shown_s) add(format(t));
+  if (r.grid.known()) {
+    add(std::to_string(r.seed));
+    add(grid_text(r.grid.from_g));
+    add(grid_text(r.grid.to_g));
+    add(std::to_string(r.grid.steps));
+  }
   for (double t : r.risk_crossing_s) add(format(t));
   for (double t : r.probability_crossing_s) add(format(t));
   for (double t : r.nominal_risk_crossing_s) add(format(t));
@@ -324,9 +522,13 @@ EvalTable read_eval_csv(const std::string& path) {
                        std::string(kFixedColumns[i]) + "\", got \"" + f[i] + "\"");
     }
   }
+  table.has_grid = f.size() >= kFixedColumns.size() + kGridColumns.size() &&
+                   std::equal(kGridColumns.begin(), kGridColumns.end(),
+                              f.begin() + static_cast<std::ptrdiff_t>(kFixedColumns.size()));
+  const std::size_t first_grid = kFixedColumns.size() + (table.has_grid ? kGridColumns.size() : 0);
   std::vector<double> nominal_grid;
   bool pwave_block = false;  // p_pick_s, strong_motion_s, pwave_trigger_s, then pwave_ge_
-  for (std::size_t i = kFixedColumns.size(); i < f.size(); ++i) {
+  for (std::size_t i = first_grid; i < f.size(); ++i) {
     double v = 0.0;
     if (f[i] == "p_pick_s" && !pwave_block && i + 2 < f.size() && f[i + 1] == "strong_motion_s" &&
         f[i + 2] == "pwave_trigger_s") {
@@ -387,6 +589,28 @@ EvalTable read_eval_csv(const std::string& path) {
       r.first_shown_s[i] = parse_time(f[7 + i], where, kFixedColumns[7 + i]);
     }
     std::size_t c = kFixedColumns.size();
+    if (table.has_grid) {
+      const double seed = parse_number(f[c], where, "seed");
+      if (seed < 0.0 || seed != std::floor(seed) || seed > 4294967295.0) {
+        throw InputError(where + ": seed: expected a whole number from 0 to 4294967295, got " +
+                         f[c]);
+      }
+      r.seed = static_cast<std::uint32_t>(seed);
+      r.grid.from_g = parse_number(f[c + 1], where, "pga_from_g");
+      r.grid.to_g = parse_number(f[c + 2], where, "pga_to_g");
+      const double steps = parse_number(f[c + 3], where, "pga_steps");
+      if (!(r.grid.from_g > 0.0) || !(r.grid.to_g >= r.grid.from_g)) {
+        throw InputError(where + ": pga_from_g, pga_to_g: expected 0 < from <= to, got " +
+                         f[c + 1] + ", " + f[c + 2]);
+      }
+      if (steps < 1.0 || steps != std::floor(steps) || steps > kMaxGridSteps ||
+          (steps > 1.0 && !(r.grid.to_g > r.grid.from_g))) {
+        throw InputError(where + ": pga_steps: expected a whole number from 1 to " +
+                         std::to_string(kMaxGridSteps) + " (1 when from = to), got " + f[c + 3]);
+      }
+      r.grid.steps = static_cast<int>(steps);
+      c += kGridColumns.size();
+    }
     for (std::size_t i = 0; i < table.grids.risk.size(); ++i, ++c) {
       r.risk_crossing_s.push_back(parse_time(f[c], where, "risk crossing"));
     }
@@ -406,6 +630,7 @@ EvalTable read_eval_csv(const std::string& path) {
     }
     table.runs.push_back(std::move(r));
   }
+  if (table.has_grid) assign_case_collapses(table.runs, path);
   return table;
 }
 

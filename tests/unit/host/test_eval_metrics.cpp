@@ -2,6 +2,7 @@
 // calibration choice, and the runs file.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -111,19 +112,19 @@ TEST(EvalMetrics, ChoosesTheLongestLeadWithinTheTarget) {
   // Within 0 false alarms and 0 misses: nothing; the rules without a false alarm all miss one.
   // Safety first: of the rules that miss none, the fewest false alarms (one in two), then the
   // longest lead: "probability 0.5" (leads 6 and 7).
-  Choice c = choose_rule(points, {0.0, 0});
+  Choice c = choose_rule(points, {0.0, 0, FalseAlarm::kPeak});
   ASSERT_TRUE(c.found);
   EXPECT_FALSE(c.meets_target);
   EXPECT_EQ(c.point.outcome.misses, 0);
   EXPECT_EQ(c.point.outcome.false_alarms, 1);
   EXPECT_DOUBLE_EQ(c.point.outcome.lead_quantile(0.5), 6.5);
   // Allowing a miss but no false alarm: the fewest misses within the rate, then the lead.
-  c = choose_rule(points, {0.0, 1});
+  c = choose_rule(points, {0.0, 1, FalseAlarm::kPeak});
   ASSERT_TRUE(c.meets_target);
   EXPECT_EQ(c.point.outcome.false_alarms, 0);
   EXPECT_EQ(c.point.outcome.misses, 1);
   // Allowing one false alarm in two: "probability 0.5" (leads 6 and 7) beats the others.
-  c = choose_rule(points, {0.5, 0});
+  c = choose_rule(points, {0.5, 0, FalseAlarm::kPeak});
   ASSERT_TRUE(c.meets_target);
   EXPECT_EQ(c.point.rule.probability_index, 0);
   EXPECT_DOUBLE_EQ(c.point.outcome.lead_quantile(0.5), 6.5);
@@ -135,7 +136,7 @@ TEST(EvalMetrics, ChoosesTheLongestLeadWithinTheTarget) {
 // "probability 1.0" the longest lead of those (3 s and a miss: median 1.5).
 TEST(EvalMetrics, FrontierIsTheFewestFalseAlarmsEachConstraintAllows) {
   const CrossingGrids grids{{0.2, 0.5, 0.8}, {0.5, 1.0}};
-  const std::vector<FrontierRow> rows = frontier(roc(roc_runs(), grids));
+  const std::vector<FrontierRow> rows = frontier(roc(roc_runs(), grids), FalseAlarm::kPeak);
   ASSERT_EQ(rows.size(), 6U);
   for (std::size_t i = 0; i < 4; ++i) {  // the "no miss" constraints: all met by one rule
     SCOPED_TRACE(rows[i].constraint);
@@ -152,7 +153,8 @@ TEST(EvalMetrics, FrontierIsTheFewestFalseAlarmsEachConstraintAllows) {
     EXPECT_DOUBLE_EQ(rows[i].point.outcome.lead_quantile(0.5), 1.5);
   }
   // The risk alone at 0.2 and 0.5: nothing within 5 %, nothing with a 3 s median but 0.2's.
-  const std::vector<FrontierRow> risk_only = frontier(roc(roc_runs(), {{0.2, 0.5}, {}}));
+  const std::vector<FrontierRow> risk_only =
+      frontier(roc(roc_runs(), {{0.2, 0.5}, {}}), FalseAlarm::kPeak);
   EXPECT_FALSE(risk_only[4].found);
   ASSERT_TRUE(risk_only[3].found);
   EXPECT_EQ(risk_only[3].point.rule.risk_index, 0);
@@ -171,6 +173,157 @@ TEST(EvalMetrics, TheNominalSignalReadsTheNominalStatuesCrossings) {
   EXPECT_EQ(nominal[0].rule.risk_signal, RiskSignal::kNominal);
   EXPECT_EQ(nominal[0].outcome.misses, 1);        // run 1 never crosses
   EXPECT_EQ(nominal[0].outcome.false_alarms, 0);
+}
+
+// One case on a grid of 0.5, 1, 1.5, 2, 2.5 g: rows from 0.5 g up to `first_collapse` (a grid
+// index) or, with -1, to the top; alarms raised in the rows whose index is in `raised`.
+std::vector<EvalRun> case_rows(const std::string& record, int first_collapse,
+                               const std::vector<int>& raised) {
+  const PgaGrid grid{0.5, 2.5, 5};
+  std::vector<EvalRun> rows;
+  for (int i = 0; i < grid.steps; ++i) {
+    const bool alarm = std::find(raised.begin(), raised.end(), i) != raised.end();
+    EvalRun r = i == first_collapse ? collapse_at(5.0, alarm ? 4.0 : -1.0)
+                                    : standing(0.1, alarm ? 3.0 : -1.0);
+    r.record = record;
+    r.scene = "s.toml";
+    r.seed = 7;
+    r.grid = grid;
+    r.scale_g = grid.at(i);
+    rows.push_back(r);
+    if (i == first_collapse) break;
+  }
+  return rows;
+}
+
+TEST(EvalMetrics, TheCollapseMarginIsTheCasesLowestCollapseOverTheRunsPga) {
+  // Collapses at 2 g: its runs at 0.5, 1 and 1.5 g have margins 4, 2 and 1.33.
+  std::vector<EvalRun> runs = case_rows("a.AT2", 3, {0, 1, 2});
+  // Never collapses up to 2.5 g: margins at least 5, 2.5, 1.67, 1.25 and 1.
+  for (const EvalRun& r : case_rows("b.AT2", -1, {1, 2, 4})) runs.push_back(r);
+  assign_case_collapses(runs, "test");
+  EXPECT_DOUBLE_EQ(runs[0].case_collapse_g, 2.0);
+  EXPECT_DOUBLE_EQ(runs[0].collapse_margin(), 4.0);
+  EXPECT_FALSE(runs[0].margin_is_lower_bound());
+  EXPECT_DOUBLE_EQ(runs[2].collapse_margin(), 2.0 / 1.5);
+  EXPECT_EQ(runs[4].case_collapse_g, -1.0);
+  EXPECT_TRUE(runs[4].margin_is_lower_bound());
+  EXPECT_DOUBLE_EQ(runs[4].collapse_margin(), 5.0);
+  const WarningOutcome o = level_outcome(runs, EvalLevel::kAlarm);
+  const MarginBands& m = o.margins;
+  // Known: 1.33 (raised) in 1.25-1.5, 2 (raised) in 2-3, 4 (raised) and >= 5 (not) in >= 3.
+  EXPECT_EQ(m.known[0].runs, 0);
+  EXPECT_EQ(m.known[1].runs, 1);
+  EXPECT_EQ(m.known[1].alarms, 1);
+  EXPECT_EQ(m.known[2].runs, 0);
+  EXPECT_EQ(m.known[3].runs, 1);
+  EXPECT_EQ(m.known[3].alarms, 1);
+  EXPECT_EQ(m.known[4].runs, 2);
+  EXPECT_EQ(m.known[4].alarms, 1);
+  EXPECT_EQ(m.known[4].quiet, 2);  // both stood with a peak of 0.1
+  // Bounded below only: >= 1 (raised), >= 1.25 (not), >= 1.67 (raised), >= 2.5 (raised).
+  EXPECT_EQ(m.lower_bound[0].runs, 1);
+  EXPECT_EQ(m.lower_bound[0].alarms, 1);
+  EXPECT_EQ(m.lower_bound[1].runs, 1);
+  EXPECT_EQ(m.lower_bound[1].alarms, 0);
+  EXPECT_EQ(m.lower_bound[2].alarms, 1);
+  EXPECT_EQ(m.lower_bound[3].runs, 1);
+  EXPECT_EQ(m.lower_bound[3].alarms, 1);
+  // Unneeded: margin 2, 4, >= 5, >= 2.5: 3 raised of 4. Unknown: >= 1, 1.25, 1.67: 2 of 3.
+  EXPECT_EQ(o.unneeded().runs, 4);
+  EXPECT_EQ(o.unneeded().alarms, 3);
+  EXPECT_DOUBLE_EQ(o.false_alarm_rate(FalseAlarm::kMargin), 0.75);
+  EXPECT_EQ(o.margin_unknown().runs, 3);
+  EXPECT_EQ(o.margin_unknown().alarms, 2);
+  // The peak counts every standing run here (peak 0.1): 6 raised of 8.
+  EXPECT_DOUBLE_EQ(o.false_alarm_rate(FalseAlarm::kPeak), 6.0 / 8.0);
+  EXPECT_EQ(o.collapses, 1);
+  // Without the grid (a file of an earlier plinth-eval) no run has a margin.
+  for (EvalRun& r : runs) r.grid = {};
+  EXPECT_EQ(level_outcome(runs, EvalLevel::kAlarm).unneeded().runs, 0);
+}
+
+TEST(EvalMetrics, TheCalibrationCountsTheFalseAlarmsItIsTold) {
+  // A collapse at 2 g warned by both rules; rule 0 (risk) also raises in the run at 1.5 g
+  // (quiet, margin 1.33: needed by the margin), rule 1 (probability) in the run at 0.5 g (a
+  // near miss past half the angle, margin 4: unneeded).
+  std::vector<EvalRun> runs = case_rows("a.AT2", 3, {});
+  for (EvalRun& r : runs) {
+    r.risk_crossing_s = {-1.0};
+    r.probability_crossing_s = {-1.0};
+  }
+  runs[3].risk_crossing_s = {2.0};
+  runs[3].probability_crossing_s = {2.0};
+  runs[2].risk_crossing_s = {1.0};
+  runs[0].probability_crossing_s = {1.0};
+  runs[0].peak_ratio = 0.6;
+  assign_case_collapses(runs, "test");
+  const WarningOutcome never = outcome_of(runs, [](const EvalRun&) { return -1.0; });
+  EXPECT_EQ(never.margins.known[4].quiet, 0);  // the run at 0.5 g rocked past half the angle
+  EXPECT_EQ(never.margins.known[1].quiet, 1);
+  const std::vector<RocPoint> points = roc(runs, {{0.5}, {0.5}});
+  const Choice by_margin = choose_rule(points, {0.0, 0, FalseAlarm::kMargin});
+  const Choice by_peak = choose_rule(points, {0.0, 0, FalseAlarm::kPeak});
+  ASSERT_TRUE(by_margin.meets_target);
+  ASSERT_TRUE(by_peak.meets_target);
+  EXPECT_EQ(by_margin.point.rule.risk_index, 0);
+  EXPECT_EQ(by_margin.point.rule.probability_index, -1);
+  EXPECT_EQ(by_peak.point.rule.risk_index, -1);
+  EXPECT_EQ(by_peak.point.rule.probability_index, 0);
+  const FrontierRow margin_row = frontier(points, FalseAlarm::kMargin)[0];
+  EXPECT_EQ(margin_row.point.rule.risk_index, 0);
+  EXPECT_EQ(frontier(points, FalseAlarm::kPeak)[0].point.rule.probability_index, 0);
+  FalseAlarm parsed = FalseAlarm::kMargin;
+  EXPECT_TRUE(parse_false_alarm("peak", parsed));
+  EXPECT_EQ(parsed, FalseAlarm::kPeak);
+  EXPECT_FALSE(parse_false_alarm("quiet", parsed));
+  EXPECT_STREQ(false_alarm_name(FalseAlarm::kMargin), "margin");
+}
+
+std::string case_error(std::vector<EvalRun> runs) {
+  try {
+    assign_case_collapses(runs, "f.csv");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no InputError";
+  return "";
+}
+
+TEST(EvalMetrics, ACasesRowsMustRunUpItsGrid) {
+  std::vector<EvalRun> runs = case_rows("a.AT2", -1, {});
+  EXPECT_EQ(case_error({runs[0], runs[1], runs[2], runs[3]}),
+            "f.csv: case a.AT2, s.toml, statue 0, seed 7: its rows stop at 2 g without a collapse, "
+            "below its grid's top 2.5 g (a file cut short, or part of a shard?)");
+  EXPECT_EQ(case_error({runs[0], runs[2], runs[3], runs[4]}),
+            "f.csv: case a.AT2, s.toml, statue 0, seed 7: no row at 1 g, below its rows at higher "
+            "PGA (its rows run up the grid from 0.5 g)");
+  EXPECT_EQ(case_error({runs[0], runs[1], runs[1], runs[2], runs[3], runs[4]}),
+            "f.csv: case a.AT2, s.toml, statue 0, seed 7: two rows at 1 g (its rows run up the grid "
+            "from 0.5 g)");
+  std::vector<EvalRun> off = runs;
+  off[2].scale_g = 1.6;
+  EXPECT_EQ(case_error(off), "f.csv: case a.AT2, s.toml, statue 0, seed 7: scale_g 1.6 g is not a "
+                             "point of its grid (0.5 to 2.5 g in 5 steps)");
+  std::vector<EvalRun> mixed = runs;
+  mixed[3].grid.to_g = 3.0;
+  EXPECT_EQ(case_error(mixed), "f.csv: case a.AT2, s.toml, statue 0, seed 7: rows of two grids (0.5 "
+                               "to 2.5 g in 5 steps, 0.5 to 3 g in 5 steps)");
+  // Another seed is another case; rows in any order; past the first collapse (--all-scales) fine.
+  std::vector<EvalRun> two = runs;
+  for (EvalRun r : runs) {
+    r.seed = 8;
+    two.insert(two.begin(), r);
+  }
+  EXPECT_EQ(eval_cases(two, "f.csv").size(), 2U);
+  std::vector<EvalRun> all_scales = case_rows("a.AT2", -1, {});
+  all_scales[2].collapsed = true;
+  all_scales[2].collapse_time_s = 5.0;
+  std::reverse(all_scales.begin(), all_scales.end());
+  assign_case_collapses(all_scales, "f.csv");
+  EXPECT_DOUBLE_EQ(all_scales[0].case_collapse_g, 1.5);  // the 2.5 g row, standing again
+  EXPECT_DOUBLE_EQ(all_scales[0].collapse_margin(), 0.6);
+  EXPECT_EQ(level_outcome(all_scales, EvalLevel::kAlarm).margins.below_one.runs, 2);
 }
 
 std::string temp_path(const std::string& name) {
@@ -196,7 +349,7 @@ TEST(EvalMetrics, RunsFileRoundTrips) {
   const std::string path = temp_path("roundtrip.csv");
   std::FILE* f = std::fopen(path.c_str(), "w");
   ASSERT_NE(f, nullptr);
-  write_eval_csv_header(f, grids);
+  write_eval_csv_header(f, grids, false);
   write_eval_csv_row(f, a);
   write_eval_csv_row(f, b);
   std::fclose(f);
@@ -212,6 +365,49 @@ TEST(EvalMetrics, RunsFileRoundTrips) {
   EXPECT_EQ(t.runs[1].probability_crossing_s, b.probability_crossing_s);
   EXPECT_EQ(t.runs[0].nominal_risk_crossing_s, a.nominal_risk_crossing_s);
   EXPECT_FALSE(t.runs[1].collapsed);
+  EXPECT_FALSE(t.has_grid);  // runs without a grid: the header has no grid columns
+  std::filesystem::remove(path);
+}
+
+TEST(EvalMetrics, RunsFileKeepsTheCaseAndItsGridAndReadsEarlierFiles) {
+  const CrossingGrids grids{{0.5}, {0.25}};
+  std::vector<EvalRun> runs = case_rows("r.AT2", 2, {0, 2});
+  for (EvalRun& r : runs) {
+    r.seed = 4000000000U;
+    r.risk_crossing_s = {-1.0};
+    r.probability_crossing_s = {-1.0};
+    r.nominal_risk_crossing_s = {-1.0};
+  }
+  const std::string path = temp_path("grid.csv");
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  write_eval_csv_header(f, grids, true);
+  for (const EvalRun& r : runs) write_eval_csv_row(f, r);
+  std::fclose(f);
+  const EvalTable t = read_eval_csv(path);
+  ASSERT_TRUE(t.has_grid);
+  ASSERT_EQ(t.runs.size(), 3U);
+  EXPECT_EQ(t.runs[0].seed, 4000000000U);
+  EXPECT_EQ(t.runs[0].grid, runs[0].grid);
+  EXPECT_DOUBLE_EQ(t.runs[0].case_collapse_g, 1.5);  // set from the rows as they are read
+  EXPECT_DOUBLE_EQ(t.runs[1].collapse_margin(), 1.5);
+  // The same file without the four columns, as a plinth-eval before the margin wrote it.
+  std::ifstream in(path);
+  std::string text;
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::size_t> commas;
+    for (std::size_t i = 0; i < line.size(); ++i) {
+      if (line[i] == ',') commas.push_back(i);
+    }
+    text += line.substr(0, commas[9]) + line.substr(commas[13]) + "\n";
+  }
+  in.close();
+  std::ofstream(path) << text;
+  const EvalTable old = read_eval_csv(path);
+  EXPECT_FALSE(old.has_grid);
+  ASSERT_EQ(old.runs.size(), 3U);
+  EXPECT_FALSE(old.runs[0].grid.known());
+  EXPECT_EQ(old.runs[1].risk_crossing_s, runs[1].risk_crossing_s);
   std::filesystem::remove(path);
 }
 
@@ -255,6 +451,24 @@ TEST(EvalMetrics, RunsFileErrorsNameTheLineAndColumn) {
                           "first_advisory_s,first_warning_s,first_alarm_s,risk_ge_0.5\n")
                 .find(":1: the nominal_risk_ge_ columns must repeat the risk_ge_ grid"),
             std::string::npos);
+  const std::string grid_header =
+      "record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,first_advisory_s,"
+      "first_warning_s,first_alarm_s,seed,pga_from_g,pga_to_g,pga_steps,risk_ge_0.5,"
+      "nominal_risk_ge_0.5\n";
+  EXPECT_NE(error_reading(grid_header + "r,s,0,0.3,0,-1,0.1,-1,-1,-1,-2,0.3,0.3,1,-1,-1\n")
+                .find(":2: seed: expected a whole number from 0 to 4294967295, got -2"),
+            std::string::npos);
+  EXPECT_NE(error_reading(grid_header + "r,s,0,0.3,0,-1,0.1,-1,-1,-1,7,0.3,0.2,1,-1,-1\n")
+                .find(":2: pga_from_g, pga_to_g: expected 0 < from <= to, got 0.3, 0.2"),
+            std::string::npos);
+  EXPECT_NE(error_reading(grid_header + "r,s,0,0.3,0,-1,0.1,-1,-1,-1,7,0.3,0.3,2,-1,-1\n")
+                .find(":2: pga_steps: expected a whole number from 1 to 1000 (1 when from = to), "
+                      "got 2"),
+            std::string::npos);
+  EXPECT_NE(error_reading(grid_header + "r,s,0,0.3,0,-1,0.1,-1,-1,-1,7,0.3,0.6,2,-1,-1\n")
+                .find("bad.csv: case r, s, statue 0, seed 7: its rows stop at 0.3 g without a "
+                      "collapse"),
+            std::string::npos);
   EXPECT_NE(error_reading("record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,"
                           "first_advisory_s,first_warning_s,first_alarm_s,colour\n")
                 .find(":1: column 11: unknown column \"colour\""),
@@ -284,7 +498,7 @@ TEST(EvalPWaveColumns, RoundTripAfterTheOtherGrids) {
   const std::string path = temp_path("pwave_roundtrip.csv");
   std::FILE* f = std::fopen(path.c_str(), "w");
   ASSERT_NE(f, nullptr);
-  write_eval_csv_header(f, grids);
+  write_eval_csv_header(f, grids, false);
   write_eval_csv_row(f, run_with(1.5, 2.25, {3.0, -1.0}));
   write_eval_csv_row(f, run_with(-1.0, -1.0, {-1.0, -1.0}));
   std::fclose(f);

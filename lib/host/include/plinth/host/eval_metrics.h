@@ -9,6 +9,12 @@
 //                at all is a false alarm;
 //   a near miss  otherwise (it rocked past half the angle and stood): the level shown there is
 //                counted apart, neither hit nor false alarm.
+// An alarm in a run that stood is also scored by the run's collapse margin (FEMA P-695's collapse
+// margin ratio on incremental dynamic analysis): its case's lowest collapsing PGA on the grid
+// divided by the run's PGA. An alarm is unneeded when the margin is >= 2 (the shaking would have
+// to double to topple the statue). A case that never collapses up to the grid's top bounds the
+// margin from below only (top / PGA): such a run counts as unneeded when that bound is >= 2 and
+// is counted apart, as "margin unknown", when it is below 2.
 // The ROC (lead against false-alarm rate as a threshold moves) comes from first-crossing times
 // the box records for a grid of thresholds on each of its signals (reactive risk, forecast
 // probability); a rule "signal A at a or signal B at b" is first true at the earlier of the
@@ -17,6 +23,7 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -24,6 +31,29 @@
 namespace plinth::host {
 
 inline constexpr double kQuietPeakRatio = 0.5;  // of the overturning angle: below it, quiet
+inline constexpr double kUnneededMargin = 2.0;   // collapse margin from which an alarm is unneeded
+
+// Which alarms a calibration or a frontier counts as false: those raised in runs with a collapse
+// margin >= 2 (kMargin, unneeded alarms), or in quiet runs (kPeak, below half the angle).
+enum class FalseAlarm { kMargin, kPeak };
+[[nodiscard]] const char* false_alarm_name(FalseAlarm definition);  // "margin", "peak"
+// "margin" or "peak" into `definition`; false otherwise.
+[[nodiscard]] bool parse_false_alarm(const std::string& text, FalseAlarm& definition);
+
+// plinth-eval run's PGA grid: `steps` points from from_g to to_g, evenly spaced (steps 0: not
+// known, a runs file written before the grid was recorded).
+struct PgaGrid {
+  double from_g = 0.0;
+  double to_g = 0.0;
+  int steps = 0;
+
+  [[nodiscard]] bool known() const { return steps > 0; }
+  [[nodiscard]] double at(int i) const;  // the i-th point, g
+  [[nodiscard]] double top_g() const { return at(steps - 1); }
+  // The index of the grid point `pga_g` is (within the runs file's 6 digits), or -1.
+  [[nodiscard]] int index_of(double pga_g) const;
+  friend bool operator==(const PgaGrid&, const PgaGrid&) = default;
+};
 
 enum class EvalLevel : std::size_t { kAdvisory = 0, kWarning = 1, kAlarm = 2 };
 inline constexpr std::size_t kEvalLevels = 3;
@@ -45,6 +75,12 @@ struct EvalRun {
   std::string scene;   // file name
   int statue = 0;      // index of the true statue drawn for this record and scene
   double scale_g = 0.0;  // the record's PGA, g
+  // The case is (record, scene, statue, seed): the statues are drawn from the seed.
+  std::uint32_t seed = 0;
+  PgaGrid grid;  // the grid its case ran up
+  // The case's lowest collapsing PGA on the grid, g (-1: none up to the grid's top). Not a column
+  // of the runs file: read_eval_csv sets it from the case's rows (assign_case_collapses).
+  double case_collapse_g = -1.0;
   // Truth.
   bool collapsed = false;
   double collapse_time_s = -1.0;  // -1: none
@@ -66,6 +102,28 @@ struct EvalRun {
 
   [[nodiscard]] bool quiet() const { return !collapsed && peak_ratio < kQuietPeakRatio; }
   [[nodiscard]] bool near_miss() const { return !collapsed && peak_ratio >= kQuietPeakRatio; }
+  // The collapse margin: case_collapse_g / scale_g; when the case never collapsed, the lower bound
+  // top / scale_g (margin_is_lower_bound). 0 when the grid is not known.
+  [[nodiscard]] double collapse_margin() const;
+  [[nodiscard]] bool margin_is_lower_bound() const { return case_collapse_g < 0.0; }
+};
+
+// The runs that stood, by collapse margin: [1, 1.25), [1.25, 1.5), [1.5, 2), [2, 3), >= 3.
+inline constexpr std::array<double, 5> kMarginBandFloors{1.0, 1.25, 1.5, 2.0, 3.0};
+inline constexpr std::size_t kMarginBands = kMarginBandFloors.size();
+struct BandCount {
+  int runs = 0;
+  int alarms = 0;  // runs in which the rule or level was raised
+  int quiet = 0;   // runs whose peak stayed below half the angle: false alarms by the peak
+  [[nodiscard]] double rate() const;  // alarms / runs (0 if none)
+};
+struct MarginBands {
+  // Margin known to lie in the band (the top band also takes lower bounds >= 3).
+  std::array<BandCount, kMarginBands> known;
+  // Margin known only to be >= a bound in band i < 4 (the case stood up to the grid's top); the
+  // last of these (bound in [2, 3)) is unneeded all the same, the others are "margin unknown".
+  std::array<BandCount, kMarginBands - 1> lower_bound;
+  BandCount below_one;  // stood above its case's lowest collapse (plinth-eval run --all-scales)
 };
 
 // What a rule (or a level) did over a set of runs.
@@ -78,10 +136,21 @@ struct WarningOutcome {
   int near_miss_runs = 0;
   int raised_on_near_misses = 0;
   std::vector<double> leads_s;  // one per collapse; 0 for a miss
+  MarginBands margins;          // the runs that stood, by collapse margin (none without the grid)
 
   [[nodiscard]] double false_alarm_rate() const;    // false_alarms / quiet_runs (0 if none)
+  // Alarms in runs with a margin >= 2 (known, or bounded below by >= 2), and those runs.
+  [[nodiscard]] BandCount unneeded() const;
+  // Runs whose margin is bounded below by less than 2 only: neither needed nor unneeded.
+  [[nodiscard]] BandCount margin_unknown() const;
+  [[nodiscard]] double unneeded_rate() const { return unneeded().rate(); }
+  // false_alarm_rate() or unneeded_rate().
+  [[nodiscard]] double false_alarm_rate(FalseAlarm definition) const;
   [[nodiscard]] double lead_quantile(double q) const;  // of leads_s, misses as 0; -1 if empty
 };
+
+// Counts a run that stood, raised or not, into its margin band (nothing without the grid).
+void count_margin(const EvalRun& run, bool raised, MarginBands& bands);
 
 // The outcome of the rule whose first time in each run is `first_time(run)` (-1: never).
 template <class FirstTime>
@@ -94,13 +163,16 @@ template <class FirstTime>
       const bool hit = t >= 0.0 && t < r.collapse_time_s;
       (hit ? o.hits : o.misses) += 1;
       o.leads_s.push_back(hit ? r.collapse_time_s - t : 0.0);
-    } else if (r.quiet()) {
+      continue;
+    }
+    if (r.quiet()) {
       ++o.quiet_runs;
       o.false_alarms += t >= 0.0 ? 1 : 0;
     } else {
       ++o.near_miss_runs;
       o.raised_on_near_misses += t >= 0.0 ? 1 : 0;
     }
+    count_margin(r, t >= 0.0, o.margins);
   }
   return o;
 }
@@ -133,6 +205,7 @@ struct RocPoint {
 struct LevelTarget {
   double max_false_alarm_rate = 0.05;
   int max_misses = 0;  // tried first; relaxed upward when no rule meets both
+  FalseAlarm false_alarm = FalseAlarm::kMargin;  // which rate max_false_alarm_rate bounds
 };
 // The rule that meets the target with the longest median lead (ties: the lower false-alarm
 // rate). When none does, safety first: among the rules that miss at most max_misses collapses,
@@ -154,18 +227,42 @@ struct FrontierRow {
   bool found = false;  // some rule meets the constraint
   RocPoint point;
 };
-[[nodiscard]] std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points);
+[[nodiscard]] std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points,
+                                               FalseAlarm false_alarm = FalseAlarm::kMargin);
+
+// A case (record, scene, statue, seed) as its rows tell it: they run up its grid from the first
+// point, each once, to its first collapse (or on: --all-scales) or to the top.
+struct EvalCaseRows {
+  std::string record;
+  std::string scene;
+  int statue = 0;
+  std::uint32_t seed = 0;
+  PgaGrid grid;
+  int first_collapse = -1;  // grid index of its lowest collapsing PGA; -1: none up to the top
+  std::vector<std::size_t> runs;  // indices into the runs, in grid order
+};
+// The cases of runs whose grid is known, in the order their first rows come. Throws InputError
+// (prefixed with `where`) naming a case whose rows are not its grid's from the first point up to
+// a collapse or the top: a row off the grid, twice, or missing (a file cut short).
+[[nodiscard]] std::vector<EvalCaseRows> eval_cases(const std::vector<EvalRun>& runs,
+                                                   const std::string& where);
+// Sets every run's case_collapse_g from its case's rows (eval_cases).
+void assign_case_collapses(std::vector<EvalRun>& runs, const std::string& where);
 
 // CSV: one run per row (header first); the grids are written in the header's column names
-// (risk_ge_0.3, probability_ge_0.5625, nominal_risk_ge_0.3). With the P-wave stage the row ends
-// with p_pick_s, strong_motion_s, pwave_trigger_s and the pwave_ge_<p> crossings; a file
-// without them reads as a run without the stage. read_eval_csv checks the header and every field and
-// throws InputError naming the file and line.
-void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids);
+// (risk_ge_0.3, probability_ge_0.5625, nominal_risk_ge_0.3). read_eval_csv checks the header and
+// every field and throws InputError naming the file and line. The columns seed, pga_from_g,
+// pga_to_g and pga_steps (the case's draw and grid, after first_alarm_s) are read when present:
+// a file of an earlier plinth-eval has none, and its runs have no known grid (has_grid false).
+// With the P-wave stage the row ends with p_pick_s, strong_motion_s, pwave_trigger_s and the
+// pwave_ge_<p> crossings; a file without them reads as runs without the stage.
+void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with_grid);
+// with_grid: the seed and grid columns. A row has them when run.grid is known (as the header must).
 void write_eval_csv_row(std::FILE* out, const EvalRun& run);
 struct EvalTable {
   CrossingGrids grids;
   std::vector<EvalRun> runs;
+  bool has_grid = false;  // the file records each case's grid: collapse margins are known
 };
 [[nodiscard]] EvalTable read_eval_csv(const std::string& path);
 
