@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The --record/--vertical pairs of a folder of three-component PEER records, for plinth-eval
 # (docs/pwave.md): per station (the RSN<number>_ prefix), each horizontal component with the
-# station's vertical one (the file whose name ends in UP, V, DWN or Z before .AT2).
+# station's vertical one (the file whose name ends in UP, V, DWN or Z before .AT2; horizontals
+# end in an azimuth or E, N, W, S).
 #   plinth-eval run ... $(tools/pwave-records.sh sim/data/records/pwave)
 # --first: only the first horizontal of each station (sorted by name).
 set -euo pipefail
@@ -15,7 +16,7 @@ stations=()
 for f in "$folder"/RSN*.AT2; do
   name=$(basename "$f")
   rsn=${name%%_*}
-  if [[ "$name" =~ (UP|[-_]V|DWN|[-_]Z|HNZ)\.AT2$ ]]; then
+  if [[ "$name" =~ (UP|V|DWN|Z)\.AT2$ ]]; then
     [[ -n "${vertical[$rsn]:-}" ]] && { echo "pwave-records.sh: $rsn has two verticals" >&2; exit 2; }
     vertical[$rsn]="$f"
     stations+=("$rsn")

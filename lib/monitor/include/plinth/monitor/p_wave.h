@@ -93,25 +93,25 @@ inline constexpr std::size_t kMaxPWavePredictorPoints = 8;
 //   plinth-eval pwave-fit $(tools/pwave-records.sh sim/data/records/pwave) [--channel horizontal]
 inline constexpr std::array<PWavePredictorPoint, kMaxPWavePredictorPoints>
     kDefaultVerticalPredictor{{
-        {0.5, 3.059, 0.0, 0.650},
-        {1.0, 2.701, 0.0, 0.786},
-        {1.5, 2.529, 0.0, 0.735},
-        {2.0, 2.435, 0.0, 0.723},
-        {2.5, 2.231, 0.0, 0.938},
-        {3.0, 2.030, 0.0, 0.937},
+        {0.5, 3.091, 0.0, 0.649},
+        {1.0, 2.749, 0.0, 0.802},
+        {1.5, 2.588, 0.0, 0.767},
+        {2.0, 2.484, 0.0, 0.749},
+        {2.5, 2.290, 0.0, 0.962},
+        {3.0, 2.052, 0.0, 0.945},
         {3.5, 1.877, 0.0, 1.003},
         {4.0, 1.758, 0.0, 1.023},
     }};
 inline constexpr std::array<PWavePredictorPoint, kMaxPWavePredictorPoints>
     kDefaultHorizontalPredictor{{
-        {0.5, 3.344, 0.0, 0.829},
-        {1.0, 3.066, 0.0, 0.855},
-        {1.5, 2.749, 0.0, 0.944},
-        {2.0, 2.376, 0.0, 1.090},
-        {2.5, 1.985, 0.0, 1.050},
-        {3.0, 1.550, 0.0, 0.977},
-        {3.5, 1.190, 0.0, 0.815},
-        {4.0, 1.029, 0.0, 0.754},
+        {0.5, 3.357, 0.0, 0.821},
+        {1.0, 3.082, 0.0, 0.858},
+        {1.5, 2.750, 0.0, 0.943},
+        {2.0, 2.375, 0.0, 1.079},
+        {2.5, 2.004, 0.0, 1.041},
+        {3.0, 1.566, 0.0, 0.953},
+        {3.5, 1.227, 0.0, 0.806},
+        {4.0, 1.076, 0.0, 0.757},
     }};
 
 // The table fitted for a channel.
