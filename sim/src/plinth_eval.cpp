@@ -281,7 +281,7 @@ int run_report(const ReportOptions& opt) {
   const plinth::eval::Report report = plinth::eval::make_report(
       table, targets, opt.frontier, opt.calibration_path.empty() ? nullptr : &calibration);
   std::fputs(plinth::eval::report_text(report, table.grids).c_str(), stdout);
-  if (!table.grids.pwave.empty()) {
+  if (!table.grids.pwave.empty() || !opt.pwave_calibrate_on.empty()) {
     std::optional<EvalTable> other;
     if (!opt.pwave_calibrate_on.empty()) other = plinth::host::read_eval_csv(opt.pwave_calibrate_on);
     std::fputs(plinth::eval::pwave_report_text(
