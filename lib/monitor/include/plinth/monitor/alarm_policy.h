@@ -85,8 +85,10 @@ struct AlarmPolicySettings {
   RiskThresholds advisory_forecast{Real(0.125), Real(0.0625)};
   RiskThresholds warning_forecast{Real(0.25), Real(0.1875)};
   RiskThresholds alarm_forecast{Real(0.375), Real(0.3125)};
-  // On the P-wave stage's probability of collapse (warning only; docs/pwave.md calibrated it).
-  RiskThresholds warning_pwave{Real(0.5), Real(0.4)};
+  // On the P-wave stage's probability of collapse (warning only). Calibrated with plinth-eval on
+  // the bundled three-component records (docs/pwave.md): the longest median lead where the P
+  // wave comes 3 s early, within 5 points more unneeded warnings than the box without it.
+  RiskThresholds warning_pwave{Real(0.8), Real(0.6)};
   // s, >= 0: a condition holds this long before its level rises. 0: the sample it starts (a
   // margin run out is news at once), so plinth-eval's rules are exactly what the box applies;
   // 0.1 s missed a collapse they caught and cost 0.1-0.2 s of lead (docs/forecast.md).
