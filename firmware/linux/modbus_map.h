@@ -63,7 +63,7 @@ inline constexpr CodeTable<monitor::AlarmCause, 13> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kInternalFault, 9},
     {monitor::AlarmCause::kCollapseForecast, 10},
     {monitor::AlarmCause::kNotCalibrated, 11},
-    {monitor::AlarmCause::kPWave, 12},
+    {monitor::AlarmCause::kPWave, 13},  // 12: outside_model (the hostile branch)
 }}};
 inline constexpr CodeTable<Phase, 6> kPhaseCodes{{{
     {Phase::kFullContact, 0},

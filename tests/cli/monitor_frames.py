@@ -22,7 +22,7 @@ CORNERS = ["none", "left", "right"]
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", "p_wave"]
+          "collapse_forecast", "not_calibrated", None, "p_wave"]  # 12: outside_model (hostile)
 STATUS_ID, ALARM_ID = 0x320, 0x330
 
 
@@ -33,7 +33,7 @@ def bits(data, start, length):
 
 def named(names, value, signal):
     """The value table's name of `value` (plinth.dbc); a value outside it is an error."""
-    if value >= len(names):
+    if value >= len(names) or names[value] is None:
         raise ValueError("%s %d is not in plinth.dbc's value table" % (signal, value))
     return names[value]
 

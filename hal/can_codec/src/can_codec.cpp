@@ -60,7 +60,7 @@ enum EventSignal : std::size_t { kLevel, kPreviousLevel, kCause, kLatched, kTime
 constexpr std::array<SignalLayout, 6> kEventSignals{{
     {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
-    {"Cause", 8, 8, false, 1.0, 0.0, 0, 12, "", true, kNoSpecialRaw},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 13, "", true, kNoSpecialRaw},
     {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true, kNoSpecialRaw},
     {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false, kNoSpecialRaw},
     {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
@@ -430,12 +430,18 @@ DecodeResult decode(const CanFrame& frame, MonitorStatus& message) {
   return unpacker.result();
 }
 
+// Cause 12 is outside_model's (the hostile branch): a gap in the value table until it lands.
+constexpr std::uint8_t kReservedCause = 12;
+
 EncodeResult encode(const AlarmEvent& message, CanFrame& frame) {
   const auto& s = kEventSignals;
   Packer packer;
   packer.enumeration(message.level, s[kLevel]);
   packer.enumeration(message.previous_level, s[kPreviousLevel]);
   packer.enumeration(message.cause, s[kCause]);
+  if (static_cast<std::uint8_t>(message.cause) == kReservedCause) {
+    packer.fail(CodecError::kInvalidEnum, s[kCause].name);
+  }
   packer.integer(message.latched ? 1U : 0U, s[kLatched]);
   packer.integer(message.time_since_start_ms, s[kTime]);
   packer.integer(message.sequence, s[kEvSequence]);
@@ -449,6 +455,9 @@ DecodeResult decode(const CanFrame& frame, AlarmEvent& message) {
   m.level = unpacker.enumeration<AlarmLevel>(s[kLevel]);
   m.previous_level = unpacker.enumeration<AlarmLevel>(s[kPreviousLevel]);
   m.cause = unpacker.enumeration<AlarmCause>(s[kCause]);
+  if (static_cast<std::uint8_t>(m.cause) == kReservedCause) {
+    unpacker.fail(CodecError::kInvalidEnum, s[kCause].name);
+  }
   m.latched = unpacker.integer<std::uint8_t>(s[kLatched]) != 0;
   m.time_since_start_ms = unpacker.integer<std::uint32_t>(s[kTime]);
   m.sequence = unpacker.integer<std::uint8_t>(s[kEvSequence]);

@@ -12,6 +12,7 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -731,7 +732,8 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
     EXPECT_STREQ(rk.signal, "Level");
   }
-  for (unsigned v = 13; v <= 255; ++v) {
+  for (unsigned v = 12; v <= 255; ++v) {
+    if (v == 13) continue;  // p_wave; 12 is outside_model's, not yet on this branch
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -749,7 +751,9 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  e.cause = static_cast<AlarmCause>(13);
+  e.cause = static_cast<AlarmCause>(14);
+  EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
+  e.cause = static_cast<AlarmCause>(12);
   EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
   e = AlarmEvent{};
   e.previous_level = static_cast<AlarmLevel>(255);
@@ -1073,8 +1077,13 @@ TEST(CanDbc, ValueTablesMatchTheCodecsEnumerations) {
       }
       if (!c.has_value_table) continue;
       const auto& table = it->second;
-      // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names.
-      ASSERT_EQ(table.size(), static_cast<std::size_t>(c.raw_max - c.raw_min + 1));
+      // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names (but
+      // Cause 12, outside_model's on the hostile branch, which decode refuses until it lands).
+      const std::size_t gaps = std::string_view(c.name) == "Cause" ? 1 : 0;
+      ASSERT_EQ(table.size() + gaps, static_cast<std::size_t>(c.raw_max - c.raw_min + 1));
+      if (gaps != 0) {
+        EXPECT_EQ(table.count(12), 0U);
+      }
       for (const auto& [value, name] : table) {
         EXPECT_GE(static_cast<std::int64_t>(value), c.raw_min);
         EXPECT_LE(static_cast<std::int64_t>(value), c.raw_max);

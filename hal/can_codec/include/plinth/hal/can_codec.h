@@ -103,7 +103,8 @@ enum class AlarmCause : std::uint8_t {
   kInternalFault = 9,       // the monitor's own self-check failed
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet
-  kPWave = 12,              // the P-wave stage's probability of collapse crossed its threshold
+  // 12 is outside_model's (the hostile branch, issue 25); until it lands, decode refuses 12.
+  kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
 };
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.

@@ -31,7 +31,8 @@ enum class AlarmCause : std::uint8_t {
   kInternalFault = 9,       // the monitor's own self-check failed
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet: nothing to vouch for
-  kPWave = 12,              // the P-wave stage's probability of collapse crossed its threshold
+  // 12 is outside_model's (the hostile branch); p_wave is 13 on the wire.
+  kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
 };
 
 // The names in status and alarm lines (also the DBC's VAL_ names).
