@@ -8,23 +8,42 @@
 #   loaded  POLLERS mbpoll clients polling the 32 input registers every 11 ms, a mosquitto_sub
 #           on the box's topics, the state published at every status (0.01 s)
 # It starts its own mosquitto broker on a free loopback port and stops everything it started.
-# Prints each run's median, 99th percentile and maximum, then the ratios loaded/off and
-# loaded/idle.
+# Prints each run's median, 99th percentile and maximum, from arrival and from the deadline the
+# replay's pacing set (--latency's latency_from_due: the wake-up's lateness included), then the
+# ratios loaded/off and loaded/idle.
+#   --policy   the monitor's scheduling (the others' stay as they are): other (default), nice
+#              (nice -n -10, as Nice=-10 would), fifo (chrt --fifo --reset-on-fork 50: the loop's
+#              thread alone, as the unit's CPUSchedulingPolicy=fifo, CPUSchedulingPriority=50,
+#              CPUSchedulingResetOnFork=yes); docs/install.md, "Real-time scheduling"
+#   --hogs N   N busy loops (one process each, at the default priority) for the whole run: other
+#              work competing for the cores
 #
 # Usage: tools/latency-under-load.sh [--monitor PATH] [--speed FACTOR] [--pollers N]
+#                                    [--policy other|nice|fifo] [--hogs N]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 MONITOR=build/release/firmware/linux/plinth-monitor
 SPEED=2
 POLLERS=4
+POLICY=other
+HOGS=0
 while (($# > 0)); do
   case $1 in
     --monitor) MONITOR=$2; shift 2 ;;
     --speed) SPEED=$2; shift 2 ;;
     --pollers) POLLERS=$2; shift 2 ;;
-    *) echo "usage: $0 [--monitor PATH] [--speed FACTOR] [--pollers N]" >&2; exit 2 ;;
+    --policy) POLICY=$2; shift 2 ;;
+    --hogs) HOGS=$2; shift 2 ;;
+    *) echo "usage: $0 [--monitor PATH] [--speed FACTOR] [--pollers N] [--policy other|nice|fifo] [--hogs N]" >&2
+       exit 2 ;;
   esac
 done
+case $POLICY in
+  other) SCHED=() ;;
+  nice) SCHED=(nice -n -10) ;;
+  fifo) SCHED=(chrt --fifo --reset-on-fork 50) ;;
+  *) echo "--policy: other, nice or fifo, got '$POLICY'" >&2; exit 2 ;;
+esac
 [[ -x "$MONITOR" ]] || { echo "$MONITOR: not an executable (build plinth-monitor)" >&2; exit 2; }
 for tool in mbpoll mosquitto_sub python3; do
   command -v "$tool" >/dev/null || { echo "$tool is missing (tools/install-deps.sh)" >&2; exit 2; }
@@ -42,6 +61,11 @@ trap cleanup EXIT
 free_port() {
   python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
 }
+
+for ((h = 0; h < HOGS; h++)); do
+  bash -c 'while :; do :; done' &
+  PIDS+=($!)
+done
 
 BROKER=$(free_port)
 printf 'listener %s 127.0.0.1\nallow_anonymous true\npersistence false\n' "$BROKER" \
@@ -61,7 +85,7 @@ common=(--scene sim/scenes/paper-isolated.toml --replay "$RECORD" --scale 20 --s
 run() {
   local name=$1
   shift
-  "$MONITOR" "${common[@]}" "$@" >"$WORK/$name.out" 2>"$WORK/$name.err" ||
+  "${SCHED[@]}" "$MONITOR" "${common[@]}" "$@" >"$WORK/$name.out" 2>"$WORK/$name.err" ||
     { echo "$name: plinth-monitor failed: $(head -c 300 "$WORK/$name.err")" >&2; exit 1; }
   tail -n 1 "$WORK/$name.out" >"$WORK/$name.json"
 }
@@ -78,7 +102,7 @@ outputs
 run idle --config "$WORK/box.toml"
 
 outputs
-"$MONITOR" "${common[@]}" --config "$WORK/box.toml" >"$WORK/loaded.out" 2>"$WORK/loaded.err" &
+"${SCHED[@]}" "$MONITOR" "${common[@]}" --config "$WORK/box.toml" >"$WORK/loaded.out" 2>"$WORK/loaded.err" &
 BOX=$!
 PIDS+=("$BOX")
 mosquitto_sub -h 127.0.0.1 -p "$BROKER" -t 'plinth/bench/#' -v >"$WORK/sub.out" 2>&1 &
@@ -96,16 +120,22 @@ tail -n 1 "$WORK/loaded.out" >"$WORK/loaded.json"
 polls=$(cat "$WORK"/poller*.out | grep -c '^\[31\]:' || true)
 messages=$(wc -l <"$WORK/sub.out")
 
-python3 - "$WORK" "$polls" "$messages" "$SPEED" "$POLLERS" <<'PY'
+python3 - "$WORK" "$polls" "$messages" "$SPEED" "$POLLERS" "$POLICY" "$HOGS" <<'PY'
 import json, sys
-work, polls, messages, speed, pollers = sys.argv[1:]
+work, polls, messages, speed, pollers = sys.argv[1:6]
 runs = {n: json.load(open("%s/%s.json" % (work, n))) for n in ("off", "idle", "loaded")}
 lat = {n: r["latency"] for n, r in runs.items()}
 print("per-sample latency, arrival to status ready (plinth-monitor --latency), replay at "
-      "--speed %s:" % speed)
+      "--speed %s, policy %s, %s busy loops:" % (speed, sys.argv[6], sys.argv[7]))
 print("%-7s %8s %10s %10s %10s" % ("run", "samples", "median_us", "p99_us", "max_us"))
 for n in ("off", "idle", "loaded"):
     l = lat[n]
+    print("%-7s %8d %10.3f %10.3f %10.3f" % (n, l["samples"], l["median_us"], l["p99_us"],
+                                            l["max_us"]))
+print("the same from each sample's deadline (the replay's pacing: the wake-up's lateness "
+      "included):")
+for n in ("off", "idle", "loaded"):
+    l = runs[n]["latency_from_due"]
     print("%-7s %8d %10.3f %10.3f %10.3f" % (n, l["samples"], l["median_us"], l["p99_us"],
                                             l["max_us"]))
 m = runs["loaded"]

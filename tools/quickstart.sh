@@ -3,10 +3,13 @@
 # on the bundled default: plinth-monitor replaying the paper's Fig. 8 case H (eccentric block on
 # the isolated base with stops, Buia 1976 record scaled by 6.5), showing the alarm timeline,
 # and the event recorder's capture drawn as a PNG (tools/plinth-event-plot).
+# It installs what building and running these programs needs (tools/install-deps.sh --build: no
+# test, emulation or cross tooling) and configures without the test suites; the second command
+# (tools/test-all.sh) installs the rest and configures them back in.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-tools/install-deps.sh
-cmake --preset release >/dev/null
+tools/install-deps.sh --build
+cmake --preset release -DPLINTH_BUILD_TESTS=OFF -DPLINTH_BUILD_BENCHMARKS=OFF >/dev/null
 cmake --build --preset release --target plinth-monitor plinth-sim
 echo
 echo "plinth-monitor: alarm changes and phase events (all status lines: build/release/quickstart.jsonl)"

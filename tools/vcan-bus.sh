@@ -461,14 +461,32 @@ route_qemu() {
   local accelerators=(-accel tcg)
   [ "$accel" = tcg ] || accelerators=(-accel kvm)
   [ "${PLINTH_QEMU_ACCEL:-auto}" != auto ] || [ "$accel" = tcg ] || accelerators+=(-accel tcg)
+  qemu_boot "${accelerators[@]}"
+  local status=0
+  collect qemu || status=$?
+  # QEMU's own fallback covers a KVM that cannot open, not one that aborts after (seen on an
+  # AMD host: "failed to set MSR 0x10a", an assertion in kvm_buf_set_msrs): in auto, a KVM
+  # guest that stopped before its init boots again under TCG.
+  if [ "$status" -eq 77 ] && [ "$accel" = kvm ] && [ "${PLINTH_QEMU_ACCEL:-auto}" = auto ]; then
+    echo "$me: route qemu: KVM stopped the guest before its init ($why); booting under TCG" >&2
+    why=""
+    accel=tcg
+    rm -f "$run"/{booted,started,status,stdout,stderr,setup-error,accel,console.log}
+    qemu_boot -accel tcg
+    status=0
+    collect qemu || status=$?
+  fi
+  return "$status"
+}
+
+qemu_boot() {  # ACCELERATOR OPTIONS...
   boot_guest "$run/qemu.log" qemu-system-x86_64 -nodefaults -no-user-config -machine pc \
-    "${accelerators[@]}" -cpu max -m "$mem" -smp "$cpus" -kernel "$kernel_image" \
+    "$@" -cpu max -m "$mem" -smp "$cpus" -kernel "$kernel_image" \
     -initrd "$run/initramfs.cpio" -append "console=ttyS0 panic=-1 quiet $qemu_kernel_options" \
     -virtfs local,path=/,mount_tag=hostroot,security_model=none,multidevs=remap \
     -chardev "file,id=console,path=$run/console.log" -serial chardev:console \
     -display none -monitor none -no-reboot
   [ ! -s "$run/accel" ] || accel=$(cat "$run/accel")
-  collect qemu
 }
 
 # --- Choosing -------------------------------------------------------------------------------

@@ -1,9 +1,10 @@
 #include "event_recorder.h"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <functional>
 
 #include "plinth/hal/candump_log.h"
 #include "plinth/host/input_error.h"
@@ -42,6 +43,11 @@ EventRecorder::EventRecorder(EventRecorderSettings settings) : settings_(std::mo
     throw host::InputError("event recorder: cannot create the directory '" + settings_.directory +
                            "': " + (ec ? ec.message() : std::string("not a directory")));
   }
+  if (!std::isfinite(settings_.test_pause_mid_write_s) || settings_.test_pause_mid_write_s < 0.0) {
+    throw bad("the test pause must be a finite number of seconds >= 0");
+  }
+  partial_files_removed_ = remove_partial_files(settings_.directory);
+  next_index_ = first_index_ = next_capture_index(scan_captures(settings_.directory));
   pre_ns_ = seconds_to_ns(settings_.pre_trigger_s);
   post_ns_ = seconds_to_ns(settings_.post_trigger_s);
   ring_.resize(frames_in(settings_.pre_trigger_s, settings_.frame_rate_hz));
@@ -81,6 +87,7 @@ void EventRecorder::on_frame(const hal::TimedFrame& frame) {
 void EventRecorder::trigger(const TriggerInfo& info, std::int64_t time_ns) {
   if (active_ != nullptr) {  // a later alarm within the capture: keep recording after it
     active_->end_ns = time_ns + post_ns_;
+    active_->reached_alarm = active_->reached_alarm || info.alarm;
     return;
   }
   {
@@ -103,6 +110,7 @@ void EventRecorder::trigger(const TriggerInfo& info, std::int64_t time_ns) {
   active_->trigger_ns = time_ns;
   active_->end_ns = time_ns + post_ns_;
   active_->index = next_index_++;
+  active_->reached_alarm = info.alarm;
 }
 
 void EventRecorder::flush() {
@@ -141,17 +149,14 @@ void EventRecorder::writer_loop() {
 }
 
 void EventRecorder::write(const Capture& c) {
-  char stem[64];
-  std::snprintf(stem, sizeof stem, "event-%03d", c.index);
-  const std::filesystem::path dir(settings_.directory);
-  const std::string log_path = (dir / (std::string(stem) + ".log")).string();
-  const std::string json_path = (dir / (std::string(stem) + ".json")).string();
-  std::ofstream log(log_path);
+  const std::string stem = capture_stem(c.index);
+  const std::string log_path = (std::filesystem::path(settings_.directory) / (stem + ".log")).string();
+  std::string log;
+  log.reserve(c.frames.size() * 48);
   for (const hal::TimedFrame& f : c.frames) {
-    log << hal::format_candump_line(f.timestamp_ns, settings_.interface_name, f.frame) << '\n';
+    log += hal::format_candump_line(f.timestamp_ns, settings_.interface_name, f.frame);
+    log += '\n';
   }
-  log.flush();
-  std::ofstream json(json_path);
   const double first = c.frames.empty() ? 0.0 : static_cast<double>(c.frames.front().timestamp_ns) * 1e-9;
   const double last = c.frames.empty() ? 0.0 : static_cast<double>(c.frames.back().timestamp_ns) * 1e-9;
   char numbers[256];
@@ -160,18 +165,48 @@ void EventRecorder::write(const Capture& c) {
                 "\"pre_trigger_s\":%g,\"post_trigger_s\":%g",
                 c.info.t, c.frames.size(), first, last, settings_.pre_trigger_s,
                 settings_.post_trigger_s);
-  json << "{\"event\":" << c.index << ",\"level\":\"" << c.info.level << "\",\"cause\":\""
-       << c.info.cause << "\"," << numbers << ",\"log\":\"" << log_path << '"';
-  if (!c.info.detail.empty()) json << ',' << c.info.detail;
-  json << "}\n";
-  json.flush();
-  if (!log || !json) {
-    write_errors_.fetch_add(1);
+  std::string json = "{\"event\":" + std::to_string(c.index) + ",\"level\":\"" + c.info.level +
+                     "\",\"highest_level\":\"" + (c.reached_alarm ? "alarm" : c.info.level) +
+                     "\",\"cause\":\"" + c.info.cause + "\"," + numbers + ",\"log\":\"" + log_path +
+                     '"';
+  if (!c.info.detail.empty()) json += ',' + c.info.detail;
+  if (!settings_.identity_json.empty()) json += ',' + settings_.identity_json;
+  json += "}\n";
+  // The log, then its summary, each whole under its final name or not at all; the folder last.
+  std::string error;
+  const auto pause = [this] {
+    std::this_thread::sleep_for(std::chrono::duration<double>(settings_.test_pause_mid_write_s));
+  };
+  const bool ok =
+      write_file_whole(settings_.directory, stem + ".log", log, error,
+                       settings_.test_pause_mid_write_s > 0.0 ? pause : std::function<void()>()) &&
+      write_file_whole(settings_.directory, stem + ".json", json, error) &&
+      commit_folder(settings_.directory, error);
+  if (!ok) {
+    if (write_errors_.fetch_add(1) == 0) {  // once: a full disk must not flood stderr
+      std::fprintf(stderr, "plinth-monitor: event recorder: %s\n", error.c_str());
+    }
     return;
   }
   written_.fetch_add(1);
-  const std::lock_guard lock(mutex_);
-  paths_.push_back(log_path);
+  {
+    const std::lock_guard lock(mutex_);
+    paths_.push_back(log_path);
+  }
+  keep_retention();
+}
+
+void EventRecorder::keep_retention() {
+  const RetentionLimits& limits = settings_.retention;
+  if (limits.max_captures == 0 && limits.max_bytes == 0) return;
+  const std::filesystem::path dir(settings_.directory);
+  for (const int index : captures_to_delete(scan_captures(settings_.directory), limits)) {
+    std::error_code ec;
+    const std::string stem = capture_stem(index);
+    std::filesystem::remove(dir / (stem + ".log"), ec);
+    std::filesystem::remove(dir / (stem + ".json"), ec);
+    deleted_.fetch_add(1);
+  }
 }
 
 }  // namespace plinth::firmware

@@ -47,6 +47,7 @@ class RecordInput final : public MonitorInput {
         config_, static_cast<std::int64_t>(n_),
         n_ < lead_in_ ? Eigen::Vector3d::Zero() : record_.samples[n_ - lead_in_], kStandardGravity);
     if (!pacer_.wait_until(item.sample.receive_time_ns, stop_)) return false;
+    item.due_ns = pacer_.paced() ? pacer_.deadline_ns(item.sample.receive_time_ns) : 0;
     item.kind = InputItem::Kind::kSample;
     item.has_frame = frames_ && encode_frame(item.sample, item.frame);
     ++n_;

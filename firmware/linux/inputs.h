@@ -31,6 +31,9 @@ struct InputItem {
   bool has_frame = false;
   std::int64_t time_ns = 0;
   bool bus_fault = false;
+  // A paced replay's item: the CLOCK_MONOTONIC time it was due at (--latency measures from it
+  // too, the wake-up's lateness included); 0 otherwise.
+  std::int64_t due_ns = 0;
 };
 
 // Live bus trouble, for the summary.

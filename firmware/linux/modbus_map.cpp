@@ -25,6 +25,15 @@ constexpr Point counter(int address, const char* name, const char* json, const c
   return {Table::kRegister, address, 2,    Type::kUint32, name, "1", "", false,
           Codes::kPlain,     -1,      json, meaning};
 }
+// A file's two points: given (1 or 0), then its digest's leading 64 bits.
+constexpr Point file_given(int address, const char* name, const char* meaning) {
+  return word(address, name, "", meaning);
+}
+constexpr Point file_digest(int address, const char* name, const char* json,
+                            const char* meaning) {
+  return {Table::kRegister, address, reg::kDigestWords, Type::kUint64, name, "1", "", true,
+          Codes::kPlain,     -1,      json,              meaning};
+}
 constexpr Point level_bit(monitor::AlarmLevel level, const char* name) {
   const int code = kAlarmLevelCodes.code(level);
   return {Table::kDiscreteInput, code, 1, Type::kBit, name, "1", "", false, Codes::kAlarmLevel,
@@ -78,7 +87,7 @@ constexpr std::array<Point, kPointCount> kPoints = {{
     word(reg::kCommands, "commands", "",
          "operator commands carried out (acknowledge and reset), modulo 65536"),
     word(reg::kAlarmEvents, "alarm_events", "", "alarm events so far, modulo 65536"),
-    word(reg::kMapVersion, "map_version", "", "the version of this map: 2"),
+    word(reg::kMapVersion, "map_version", "", "the version of this map: 3"),
     scaled(reg::kProbability, "probability", "0.0001", "", false, "status.probability",
            "the forecast's probability of a collapse within its horizon, 0 .. 1"),
     word(reg::kForecastAxis, "forecast_axis", "",
@@ -96,6 +105,23 @@ constexpr std::array<Point, kPointCount> kPoints = {{
      "git_description", "1", "", false, Codes::kPlain, -1, "version.git",
      "git describe of the source at build time (as --version prints it), ASCII, two "
      "characters a register (the first in the high byte), NUL-padded"},
+    file_given(reg::kSceneGiven, "scene_given",
+               "1: registers 72-75 hold the scene file's digest (--scene; always given)"),
+    file_digest(reg::kSceneSha256, "scene_sha256", "first_status.scene_sha256",
+                "the scene file's SHA-256, its leading 64 bits (sha256sum's first 16 hex "
+                "digits), high word first"),
+    file_given(reg::kSceneYGiven, "scene_y_given",
+               "1: registers 77-80 hold the second axis's scene file's digest; 0: one axis, no "
+               "such file (registers 77-80 read 65535)"),
+    file_digest(reg::kSceneYSha256, "scene_y_sha256", "first_status.scene_y_sha256",
+                "the second axis's scene file's SHA-256 (--scene-y or monitor.second_scene), "
+                "its leading 64 bits, high word first; 65535 in each register without one"),
+    file_given(reg::kConfigGiven, "config_given",
+               "1: registers 82-85 hold the box file's digest; 0: no --config (registers 82-85 "
+               "read 65535)"),
+    file_digest(reg::kConfigSha256, "config_sha256", "first_status.config_sha256",
+                "the box's configuration file's SHA-256 (--config), its leading 64 bits, high "
+                "word first; 65535 in each register without one"),
     level_bit(monitor::AlarmLevel::kNormal, "level_normal"),
     level_bit(monitor::AlarmLevel::kAdvisory, "level_advisory"),
     level_bit(monitor::AlarmLevel::kWarning, "level_warning"),
@@ -124,7 +150,7 @@ constexpr bool contiguous() {
   return next == reg::kCount && bits == discrete::kCount;
 }
 static_assert(contiguous());
-static_assert(kMapVersion == 2, "the map_version row says 2");
+static_assert(kMapVersion == 3, "the map_version row says 3");
 
 void put16(std::uint16_t* r, int address, std::uint64_t value) {
   r[address] = static_cast<std::uint16_t>(value & 0xFFFFU);
@@ -216,9 +242,10 @@ constexpr NameTable<Table, 3> kTableFunctions{{{
     {Table::kDiscreteInput, "02"},
     {Table::kCoil, "01 05 15"},
 }}};
-constexpr NameTable<Type, 4> kTypeNames{{{
+constexpr NameTable<Type, 5> kTypeNames{{{
     {Type::kUint16, "uint16"},
     {Type::kUint32, "uint32"},
+    {Type::kUint64, "uint64"},
     {Type::kAscii, "ascii"},
     {Type::kBit, "bit"},
 }}};
@@ -274,24 +301,42 @@ void fill(const StatusSnapshot& s, std::uint64_t alarm_events, Image& out) {
                              : static_cast<std::uint16_t>(std::clamp(collapse_in_ms, 0.0,
                                                                      kNone - 1.0)));
   put16(r, reg::kForecastWorstMember, index_or_none(s.forecast_worst_member));
+  for (int i = 0; i < discrete::kCount; ++i) {
+    out.discrete_inputs[static_cast<std::size_t>(i)] = kAlarmLevelCodes.code(s.level) == i ? 1 : 0;
+  }
+}
+
+void fill_identity(const RunIdentity& identity, Image& out) {
+  std::uint16_t* r = out.registers.data();
   const std::array<std::uint16_t, 3> version = version_numbers();
   put16(r, reg::kVersionMajor, version[0]);
   put16(r, reg::kVersionMinor, version[1]);
   put16(r, reg::kVersionPatch, version[2]);
   put_text(r, reg::kGitDescription, reg::kGitDescriptionWords, kGitDescription);
-  for (int i = 0; i < discrete::kCount; ++i) {
-    out.discrete_inputs[static_cast<std::size_t>(i)] = kAlarmLevelCodes.code(s.level) == i ? 1 : 0;
+  const struct {
+    int given;
+    int digest;
+    const std::optional<Sha256Digest>& value;
+  } files[] = {{reg::kSceneGiven, reg::kSceneSha256, identity.scene},
+               {reg::kSceneYGiven, reg::kSceneYSha256, identity.scene_y},
+               {reg::kConfigGiven, reg::kConfigSha256, identity.config}};
+  for (const auto& f : files) {
+    put16(r, f.given, f.value ? 1 : 0);
+    const std::uint64_t bits = f.value ? leading_64_bits(*f.value) : ~std::uint64_t{0};
+    for (int i = 0; i < reg::kDigestWords; ++i) {
+      put16(r, f.digest + i, bits >> (16 * (reg::kDigestWords - 1 - i)));
+    }
   }
 }
 
 std::string map_csv() {
   std::string out = "table,functions,address,words,name,type,scale,unit,none,codes,json,meaning\n";
   for (const Point& p : kPoints) {
+    const char* none = !p.none ? "" : p.type == Type::kUint64 ? "18446744073709551615" : "65535";
     out += std::string(kTableNames.name(p.table)) + "," + kTableFunctions.name(p.table) + "," +
            std::to_string(p.address) + "," + std::to_string(p.words) + "," + p.name + "," +
-           kTypeNames.name(p.type) + "," + p.scale + "," + p.unit + "," +
-           (p.none ? "65535" : "") + "," + field(codes_text(p)) + "," + p.json + "," +
-           field(p.meaning) + "\n";
+           kTypeNames.name(p.type) + "," + p.scale + "," + p.unit + "," + none + "," +
+           field(codes_text(p)) + "," + p.json + "," + field(p.meaning) + "\n";
   }
   return out;
 }

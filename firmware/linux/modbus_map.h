@@ -16,13 +16,15 @@
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/sensor_health.h"
+#include "run_identity.h"
 #include "status_outputs.h"
 
 namespace plinth::firmware::modbus {
 
 inline constexpr std::uint16_t kNone = 0xFFFF;  // a register with no value (yet)
-inline constexpr std::uint16_t kMapVersion = 2;  // register 31; 2: holding registers, discrete
-                                                 // inputs, causes 10-11, forecast, version
+inline constexpr std::uint16_t kMapVersion = 3;  // register 31; 2: holding registers, discrete
+                                                 // inputs, causes 10-11, forecast, version;
+                                                 // 3: the files' digests
 
 template <class Enum>
 struct Code {
@@ -111,8 +113,8 @@ static_assert(pins_every_value(kHealthStateCodes, monitor::kHealthStateNames));
 static_assert(pins_every_value(kAckOutcomeCodes, monitor::kAckOutcomeNames));
 
 // Registers (functions 03 and 04 read the same values), 0-based addresses. 32-bit values: two
-// registers, the high word first; text: two ASCII characters a register, the first in the high
-// byte, NUL-padded.
+// registers, the high word first; 64-bit values: four, the highest word first; text: two ASCII
+// characters a register, the first in the high byte, NUL-padded.
 namespace reg {
 inline constexpr int kAlarmLevel = 0;     // kAlarmLevelCodes
 inline constexpr int kHeartbeat = 1;      // status reports, modulo 65536
@@ -147,7 +149,16 @@ inline constexpr int kVersionMinor = 37;
 inline constexpr int kVersionPatch = 38;
 inline constexpr int kGitDescription = 39;  // kGitDescription, kGitDescriptionWords registers
 inline constexpr int kGitDescriptionWords = 32;  // 64 characters
-inline constexpr int kCount = 71;
+// Each file the box runs (run_identity.h): 1 while it was given, then its SHA-256's leading 64
+// bits (kDigestWords registers); a file not given reads 0, then kNone in each register.
+inline constexpr int kSceneGiven = 71;
+inline constexpr int kSceneSha256 = 72;
+inline constexpr int kSceneYGiven = 76;
+inline constexpr int kSceneYSha256 = 77;
+inline constexpr int kConfigGiven = 81;
+inline constexpr int kConfigSha256 = 82;
+inline constexpr int kDigestWords = 4;
+inline constexpr int kCount = 86;
 }  // namespace reg
 
 // Discrete inputs (function 02): one per alarm level, 1 while that level is shown (exactly one
@@ -164,7 +175,7 @@ inline constexpr int kCount = 2;
 }  // namespace coil
 
 enum class Table : std::uint8_t { kRegister, kDiscreteInput, kCoil };
-enum class Type : std::uint8_t { kUint16, kUint32, kAscii, kBit };
+enum class Type : std::uint8_t { kUint16, kUint32, kUint64, kAscii, kBit };
 enum class Codes : std::uint8_t {
   kPlain,
   kAlarmLevel,
@@ -184,7 +195,7 @@ struct Point {
   const char* name;
   const char* scale;  // the quantity is the raw value times this
   const char* unit;   // of the quantity; "" for codes and counts
-  bool none;          // kNone (65535) means "no value"
+  bool none;          // kNone (65535; in each register of a uint64) means "no value"
   Codes codes;
   int bit_code;       // a discrete input: 1 while the field's code is this one; -1 otherwise
   const char* json;   // the field of the JSON lines with the same value, "" if none
@@ -192,7 +203,7 @@ struct Point {
 };
 
 // The rows, in the CSV's order: registers, discrete inputs, coils, each by address.
-inline constexpr std::size_t kPointCount = 39;
+inline constexpr std::size_t kPointCount = 45;
 [[nodiscard]] const std::array<Point, kPointCount>& points();
 
 // The values the server answers with.
@@ -201,8 +212,13 @@ struct Image {
   std::array<std::uint8_t, discrete::kCount> discrete_inputs{};
 };
 
-// The registers and discrete inputs of `snapshot`, with `alarm_events` alarm events so far.
+// The registers and discrete inputs of `snapshot`, with `alarm_events` alarm events so far; the
+// registers of the run's identity are left as they are.
 void fill(const StatusSnapshot& snapshot, std::uint64_t alarm_events, Image& out);
+
+// The registers that stay for a run: the version (36-70) and the files' digests (71-85), from
+// `identity`. Once, at start.
+void fill_identity(const RunIdentity& identity, Image& out);
 
 // modbus-map.csv: a header, then one line per point.
 [[nodiscard]] std::string map_csv();

@@ -14,6 +14,7 @@
 
 #include "modbus_map.h"
 #include "plinth/host/input_error.h"
+#include "socket_activation.h"
 #include "status_json.h"
 
 namespace plinth::firmware {
@@ -57,7 +58,9 @@ void check_resolves(const Endpoint& endpoint, const std::string& where) {
 
 }  // namespace
 
-ModbusServer::ModbusServer(const ModbusSettings& settings) : settings_(settings) {
+ModbusServer::ModbusServer(const ModbusSettings& settings, const RunIdentity& identity)
+    : settings_(settings) {
+  modbus::fill_identity(identity, image_);
   const Endpoint endpoint = parse_endpoint(settings.listen, settings.listen_where);
   check_resolves(endpoint, settings.listen_where);
   const std::string port = std::to_string(endpoint.port);
@@ -66,7 +69,9 @@ ModbusServer::ModbusServer(const ModbusSettings& settings) : settings_(settings)
     throw host::InputError(settings.listen_where + ": cannot listen at " + endpoint.text() + ": " +
                            modbus_strerror(errno));
   }
-  listen_socket_ = modbus_tcp_pi_listen(context_, settings.max_clients);
+  // Under systemd, the socket unit's listening socket (port 502 without privileges); else ours.
+  listen_socket_ = inherited_listening_socket("modbus", endpoint.port, settings.listen_where);
+  if (listen_socket_ < 0) listen_socket_ = modbus_tcp_pi_listen(context_, settings.max_clients);
   if (listen_socket_ < 0) {
     const int error = errno;
     modbus_free(context_);
@@ -111,11 +116,10 @@ void ModbusServer::refresh() {
 // The snapshot into the input registers, the holding registers (the same) and the discrete
 // inputs.
 void ModbusServer::publish_image() {
-  modbus::Image image;
-  modbus::fill(snapshot_, alarm_events_, image);
-  std::copy(image.registers.begin(), image.registers.end(), map_->tab_input_registers);
-  std::copy(image.registers.begin(), image.registers.end(), map_->tab_registers);
-  std::copy(image.discrete_inputs.begin(), image.discrete_inputs.end(), map_->tab_input_bits);
+  modbus::fill(snapshot_, alarm_events_, image_);
+  std::copy(image_.registers.begin(), image_.registers.end(), map_->tab_input_registers);
+  std::copy(image_.registers.begin(), image_.registers.end(), map_->tab_registers);
+  std::copy(image_.discrete_inputs.begin(), image_.discrete_inputs.end(), map_->tab_input_bits);
 }
 
 void ModbusServer::serve() {

@@ -10,6 +10,8 @@
 #include <string>
 #include <thread>
 
+#include "modbus_map.h"
+#include "run_identity.h"
 #include "status_outputs.h"
 
 struct _modbus;
@@ -27,9 +29,10 @@ struct ModbusSettings {
 
 class ModbusServer final : public StatusOutput {
  public:
-  // Listens at settings.listen now and serves on its own thread. Throws host::InputError
-  // naming settings.listen_where: an address that does not resolve, a port in use, ...
-  explicit ModbusServer(const ModbusSettings& settings);
+  // Listens at settings.listen now and serves on its own thread, `identity`'s version and
+  // digests in their registers for the whole run. Throws host::InputError naming
+  // settings.listen_where: an address that does not resolve, a port in use, ...
+  ModbusServer(const ModbusSettings& settings, const RunIdentity& identity);
   ~ModbusServer() override;
   ModbusServer(const ModbusServer&) = delete;
   ModbusServer& operator=(const ModbusServer&) = delete;
@@ -51,6 +54,7 @@ class ModbusServer final : public StatusOutput {
   _modbus_mapping_t* map_ = nullptr;
   int listen_socket_ = -1;
   OutputMailbox mailbox_;
+  modbus::Image image_;      // the identity's registers written once, the rest at each refresh
   StatusSnapshot snapshot_;  // the serving thread's newest
   std::uint64_t alarm_events_ = 0;
   std::atomic<bool> stopping_{false};

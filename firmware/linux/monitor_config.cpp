@@ -56,6 +56,17 @@ std::function<bool(const toml::node&)> integer_into(int& target) {
   };
 }
 
+// A count or size: an integer from 0 to 2^53.
+std::function<bool(const toml::node&)> count_into(std::uint64_t& target) {
+  return [&target](const toml::node& n) {
+    if (!n.is_integer()) return false;
+    const std::int64_t v = n.value<std::int64_t>().value_or(-1);
+    if (v < 0 || v > (std::int64_t{1} << 53)) return false;
+    target = static_cast<std::uint64_t>(v);
+    return true;
+  };
+}
+
 std::function<bool(const toml::node&)> flag_into(bool& target) {
   return [&target](const toml::node& n) {
     if (!n.is_boolean()) return false;
@@ -224,6 +235,12 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
   relay_bindings(b, f.relays, relay_active_low);
   b.push_back({"watchdog.notify", flag_into(f.watchdog.notify), "true or false"});
   b.push_back({"watchdog.test_stall_after_s", number_into(f.watchdog.test_stall_after_s),
+               "a number (s; test only)"});
+  b.push_back({"recorder.max_captures", count_into(f.recorder.retention.max_captures),
+               "an integer from 0 (no limit) to 2^53"});
+  b.push_back({"recorder.max_bytes", count_into(f.recorder.retention.max_bytes),
+               "an integer from 0 (no limit) to 2^53"});
+  b.push_back({"recorder.test_pause_mid_write_s", number_into(f.recorder.test_pause_mid_write_s),
                "a number (s; test only)"});
   output_bindings(b, f.modbus, f.mqtt);
   for (auto [name, thresholds] : {std::pair<const char*, monitor::RiskThresholds*>{"advisory", &alarm.advisory},
@@ -529,6 +546,11 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   if (!std::isfinite(file.watchdog.test_stall_after_s) || file.watchdog.test_stall_after_s < 0.0) {
     lines.fail("watchdog.test_stall_after_s",
                "watchdog.test_stall_after_s: must be a finite number of seconds >= 0");
+  }
+  if (!std::isfinite(file.recorder.test_pause_mid_write_s) ||
+      file.recorder.test_pause_mid_write_s < 0.0 || file.recorder.test_pause_mid_write_s > 600.0) {
+    lines.fail("recorder.test_pause_mid_write_s",
+               "recorder.test_pause_mid_write_s: must be a number of seconds in [0, 600]");
   }
   check(file.config, lines);
   check_outputs(file, lines, origin);

@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "capture_store.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/firmware/record_replay.h"
 #include "modbus_server.h"
@@ -15,11 +16,19 @@
 
 namespace plinth::firmware {
 
+// [recorder]: the event recorder's folder (docs/monitor.md, "Event recorder").
+struct RecorderFileSettings {
+  RetentionLimits retention;  // recorder.max_captures, recorder.max_bytes (0: no limit)
+  // recorder.test_pause_mid_write_s, TEST ONLY (event_recorder.h); a box never sets it.
+  double test_pause_mid_write_s = 0.0;
+};
+
 struct MonitorFile {
   MonitorConfig config;
   std::string second_scene_path;  // monitor.second_scene, resolved against the file's folder
   RelaySettings relays;           // [relays]
   WatchdogSettings watchdog;      // [watchdog]
+  RecorderFileSettings recorder;  // [recorder]
   ModbusSettings modbus;          // [modbus]
   MqttSettings mqtt;              // [mqtt]
 };

@@ -102,7 +102,11 @@ extern "C" void log_callback(mosquitto*, void* self, int level, const char* text
 
 }  // namespace
 
-MqttPublisher::MqttPublisher(const MqttSettings& settings) : settings_(settings) {
+MqttPublisher::MqttPublisher(const MqttSettings& settings, const RunIdentity& identity)
+    : settings_(settings) {
+  for (const NamedDigest& d : named_digests(identity)) {
+    digests_.push_back({d.member, d.file, d.digest->has_value() ? hex(**d.digest) : ""});
+  }
   static std::once_flag library;
   std::call_once(library, [] { mosquitto_lib_init(); });
   const Endpoint endpoint = parse_endpoint(settings.broker, settings.broker_where);
@@ -404,8 +408,9 @@ void MqttPublisher::take_results() {
 }
 
 // Home Assistant MQTT discovery: retained configs under DISCOVERY/<component>/<node>/<object>/
-// for the level, the latched level, the risk, the forecast's probability, the connection and,
-// with commands on, an acknowledge button; one device per box.
+// for the level, the latched level, the risk, the forecast's probability, the connection, the
+// digest of each file given (diagnostic: a device block has no key for them) and, with commands
+// on, an acknowledge button; one device per box.
 void MqttPublisher::publish_discovery() {
   if (!settings_.discovery) return;
   std::string node = "plinth_" + settings_.box_id;  // [A-Za-z0-9_-] only in discovery topics
@@ -453,6 +458,13 @@ void MqttPublisher::publish_discovery() {
          state_sensor("Collapse probability", "{{ value_json.forecast.probability }}")
              .text("state_class", "measurement")
              .count("suggested_display_precision", 4));
+  for (const DigestMember& d : digests_) {
+    if (d.hex.empty()) continue;
+    const std::string value_template = "{{ value_json." + d.member + " }}";
+    config("sensor", d.member.c_str(),
+           state_sensor((d.file + " SHA-256").c_str(), value_template.c_str())
+               .text("entity_category", "diagnostic"));
+  }
   config("binary_sensor", "availability",
          JsonObject()
              .text("name", "Online")
@@ -500,8 +512,8 @@ std::string MqttPublisher::state_json() const {
                                    .count("rejected", c.non_finite + c.out_of_range +
                                                           c.undefined_status)
                                    .close();
-  return JsonObject()
-      .text("box", settings_.box_id)
+  JsonObject state;
+  state.text("box", settings_.box_id)
       .fixed("t", s.t, 6)
       .text("time", utc_text(s.wall_time_ns))
       .text("level", monitor::alarm_level_name(s.level))
@@ -519,8 +531,11 @@ std::string MqttPublisher::state_json() const {
       .raw("version", JsonObject()
                           .text("project", kProjectVersion)
                           .text("git", kGitDescription)
-                          .close())
-      .close();
+                          .close());
+  for (const DigestMember& d : digests_) {
+    state.raw(d.member, d.hex.empty() ? "null" : host::json_quoted(d.hex));
+  }
+  return state.close();
 }
 
 void MqttPublisher::publish_state(std::int64_t now_ns) {

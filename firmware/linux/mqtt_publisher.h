@@ -1,6 +1,6 @@
 // plinth-monitor's MQTT client (libmosquitto), on its own thread (status_outputs.h):
 //   PREFIX/BOX/state          retained JSON: level, latched, cause, risk, the forecast, phase per
-//                             axis, sensor counters, version, times
+//                             axis, sensor counters, version and the files' digests, times
 //   PREFIX/BOX/events         every alarm line, QoS 1, in order
 //   PREFIX/BOX/availability   retained "online"; the Last Will, and a clean stop, say "offline"
 //   PREFIX/BOX/command        the operator's acknowledgement (subscribed; mqtt.commands)
@@ -22,6 +22,7 @@
 #include <thread>
 #include <vector>
 
+#include "run_identity.h"
 #include "status_outputs.h"
 
 struct mosquitto;
@@ -55,8 +56,9 @@ struct MqttSettings {
 class MqttPublisher final : public StatusOutput {
  public:
   // Checks the settings (the password and TLS files are read now: a missing one is an
-  // host::InputError naming its key and flag), then connects on its own thread.
-  explicit MqttPublisher(const MqttSettings& settings);
+  // host::InputError naming its key and flag), then connects on its own thread. The state
+  // carries `identity`'s digests for the whole run.
+  MqttPublisher(const MqttSettings& settings, const RunIdentity& identity);
   ~MqttPublisher() override;
   MqttPublisher(const MqttPublisher&) = delete;
   MqttPublisher& operator=(const MqttPublisher&) = delete;
@@ -100,6 +102,12 @@ class MqttPublisher final : public StatusOutput {
   [[nodiscard]] std::string state_json() const;
 
   MqttSettings settings_;
+  struct DigestMember {
+    std::string member;  // "scene_sha256", ...
+    std::string file;    // "Scene", ...
+    std::string hex;     // "" when the file was not given
+  };
+  std::vector<DigestMember> digests_;  // the run's identity, written once
   std::string endpoint_text_;  // "HOST:PORT (where)"
   std::string host_;
   int port_ = 0;

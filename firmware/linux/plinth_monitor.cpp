@@ -34,6 +34,7 @@
 #include "plinth/host/scene_toml.h"
 #include "relay_gpiod.h"
 #include "relay_outputs.h"
+#include "run_identity.h"
 #include "sample_trace.h"
 #include "status_json.h"
 #include "supervisor.h"
@@ -150,10 +151,15 @@ class Outputs {
         totals.max_level = e.level;
       }
       if (e.level == mon::AlarmLevel::kWarning || e.level == mon::AlarmLevel::kAlarm) trigger(e);
+      if (supervisor != nullptr) {
+        supervisor->alarm_changed(e, static_cast<double>(e.time_ns) * 1e-9 - t_origin_);
+      }
       post_alarm(e);
     }
     if (u.status_due) {
-      print_line(fw::status_json(s, t_origin_));
+      // The first status line says what runs: the version, the scene and box files' digests.
+      print_line(snapshot_.statuses == 0 ? fw::with_members(fw::status_json(s, t_origin_), identity)
+                                         : fw::status_json(s, t_origin_));
       ++snapshot_.statuses;
     }
     if (trace != nullptr) trace->after_update(monitor_);
@@ -200,6 +206,8 @@ class Outputs {
 
   fw::RunTotals totals;
   fw::SampleTrace* trace = nullptr;  // --trace
+  fw::Supervisor* supervisor = nullptr;  // STATUS= and the journal at each alarm change
+  std::string identity;  // run_identity.h's members, in the first status line
   std::int64_t last_frame_ns = 0;  // receive time of the newest frame (the recorder's clock)
 
  private:
@@ -214,6 +222,7 @@ class Outputs {
     std::snprintf(detail, sizeof detail, "\"risk\": %.4f, \"phase\": \"%s\"", s.risk,
                   plinth::phase_name(s.axes[0].mode.phase));
     info.detail = detail;
+    info.alarm = e.level == mon::AlarmLevel::kAlarm;
     recorder_->trigger(info, last_frame_ns);
   }
 
@@ -324,8 +333,9 @@ void start_monitor(fw::Monitor& monitor, const fw::MonitorConfig& config,
   throw InputError(message);
 }
 
-std::unique_ptr<fw::EventRecorder> make_recorder(const Options& opt,
-                                                 const fw::MonitorConfig& config) {
+std::unique_ptr<fw::EventRecorder> make_recorder(const Options& opt, const fw::MonitorFile& file,
+                                                 const std::string& identity) {
+  const fw::MonitorConfig& config = file.config;
   if (opt.record_dir.empty()) return nullptr;
   fw::EventRecorderSettings rs;
   rs.directory = opt.record_dir;
@@ -333,6 +343,9 @@ std::unique_ptr<fw::EventRecorder> make_recorder(const Options& opt,
   rs.pre_trigger_s = opt.pre_trigger;
   rs.post_trigger_s = opt.post_trigger;
   rs.frame_rate_hz = 2.0 * config.estimator.sample_rate_hz + 100.0;
+  rs.retention = file.recorder.retention;
+  rs.test_pause_mid_write_s = file.recorder.test_pause_mid_write_s;
+  rs.identity_json = identity;
   return std::make_unique<fw::EventRecorder>(rs);
 }
 
@@ -349,7 +362,7 @@ std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings)
 template <typename Restart>
 bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
               fw::EventRecorder* recorder, fw::Supervisor& supervisor, fw::LatencyLog* latency,
-              Restart restart) {
+              fw::LatencyLog* due_latency, Restart restart) {
   supervisor.ready("monitoring " + input.source());
   fw::InputItem item;
   bool estimated = false;
@@ -359,7 +372,9 @@ bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
     estimated = estimated || monitor.status().estimating;
     if (latency != nullptr && item.kind != fw::InputItem::Kind::kTick &&
         item.kind != fw::InputItem::Kind::kBusFault) {
-      latency->add(fw::monotonic_ns() - arrival_ns);
+      const std::int64_t ready_ns = fw::monotonic_ns();
+      latency->add(ready_ns - arrival_ns);
+      if (item.due_ns > 0) due_latency->add(ready_ns - item.due_ns);
     }
     outputs.carry_out_commands(monitor, restart);
     const std::int64_t now_ns = plinth::hal::monotonic_now_ns();
@@ -409,6 +424,9 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
     t.captures_written = recorder->captures_written();
     t.captures_dropped = recorder->captures_dropped();
     t.recorder_write_errors = recorder->write_errors();
+    t.captures_deleted = recorder->captures_deleted();
+    t.recorder_first_index = static_cast<std::uint64_t>(recorder->first_index());
+    t.partial_files_removed = static_cast<std::uint64_t>(recorder->partial_files_removed());
   }
   return t;
 }
@@ -416,13 +434,16 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
 // Samples whose latency --latency keeps (4 bytes each); later ones are counted only.
 constexpr std::size_t kLatencyCapacity = std::size_t{1} << 22;
 
-// The outputs off the loop that the configuration enables.
-std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFile& file) {
+// The outputs off the loop that the configuration enables, each given the run's identity once.
+std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFile& file,
+                                                             const fw::RunIdentity& identity) {
   std::vector<std::unique_ptr<fw::StatusOutput>> outputs;
   if (!file.modbus.listen.empty()) {
-    outputs.push_back(std::make_unique<fw::ModbusServer>(file.modbus));
+    outputs.push_back(std::make_unique<fw::ModbusServer>(file.modbus, identity));
   }
-  if (!file.mqtt.broker.empty()) outputs.push_back(std::make_unique<fw::MqttPublisher>(file.mqtt));
+  if (!file.mqtt.broker.empty()) {
+    outputs.push_back(std::make_unique<fw::MqttPublisher>(file.mqtt, identity));
+  }
   return outputs;
 }
 
@@ -475,7 +496,10 @@ int run(const Options& opt, const CLI::App& app) {
     sinks.emplace_back(i, monitor, input->t_origin(), !opt.quiet_events);
     monitor.set_event_sink(i, &sinks.back());
   }
-  const std::unique_ptr<fw::EventRecorder> recorder = make_recorder(opt, config);
+  const fw::RunIdentity run_identity =
+      fw::run_identity(opt.scene_path, file.second_scene_path, opt.config.config_path);
+  const std::string identity = fw::identity_members(run_identity);
+  const std::unique_ptr<fw::EventRecorder> recorder = make_recorder(opt, file, identity);
   // --frames-out: the frames a replay sends, stamped with the receive time of the input that
   // caused them (what candump on the bus would show).
   const Outputs* frames_clock = nullptr;
@@ -492,7 +516,7 @@ int run(const Options& opt, const CLI::App& app) {
     std::setvbuf(stdout, nullptr, _IOLBF, 0);
   }
   const std::unique_ptr<fw::RelayOutputs> relays = make_relays(file.relays);
-  const std::vector<std::unique_ptr<fw::StatusOutput>> network = start_outputs(file);
+  const std::vector<std::unique_ptr<fw::StatusOutput>> network = start_outputs(file, run_identity);
   std::vector<fw::StatusOutput*> output_list;
   for (const auto& o : network) output_list.push_back(o.get());
   Outputs outputs(monitor, input->t_origin(), recorder.get(), bus, relays.get(), output_list);
@@ -502,13 +526,20 @@ int run(const Options& opt, const CLI::App& app) {
     outputs.trace = &trace.emplace(opt.trace_path, config.axis_count, input->t_origin());
   }
   std::optional<fw::LatencyLog> latency;
-  if (opt.latency) latency.emplace(kLatencyCapacity);
+  std::optional<fw::LatencyLog> due_latency;  // a paced replay: from each sample's deadline
+  if (opt.latency) {
+    latency.emplace(kLatencyCapacity);
+    due_latency.emplace(kLatencyCapacity);
+  }
   fw::Supervisor supervisor(file.watchdog);
+  outputs.supervisor = &supervisor;
+  outputs.identity = identity;
   const auto restart = [&] {
     start_monitor(monitor, config, scene_x, scene_y, app, opt.config.config_path);
   };
   const bool estimated = run_loop(*input, monitor, outputs, recorder.get(), supervisor,
-                                  latency ? &*latency : nullptr, restart);
+                                  latency ? &*latency : nullptr,
+                                  due_latency ? &*due_latency : nullptr, restart);
   if (trace) trace->close();
   if (recorder) recorder->close();  // every capture is on disk before the summary
   if (frames_log && !frames_log->flush()) throw InputError("--frames-out: " + frames_log->error());
@@ -519,6 +550,9 @@ int run(const Options& opt, const CLI::App& app) {
     totals.outputs.emplace_back(o->name(), o->summary_json());
   }
   if (latency) totals.outputs.emplace_back("latency", latency->summary_json());
+  if (due_latency && input_settings.speed > 0.0) {
+    totals.outputs.emplace_back("latency_from_due", due_latency->summary_json());
+  }
   totals.input_fault = input_fault(*input, estimated);
   print_line(fw::summary_json(monitor, totals, input->t_origin()));
   std::fflush(stdout);

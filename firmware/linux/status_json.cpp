@@ -284,6 +284,9 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
                              .count("captures_written", totals.captures_written)
                              .count("captures_dropped", totals.captures_dropped)
                              .count("write_errors", totals.recorder_write_errors)
+                             .count("captures_deleted", totals.captures_deleted)
+                             .count("first_index", totals.recorder_first_index)
+                             .count("partial_files_removed", totals.partial_files_removed)
                              .close());
   }
   for (const auto& [key, json] : totals.outputs) line.raw(key, json);

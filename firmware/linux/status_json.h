@@ -68,6 +68,9 @@ struct RunTotals {
   std::uint64_t captures_written = 0;
   std::uint64_t captures_dropped = 0;
   std::uint64_t recorder_write_errors = 0;
+  std::uint64_t captures_deleted = 0;       // by the retention limit
+  std::uint64_t recorder_first_index = 0;   // this run's first capture number
+  std::uint64_t partial_files_removed = 0;  // left by a process killed while writing
   // Members written already, after the others: the outputs' counters ("modbus": {...}, ...).
   std::vector<std::pair<std::string, std::string>> outputs;
 };

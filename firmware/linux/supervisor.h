@@ -1,15 +1,26 @@
 // Supervision by systemd (sd_notify(3), libsystemd): READY=1 once the loop runs, WATCHDOG=1
 // from the loop while it makes progress, at half the service's WatchdogSec (WATCHDOG_USEC), so
-// a loop that hangs is killed and restarted (firmware/linux/systemd/plinth-monitor.service,
-// docs/relays-and-supervision.md). Without NOTIFY_SOCKET (not under systemd) it sends nothing.
-// Host code: may allocate and throw.
+// a loop that hangs is killed and restarted (firmware/linux/systemd/plinth-monitor@.service,
+// docs/relays-and-supervision.md); STATUS= kept at the alarm level shown, for `systemctl
+// status`. Without NOTIFY_SOCKET (not under systemd) it sends nothing. Under systemd (a service
+// has INVOCATION_ID) each alarm change also goes to the journal (sd_journal_send(3)) at its own
+// priority with structured fields: PLINTH_ALARM_LEVEL, PLINTH_ALARM_PREVIOUS, PLINTH_ALARM_CAUSE,
+// PLINTH_ALARM_T (s), PLINTH_ALARM_LATCHED, PLINTH_ALARM_SEQUENCE. Host code: may allocate and
+// throw.
 #pragma once
 
 #include <csignal>
 #include <cstdint>
 #include <string>
 
+#include "plinth/monitor/alarm_policy.h"
+
 namespace plinth::firmware {
+
+// The journal's priority (syslog(3)) of a change to `level`: alarm LOG_ALERT (1); warning and
+// fault LOG_CRIT (2); advisory LOG_WARNING (4); back to normal LOG_NOTICE (5). The box's other
+// messages (its JSON lines on stdout) are LOG_INFO (6).
+[[nodiscard]] int journal_priority(monitor::AlarmLevel level);
 
 // The box's [watchdog] table.
 struct WatchdogSettings {
@@ -34,6 +45,10 @@ class Supervisor {
   }
   // STOPPING=1: the loop ended (input done, a signal, --duration).
   void stopping();
+  // An alarm change (t in s, the status lines' time): STATUS= with the level now, and the
+  // journal entry. Called on the loop at each change only (a datagram each, no waiting).
+  void alarm_changed(const monitor::AlarmEventRecord& event, double t);
+  [[nodiscard]] std::uint64_t journal_entries() const { return journal_entries_; }
 
   // TEST ONLY (watchdog.test_stall_after_s): true once the stall is due at `now_ns`.
   [[nodiscard]] bool stall_due(std::int64_t now_ns) const {
@@ -52,6 +67,10 @@ class Supervisor {
   void notify(const char* state);
 
   bool enabled_;
+  bool journal_ = false;  // under systemd (INVOCATION_ID)
+  std::string source_;    // "monitoring can0", the STATUS= lines' end
+  std::uint64_t journal_entries_ = 0;
+  std::uint64_t journal_errors_ = 0;
   std::int64_t interval_ns_ = 0;
   std::int64_t next_ping_ns_ = 0;
   std::int64_t stall_after_ns_ = 0;

@@ -74,7 +74,9 @@ struct ThresholdCase {
 };
 
 struct Options {
-  std::string source_dir = PLINTH_SOURCE_DIR;
+  std::string source_dir;  // a checkout; empty: find_data (the install's, or the build's checkout)
+  std::string scenes_dir;  // set by find_data
+  std::string records_dir;
   std::string out_dir = ".";
   bool plot = false;
   bool quick = false;
@@ -152,9 +154,9 @@ struct Input {
 Input load(const Options& opt, const Case& c) {
   Input in;
   in.c = &c;
-  in.scene = plinth::host::load_scene_file(opt.source_dir + "/sim/scenes/" + c.scene + ".toml");
+  in.scene = plinth::host::load_scene_file(opt.scenes_dir + "/" + c.scene + ".toml");
   if (!c.record.empty()) {
-    in.record = plinth::host::read_record(opt.source_dir + "/sim/data/records/" + c.record + ".AT2",
+    in.record = plinth::host::read_record(opt.records_dir + "/" + c.record + ".AT2",
                                           in.scene.g);
   }
   return in;
@@ -643,17 +645,56 @@ int run(const Options& opt) {
   return 0;
 }
 
+// The bundled scenes and records: --source-dir's checkout; else, installed (PREFIX/bin/
+// plinth-accuracy), PREFIX/share/plinth's; else the checkout holding the build tree the program
+// runs from (the first folder above it with sim/scenes). No path is compiled in.
+void find_data(Options& opt) {
+  namespace fs = std::filesystem;
+  const auto use_checkout = [&opt](const fs::path& root) {
+    opt.scenes_dir = (root / "sim" / "scenes").string();
+    opt.records_dir = (root / "sim" / "data" / "records").string();
+  };
+  if (!opt.source_dir.empty()) {
+    use_checkout(opt.source_dir);
+    return;
+  }
+  std::error_code ec;
+  const fs::path program = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw InputError("cannot find the bundled scenes (/proc/self/exe: " + ec.message() +
+                           "): give --source-dir");
+  const fs::path installed = program.parent_path().parent_path() / "share" / "plinth";
+  if (fs::is_directory(installed / "scenes") && fs::is_directory(installed / "records")) {
+    opt.scenes_dir = (installed / "scenes").string();
+    opt.records_dir = (installed / "records").string();
+    return;
+  }
+  for (fs::path dir = program.parent_path(); !dir.empty() && dir != dir.parent_path();
+       dir = dir.parent_path()) {
+    if (fs::is_directory(dir / "sim" / "scenes")) {
+      use_checkout(dir);
+      return;
+    }
+  }
+  throw InputError("the bundled scenes and records are neither in " + installed.string() +
+                   " nor in a checkout above " + program.parent_path().string() +
+                   ": give --source-dir");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"plinth-accuracy: error against cost of the solver's steppers (docs/accuracy.md)"};
   Options opt;
-  app.add_option("--source-dir", opt.source_dir, "the plinth tree (scenes and records)");
+  app.add_option("--source-dir", opt.source_dir,
+                 "a plinth checkout (scenes, records); default: the install's share/plinth");
   app.add_option("--out-dir", opt.out_dir, "where the CSV, Markdown and plot files go");
   app.add_flag("--plot", opt.plot, "draw accuracy.png and accuracy.svg with gnuplot");
   app.add_flag("--quick", opt.quick, "one case, two steps: a smoke test (seconds)");
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
     return *exit_code;
   }
-  return plinth::host::run_tool("plinth-accuracy", [&] { return run(opt); });
+  return plinth::host::run_tool("plinth-accuracy", [&] {
+    find_data(opt);
+    return run(opt);
+  });
 }

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Checks what mbpoll read from plinth-monitor's Modbus server against the shipped map
 (firmware/linux/modbus-map.csv), row by row: each register, discrete input and coil of the map
-has the value that the box's JSON lines (status, alarm, command, summary) and --version say.
+has the value that the box's JSON lines (status, alarm, command, summary; the first status line
+for the files' digests) and --version say.
 A row the map gains without a rule here fails, so the map and this check cannot drift apart.
 
 usage: modbus_map_check.py MAP READS AT_READ BOX_OUT VERSION_TEXT HEARTBEAT_BEFORE
@@ -30,7 +31,8 @@ def main():
         elif len(parts) == 3:
             reads[(parts[0], int(parts[1]))] = int(parts[2])
     lines = [json.loads(l) for l in open(at_read) if l.startswith("{")]
-    status = [l for l in lines if l["type"] == "status"][-1]
+    statuses = [l for l in lines if l["type"] == "status"]
+    status, first_status = statuses[-1], statuses[0]
     alarms = [l for l in lines if l["type"] == "alarm"]
     commands = [l for l in lines if l["type"] == "command" and l["command"] == "acknowledge"]
     summary = json.loads(open(box_out).read().splitlines()[-1])
@@ -58,6 +60,8 @@ def main():
             return commands[-1][key] if commands else "none"
         if kind == "version":
             return version[key]
+        if kind == "first_status":
+            return first_status.get(key)  # None: the member is left out
         raise KeyError(source)
 
     for row in rows:
@@ -77,7 +81,11 @@ def main():
         if None in raw:
             fail(row, "not read")
             continue
-        value = raw[0] if row["type"] != "uint32" else (raw[0] << 16) | raw[1]
+        value = raw[0]
+        if row["type"] in ("uint32", "uint64"):  # the high word first
+            value = 0
+            for w in raw:
+                value = value << 16 | w
         source, name = row["json"], row["name"]
         if row["type"] == "bit" and row["table"] == "discrete_input":
             bit, level = row["codes"].split("=", 1)
@@ -99,6 +107,15 @@ def main():
                 fail(row, "%d, not between the first read's %d and the summary's %d" % (
                     value, earlier, total))
             continue
+        elif row["type"] == "uint64" and source.startswith("first_status."):
+            # A file's digest: sha256sum's first 16 hex digits; the none value without the file.
+            digest = field(source)
+            expected = int(digest[:16], 16) if digest else int(row["none"])
+            if value != expected:
+                fail(row, "reads %016x, the first status line says %s" % (value, digest))
+            continue
+        elif name.endswith("_given"):  # 1 while the digest that follows is the file's
+            expected = 1 if name[:-len("given")] + "sha256" in first_status else 0
         elif name == "collapse_in":
             t = status["collapse_forecast_t"]
             expected = 65535 if t is None else max(0, math.ceil((t - status["t"]) * 1000))
@@ -128,7 +145,7 @@ def main():
         elif name == "alarm_events":
             expected = len(alarms)
         elif name == "map_version":
-            expected = 2
+            expected = 3
         elif name == "forecast_axis":  # one axis: x once a forecast ran
             expected = 0 if status["collapse_forecast_t"] is not None else value
         elif name == "forecast_worst_member":  # one member: member 0 is the first to collapse

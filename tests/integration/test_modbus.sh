@@ -2,7 +2,8 @@
 # plinth-monitor's Modbus TCP server against the real mbpoll client on loopback
 # (docs/integration.md): every row of the shipped map (firmware/linux/modbus-map.csv) read with
 # mbpoll equals what the JSON lines and --version say (modbus_map_check.py), the holding
-# registers equal the input registers, one discrete input per level; several clients at once, a
+# registers equal the input registers, one discrete input per level; the files' digests as
+# sha256sum prints them, with and without a second scene and a box file; several clients at once, a
 # coil write refused while writes are off, register writes always refused, acknowledge and
 # reset when writes are on, and bad addresses refused with a message naming the key or flag.
 #
@@ -14,6 +15,7 @@ set -u
 source "$(dirname "${BASH_SOURCE[0]}")/outputs_harness.sh"
 require_tools mbpoll
 ISOLATED=$SCENES/paper-isolated.toml
+ECCENTRIC=$SCENES/paper-eccentric.toml
 
 MAP=$SRC/firmware/linux/modbus-map.csv
 # The map's extent: registers, discrete inputs, coils.
@@ -35,6 +37,15 @@ read_table() {
 registers() { read_table 3 input "$1" "$REGISTERS" | cut -d' ' -f2-; }
 # register PORT ADDRESS
 register() { registers "$1" | awk -v a="$2" '$1 == a { print $2 }'; }
+# digest PORT ADDRESS: the four registers from ADDRESS as 16 lowercase hex digits (mbpoll's
+# hex display, the high word first), as sha256sum starts.
+digest() {
+  mbpoll -m tcp -t 3:hex -0 -r "$2" -c 4 -1 -p "$1" 127.0.0.1 2>/dev/null |
+    sed -n 's/^\[[0-9]*\]:[[:space:]]*0x\([0-9A-Fa-f]\{4\}\).*/\1/p' | tr -d '\n' |
+    tr 'A-F' 'a-f'
+}
+# sha16 FILE: sha256sum's first 16 hex digits.
+sha16() { sha256sum "$1" | cut -c1-16; }
 # read_map PORT: every table of the map.
 read_map() {
   read_table 3 input "$1" "$REGISTERS"
@@ -57,11 +68,13 @@ status_count() { grep -c '"type": "status"' "$TMP/box.out"; }
 
 # 1. Writes off: the registers against the status lines after the overturn (a steady state:
 #    alarm latched, risk 1, for the record's last 24 s, 12 s at --speed 2: time for the reads below
-#    even on a loaded machine), three clients polling at once, a coil write refused.
+#    even on a loaded machine), three clients polling at once, a coil write refused. A box file
+#    that sets nothing: its digest in registers 81-85.
 PORT=$(free_port)
+echo "# monitor_modbus: the Modbus server from the command line" >"$TMP/run1.toml"
 STARTED=$(date +%s.%N)
 "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
-  --modbus "127.0.0.1:$PORT" >"$TMP/box.out" 2>"$TMP/box.err" &
+  --modbus "127.0.0.1:$PORT" --config "$TMP/run1.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
 BOX=$!
 if ! wait_listening "$PORT"; then
   fail "modbus: the server answers" "no answer on port $PORT; stderr: $(head -c 300 "$TMP/box.err")"
@@ -80,6 +93,14 @@ else
     after=$(status_count)
     cp "$TMP/box.out" "$TMP/at_read.out"
     elapsed=$(echo "$(date +%s.%N) - $STARTED" | bc)
+    scene=$(digest "$PORT" 72)
+    config=$(digest "$PORT" 82)
+    if [[ "$scene" == "$(sha16 "$ISOLATED")" && "$config" == "$(sha16 "$TMP/run1.toml")" ]]; then
+      pass "modbus: registers 72-75, 82-85: sha256sum's first 16 hex digits of scene, box file"
+    else
+      sums="$(sha16 "$ISOLATED"), $(sha16 "$TMP/run1.toml")"
+      fail "modbus: digests" "scene $scene, box file $config; sha256sum: $sums"
+    fi
     first=$(register "$PORT" 1)
     sleep 0.5
     second=$(register "$PORT" 1)
@@ -130,6 +151,29 @@ if [[ -s "$TMP/reads" ]]; then
     fail "modbus: the map, row by row" "$problem"
   fi
 fi
+
+# 1b. Two axes (--scene-y), no box file: the second scene's digest in registers 76-80, 81-85
+#     say none (0, then 65535 in each).
+PORT=$(free_port)
+"$BIN" --scene "$ISOLATED" --scene-y "$ECCENTRIC" --replay "$AT2" --speed 1 --no-events \
+  --modbus "127.0.0.1:$PORT" >"$TMP/box.out" 2>"$TMP/box.err" &
+BOX=$!
+if wait_listening "$PORT"; then
+  scene_y=$(digest "$PORT" 77)
+  config=$(digest "$PORT" 82)
+  flags="$(register "$PORT" 71) $(register "$PORT" 76) $(register "$PORT" 81)"
+  if [[ "$scene_y" == "$(sha16 "$ECCENTRIC")" && "$config" == ffffffffffffffff &&
+    "$flags" == "1 1 0" ]]; then
+    pass "modbus: a second scene's digest in 77-80; no box file: 81 reads 0, 82-85 65535"
+  else
+    fail "modbus: digests, two axes" \
+      "given $flags, scene_y $scene_y (sha256sum $(sha16 "$ECCENTRIC")), box file $config"
+  fi
+else
+  fail "modbus: two axes" "no answer on port $PORT; stderr: $(head -c 300 "$TMP/box.err")"
+fi
+kill -INT "$BOX" 2>/dev/null
+wait "$BOX" 2>/dev/null
 
 # 2. Writes on (the configuration file): acknowledge releases the latch (the collapse holds the
 #    alarm), reset starts the monitor again.

@@ -5,7 +5,8 @@
 # alarm line arrives on the events topic, in order, across a broker restart in the middle of a
 # replay; the retained state and availability; the acknowledge command (an ACL lets only the
 # operator publish it; replies accepted or refused with the reason); Home Assistant discovery,
-# on and off; the state's forecast, counters and version; the Last Will when the box is killed
+# on and off; the state's forecast, counters, version and the digests of the scene and box files
+# (as sha256sum prints them; null for a file not given); the Last Will when the box is killed
 # (-9); a wrong password refused with a clear message; bad settings refused naming the key or
 # flag.
 #
@@ -18,6 +19,8 @@ source "$(dirname "${BASH_SOURCE[0]}")/outputs_harness.sh"
 require_tools mosquitto mosquitto_sub mosquitto_pub mosquitto_passwd openssl
 MOSQUITTO=$(command -v mosquitto || echo /usr/sbin/mosquitto)
 ISOLATED=$SCENES/paper-isolated.toml
+ECCENTRIC=$SCENES/paper-eccentric.toml
+sha() { sha256sum "$1" | cut -d' ' -f1; }
 BROKER_PID=
 BOX=
 cleanup() {
@@ -112,15 +115,19 @@ restart_replay() {
   "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
     --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
   BOX=$!
-  # The broker stops once the normal event reached the subscriber (and its acknowledgement the
-  # box): on a loaded machine the box's stdout runs ahead of the broker.
-  if wait_for "$TMP/events.out" '"level": "normal"' 30; then
+  # The box is held (SIGSTOP) as soon as it writes its normal event, until that event reached
+  # the subscriber and the broker stopped: on a loaded machine the subscriber runs seconds behind
+  # the box, and the advisory would otherwise reach the broker before it stops.
+  if wait_for "$TMP/box.out" '"level": "normal"' 30 && kill -STOP "$BOX" &&
+    wait_for "$TMP/events.out" '"level": "normal"' 30; then
     sleep 0.5
     stop_broker
+    kill -CONT "$BOX"
     wait_for "$TMP/box.out" '"level": "alarm", "previous"' 30
     sleep 1
     start_broker || fail "mqtt: the broker starts again" "$(tail -n 3 "$TMP/broker.log")"
   else
+    kill -CONT "$BOX" 2>/dev/null
     fail "mqtt: replay" "no normal level within 30 s"
   fi
   wait "$BOX"
@@ -218,10 +225,12 @@ fi
 #     acknowledgement is refused by the broker's ACL (MQTT v5 tells the publisher: Not
 #     authorized) and never reaches the box; the operator's malformed, wrong-level and stale
 #     ones are refused with the reason, the last one accepted (the latch released); the
-#     discovery configs are retained, the state carries the forecast, counters and version.
+#     discovery configs are retained, the state carries the forecast, counters, version and
+#     digests (the scene's and the box file's; no second scene: null).
 OPERATOR=(-h 127.0.0.1 -p "$PLAIN" -u operator -P operator-secret)
 printf '[mqtt]\nbroker = "127.0.0.1:%s"\nbox_id = "b6"\nusername = "box"\n' "$PLAIN" >"$TMP/box.toml"
 printf '%s\n' 'password_file = "box.pw"' 'state_interval_s = 0.2' 'commands = true' >>"$TMP/box.toml"
+DIGESTS=("$(sha "$ISOLATED")" "$(sha "$TMP/box.toml")")
 mosquitto_sub "${OPERATOR[@]}" -q 1 -t plinth/b6/command/reply >"$TMP/replies.out" 2>&1 &
 REPLIES=$!
 sleep 0.5
@@ -272,7 +281,7 @@ ack = [l for l in lines if l["type"] == "alarm"][-1]
 assert ack["cause"] == "acknowledged" and ack["latched"] is False, ack
 mqtt = lines[-1]["mqtt"]
 assert mqtt["commands_received"] == 4 and mqtt["commands_accepted"] == 1, mqtt
-assert mqtt["commands_refused"] == 3 and mqtt["discovery_configs"] >= 6, mqtt
+assert mqtt["commands_refused"] == 3 and mqtt["discovery_configs"] >= 8, mqtt
 PY
 )
 if ((rc == 0)) && [[ -z "$problem" ]]; then
@@ -280,7 +289,7 @@ if ((rc == 0)) && [[ -z "$problem" ]]; then
 else
   fail "mqtt: commands" "exit $rc; $problem; replies: $(head -c 600 "$TMP/replies.out")"
 fi
-problem=$(python3 - "$TMP/discovery.out" "$TMP/state.out" "$("$BIN" --version)" 2>&1 <<'PY'
+problem=$(python3 - "$TMP/discovery.out" "$TMP/state.out" "$("$BIN" --version)" "${DIGESTS[@]}" 2>&1 <<'PY'
 import json, sys
 configs = dict(l.split(" ", 1) for l in open(sys.argv[1]).read().splitlines()
                if l.startswith("homeassistant/"))
@@ -290,8 +299,13 @@ expected = {prefix % ("sensor", "level"): "{{ value_json.level }}",
             prefix % ("sensor", "latched"): "{{ value_json.latched }}",
             prefix % ("sensor", "risk"): "{{ value_json.risk }}",
             prefix % ("sensor", "probability"): "{{ value_json.forecast.probability }}"}
+digests = {prefix % ("sensor", "scene_sha256"): "{{ value_json.scene_sha256 }}",
+           prefix % ("sensor", "config_sha256"): "{{ value_json.config_sha256 }}"}
+expected.update(digests)  # no second scene: no sensor for its digest
 others = {prefix % ("binary_sensor", "availability"), prefix % ("button", "acknowledge")}
 assert set(configs) == set(expected) | others, sorted(configs)
+for topic in digests:
+    assert configs[topic]["entity_category"] == "diagnostic", configs[topic]
 version = sys.argv[3].split(" ", 1)[1]
 for topic, config in configs.items():
     assert config["unique_id"].startswith("plinth_b6_"), config
@@ -313,21 +327,26 @@ assert state["forecast"]["worst_member"] == 0 and state["forecast"]["collapse_in
 assert state["sensor_counters"]["fed"] > 1000 and state["sensor_counters"]["missing"] == 0, state
 assert state["sensors_state"] == "ok" and state["estimator_restarts"] == 1, state
 assert "%s (%s)" % (state["version"]["project"], state["version"]["git"]) == version, state
+scene, config = sys.argv[4:6]  # sha256sum's
+assert state["scene_sha256"] == scene and state["config_sha256"] == config, (state, scene, config)
+assert "scene_y_sha256" in state and state["scene_y_sha256"] is None, state
 PY
 )
 if [[ -z "$problem" ]]; then
-  pass "mqtt: discovery configs retained; the state carries the forecast, counters and version"
+  pass "mqtt: discovery configs retained; the state: forecast, counters, version, digests"
 else
   fail "mqtt: discovery and state" "$problem"
 fi
 
-# 1e. Commands off (the default) and discovery off: the reply says why, no config published.
+# 1e. Commands off (the default) and discovery off: the reply says why, no config published. Two
+#     axes: the state carries the second scene's digest too.
 printf '[mqtt]\nbroker = "127.0.0.1:%s"\nbox_id = "b7"\nusername = "box"\n' "$PLAIN" >"$TMP/box.toml"
 printf '%s\n' 'password_file = "box.pw"' 'discovery = false' >>"$TMP/box.toml"
+DIGESTS=("$(sha "$ISOLATED")" "$(sha "$ECCENTRIC")" "$(sha "$TMP/box.toml")")
 mosquitto_sub "${OPERATOR[@]}" -C 1 -W 30 -t plinth/b7/command/reply >"$TMP/replies.out" 2>&1 &
 REPLIES=$!
-"$BIN" --scene "$ISOLATED" --replay "$AT2" --speed 4 --no-events --config "$TMP/box.toml" \
-  >"$TMP/box.out" 2>"$TMP/box.err" &
+"$BIN" --scene "$ISOLATED" --scene-y "$ECCENTRIC" --replay "$AT2" --speed 4 --no-events \
+  --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
 BOX=$!
 for ((i = 0; i < 100; i++)); do
   [[ "$(mosquitto_sub "${WATCH[@]}" -C 1 -W 1 -t plinth/b7/availability 2>/dev/null)" == online ]] &&
@@ -346,6 +365,21 @@ if grep -qF "$reply" "$TMP/replies.out" && ((discovered == 0)) &&
   pass "mqtt: with commands off the reply says so; discovery off publishes no config"
 else
   fail "mqtt: commands and discovery off" "reply: $(cat "$TMP/replies.out"); $discovered configs"
+fi
+mosquitto_sub "${WATCH[@]}" -C 1 -W 2 -t plinth/b7/state >"$TMP/state.out" 2>&1
+problem=$(python3 - "$TMP/state.out" "$TMP/box.out" "${DIGESTS[@]}" 2>&1 <<'PY'
+import json, sys
+state = json.loads(open(sys.argv[1]).read())
+first = [json.loads(l) for l in open(sys.argv[2]) if l.startswith('{"type": "status"')][0]
+got = [state[k] for k in ("scene_sha256", "scene_y_sha256", "config_sha256")]
+assert got == sys.argv[3:6], "state %s, sha256sum %s" % (got, sys.argv[3:6])
+assert got == [first[k] for k in ("scene_sha256", "scene_y_sha256", "config_sha256")], first
+PY
+)
+if [[ -z "$problem" ]]; then
+  pass "mqtt: two axes: the state's three digests are sha256sum's and the first status line's"
+else
+  fail "mqtt: digests, two axes" "$problem"
 fi
 
 # 2. The Last Will: the box killed (-9) while connected on the plain listener.

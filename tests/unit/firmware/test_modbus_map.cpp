@@ -1,5 +1,6 @@
 // plinth-monitor's Modbus map (firmware/linux/modbus_map.h): the shipped modbus-map.csv is the
-// code's map, the registers and discrete inputs of a snapshot, the pinned codes.
+// code's map, the registers and discrete inputs of a snapshot, the run's identity (version and
+// file digests), the pinned codes.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -85,7 +86,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 2);
+  EXPECT_EQ(at(reg::kMapVersion), 3);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";
@@ -93,6 +94,33 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   for (int level = 0; level < discrete::kCount; ++level) {
     EXPECT_EQ(image.discrete_inputs[static_cast<std::size_t>(level)], level == 2 ? 1 : 0) << level;
   }
+}
+
+std::uint64_t read64(const Image& image, int address) {
+  return (std::uint64_t{read32(image, address)} << 32) | read32(image, address + 2);
+}
+
+TEST(ModbusMap, TheRunsIdentity) {
+  RunIdentity identity;
+  identity.scene = sha256("abc");  // ba7816bf 8f01cfea ...
+  identity.config = sha256("");    // e3b0c442 98fc1c14 ...
+  Image image;
+  fill_identity(identity, image);
+  const auto at = [&](int address) { return image.registers[static_cast<std::size_t>(address)]; };
+  EXPECT_EQ(at(reg::kSceneGiven), 1);
+  EXPECT_EQ(at(reg::kSceneSha256), 0xba78) << "the high word first";
+  EXPECT_EQ(at(reg::kSceneSha256 + 3), 0xcfea);
+  EXPECT_EQ(read64(image, reg::kSceneSha256), 0xba7816bf8f01cfeaULL);
+  EXPECT_EQ(at(reg::kConfigGiven), 1);
+  EXPECT_EQ(read64(image, reg::kConfigSha256), 0xe3b0c44298fc1c14ULL);
+  // No second scene: its flag 0, kNone in each register of its digest.
+  EXPECT_EQ(at(reg::kSceneYGiven), 0);
+  for (int i = 0; i < reg::kDigestWords; ++i) EXPECT_EQ(at(reg::kSceneYSha256 + i), kNone) << i;
+  // A snapshot leaves them as they are.
+  StatusSnapshot s;
+  fill(s, 0, image);
+  EXPECT_EQ(read64(image, reg::kSceneSha256), 0xba7816bf8f01cfeaULL);
+  EXPECT_EQ(at(reg::kSceneYGiven), 0);
   // The version: the numbers of kProjectVersion, the description two characters a register.
   const std::string version = std::to_string(at(reg::kVersionMajor)) + "." +
                               std::to_string(at(reg::kVersionMinor)) + "." +
