@@ -18,8 +18,11 @@ PW=$SRC/sim/data/records/pwave
 # (Rinaldi, no P wave before it).
 STATIONS=(--record "$PW/RSN990_NORTHR_LAC090.AT2" --vertical "$PW/RSN990_NORTHR_LAC-UP.AT2"
   --record "$PW/RSN1063_NORTHR_RRS228.AT2" --vertical "$PW/RSN1063_NORTHR_RRS-UP.AT2")
-# The isolated block with a fragility (the numbers are this test's).
-sed -e '$a\' "$SRC/sim/scenes/eval/isolated.toml" > isolated.toml
+# The isolated block without its fragility, and with one (the numbers are this test's).
+sed -e '/^\[fragility\]/,/^\[/{/^\[fragility\]/d;/^median_g/d;/^beta/d}' \
+  "$SRC/sim/scenes/eval/isolated.toml" > no-fragility.toml
+grep -q "median_g" no-fragility.toml && { echo "no-fragility.toml kept its fragility" >&2; exit 1; }
+cp no-fragility.toml isolated.toml
 printf '\n[fragility]\nmedian_g = 0.8\nbeta = 0.3\n' >> isolated.toml
 CASES=(--scene isolated.toml "${STATIONS[@]}" --statues 2 --pga-from 0.4g --pga-to 1.6g
   --pga-steps 4 --jobs 2)
@@ -124,7 +127,7 @@ expect_failure "as many --vertical as --record" "i-th --vertical belongs to the 
   -- run --scene isolated.toml --record "$PW/RSN990_NORTHR_LAC090.AT2" \
   --vertical "$PW/RSN990_NORTHR_LAC-UP.AT2" --record "$PW/RSN1063_NORTHR_RRS228.AT2" --out x.csv
 expect_failure "the stage needs the scene's fragility" "needs the scene's \[fragility\]" \
-  -- run --scene "$SRC/sim/scenes/eval/isolated.toml" "${STATIONS[@]}" --statues 1 \
+  -- run --scene no-fragility.toml "${STATIONS[@]}" --statues 1 \
   --pga-steps 1 --pwave on --out x.csv
 expect_failure "--pwave is on or off" "--pwave: expected on or off" \
   -- run "${CASES[@]}" --pwave yes --out x.csv
