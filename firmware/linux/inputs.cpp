@@ -18,6 +18,9 @@
 #include "record_input.h"
 
 namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
 namespace {
 
 using host::InputError;

@@ -176,7 +176,7 @@ std::uint16_t index_or_none(int value) {
 // MAJOR.MINOR.PATCH of kProjectVersion.
 std::array<std::uint16_t, 3> version_numbers() {
   std::array<std::uint16_t, 3> out{};
-  const char* at = kProjectVersion;
+  const char* at = version::kProjectVersion;
   for (std::uint16_t& part : out) {
     char* end = nullptr;
     part = static_cast<std::uint16_t>(std::strtoul(at, &end, 10));
@@ -312,7 +312,7 @@ void fill_identity(const RunIdentity& identity, Image& out) {
   put16(r, reg::kVersionMajor, version[0]);
   put16(r, reg::kVersionMinor, version[1]);
   put16(r, reg::kVersionPatch, version[2]);
-  put_text(r, reg::kGitDescription, reg::kGitDescriptionWords, kGitDescription);
+  put_text(r, reg::kGitDescription, reg::kGitDescriptionWords, version::kGitDescription);
   const struct {
     int given;
     int digest;

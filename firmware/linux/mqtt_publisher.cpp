@@ -422,7 +422,7 @@ void MqttPublisher::publish_discovery() {
                                  .text("name", "plinth " + settings_.box_id)
                                  .text("manufacturer", "plinth")
                                  .text("model", "plinth-monitor")
-                                 .text("sw_version", kVersionText)
+                                 .text("sw_version", version::kVersionText)
                                  .close();
   std::vector<std::string> levels;
   for (const auto& level : monitor::kAlarmLevelNames) {
@@ -529,8 +529,8 @@ std::string MqttPublisher::state_json() const {
       .count("estimator_restarts", s.estimator_restarts)
       .count("heartbeat", s.statuses)
       .raw("version", JsonObject()
-                          .text("project", kProjectVersion)
-                          .text("git", kGitDescription)
+                          .text("project", version::kProjectVersion)
+                          .text("git", version::kGitDescription)
                           .close());
   for (const DigestMember& d : digests_) {
     state.raw(d.member, d.hex.empty() ? "null" : host::json_quoted(d.hex));

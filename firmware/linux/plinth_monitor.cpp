@@ -24,7 +24,7 @@
 #include "modbus_server.h"
 #include "monitor_config.h"
 #include "mqtt_publisher.h"
-#include "plinth/firmware/can_frames.h"
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/hal/candump_log.h"
 #include "plinth/hal/pacing.h"
@@ -126,11 +126,11 @@ class Outputs {
         relays_(relays),
         outputs_(std::move(outputs)),
         start_ns_(fw::monotonic_ns()) {
-    post_snapshot();
+    post_snapshot(monitor.status());
   }
 
   void handle(const fw::MonitorUpdate& u) {
-    const fw::MonitorStatus& s = monitor_.status();
+    const fw::BoxStatus& s = *u.status;
     if (relays_ != nullptr) {  // first: the alarm panel's contacts
       relays_->update(s.alarm, s.latched,
                       s.sensors_state == mon::HealthState::kFault || s.disagreement);
@@ -150,7 +150,7 @@ class Outputs {
       } else if (static_cast<int>(e.level) > static_cast<int>(totals.max_level)) {
         totals.max_level = e.level;
       }
-      if (e.level == mon::AlarmLevel::kWarning || e.level == mon::AlarmLevel::kAlarm) trigger(e);
+      if (e.level == mon::AlarmLevel::kWarning || e.level == mon::AlarmLevel::kAlarm) trigger(s, e);
       if (supervisor != nullptr) {
         supervisor->alarm_changed(e, static_cast<double>(e.time_ns) * 1e-9 - t_origin_);
       }
@@ -162,12 +162,12 @@ class Outputs {
                                          : fw::status_json(s, t_origin_));
       ++snapshot_.statuses;
     }
-    if (trace != nullptr) trace->after_update(monitor_);
-    post_snapshot();
+    if (trace != nullptr) trace->after_update(u, monitor_);
+    post_snapshot(s);
   }
 
-  // The outputs' operator commands, carried out on the loop: an acknowledgement as the bus's
-  // Acknowledge frame would bring it; a reset starts the monitor again (`restart`).
+  // The outputs' operator commands, carried out on the loop: an acknowledgement is the
+  // monitor's (as one from the bus); a reset starts the monitor again (`restart`).
   template <typename Restart>
   void carry_out_commands(fw::Monitor& monitor, Restart restart) {
     for (fw::StatusOutput* output : outputs_) {
@@ -184,11 +184,11 @@ class Outputs {
                          .text("command", "reset")
                          .text("source", output->name())
                          .close());
-          post_snapshot();
+          post_snapshot(monitor.status());
           output->mailbox().post_result({c.id, mon::AckOutcome::kNone});
           continue;
         }
-        const fw::MonitorUpdate u = monitor.on_frame(acknowledge_frame(c));
+        const fw::MonitorUpdate u = monitor.acknowledge({c.level, c.event_sequence});
         snapshot_.last_ack = u.acknowledgement;
         print_line(fw::JsonObject()
                        .text("type", "command")
@@ -211,9 +211,8 @@ class Outputs {
   std::int64_t last_frame_ns = 0;  // receive time of the newest frame (the recorder's clock)
 
  private:
-  void trigger(const mon::AlarmEventRecord& e) {
+  void trigger(const fw::BoxStatus& s, const mon::AlarmEventRecord& e) {
     if (recorder_ == nullptr) return;
-    const fw::MonitorStatus& s = monitor_.status();
     fw::TriggerInfo info;
     info.t = static_cast<double>(e.time_ns) * 1e-9 - t_origin_;
     info.level = mon::alarm_level_name(e.level);
@@ -233,28 +232,14 @@ class Outputs {
     for (fw::StatusOutput* output : outputs_) output->mailbox().post_alarm({e, t_origin_});
   }
 
-  void post_snapshot() {
+  void post_snapshot(const fw::BoxStatus& status) {
     if (outputs_.empty()) return;
-    fw::copy_status(monitor_, t_origin_, snapshot_);
+    fw::copy_status(status, t_origin_, snapshot_);
     ++snapshot_.updates;
     snapshot_.wall_time_ns = fw::wall_clock_ns();
     snapshot_.uptime_ns = fw::monotonic_ns() - start_ns_;
     for (fw::StatusOutput* output : outputs_) output->mailbox().post_status(snapshot_);
   }
-
-  // The Acknowledge frame of a command (source id kCommandSourceId), at the newest frame's time.
-  plinth::hal::TimedFrame acknowledge_frame(const fw::CommandRequest& c) const {
-    plinth::can::Acknowledge message;
-    message.level = fw::to_wire(c.level);
-    message.source_id = kCommandSourceId;
-    message.event_sequence = c.event_sequence;
-    plinth::hal::TimedFrame frame;
-    frame.timestamp_ns = last_frame_ns;
-    (void)plinth::can::encode(message, frame.frame);  // every level and sequence encodes
-    return frame;
-  }
-
-  static constexpr std::uint8_t kCommandSourceId = 0xF0;  // the box's own outputs
 
   const fw::Monitor& monitor_;
   double t_origin_;
@@ -267,8 +252,8 @@ class Outputs {
 };
 
 // The monitor takes one input item.
-void take(const fw::InputItem& item, fw::Monitor& monitor, Outputs& outputs,
-          fw::EventRecorder* recorder) {
+void take(const fw::InputItem& item, fw::Monitor& monitor, fw::FrameDecoder& decoder,
+          Outputs& outputs, fw::EventRecorder* recorder) {
   switch (item.kind) {
     case fw::InputItem::Kind::kSample:
       if (recorder != nullptr && item.has_frame) recorder->on_frame(item.frame);
@@ -279,7 +264,7 @@ void take(const fw::InputItem& item, fw::Monitor& monitor, Outputs& outputs,
     case fw::InputItem::Kind::kFrame:
       if (recorder != nullptr) recorder->on_frame(item.frame);
       outputs.last_frame_ns = item.frame.timestamp_ns;
-      outputs.handle(monitor.on_frame(item.frame));
+      outputs.handle(fw::on_frame(monitor, decoder, item.frame));
       break;
     case fw::InputItem::Kind::kTick:
       outputs.handle(monitor.on_tick(item.time_ns));
@@ -307,16 +292,19 @@ std::string option_of(const std::string& field) {
 
 // Each axis's ensemble: the scene file's statue first, then the corners of its [uncertainty]
 // (one member when it declares none). Monitor::start's error names the option or the file that
-// gave the setting.
-void start_monitor(fw::Monitor& monitor, const fw::MonitorConfig& config,
-                   const plinth::host::UncertainScene& scene_x,
+// gave the setting. The frames' decoder starts afresh with it.
+void start_monitor(fw::Monitor& monitor, fw::FrameDecoder& decoder,
+                   const fw::MonitorConfig& config, const plinth::host::UncertainScene& scene_x,
                    const std::optional<plinth::host::UncertainScene>& scene_y,
                    const CLI::App& app, const std::string& config_path) {
   const plinth::Error e = monitor.start(
       config, {std::span<const plinth::Scene>(scene_x.members),
                scene_y ? std::span<const plinth::Scene>(scene_y->members)
                        : std::span<const plinth::Scene>()});
-  if (e.ok()) return;
+  if (e.ok()) {
+    decoder.start(config);
+    return;
+  }
   const std::string option = option_of(e.field);
   std::string where;
   if (!option.empty() && app.count(option) > 0) {
@@ -360,15 +348,15 @@ std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings)
 // commands carried out, the watchdog told of the progress. True when the estimators ran at some
 // point.
 template <typename Restart>
-bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, Outputs& outputs,
-              fw::EventRecorder* recorder, fw::Supervisor& supervisor, fw::LatencyLog* latency,
-              fw::LatencyLog* due_latency, Restart restart) {
+bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, fw::FrameDecoder& decoder,
+              Outputs& outputs, fw::EventRecorder* recorder, fw::Supervisor& supervisor,
+              fw::LatencyLog* latency, fw::LatencyLog* due_latency, Restart restart) {
   supervisor.ready("monitoring " + input.source());
   fw::InputItem item;
   bool estimated = false;
   while (g_stop == 0 && input.next(item)) {
     const std::int64_t arrival_ns = latency != nullptr ? fw::monotonic_ns() : 0;
-    take(item, monitor, outputs, recorder);
+    take(item, monitor, decoder, outputs, recorder);
     estimated = estimated || monitor.status().estimating;
     if (latency != nullptr && item.kind != fw::InputItem::Kind::kTick &&
         item.kind != fw::InputItem::Kind::kBusFault) {
@@ -405,11 +393,12 @@ fw::InputOptions input_options(const Options& opt) {
 
 // The summary's totals besides the monitor's own counters.
 fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
-                         const fw::Monitor& monitor, const fw::EventRecorder* recorder,
-                         const std::vector<AxisEvents>& sinks) {
+                         const fw::Monitor& monitor, const fw::FrameDecoder& decoder,
+                         const fw::EventRecorder* recorder, const std::vector<AxisEvents>& sinks) {
   fw::RunTotals t = outputs.totals;
   t.source = input.source();
-  t.samples += monitor.frames().sensor_samples;
+  t.frames = decoder.counters();
+  t.samples += t.frames.sensor_samples;
   for (const AxisEvents& sink : sinks) t.phase_events += sink.count;
   const fw::InputTimeCounters time = input.time_counters();
   t.log_time_back = time.went_back;
@@ -418,7 +407,7 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
   const fw::BusCounters bus = input.bus_counters();
   t.bus_errors = bus.bus_errors;
   t.bus_dropped_frames = bus.dropped_frames;
-  if (input.sink() != nullptr) t.bus_send_errors += monitor.frames().not_encoded;
+  if (input.sink() != nullptr) t.bus_send_errors += monitor.frames_not_encoded();
   if (recorder != nullptr) {
     t.recorder = true;
     t.captures_written = recorder->captures_written();
@@ -489,7 +478,8 @@ int run(const Options& opt, const CLI::App& app) {
   const std::unique_ptr<fw::MonitorInput> input = fw::open_input(input_settings, config, g_stop);
 
   fw::Monitor monitor;
-  start_monitor(monitor, config, scene_x, scene_y, app, opt.config.config_path);
+  fw::FrameDecoder decoder;
+  start_monitor(monitor, decoder, config, scene_x, scene_y, app, opt.config.config_path);
   std::vector<AxisEvents> sinks;
   sinks.reserve(static_cast<std::size_t>(config.axis_count));
   for (int i = 0; i < config.axis_count; ++i) {
@@ -535,16 +525,16 @@ int run(const Options& opt, const CLI::App& app) {
   outputs.supervisor = &supervisor;
   outputs.identity = identity;
   const auto restart = [&] {
-    start_monitor(monitor, config, scene_x, scene_y, app, opt.config.config_path);
+    start_monitor(monitor, decoder, config, scene_x, scene_y, app, opt.config.config_path);
   };
-  const bool estimated = run_loop(*input, monitor, outputs, recorder.get(), supervisor,
+  const bool estimated = run_loop(*input, monitor, decoder, outputs, recorder.get(), supervisor,
                                   latency ? &*latency : nullptr,
                                   due_latency ? &*due_latency : nullptr, restart);
   if (trace) trace->close();
   if (recorder) recorder->close();  // every capture is on disk before the summary
   if (frames_log && !frames_log->flush()) throw InputError("--frames-out: " + frames_log->error());
-  fw::RunTotals totals = run_totals(outputs, *input, monitor, recorder.get(), sinks);
-  if (frames_log) totals.bus_send_errors += monitor.frames().not_encoded;
+  fw::RunTotals totals = run_totals(outputs, *input, monitor, decoder, recorder.get(), sinks);
+  if (frames_log) totals.bus_send_errors += monitor.frames_not_encoded();
   for (const auto& o : network) {
     o->stop();  // the MQTT publisher delivers its queue first (bounded)
     totals.outputs.emplace_back(o->name(), o->summary_json());

@@ -119,7 +119,7 @@ std::uint64_t leading_64_bits(const Sha256Digest& digest) {
 RunIdentity run_identity(const std::string& scene_path, const std::string& scene_y_path,
                          const std::string& config_path) {
   RunIdentity id;
-  id.version = kVersionText;
+  id.version = version::kVersionText;
   const auto digest = [](const std::string& path) {
     return path.empty() ? std::nullopt : std::optional<Sha256Digest>(file_sha256(path));
   };

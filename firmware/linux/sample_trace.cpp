@@ -31,8 +31,8 @@ SampleTrace::SampleTrace(const std::string& path, int axis_count, double t_origi
   std::fputc('\n', file_.get());
 }
 
-void SampleTrace::after_update(const Monitor& monitor) {
-  const MonitorStatus& s = monitor.status();
+void SampleTrace::after_update(const MonitorUpdate& update, const Monitor& monitor) {
+  const BoxStatus& s = *update.status;
   if (s.newest_sample_time_ns == last_sample_ns_) return;
   last_sample_ns_ = s.newest_sample_time_ns;
   std::FILE* f = file_.get();
@@ -44,7 +44,7 @@ void SampleTrace::after_update(const Monitor& monitor) {
       continue;
     }
     const AxisStatus& a = s.axes[static_cast<std::size_t>(axis)];
-    std::fprintf(f, "\t%.5f\t%.6f\t%d", monitor.estimator(axis).ground().horizontal,
+    std::fprintf(f, "\t%.5f\t%.6f\t%d", monitor.ensemble(axis).nominal().ground().horizontal,
                  a.state[kTheta], static_cast<int>(a.mode.phase));
   }
   std::fputc('\n', f);

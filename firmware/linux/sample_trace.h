@@ -19,8 +19,9 @@ class SampleTrace {
   // Creates `path` and writes its header (the columns, the codes of levels and phases). Throws
   // host::InputError naming the file when it cannot be written.
   SampleTrace(const std::string& path, int axis_count, double t_origin);
-  // A line when the monitor took a new sample since the previous call.
-  void after_update(const Monitor& monitor);
+  // A line when the monitor took a new sample since the previous call: the update's status, and
+  // the ground acceleration each axis's nominal statue took (`monitor`'s ensembles).
+  void after_update(const MonitorUpdate& update, const Monitor& monitor);
   // Flushes and closes; throws host::InputError on a write error (a full disk).
   void close();
 

@@ -8,6 +8,9 @@
 #include "plinth/host/run_output.h"
 
 namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
 namespace {
 
 constexpr const char* kAxisNames[] = {"x", "y"};
@@ -31,7 +34,7 @@ std::string formatted(double value, int digits, bool fixed) {
 
 // One axis's value, or {"x": .., "y": ..} with two axes.
 template <typename ValueOf>
-std::string per_axis(const MonitorStatus& s, ValueOf value_of) {
+std::string per_axis(const BoxStatus& s, ValueOf value_of) {
   if (s.axis_count == 1) return value_of(s.axes[0]);
   JsonObject axes;
   for (int i = 0; i < s.axis_count; ++i) {
@@ -64,7 +67,7 @@ std::string rms_value(const SensorStatus& sensor) {
 }
 
 // The sensors of a status line, each with its health and cross-check.
-std::string status_sensors(const MonitorStatus& s) {
+std::string status_sensors(const BoxStatus& s) {
   std::vector<std::string> sensors;
   for (int i = 0; i < s.sensor_count; ++i) {
     const SensorStatus& sensor = s.sensors[static_cast<std::size_t>(i)];
@@ -94,7 +97,8 @@ JsonObject& stream_counts(JsonObject& object, const monitor::SensorCounters& c) 
       .count("long_gaps", c.long_gaps);
 }
 
-std::string frame_counters(const FrameCounters& f) {
+// The frame decoder's counters and the frames the monitor could not encode.
+std::string frame_counters(const FrameCounters& f, std::uint64_t not_encoded) {
   return JsonObject()
       .count("received", f.received)
       .count("sensor_samples", f.sensor_samples)
@@ -105,7 +109,7 @@ std::string frame_counters(const FrameCounters& f) {
       .count("rejected", f.rejected)
       .count("unknown_identifiers", f.unknown_identifiers)
       .text("last_error", can::codec_error_text(f.last_error))
-      .count("not_encoded", f.not_encoded)
+      .count("not_encoded", not_encoded)
       .close();
 }
 
@@ -125,7 +129,7 @@ std::string sensor_counters(const monitor::SensorHealth& h) {
 }
 
 // Every sensor's totals.
-std::string summary_sensors(const MonitorStatus& s) {
+std::string summary_sensors(const BoxStatus& s) {
   std::vector<std::string> sensors;
   for (int i = 0; i < s.sensor_count; ++i) {
     const SensorStatus& sensor = s.sensors[static_cast<std::size_t>(i)];
@@ -198,7 +202,7 @@ std::string json_array(const std::vector<std::string>& values) {
   return out + "]";
 }
 
-std::string status_json(const MonitorStatus& s, double t_origin) {
+std::string status_json(const BoxStatus& s, double t_origin) {
   JsonObject line;
   line.text("type", "status").fixed("t", seconds(s.time_ns, t_origin), 6);
   line.raw("phase",
@@ -248,7 +252,7 @@ std::string event_json(int axis, const Event& event) {
 }
 
 std::string summary_json(const Monitor& monitor, const RunTotals& totals, double t_origin) {
-  const MonitorStatus& s = monitor.status();
+  const BoxStatus& s = monitor.status();
   JsonObject line;
   line.text("type", "summary")
       .text("source", totals.source)
@@ -264,7 +268,7 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
   line.count("alarm_events", totals.alarm_events)
       .count("fault_events", totals.fault_events)
       .count("phase_events", totals.phase_events)
-      .raw("frames", frame_counters(monitor.frames()))
+      .raw("frames", frame_counters(totals.frames, monitor.frames_not_encoded()))
       .raw("sensor", sensor_counters(s.sensor))
       .count("estimator_restarts", s.estimator_restarts)
       .count("bus_send_errors", totals.bus_send_errors)

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "plinth/core/events.h"
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
@@ -37,7 +38,7 @@ class JsonObject {
 
 // {"type": "status", "t": .., "phase": .., "risk": .., "alarm": .., ...}: the monitor's status;
 // t in s of monitor time less `t_origin` (a record replay's lead-in).
-[[nodiscard]] std::string status_json(const MonitorStatus& status, double t_origin);
+[[nodiscard]] std::string status_json(const BoxStatus& status, double t_origin);
 
 // {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
 [[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);
@@ -49,6 +50,7 @@ class JsonObject {
 // What a run did besides the monitor's own counters: the summary's other fields.
 struct RunTotals {
   std::string source;  // the record, the log or the interface
+  FrameCounters frames;  // the frame decoder's (a log or a bus)
   std::uint64_t samples = 0;
   double max_risk = 0.0;
   monitor::AlarmLevel max_level = monitor::AlarmLevel::kNormal;  // the highest but fault

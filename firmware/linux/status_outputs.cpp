@@ -22,8 +22,7 @@ std::int64_t clock_ns(clockid_t clock) {
 std::int64_t monotonic_ns() { return clock_ns(CLOCK_MONOTONIC); }
 std::int64_t wall_clock_ns() { return clock_ns(CLOCK_REALTIME); }
 
-void copy_status(const Monitor& monitor, double t_origin, StatusSnapshot& snapshot) {
-  const MonitorStatus& s = monitor.status();
+void copy_status(const BoxStatus& s, double t_origin, StatusSnapshot& snapshot) {
   snapshot.time_ns = s.time_ns;
   snapshot.t = static_cast<double>(s.time_ns) * 1e-9 - t_origin;
   snapshot.level = s.alarm;

@@ -180,9 +180,9 @@ class StatusOutput {
   [[nodiscard]] virtual const char* name() const = 0;  // the summary's key: "modbus", "mqtt"
 };
 
-// Copies `monitor`'s status into `snapshot` (time, level, risk, phases, sensors); the fields the
-// loop keeps itself (updates, statuses, the latest event, commands) are left as they are.
-void copy_status(const Monitor& monitor, double t_origin, StatusSnapshot& snapshot);
+// Copies the monitor's `status` into `snapshot` (time, level, risk, phases, sensors); the fields
+// the loop keeps itself (updates, statuses, the latest event, commands) are left as they are.
+void copy_status(const BoxStatus& status, double t_origin, StatusSnapshot& snapshot);
 
 // CLOCK_MONOTONIC and CLOCK_REALTIME, ns.
 [[nodiscard]] std::int64_t monotonic_ns();

@@ -59,7 +59,7 @@ extern "C" int plinth_board_main() {
 
   std::int64_t now_ns = 1'500'000'999;
   plinth::hal::SemihostingCanPort port("can0", &now_ns);
-  plinth::can::CanFrame frame;
+  plinth::hal::can::CanFrame frame;
   frame.id = 0x321;
   frame.length = 8;
   frame.data = {0x01, 0x23, 0x45, 0x67, 0x89, 0xAB, 0xCD, 0xEF};

@@ -15,7 +15,7 @@
 #include "plinth/host/record_sampling.h"
 #include "plinth/monitor/p_wave.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 namespace {
 
 namespace fw = firmware;
@@ -86,17 +86,12 @@ void note_crossings(const std::vector<double>& grid, double value, double t,
   }
 }
 
-void note_level(monitor::AlarmLevel shown, double t, std::array<double, host::kEvalLevels>& first) {
-  int rank = 0;
-  switch (shown) {
-    case monitor::AlarmLevel::kAdvisory: rank = 1; break;
-    case monitor::AlarmLevel::kWarning: rank = 2; break;
-    case monitor::AlarmLevel::kAlarm: rank = 3; break;
-    case monitor::AlarmLevel::kNormal:
-    case monitor::AlarmLevel::kFault: rank = 0; break;
-  }
-  for (int level = 0; level < rank; ++level) {
-    if (first[static_cast<std::size_t>(level)] < 0.0) first[static_cast<std::size_t>(level)] = t;
+void note_level(monitor::AlarmLevel shown, double t,
+                std::array<double, monitor::kRiskLevels.size()>& first) {
+  if (shown == monitor::AlarmLevel::kFault) return;
+  for (const monitor::AlarmLevel level : monitor::kRiskLevels) {
+    double& first_shown = first[monitor::risk_level_index(level)];
+    if (shown >= level && first_shown < 0.0) first_shown = t;
   }
 }
 
@@ -153,7 +148,7 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
                                  kStandardGravity + (v.empty() ? 0.0 : gamma * v[k]));
     const monitor::SensorSample s =
         fw::record_replay_sample(config, static_cast<std::int64_t>(n), ground, kStandardGravity);
-    (void)monitor->on_sample(s);
+    const fw::MonitorUpdate update = monitor->on_sample(s);
     if (stage) {
       // What the box's conditioning gives an ideal sensor: the ground's acceleration less the
       // offset its start-up window estimated, the lead-in's (the record's first sample).
@@ -171,7 +166,7 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
     if (n < lead_in) continue;
     const double t = static_cast<double>(k) / rate;
     if (stop_s >= 0.0 && t >= stop_s) break;
-    const fw::MonitorStatus& status = monitor->status();
+    const fw::BoxStatus& status = *update.status;
     note_level(status.alarm, t, run.first_shown_s);
     if (!status.estimating) continue;
     note_crossings(grids.risk, status.risk, t, run.risk_crossing_s);
@@ -202,4 +197,4 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   return run;
 }
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

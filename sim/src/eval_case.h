@@ -17,7 +17,7 @@
 #include "plinth/host/scene_toml.h"
 #include "plinth/monitor/alarm_policy.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 
 struct BoxSettings {
   double rate_hz = 200.0;          // the ground sensor's sample rate, Hz
@@ -57,4 +57,4 @@ struct EvalCase {
 [[nodiscard]] host::EvalRun run_case(const EvalCase& c, const BoxSettings& box,
                                      const TruthSettings& truth, const host::CrossingGrids& grids);
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

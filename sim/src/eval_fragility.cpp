@@ -11,7 +11,7 @@
 #include "plinth/host/input_error.h"
 #include "plinth/host/json_text.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 namespace {
 
 using host::CollapseIntensity;
@@ -155,7 +155,7 @@ std::string fragility_json(const std::vector<SceneFragility>& scenes, CollapseIn
 }
 
 void plot_fragility(const std::vector<SceneFragility>& scenes, const std::string& png_path) {
-  const cli::PlotFolder folder;
+  const PlotFolder folder;
   double top = 0.0;
   for (const SceneFragility& s : scenes) top = std::max(top, s.top_g);
   const double x_max = 1.1 * top;
@@ -203,4 +203,4 @@ void plot_fragility(const std::vector<SceneFragility>& scenes, const std::string
   folder.draw("fragility.gp", "fragility.png", png_path);
 }
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

@@ -10,7 +10,7 @@
 #include "plinth/host/eval_metrics.h"
 #include "plinth/host/fragility_fit.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 
 // What a case's collapse intensity is taken to be, from its lowest collapsing PGA on the grid:
 // kInterval, above the grid point below it and at most it (interval-censored; default);
@@ -52,4 +52,4 @@ struct SceneFragility {
 // missing or fails.
 void plot_fragility(const std::vector<SceneFragility>& scenes, const std::string& png_path);
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

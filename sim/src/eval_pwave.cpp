@@ -13,7 +13,7 @@
 #include "plinth/host/units.h"
 #include "plinth/monitor/p_wave.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 
 using host::InputError;
 
@@ -177,4 +177,4 @@ Subcommand add_pwave_fit(CLI::App& app) {
   return {fit, [opt] { return run_fit(*opt); }};
 }
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

@@ -10,7 +10,7 @@
 
 #include "plinth/host/record_io.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 
 // The records of --record, each joined with the --vertical of the same rank when any is given
 // (then there must be as many): a vertical's file is read as any record and its one component
@@ -26,4 +26,4 @@ struct Subcommand {
 };
 [[nodiscard]] Subcommand add_pwave_fit(CLI::App& app);
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

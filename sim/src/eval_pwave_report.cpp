@@ -7,8 +7,9 @@
 #include <set>
 
 #include "plinth/host/input_error.h"
+#include "plinth/monitor/alarm_level.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 
 namespace {
 
@@ -28,7 +29,7 @@ PWaveClass class_of(const EvalRun& r) {
 
 // The warning's first time with the stage at grid index `p` (-1: without the stage).
 double warning_time(const EvalRun& r, int p) {
-  const double box = r.first_shown_s[static_cast<std::size_t>(host::EvalLevel::kWarning)];
+  const double box = r.first_shown_s[monitor::risk_level_index(monitor::AlarmLevel::kWarning)];
   if (p < 0) return box;
   const double stage = r.pwave_crossing_s[static_cast<std::size_t>(p)];
   if (stage < 0.0) return box;
@@ -175,4 +176,4 @@ std::string pwave_report_text(const PWaveReport& r) {
   return out;
 }
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

@@ -12,7 +12,7 @@
 
 #include "plinth/host/eval_metrics.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 
 // Where the stage can help: by how long the record's P wave (its AIC pick) comes before its
 // strong motion (host::RecordPhases).
@@ -47,4 +47,4 @@ inline constexpr double kPWaveUnneededAllowance = 0.05;
                                             const host::EvalTable* calibrate_on = nullptr);
 [[nodiscard]] std::string pwave_report_text(const PWaveReport& report);
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

@@ -11,12 +11,11 @@
 #include "plinth/host/input_error.h"
 #include "plinth/host/json_text.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 namespace {
 
 using host::Choice;
 using host::CrossingGrids;
-using host::EvalLevel;
 using host::EvalRun;
 using host::EvalTable;
 using host::InputError;
@@ -24,8 +23,8 @@ using host::Rule;
 using host::WarningOutcome;
 
 // The alarm policy's default risk thresholds (alarm_policy.h): today's reactive box.
-constexpr double kDefaultRiskOn[host::kEvalLevels] = {0.1, 0.5, 0.8};
-constexpr const char* kLevelNames[host::kEvalLevels] = {"advisory", "warning", "alarm"};
+// Per risk level (monitor::kRiskLevels).
+constexpr double kDefaultRiskOn[monitor::kRiskLevels.size()] = {0.1, 0.5, 0.8};
 
 std::string number(double v, int digits = 3) {
   char buffer[32];
@@ -216,10 +215,10 @@ Report make_report(const EvalTable& table, const CalibrationTargets& targets, bo
   std::size_t k = 0;
   for (const std::string& name : record_names(table.runs)) halves[k++ % 2].push_back(name);
   const std::vector<host::RocPoint> all_points = host::roc(table.runs, table.grids);
-  for (std::size_t level = 0; level < host::kEvalLevels; ++level) {
+  for (std::size_t level = 0; level < monitor::kRiskLevels.size(); ++level) {
     LevelReport l;
-    l.level = kLevelNames[level];
-    l.shown = host::level_outcome(table.runs, static_cast<EvalLevel>(level));
+    l.level = monitor::alarm_level_name(monitor::kRiskLevels[level]);
+    l.shown = host::level_outcome(table.runs, monitor::kRiskLevels[level]);
     l.reactive = nominal_risk_outcome(table.runs, grid_index(table.grids.risk, kDefaultRiskOn[level]));
     host::LevelTarget target = target_of(targets, level);
     target.false_alarm = targets.false_alarm;
@@ -384,7 +383,7 @@ void write_series(const std::string& path, const std::vector<WarningOutcome>& ou
 }  // namespace
 
 void plot_roc(const EvalTable& table, const std::string& png_path) {
-  const cli::PlotFolder folder;
+  const PlotFolder folder;
   const auto series = [&](const char* name, std::size_t n, auto outcome) {
     std::vector<WarningOutcome> outcomes;
     for (std::size_t i = 0; i < n; ++i) outcomes.push_back(outcome(static_cast<int>(i)));
@@ -430,4 +429,4 @@ void plot_roc(const EvalTable& table, const std::string& png_path) {
   folder.draw("roc.gp", "roc.png", png_path);
 }
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

@@ -8,7 +8,7 @@
 
 #include "plinth/host/eval_metrics.h"
 
-namespace plinth::eval {
+namespace plinth::sim {
 
 // The calibration's targets per level (the issue's: alarm within 5 % false alarms, warning
 // within 15 %; advisory within 30 %), each with no missed collapse wanted. The false alarms are
@@ -82,4 +82,4 @@ void require_margins(const host::EvalTable& table, const CalibrationTargets& tar
 // gnuplot). Throws InputError when gnuplot is missing or fails.
 void plot_roc(const host::EvalTable& table, const std::string& png_path);
 
-}  // namespace plinth::eval
+}  // namespace plinth::sim

@@ -16,7 +16,7 @@
 
 extern char** environ;
 
-namespace plinth::cli {
+namespace plinth::sim {
 namespace {
 
 using plinth::host::InputError;
@@ -111,4 +111,4 @@ std::string comment_text(std::string text) {
   return text;
 }
 
-}  // namespace plinth::cli
+}  // namespace plinth::sim

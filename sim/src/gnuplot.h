@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace plinth::cli {
+namespace plinth::sim {
 
 // The gnuplot executable on PATH. Throws InputError with the Debian package to install.
 [[nodiscard]] std::string find_gnuplot();
@@ -38,4 +38,4 @@ class PlotFolder {
   std::string folder_;
 };
 
-}  // namespace plinth::cli
+}  // namespace plinth::sim

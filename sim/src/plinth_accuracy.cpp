@@ -462,7 +462,7 @@ void plot(const Options& opt, const std::vector<Summary>& summary) {
     out << script;
     if (!out.flush()) throw InputError(gp + ": write failed");
   }
-  plinth::cli::run_gnuplot(gp, {data, stem + ".png", stem + ".svg"});  // names as data
+  plinth::sim::run_gnuplot(gp, {data, stem + ".png", stem + ".svg"});  // names as data
 }
 
 std::string markdown(const std::vector<Summary>& summary) {

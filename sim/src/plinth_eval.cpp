@@ -72,7 +72,7 @@ struct ReportOptions {
   std::string pwave_calibrate_on;  // choose the P-wave threshold on this runs file
   std::string calibration_path;  // choose the rules on this other runs file
   std::string false_alarm =
-      plinth::host::false_alarm_name(plinth::eval::CalibrationTargets{}.false_alarm);
+      plinth::host::false_alarm_name(plinth::sim::CalibrationTargets{}.false_alarm);
 };
 
 struct FragilityOptions {
@@ -120,8 +120,8 @@ void refuse_repeated_names(const std::vector<std::string>& paths, const char* op
   }
 }
 
-plinth::eval::BoxSettings box_settings(const RunOptions& opt) {
-  plinth::eval::BoxSettings box;
+plinth::sim::BoxSettings box_settings(const RunOptions& opt) {
+  plinth::sim::BoxSettings box;
   box.rate_hz = opt.rate_hz;
   box.steps_per_sample = opt.steps_per_sample;
   box.knows_true_statue = opt.box_knows_statue;
@@ -183,8 +183,8 @@ int run_eval(const RunOptions& opt) {
     throw InputError("--statues: expected 1 to " + std::to_string(kMaxStatues) + ", got " +
                      std::to_string(opt.statues));
   }
-  const plinth::eval::BoxSettings box = box_settings(opt);
-  plinth::eval::TruthSettings truth;
+  const plinth::sim::BoxSettings box = box_settings(opt);
+  plinth::sim::TruthSettings truth;
   truth.step_s = opt.truth_step_s;
   std::vector<plinth::host::UncertainScene> scenes;
   std::vector<std::vector<plinth::Scene>> statues;
@@ -193,7 +193,7 @@ int run_eval(const RunOptions& opt) {
     statues.push_back(draw_statues(scenes.back(), opt.statues, opt.seed + 7919U * static_cast<unsigned>(s)));
   }
   const std::vector<plinth::host::Record> records =
-      plinth::eval::read_records(opt.record_paths, opt.vertical_paths);
+      plinth::sim::read_records(opt.record_paths, opt.vertical_paths);
   std::vector<plinth::host::RecordPhases> phases;
   for (const plinth::host::Record& r : records) phases.push_back(plinth::host::record_phases(r));
   plinth::host::JobRun run;
@@ -211,7 +211,7 @@ int run_eval(const RunOptions& opt) {
     const std::size_t r = index / per_record;
     const std::size_t s = index % per_record / static_cast<std::size_t>(opt.statues);
     const auto j = static_cast<int>(index % static_cast<std::size_t>(opt.statues));
-    return plinth::eval::EvalCase{&records[r],   file_name(opt.record_paths[r]),
+    return plinth::sim::EvalCase{&records[r],   file_name(opt.record_paths[r]),
                                   &scenes[s],    file_name(opt.scene_paths[s]),
                                   j,             opt.seed,
                                   grid,          &statues[s][static_cast<std::size_t>(j)],
@@ -228,13 +228,13 @@ int run_eval(const RunOptions& opt) {
         std::vector<EvalRun> job;
         for (int i = 0; i < grid.steps; ++i) {
           if (run.stop->load()) throw plinth::host::JobCancelled();
-          job.push_back(plinth::eval::run_case(case_of(index, grid.at(i)), box, truth, grids));
+          job.push_back(plinth::sim::run_case(case_of(index, grid.at(i)), box, truth, grids));
           if (job.back().collapsed && !opt.all_scales) break;
         }
         results[index] = std::move(job);
       },
       [&](std::size_t index) {
-        const plinth::eval::EvalCase c = case_of(index, 0.0);
+        const plinth::sim::EvalCase c = case_of(index, 0.0);
         return c.record_name + ", " + c.scene_name + ", statue " + std::to_string(c.statue);
       });
   progress.finish();
@@ -265,50 +265,50 @@ void write_text(const std::string& path, const std::string& text) {
 }
 
 int run_report(const ReportOptions& opt) {
-  plinth::eval::CalibrationTargets targets;
+  plinth::sim::CalibrationTargets targets;
   if (!plinth::host::parse_false_alarm(opt.false_alarm, targets.false_alarm)) {
     throw InputError("--false-alarm: expected margin or peak, got '" + opt.false_alarm + "'");
   }
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
-  plinth::eval::require_margins(table, targets, opt.runs_path);
+  plinth::sim::require_margins(table, targets, opt.runs_path);
   EvalTable calibration;
   if (!opt.calibration_path.empty()) {
     calibration = plinth::host::read_eval_csv(opt.calibration_path);
     if (calibration.runs.empty()) throw InputError(opt.calibration_path + ": no runs");
-    plinth::eval::require_margins(calibration, targets, opt.calibration_path + " (--calibrate-on)");
+    plinth::sim::require_margins(calibration, targets, opt.calibration_path + " (--calibrate-on)");
   }
-  const plinth::eval::Report report = plinth::eval::make_report(
+  const plinth::sim::Report report = plinth::sim::make_report(
       table, targets, opt.frontier, opt.calibration_path.empty() ? nullptr : &calibration);
-  std::fputs(plinth::eval::report_text(report, table.grids).c_str(), stdout);
+  std::fputs(plinth::sim::report_text(report, table.grids).c_str(), stdout);
   if (!table.grids.pwave.empty() || !opt.pwave_calibrate_on.empty()) {
     std::optional<EvalTable> other;
     if (!opt.pwave_calibrate_on.empty()) other = plinth::host::read_eval_csv(opt.pwave_calibrate_on);
-    std::fputs(plinth::eval::pwave_report_text(
-                   plinth::eval::make_pwave_report(table, other ? &*other : nullptr))
+    std::fputs(plinth::sim::pwave_report_text(
+                   plinth::sim::make_pwave_report(table, other ? &*other : nullptr))
                    .c_str(),
                stdout);
   }
   if (!opt.json_path.empty()) {
-    write_text(opt.json_path, plinth::eval::report_json(report, table.grids));
+    write_text(opt.json_path, plinth::sim::report_json(report, table.grids));
   }
-  if (!opt.plot_path.empty()) plinth::eval::plot_roc(table, opt.plot_path);
+  if (!opt.plot_path.empty()) plinth::sim::plot_roc(table, opt.plot_path);
   return 0;
 }
 
 int run_fragility(const FragilityOptions& opt) {
-  plinth::eval::CollapseIntensityRule rule{};
-  if (!plinth::eval::parse_collapse_intensity(opt.collapse_intensity, rule)) {
+  plinth::sim::CollapseIntensityRule rule{};
+  if (!plinth::sim::parse_collapse_intensity(opt.collapse_intensity, rule)) {
     throw InputError("--collapse-intensity: expected interval or grid, got '" +
                      opt.collapse_intensity + "'");
   }
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
-  const std::vector<plinth::eval::SceneFragility> scenes =
-      plinth::eval::scene_fragilities(table, opt.runs_path, rule);
-  std::fputs(plinth::eval::fragility_text(scenes, rule).c_str(), stdout);
-  if (!opt.json_path.empty()) write_text(opt.json_path, plinth::eval::fragility_json(scenes, rule));
-  if (!opt.plot_path.empty()) plinth::eval::plot_fragility(scenes, opt.plot_path);
+  const std::vector<plinth::sim::SceneFragility> scenes =
+      plinth::sim::scene_fragilities(table, opt.runs_path, rule);
+  std::fputs(plinth::sim::fragility_text(scenes, rule).c_str(), stdout);
+  if (!opt.json_path.empty()) write_text(opt.json_path, plinth::sim::fragility_json(scenes, rule));
+  if (!opt.plot_path.empty()) plinth::sim::plot_fragility(scenes, opt.plot_path);
   return 0;
 }
 
@@ -414,7 +414,7 @@ int main(int argc, char** argv) {
   CLI::App* merge_command = app.add_subcommand("merge", "join the runs CSVs of shards");
   merge_command->add_option("--out", merge.out_path, "merged CSV")->required();
   merge_command->add_option("inputs", merge.inputs, "the shards' CSV files")->required();
-  const plinth::eval::Subcommand pwave_fit = plinth::eval::add_pwave_fit(app);
+  const plinth::sim::Subcommand pwave_fit = plinth::sim::add_pwave_fit(app);
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
     return *exit_code;
   }

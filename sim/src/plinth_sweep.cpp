@@ -150,8 +150,8 @@ int run_sweep_mode(const Options& opt) {
     axis = axis_of(opt.param, opt.from, opt.to, opt.steps, "", "", mode);
   }
   if (!opt.plot_path.empty()) {
-    (void)plinth::cli::plot_stem(opt.plot_path);
-    (void)plinth::cli::find_gnuplot();  // before hours of simulation, not after
+    (void)plinth::sim::plot_stem(opt.plot_path);
+    (void)plinth::sim::find_gnuplot();  // before hours of simulation, not after
   }
 
   const plinth::Scene scene = plinth::host::load_scene_file(opt.scene_path);
@@ -205,8 +205,8 @@ int run_sweep_mode(const Options& opt) {
   }
 
   run.stop = plinth::host::install_stop_handlers("plinth-sweep");
-  const plinth::cli::SweepOutcome outcome =
-      plinth::cli::run_to_file(plan, run, {opt.out_path, opt.fresh});
+  const plinth::sim::SweepOutcome outcome =
+      plinth::sim::run_to_file(plan, run, {opt.out_path, opt.fresh});
   if (outcome.interrupted) {
     std::fprintf(stderr,
                  "plinth-sweep: interrupted: %zu of %zu rows kept in %s (%zu found there "
@@ -223,7 +223,7 @@ int run_sweep_mode(const Options& opt) {
       outcome.wall_seconds, opt.out_path.c_str());
   if (!opt.plot_path.empty()) {
     const std::string images =
-        plinth::cli::plot_sweep(plinth::host::read_sweep_table(opt.out_path), opt.plot_path);
+        plinth::sim::plot_sweep(plinth::host::read_sweep_table(opt.out_path), opt.plot_path);
     std::printf("plinth-sweep: plotted %s\n", images.c_str());
   }
   return 0;
@@ -235,26 +235,26 @@ int run_merge(const MergeOptions& opt) {
   for (const std::string& path : opt.inputs) inputs.emplace_back("input", path);
   plinth::host::check_distinct_files({{"--out", opt.out_path}}, inputs);
   if (!opt.plot_path.empty()) {
-    (void)plinth::cli::plot_stem(opt.plot_path);
-    (void)plinth::cli::find_gnuplot();
+    (void)plinth::sim::plot_stem(opt.plot_path);
+    (void)plinth::sim::find_gnuplot();
   }
   std::vector<plinth::host::SweepTable> parts;
   for (const std::string& path : opt.inputs) parts.push_back(plinth::host::read_sweep_table(path));
   const plinth::host::SweepTable merged = plinth::host::merge_sweep_tables(parts, opt.inputs);
-  plinth::cli::write_table_file(merged, opt.out_path);
+  plinth::sim::write_table_file(merged, opt.out_path);
   std::printf("plinth-sweep merge: %zu rows from %zu files -> %s\n", merged.rows.size(),
               parts.size(), opt.out_path.c_str());
   if (!opt.plot_path.empty()) {
     std::printf("plinth-sweep: plotted %s\n",
-                plinth::cli::plot_sweep(merged, opt.plot_path).c_str());
+                plinth::sim::plot_sweep(merged, opt.plot_path).c_str());
   }
   return 0;
 }
 
 int run_plot(const PlotOptions& opt) {
-  (void)plinth::cli::plot_stem(opt.plot_path);
+  (void)plinth::sim::plot_stem(opt.plot_path);
   const std::string images =
-      plinth::cli::plot_sweep(plinth::host::read_sweep_table(opt.csv_path), opt.plot_path);
+      plinth::sim::plot_sweep(plinth::host::read_sweep_table(opt.csv_path), opt.plot_path);
   std::printf("plinth-sweep: plotted %s\n", images.c_str());
   return 0;
 }

@@ -14,7 +14,7 @@
 #include "plinth/host/run_progress.h"
 #include "plinth/host/output_file.h"
 
-namespace plinth::cli {
+namespace plinth::sim {
 namespace {
 
 using plinth::host::InputError;
@@ -136,4 +136,4 @@ SweepOutcome run_to_file(const plinth::host::SweepPlan& plan, plinth::host::JobR
   return outcome;
 }
 
-}  // namespace plinth::cli
+}  // namespace plinth::sim

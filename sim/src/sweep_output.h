@@ -11,7 +11,7 @@
 #include "plinth/host/sweep_plan.h"
 #include "plinth/host/sweep_table.h"
 
-namespace plinth::cli {
+namespace plinth::sim {
 
 struct OutputOptions {
   std::string out_path;
@@ -36,4 +36,4 @@ SweepOutcome run_to_file(const plinth::host::SweepPlan& plan, plinth::host::JobR
 // Writes `table` to `path` through a temporary file renamed over it.
 void write_table_file(const plinth::host::SweepTable& table, const std::string& path);
 
-}  // namespace plinth::cli
+}  // namespace plinth::sim

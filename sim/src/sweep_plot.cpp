@@ -18,7 +18,7 @@
 #include "plinth/host/sweep_parameter.h"
 #include "plinth/host/sweep_search.h"
 
-namespace plinth::cli {
+namespace plinth::sim {
 namespace {
 
 using plinth::host::InputError;
@@ -523,4 +523,4 @@ std::string plot_sweep(const SweepTable& table, const std::string& plot_path) {
   return stem + ".png and " + stem + ".svg";
 }
 
-}  // namespace plinth::cli
+}  // namespace plinth::sim

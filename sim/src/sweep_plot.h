@@ -8,7 +8,7 @@
 #include "gnuplot.h"
 #include "plinth/host/sweep_table.h"
 
-namespace plinth::cli {
+namespace plinth::sim {
 
 // The stem of a --plot argument ("map.png" -> "map"); throws InputError unless it ends with
 // .png or .svg.
@@ -24,4 +24,4 @@ namespace plinth::cli {
 // map.svg").
 std::string plot_sweep(const plinth::host::SweepTable& table, const std::string& plot_path);
 
-}  // namespace plinth::cli
+}  // namespace plinth::sim

@@ -85,6 +85,7 @@ fi
 #     JSON lines say (tests/cli/monitor_frames.py decodes them from the DBC's layout); one axis
 #     and two.
 FRAMES_CHECK=$(dirname "${BASH_SOURCE[0]}")/monitor_frames.py
+LOGS=$(dirname "${BASH_SOURCE[0]}")/monitor_logs.py
 if expect_success "replay: --frames-out, one axis" --scene "$ECCENTRIC" --replay "$AT2" \
     --scale 20 --status-interval 0.25 --frames-out "$TMP/frames1.log"; then
   cp "$TMP/stdout" "$TMP/frames1.jsonl"
@@ -138,18 +139,7 @@ assert s["max_risk"] > 0.0, s
   # Another box's CollapseForecast frames in the log (0x350 + axis): two valid ones counted as
   # monitor frames, a probability above 1 and a worst member beyond the members rejected; the
   # status lines carry the forecast (probability, collapse_forecast_t, members, worst_member).
-  python3 - "$log" "$TMP/forecast.log" <<'PY'
-import sys
-lines = open(sys.argv[1]).read().splitlines()
-iface = lines[0].split()[1]
-t = float(lines[len(lines) // 2].split()[0].strip("()"))
-extra = ["351#C90D0C11290928FE", "350#0000FF09FFFF6400", "350#1127000100000000",
-         "351#E803050364002800"]
-# Each a microsecond apart: a log's time never stands still for one identifier (docs/limits.md).
-out = lines[: len(lines) // 2 + 1] + ["(%.6f) %s %s" % (t + 1e-6 * k, iface, f)
-                                      for k, f in enumerate(extra)]
-open(sys.argv[2], "w").write("\n".join(out + lines[len(lines) // 2 + 1:]) + "\n")
-PY
+  python3 "$LOGS" forecast-frames "$log" "$TMP/forecast.log"
   if expect_success "candump log with CollapseForecast frames" --scene "$ISOLATED" \
       --replay "$TMP/forecast.log" --rate 344.8275862068966 --startup-window 1 \
       --status-interval 1 --stuck-samples 0; then
@@ -168,25 +158,7 @@ assert all(x["state"]["members"] == 1 and x["state"]["worst_member"] == 0 for x 
   fi
   # Two ground sensors (node 2: node 1's frames 0.5 ms later); node 1 falls silent at 60 % of
   # the log: the estimators fail over to node 2 and continue, the summary reports each sensor.
-  python3 - "$log" "$TMP/two.log" <<'PY'
-import sys
-rows = []
-lines = [l.split() for l in open(sys.argv[1]) if l.strip()]
-t0 = float(lines[0][0].strip("()"))
-t1 = float(lines[-1][0].strip("()"))
-cut = t0 + 0.6 * (t1 - t0)
-for stamp, iface, frame in lines:
-    t = float(stamp.strip("()"))
-    ident, data = frame.split("#")
-    if ident != "301":
-        continue
-    if t < cut:
-        rows.append((t, "%s %s 301#%s" % ("(%.6f)" % t, iface, data)))
-    rows.append((t + 0.0005, "(%.6f) %s 302#%s" % (t + 0.0005, iface, data)))
-with open(sys.argv[2], "w") as out:
-    for _, row in sorted(rows):
-        out.write(row + "\n")
-PY
+  python3 "$LOGS" failover "$log" "$TMP/two.log"
   printf '[[sensor]]\nnode = 1\n\n[[sensor]]\nnode = 2\nrole = "ground"\n' >"$TMP/two.toml"
   if expect_success "two ground sensors, failover" --scene "$ISOLATED" --replay "$TMP/two.log" \
       --config "$TMP/two.toml" --rate 344.8275862068966 --startup-window 1 --status-interval 1 \

@@ -9,7 +9,7 @@
 
 namespace {
 
-namespace can = plinth::can;
+namespace can = plinth::hal::can;
 
 template <typename Message>
 void round_trip(const can::CanFrame& frame) {

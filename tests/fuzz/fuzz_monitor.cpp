@@ -25,6 +25,7 @@
 
 #include "fuzz_check.h"
 #include "plinth/core/scene.h"
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/hal/can_codec.h"
 
@@ -32,7 +33,7 @@ namespace {
 
 namespace fw = plinth::firmware;
 namespace mon = plinth::monitor;
-namespace can = plinth::can;
+namespace can = plinth::hal::can;
 using plinth::fuzz::check;
 
 constexpr double kRateHz = 200.0;
@@ -101,6 +102,7 @@ class Harness {
 
   void restart() {
     check(box_->start(config_, {&scene(), nullptr}).ok(), "the fuzz configuration starts");
+    decoder_.start(config_);
     last_status_ns_ = 0;
     have_status_ = false;
     last_time_ns_ = 0;
@@ -143,7 +145,7 @@ class Harness {
   void send(const can::CanFrame& frame) {
     if (frames_sent_ >= kMaxFramesPerInput) return;
     ++frames_sent_;
-    after(box_->on_frame({frame, clock_ns_}));
+    after(fw::on_frame(*box_, decoder_, {frame, clock_ns_}));
   }
 
   void sensor_frame(std::uint8_t node, double ax, double ay, double az, std::uint8_t flags) {
@@ -203,7 +205,8 @@ class Harness {
 
   // The check function, after every call.
   void after(const fw::MonitorUpdate& u) {
-    const fw::MonitorStatus& s = box_->status();
+    const fw::BoxStatus& s = box_->status();
+    check(u.status == &s, "an update carries the monitor's status");
     check(s.time_ns >= last_time_ns_, "monitor time never goes back");
     last_time_ns_ = s.time_ns;
     check_estimator(s);
@@ -211,7 +214,7 @@ class Harness {
           "never normal while not estimating or not calibrated");
     if (u.status_due) {
       check(u.frame_count >= static_cast<std::size_t>(s.axis_count) + u.event_count ||
-                box_->frames().not_encoded > 0,
+                box_->frames_not_encoded() > 0,
             "a due status carries its frames");
       last_status_ns_ = s.time_ns;
       have_status_ = true;
@@ -221,14 +224,14 @@ class Harness {
               static_cast<std::int64_t>(config_.alarm.heartbeat_period_s * 1e9),
           "a status at least every heartbeat period");
     for (std::size_t i = 0; i < u.event_count; ++i) check_event(s, u.events[i]);
-    const fw::FrameCounters& c = box_->frames();
+    const fw::FrameCounters& c = decoder_.counters();
     if (c.rejected > rejected_) {
       check(c.last_error != can::CodecError::kOk, "a rejected frame names its error");
     }
     rejected_ = c.rejected;
   }
 
-  void check_estimator(const fw::MonitorStatus& s) {
+  void check_estimator(const fw::BoxStatus& s) {
     check(std::isfinite(s.risk) && s.risk >= 0.0 && s.risk <= 1.0, "risk in [0, 1]");
     check(std::isfinite(s.probability) && s.probability >= 0.0 && s.probability <= 1.0,
           "probability in [0, 1]");
@@ -245,12 +248,12 @@ class Harness {
       check(std::abs(a.mode.overhang) <= 1 && std::abs(a.mode.held_stop) <= 1,
             "overhang and held stop are -1, 0 or +1");
       check(a.risk.total >= 0.0 && a.risk.total <= 1.0, "axis risk in [0, 1]");
-      check(!s.estimating || box_->estimator(i).time() >= 0.0, "estimator time >= 0");
+      check(!s.estimating || box_->ensemble(i).nominal().time() >= 0.0, "estimator time >= 0");
     }
   }
 
   // A fault event reports what was rejected: the cause the monitor's inputs give now.
-  void check_event(const fw::MonitorStatus& s, const mon::AlarmEventRecord& e) {
+  void check_event(const fw::BoxStatus& s, const mon::AlarmEventRecord& e) {
     if (e.level != mon::AlarmLevel::kFault || e.cause == mon::AlarmCause::kAcknowledged) return;
     // From alarm the fault may be one held beneath it; fault to fault is a latch change.
     if (e.previous_level != mon::AlarmLevel::kAlarm &&
@@ -273,6 +276,7 @@ class Harness {
 
   fw::MonitorConfig config_;
   std::unique_ptr<fw::Monitor> box_ = std::make_unique<fw::Monitor>();
+  fw::FrameDecoder decoder_;
   std::int64_t clock_ns_ = 0;
   std::array<std::uint8_t, 16> sequences_{};
   std::int64_t last_status_ns_ = 0;

@@ -96,7 +96,7 @@ struct Cost {
 // Which cost a sample counts to: every axis in full contact, some axis moving on the base, or
 // none moving and some overturned or fallen (the estimator no longer steps).
 enum class SampleKind { kQuiet, kMoving, kOver };
-SampleKind kind_of(const fw::MonitorStatus& s) {
+SampleKind kind_of(const fw::BoxStatus& s) {
   bool moving = false;
   bool over = false;
   for (int i = 0; i < s.axis_count; ++i) {
@@ -191,14 +191,14 @@ extern "C" int plinth_board_main() {
     if (n >= lead_in) {
       const std::int64_t record_ns = sample.receive_time_ns - origin_ns;
       all.add(ticks, record_ns);
-      costs[static_cast<std::size_t>(kind_of(g_monitor.status()))].add(ticks, record_ns);
+      costs[static_cast<std::size_t>(kind_of(*update.status))].add(ticks, record_ns);
     }
     for (std::size_t i = 0; i < update.frame_count; ++i) {
       if (can.send(update.frames[i]) != hal::IoStatus::kOk) ++send_errors;
     }
   }
 
-  const fw::MonitorStatus& s = g_monitor.status();
+  const fw::BoxStatus& s = g_monitor.status();
   char text[200];
   hal::TextLine line(text, sizeof text);
   line.put("# summary samples=").decimal(static_cast<std::uint64_t>(lead_in + record.count));
@@ -211,7 +211,7 @@ extern "C" int plinth_board_main() {
   line.put(" frames=")
       .decimal(can.frames_sent())
       .put(" send_errors=")
-      .decimal(send_errors + g_monitor.frames().not_encoded);
+      .decimal(send_errors + g_monitor.frames_not_encoded());
   print(line);
   all.print_as("per_sample");
   costs[0].print_as("per_sample_quiet");
@@ -220,7 +220,7 @@ extern "C" int plinth_board_main() {
   hal::TextLine stack(text, sizeof text);
   stack.put("# stack used_bytes=").decimal(static_cast<std::uint64_t>(board::stack_used_bytes()));
   print(stack.put(" size_bytes=").decimal(static_cast<std::uint64_t>(board::stack_size_bytes())));
-  const bool ok = send_errors + g_monitor.frames().not_encoded == 0;
+  const bool ok = send_errors + g_monitor.frames_not_encoded() == 0;
   hal::semihosting::write(ok ? "# end: ok\n" : "# end: FAILED: frames not sent\n");
   return ok ? 0 : 1;
 }

@@ -3,6 +3,9 @@
 #include <cmath>
 
 namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
 namespace {
 
 template <typename Domain, typename Wire>
@@ -76,7 +79,7 @@ monitor::AlarmLevel from_wire(can::AlarmLevel level) {
   return static_cast<monitor::AlarmLevel>(level);
 }
 
-can::MonitorStatus status_message(const MonitorStatus& status, int axis, std::uint8_t sequence) {
+can::MonitorStatus status_message(const BoxStatus& status, int axis, std::uint8_t sequence) {
   const AxisStatus& a = status.axes[static_cast<std::size_t>(axis)];
   can::MonitorStatus m;
   m.axis = static_cast<std::uint8_t>(axis);
@@ -94,7 +97,7 @@ can::MonitorStatus status_message(const MonitorStatus& status, int axis, std::ui
   return m;
 }
 
-can::CollapseForecast forecast_message(const MonitorStatus& status, int axis, double horizon_s,
+can::CollapseForecast forecast_message(const BoxStatus& status, int axis, double horizon_s,
                                        std::uint8_t sequence) {
   const AxisStatus& a = status.axes[static_cast<std::size_t>(axis)];
   const ForecastOutcome& f = a.forecast;

@@ -5,7 +5,7 @@
 
 #include "plinth/core/name_table.h"
 
-namespace plinth::can {
+namespace plinth::hal::can {
 
 namespace {
 
@@ -542,4 +542,4 @@ DecodeResult decode(const CanFrame& frame, CollapseForecast& message) {
   return unpacker.result();
 }
 
-}  // namespace plinth::can
+}  // namespace plinth::hal::can

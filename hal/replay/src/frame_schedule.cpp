@@ -11,7 +11,7 @@
 #include "plinth/host/limits.h"
 #include "plinth/host/record_sampling.h"
 
-namespace plinth::replay {
+namespace plinth::hal::replay {
 namespace {
 
 constexpr double kNsPerSecond = 1e9;
@@ -199,4 +199,4 @@ bool LogSchedule::next(ScheduledFrame& out) {
   return true;
 }
 
-}  // namespace plinth::replay
+}  // namespace plinth::hal::replay

@@ -10,7 +10,7 @@
 #include "plinth/core/excitation.h"
 #include "plinth/hal/can_codec.h"
 
-namespace plinth::replay {
+namespace plinth::hal::replay {
 
 enum class FrameKind : std::uint8_t { kAcceleration, kHeartbeat };
 
@@ -104,4 +104,4 @@ class LogSchedule final : public FrameSchedule {
   std::size_t index_ = 0;
 };
 
-}  // namespace plinth::replay
+}  // namespace plinth::hal::replay

@@ -105,8 +105,8 @@ Component parse_node_record(const std::string& text) {
     throw InputError(usage);
   }
   component.node = std::stoi(node_text);
-  if (component.node < plinth::can::kFirstSensorNode ||
-      component.node > plinth::can::kLastSensorNode) {
+  if (component.node < plinth::hal::can::kFirstSensorNode ||
+      component.node > plinth::hal::can::kLastSensorNode) {
     throw InputError("--node-record: node " + node_text + " is not 1-15 in '" + text + "'");
   }
   std::string rest = text.substr(colon + 1);
@@ -128,7 +128,7 @@ double peak_of(const plinth::SampledSignal& signal) {
 
 // The record-driven schedule: every node's axes, resampled and scaled.
 struct RecordPlan {
-  std::vector<plinth::replay::SensorNodeSamples> nodes;
+  std::vector<plinth::hal::replay::SensorNodeSamples> nodes;
   std::string description;
   std::size_t clipped = 0;  // samples clipped to the full scale, all nodes
 };
@@ -146,10 +146,10 @@ std::vector<Component> components_of(const Options& opt) {
 
 // Each node's axes from the components' files, each file read once into `records` (the signals
 // point into them).
-std::map<int, plinth::replay::SensorNodeInput> node_inputs(
+std::map<int, plinth::hal::replay::SensorNodeInput> node_inputs(
     const std::vector<Component>& components,
     std::map<std::string, plinth::host::Record>& records) {
-  std::map<int, plinth::replay::SensorNodeInput> inputs;
+  std::map<int, plinth::hal::replay::SensorNodeInput> inputs;
   std::map<int, std::array<std::string, 3>> given;  // node -> the option per axis
   for (const Component& c : components) {
     if (is_candump_log(c.path)) {
@@ -173,7 +173,7 @@ std::map<int, plinth::replay::SensorNodeInput> node_inputs(
     if (found == records.end()) {
       found = records.emplace(c.path, plinth::host::read_record(c.path, kStandardGravity)).first;
     }
-    plinth::replay::SensorNodeInput& input = inputs[c.node];
+    plinth::hal::replay::SensorNodeInput& input = inputs[c.node];
     input.node = static_cast<std::uint8_t>(c.node);
     const plinth::SampledSignal signal = found->second.horizontal_signal();
     (c.axis == kX ? input.x : c.axis == kY ? input.y : input.z) = signal;
@@ -181,7 +181,7 @@ std::map<int, plinth::replay::SensorNodeInput> node_inputs(
   // A record with a vertical column (three-column CSV) also drives z of the node whose x it
   // drives, unless z is given.
   for (const Component& c : components) {
-    plinth::replay::SensorNodeInput& input = inputs[c.node];
+    plinth::hal::replay::SensorNodeInput& input = inputs[c.node];
     const plinth::host::Record& record = records.at(c.path);
     if (c.axis == kX && input.z.empty() && !record.vertical.empty())
       input.z = record.vertical_signal();
@@ -191,7 +191,7 @@ std::map<int, plinth::replay::SensorNodeInput> node_inputs(
 
 RecordPlan plan_records(const Options& opt) {
   std::map<std::string, plinth::host::Record> records;
-  const std::map<int, plinth::replay::SensorNodeInput> inputs =
+  const std::map<int, plinth::hal::replay::SensorNodeInput> inputs =
       node_inputs(components_of(opt), records);
   const plinth::host::Record& main_record = records.at(opt.record_path);
   const double scale = plinth::host::record_scale(main_record, opt.record_path, opt.pga, opt.scale,
@@ -210,10 +210,10 @@ RecordPlan plan_records(const Options& opt) {
 
   RecordPlan plan;
   for (const auto& [node, input] : inputs) {
-    plan.nodes.push_back(plinth::replay::resample(input, scale, opt.rate_hz, duration_s));
+    plan.nodes.push_back(plinth::hal::replay::resample(input, scale, opt.rate_hz, duration_s));
   }
   std::size_t clipped = 0;
-  for (const plinth::replay::SensorNodeSamples& node : plan.nodes) clipped += node.clipped;
+  for (const plinth::hal::replay::SensorNodeSamples& node : plan.nodes) clipped += node.clipped;
   char text[480];
   const int n =
       std::snprintf(text, sizeof text,
@@ -243,7 +243,7 @@ struct Destination {
 
   // Sends; a full transmit queue (the bus is slower than the schedule, as at --speed max on a
   // real controller) is waited out for up to kQueueFullWaitNs rather than the frame dropped.
-  [[nodiscard]] plinth::hal::IoStatus send(const plinth::can::CanFrame& frame) const {
+  [[nodiscard]] plinth::hal::IoStatus send(const plinth::hal::can::CanFrame& frame) const {
     plinth::hal::IoStatus status = sink->send(frame);
     const std::int64_t give_up_ns = plinth::hal::monotonic_now_ns() + kQueueFullWaitNs;
     while (status == plinth::hal::IoStatus::kIoError && port != nullptr &&
@@ -385,7 +385,7 @@ void install_stop_handlers() {
 
 // What to send: a candump log's sensor frames, or frames made from records.
 struct Input {
-  std::unique_ptr<plinth::replay::FrameSchedule> schedule;
+  std::unique_ptr<plinth::hal::replay::FrameSchedule> schedule;
   std::string description;
   std::size_t clipped_samples = 0;
   std::int64_t skipped_log_lines = 0;
@@ -397,7 +397,7 @@ Input open_input(const Options& opt, const CLI::App& app) {
     RecordPlan plan = plan_records(opt);
     input.description = plan.description;
     input.clipped_samples = plan.clipped;
-    input.schedule = std::make_unique<plinth::replay::RecordSchedule>(std::move(plan.nodes),
+    input.schedule = std::make_unique<plinth::hal::replay::RecordSchedule>(std::move(plan.nodes),
                                                                       opt.rate_hz, opt.loops);
     return input;
   }
@@ -408,15 +408,15 @@ Input open_input(const Options& opt, const CLI::App& app) {
                        opt.record_path + "): its sensor frames are sent again as logged");
     }
   }
-  plinth::replay::LoggedFrames logged =
-      plinth::replay::read_logged_sensor_frames(opt.record_path, opt.t_end_s.value_or(-1.0));
+  plinth::hal::replay::LoggedFrames logged =
+      plinth::hal::replay::read_logged_sensor_frames(opt.record_path, opt.t_end_s.value_or(-1.0));
   input.skipped_log_lines = logged.skipped;
   char text[200];
   std::snprintf(text, sizeof text, "%s: %zu sensor frames over %.4g s", opt.record_path.c_str(),
                 logged.frames.size(), static_cast<double>(logged.frames.back().virtual_ns) * 1e-9);
   input.description = text;
   input.schedule =
-      std::make_unique<plinth::replay::LogSchedule>(std::move(logged.frames), opt.loops);
+      std::make_unique<plinth::hal::replay::LogSchedule>(std::move(logged.frames), opt.loops);
   return input;
 }
 
@@ -463,9 +463,9 @@ void finish_log(const Destination& destination, const Report& report) {
 
 // Every frame of the schedule at its deadline; `current_virtual_ns` follows the frame being sent
 // (the log's clock).
-void send_all(plinth::replay::FrameSchedule& schedule, const Destination& destination,
+void send_all(plinth::hal::replay::FrameSchedule& schedule, const Destination& destination,
               plinth::hal::Pacer& pacer, std::int64_t& current_virtual_ns, Report& report) {
-  plinth::replay::ScheduledFrame next;
+  plinth::hal::replay::ScheduledFrame next;
   while (schedule.next(next)) {
     if (!pacer.wait_until(next.virtual_ns, g_stop)) {
       report.interrupted = true;
@@ -481,7 +481,7 @@ void send_all(plinth::replay::FrameSchedule& schedule, const Destination& destin
       continue;
     }
     ++report.frames_sent;
-    ++(next.kind == plinth::replay::FrameKind::kHeartbeat ? report.heartbeat_frames
+    ++(next.kind == plinth::hal::replay::FrameKind::kHeartbeat ? report.heartbeat_frames
                                                           : report.acceleration_frames);
   }
 }

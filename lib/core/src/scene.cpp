@@ -3,18 +3,13 @@
 #include <cmath>
 #include <numbers>
 
+#include "plinth/core/checks.h"
+
 namespace plinth {
 namespace {
 
 constexpr Error fail(ErrorCode code, const char* field, const char* reason) {
   return Error{code, field, reason};
-}
-
-// Checks `value` is finite and strictly positive.
-Error check_positive(Real value, const char* field) {
-  if (!std::isfinite(value)) return fail(ErrorCode::kNotFinite, field, "must be a finite number");
-  if (value <= Real(0)) return fail(ErrorCode::kOutOfRange, field, "must be greater than zero");
-  return ok_error();
 }
 
 // Checks `value` is finite and in [0, 1].

@@ -33,7 +33,7 @@ std::optional<int> parse_command_line(CLI::App& app, int argc, char** argv) {
   // "plinth-sim 0.1.0 (v0.1.0-12-g1234abc)": the program's own name, as installed.
   std::string program = argc > 0 && argv[0] != nullptr ? argv[0] : "plinth";
   program.erase(0, program.find_last_of('/') + 1);
-  app.set_version_flag("--version", program + " " + kVersionText,
+  app.set_version_flag("--version", program + " " + version::kVersionText,
                        "print the version and the git description it was built from, and exit");
   try {
     app.parse(argc, argv);

@@ -16,8 +16,6 @@ namespace plinth::host {
 
 namespace {
 
-constexpr std::array<const char*, kEvalLevels> kLevelNames{"advisory", "warning", "alarm"};
-
 // The header's fixed columns, before the crossing grids.
 constexpr std::array<std::string_view, 10> kFixedColumns{
     "record",          "scene",      "statue",           "scale_g",         "collapsed",
@@ -113,11 +111,6 @@ bool grid_value(std::string_view column, std::string_view prefix, double& value)
 }
 
 }  // namespace
-
-const char* eval_level_name(EvalLevel level) {
-  const auto i = static_cast<std::size_t>(level);
-  return i < kEvalLevels ? kLevelNames[i] : "invalid";
-}
 
 CrossingGrids default_crossing_grids() {
   CrossingGrids g;
@@ -231,9 +224,9 @@ double WarningOutcome::lead_quantile(double q) const {
   return sorted[below] + w * (sorted[above] - sorted[below]);
 }
 
-WarningOutcome level_outcome(const std::vector<EvalRun>& runs, EvalLevel level) {
+WarningOutcome level_outcome(const std::vector<EvalRun>& runs, monitor::AlarmLevel level) {
   return outcome_of(runs, [level](const EvalRun& r) {
-    return r.first_shown_s[static_cast<std::size_t>(level)];
+    return r.first_shown_s[monitor::risk_level_index(level)];
   });
 }
 
@@ -585,7 +578,7 @@ EvalTable read_eval_csv(const std::string& path) {
     }
     r.peak_ratio = parse_number(f[6], where, "peak_ratio");
     if (r.peak_ratio < 0.0) throw InputError(where + ": peak_ratio: must be >= 0");
-    for (std::size_t i = 0; i < kEvalLevels; ++i) {
+    for (std::size_t i = 0; i < monitor::kRiskLevels.size(); ++i) {
       r.first_shown_s[i] = parse_time(f[7 + i], where, kFixedColumns[7 + i]);
     }
     std::size_t c = kFixedColumns.size();

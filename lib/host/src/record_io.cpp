@@ -15,14 +15,13 @@
 #include <utility>
 #include <vector>
 
+#include "plinth/core/scene.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/text_file.h"
 
 namespace plinth::host {
 
 namespace {
-
-constexpr double kStandardGravity = 9.80665;  // m/s2, for the acceleration limit only
 
 // ---- small text helpers ------------------------------------------------------------------------
 
@@ -172,7 +171,7 @@ double parse_finite(const LineReader& reader, std::string_view token) {
 // A sample: a finite number times `factor` (to m/s2), within kMaxRecordAccelerationG.
 double parse_acceleration(const LineReader& reader, std::string_view token, double factor) {
   const double value = parse_finite(reader, token) * factor;
-  if (!(std::abs(value) <= kMaxRecordAccelerationG * kStandardGravity)) {
+  if (!(std::abs(value) <= kMaxRecordAccelerationG * static_cast<double>(kStandardGravity))) {
     reader.fail("value " + quote(token) + " is beyond the " +
                 format_number(kMaxRecordAccelerationG) + " g an accelerogram can hold");
   }

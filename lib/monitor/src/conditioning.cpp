@@ -58,14 +58,14 @@ Error validate(const ConditioningSettings& s) {
       validate_rotation(s),
       detail::check_duration(s.sample_period_s, "conditioning.sample_period_s", false),
       detail::check_duration(s.startup_window_s, "conditioning.startup_window_s", false),
-      detail::check_positive(s.startup_max_std_m_s2, "conditioning.startup_max_std_m_s2"),
-      detail::check_positive(s.startup_max_offset_m_s2, "conditioning.startup_max_offset_m_s2"),
-      detail::check_positive(s.startup_max_drift_m_s2, "conditioning.startup_max_drift_m_s2"),
-      detail::check_positive(s.startup_gravity_tolerance_m_s2,
+      check_positive(s.startup_max_std_m_s2, "conditioning.startup_max_std_m_s2"),
+      check_positive(s.startup_max_offset_m_s2, "conditioning.startup_max_offset_m_s2"),
+      check_positive(s.startup_max_drift_m_s2, "conditioning.startup_max_drift_m_s2"),
+      check_positive(s.startup_gravity_tolerance_m_s2,
                              "conditioning.startup_gravity_tolerance_m_s2"),
       detail::check_duration(s.tracking_time_constant_s, "conditioning.tracking_time_constant_s",
                              false),
-      detail::check_positive(s.tracking_gate_m_s2, "conditioning.tracking_gate_m_s2"),
+      check_positive(s.tracking_gate_m_s2, "conditioning.tracking_gate_m_s2"),
   }));
   // Needs a valid period and window.
   if (window_length(s) < 2) {

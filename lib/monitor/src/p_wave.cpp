@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "plinth/core/checks.h"
 #include "plinth/core/scene.h"
 #include "settings_checks.h"
 
@@ -37,14 +38,14 @@ Error check_predictor(const PWaveSettings& s) {
     if (!std::isfinite(p.tau_c_exponent)) {
       return {ErrorCode::kNotFinite, "pwave.predictor.tau_c_exponent", "must be finite"};
     }
-    PLINTH_TRY(detail::check_positive(p.sigma_ln, "pwave.predictor.sigma_ln"));
+    PLINTH_TRY(check_positive(p.sigma_ln, "pwave.predictor.sigma_ln"));
   }
   return ok_error();
 }
 
 Error check_fragility(const PWaveSettings& s) {
   if (!s.fragility_known) return ok_error();
-  PLINTH_TRY(detail::check_positive(s.fragility.median_g, "fragility.median_g"));
+  PLINTH_TRY(check_positive(s.fragility.median_g, "fragility.median_g"));
   if (!std::isfinite(s.fragility.beta)) {
     return {ErrorCode::kNotFinite, "fragility.beta", "must be finite"};
   }
@@ -73,18 +74,18 @@ std::int64_t samples_in(Time seconds, Time period_s) {
 Error validate(const PWaveSettings& s) {
   PLINTH_TRY(detail::first_error({
       check_time(s.sample_period_s, "pwave.sample_period_s"),
-      detail::check_positive(s.highpass_hz, "pwave.highpass_hz"),
-      detail::check_positive(s.lowpass_hz, "pwave.lowpass_hz"),
+      check_positive(s.highpass_hz, "pwave.highpass_hz"),
+      check_positive(s.lowpass_hz, "pwave.lowpass_hz"),
       check_time(s.sta_s, "pwave.sta_s"),
       check_time(s.lta_s, "pwave.lta_s"),
-      detail::check_positive(s.trigger_ratio, "pwave.trigger_ratio"),
-      detail::check_positive(s.noise_floor_m_s2, "pwave.noise_floor_m_s2"),
-      detail::check_positive(s.min_amplitude_m_s2, "pwave.min_amplitude_m_s2"),
+      check_positive(s.trigger_ratio, "pwave.trigger_ratio"),
+      check_positive(s.noise_floor_m_s2, "pwave.noise_floor_m_s2"),
+      check_positive(s.min_amplitude_m_s2, "pwave.min_amplitude_m_s2"),
       check_time(s.confirm_s, "pwave.confirm_s"),
       check_time(s.min_tau_p_s, "pwave.min_tau_p_s"),
       check_time(s.max_tau_c_s, "pwave.max_tau_c_s"),
-      detail::check_positive(s.min_vertical_ratio, "pwave.min_vertical_ratio"),
-      detail::check_positive(s.s_wave_ratio, "pwave.s_wave_ratio"),
+      check_positive(s.min_vertical_ratio, "pwave.min_vertical_ratio"),
+      check_positive(s.s_wave_ratio, "pwave.s_wave_ratio"),
       check_time(s.max_window_s, "pwave.max_window_s"),
       check_time(s.hold_s, "pwave.hold_s"),
   }));

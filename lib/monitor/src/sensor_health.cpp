@@ -32,8 +32,8 @@ Error validate(const SensorHealthSettings& s) {
   PLINTH_TRY(detail::first_error({
       detail::check_duration(s.sample_period_s, "sensor_health.sample_period_s", false),
       detail::check_duration(s.timeout_s, "sensor_health.timeout_s", false),
-      detail::check_positive(s.full_scale_g, "sensor_health.full_scale_g"),
-      detail::check_positive(s.max_valid_g, "sensor_health.max_valid_g"),
+      check_positive(s.full_scale_g, "sensor_health.full_scale_g"),
+      check_positive(s.max_valid_g, "sensor_health.max_valid_g"),
   }));
   if (s.max_bridge_samples < 0 || s.max_bridge_samples > kMaxBridgeSamples) {
     return {ErrorCode::kOutOfRange, "sensor_health.max_bridge_samples", "must lie in 0..15",

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <initializer_list>
 
+#include "plinth/core/checks.h"
 #include "plinth/core/error.h"
 #include "plinth/core/real.h"
 
@@ -28,14 +29,6 @@ inline constexpr std::int64_t kNanosecondsPerSecond = 1'000'000'000;
   if (seconds > kMaxDurationS) {
     return {ErrorCode::kOutOfRange, field, "must not exceed 1e6 s", kMaxDurationS};
   }
-  return ok_error();
-}
-
-// A positive finite quantity in the field's unit.
-[[nodiscard]] inline Error check_positive(Real value, const char* field) {
-  if (!std::isfinite(value)) return {ErrorCode::kNotFinite, field, "must be finite"};
-  if (value <= Real(0))
-    return {ErrorCode::kOutOfRange, field, "must be greater than zero", Real(0)};
   return ok_error();
 }
 

@@ -1,4 +1,5 @@
-// The ensemble's two-level design (ensemble_design.h) and the forecaster (forecast.h).
+// The ensemble's two-level design (ensemble_design.h) and the forecaster (forecast.h), run by
+// the ensemble (ensemble.h).
 #include <gtest/gtest.h>
 
 #include <array>
@@ -8,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "plinth/core/ensemble.h"
 #include "plinth/core/ensemble_design.h"
 #include "plinth/core/forecast.h"
 #include "test_support.h"
@@ -112,30 +114,24 @@ EstimatorSettings estimator_settings() {
   return e;
 }
 
-// A harness: `n` estimators on `scenes`, one forecaster, fed a signal sample by sample.
-// The estimators refer to their scenes: the ensemble keeps its own copy (ASan found the
-// estimators reading a temporary's).
-struct Ensemble {
-  explicit Ensemble(std::vector<Scene> statues, const ForecastSettings& fs)
-      : scenes(std::move(statues)), members(scenes.size()) {
-    for (std::size_t i = 0; i < scenes.size(); ++i) {
-      EXPECT_TRUE(members[i].start(scenes[i], estimator_settings(), {}).ok());
-    }
-    EXPECT_TRUE(forecaster.start(fs, 200.0).ok());
+// The statues of one axis (an Ensemble, ensemble.h) with the scenes it refers to, fed a signal
+// sample by sample.
+struct Statues {
+  Statues(std::vector<Scene> statues, const ForecastSettings& fs) : scenes(std::move(statues)) {
+    EXPECT_TRUE(ensemble.start(scenes, estimator_settings(), fs, {}).ok());
+    ensemble.restart({});
   }
-  void push(double horizontal) {
-    for (PlanarEstimator& e : members) e.push({horizontal, 0.0});
-    forecaster.on_sample({horizontal, 0.0}, members[0].time(), members);
-  }
+  void push(double horizontal) { ensemble.push({horizontal, 0.0}); }
+  [[nodiscard]] const Forecaster& forecaster() const { return ensemble.forecaster(); }
+  [[nodiscard]] const PlanarEstimator& member(int m) const { return ensemble.member(m); }
   std::vector<Scene> scenes;
-  std::vector<PlanarEstimator> members;
-  Forecaster forecaster;
+  Ensemble ensemble;
 };
 
 TEST(Forecaster, StillGroundForecastsNoCollapse) {
-  Ensemble e({make(paper_block()), make(paper_isolated())}, quick_settings());
+  Statues e({make(paper_block()), make(paper_isolated())}, quick_settings());
   for (int n = 0; n < 400; ++n) e.push(0.0);
-  const ForecastOutcome& f = e.forecaster.latest();
+  const ForecastOutcome& f = e.forecaster().latest();
   ASSERT_TRUE(f.valid);
   EXPECT_EQ(f.members, 2);
   EXPECT_EQ(f.collapsing, 0);
@@ -145,11 +141,11 @@ TEST(Forecaster, StillGroundForecastsNoCollapse) {
 }
 
 TEST(Forecaster, NothingBeforeTheWindowIsFull) {
-  Ensemble e({make(paper_block())}, quick_settings());
+  Statues e({make(paper_block())}, quick_settings());
   for (int n = 0; n < 199; ++n) e.push(0.0);  // 199 samples: the 1 s window holds 200
-  EXPECT_FALSE(e.forecaster.latest().valid);
+  EXPECT_FALSE(e.forecaster().latest().valid);
   e.push(0.0);
-  EXPECT_TRUE(e.forecaster.latest().valid);
+  EXPECT_TRUE(e.forecaster().latest().valid);
 }
 
 // A sine at 1 Hz of 0.4 g overturns the paper's block (uplift at g/3) 1.7 s after it starts
@@ -159,12 +155,12 @@ TEST(Forecaster, TellsTheMemberThatFallsFromTheOneThatStands) {
   SceneParams wide = paper_block();
   wide.block.half_width = 0.6;
   wide.block.inertia = homogeneous_rectangle_inertia(wide.block.mass, 0.6, 0.9);
-  Ensemble e({make(wide), make(paper_block())}, quick_settings());
+  Statues e({make(wide), make(paper_block())}, quick_settings());
   const double amplitude = 0.4 * kStandardGravity;
   ForecastOutcome first_valid;
   for (int n = 0; n < 260 && !first_valid.valid; ++n) {
     e.push(amplitude * std::sin(2.0 * std::numbers::pi * 1.0 * n / 200.0));
-    first_valid = e.forecaster.latest();
+    first_valid = e.forecaster().latest();
   }
   ASSERT_TRUE(first_valid.valid);
   EXPECT_EQ(first_valid.collapsing, 1);
@@ -172,7 +168,7 @@ TEST(Forecaster, TellsTheMemberThatFallsFromTheOneThatStands) {
   EXPECT_EQ(first_valid.worst_member, 1);
   EXPECT_GT(first_valid.collapse_in_s, 0.0);
   EXPECT_LE(first_valid.collapse_in_s, 3.0);
-  EXPECT_FALSE(e.members[1].mode().terminal());  // a forecast, not a report
+  EXPECT_FALSE(e.member(1).mode().terminal());  // a forecast, not a report
 }
 
 // The forecast is the simulator run from the member's state under the window repeated: the
@@ -181,7 +177,7 @@ TEST(Forecaster, EqualsADirectRunOfTheContinuation) {
   const Scene scene = make(paper_block());
   ForecastSettings fs = quick_settings();
   fs.growth = 1.5;
-  Ensemble e({scene}, fs);
+  Statues e({scene}, fs);
   const double amplitude = 0.3 * kStandardGravity;
   std::vector<double> fed;
   for (int n = 0; n < 200; ++n) {
@@ -189,7 +185,7 @@ TEST(Forecaster, EqualsADirectRunOfTheContinuation) {
     fed.push_back(a);
     e.push(a);
   }
-  const ForecastOutcome& f = e.forecaster.latest();
+  const ForecastOutcome& f = e.forecaster().latest();
   ASSERT_TRUE(f.valid);
   ASSERT_EQ(f.collapsing, 1) << "the test wants a collapse to compare";
   // The last 200 samples, oldest first, repeated, times 1.5.
@@ -205,7 +201,7 @@ TEST(Forecaster, EqualsADirectRunOfTheContinuation) {
                                                    {v.data(), v.size(), 1.0 / 200.0}),
                                 solver, sim)
                   .ok());
-  sim.start_from(e.members[0].mode(), e.members[0].state());
+  sim.start_from(e.member(0).mode(), e.member(0).state());
   while (!sim.mode().terminal() && sim.time() < fs.horizon_s) sim.step();
   ASSERT_TRUE(sim.mode().terminal());
   EXPECT_DOUBLE_EQ(f.collapse_in_s, sim.time());
@@ -216,17 +212,17 @@ TEST(Forecaster, EqualsADirectRunOfTheContinuation) {
 TEST(Forecaster, SpreadsItsWorkOverTheSamples) {
   ForecastSettings fs = quick_settings();
   fs.work_steps_per_s = 20000.0;  // 100 steps per sample at 200 Hz
-  Ensemble e({make(paper_block()), make(paper_block(0.1)), make(paper_isolated())}, fs);
-  std::int64_t before = e.forecaster.steps_taken();
+  Statues e({make(paper_block()), make(paper_block(0.1)), make(paper_isolated())}, fs);
+  std::int64_t before = e.forecaster().steps_taken();
   std::int64_t most = 0;
   for (int n = 0; n < 1400; ++n) {
     e.push(0.05 * kStandardGravity * std::sin(n * 0.1));
-    most = std::max(most, e.forecaster.steps_taken() - before);
-    before = e.forecaster.steps_taken();
+    most = std::max(most, e.forecaster().steps_taken() - before);
+    before = e.forecaster().steps_taken();
   }
   EXPECT_LE(most, 100);
-  ASSERT_TRUE(e.forecaster.latest().valid);  // 3 members x 1200 steps = 36 samples each
-  EXPECT_EQ(e.forecaster.latest().collapsing, 0);
+  ASSERT_TRUE(e.forecaster().latest().valid);  // 3 members x 1200 steps = 36 samples each
+  EXPECT_EQ(e.forecaster().latest().collapsing, 0);
 }
 
 // The strongest window comes back in the forecast, fading with memory_s: after a burst that
@@ -236,7 +232,7 @@ TEST(Forecaster, StrongestWindowFadesWithItsMemory) {
   ForecastSettings fs = quick_settings(Continuation::kStrongestWindow);
   fs.memory_s = 5.0;
   fs.growth = 1.5;
-  Ensemble e({make(paper_block())}, fs);
+  Statues e({make(paper_block())}, fs);
   // One period (1 s) of 0.4 g at 1 Hz: the block rocks and survives it.
   for (int n = 0; n < 200; ++n) {
     e.push(0.4 * kStandardGravity * std::sin(2.0 * std::numbers::pi * n / 200.0));
@@ -245,32 +241,32 @@ TEST(Forecaster, StrongestWindowFadesWithItsMemory) {
   int n = 0;
   for (; n < 200 * 4; ++n) {
     e.push(0.0);
-    if (e.members[0].mode().phase == Phase::kFullContact && e.forecaster.latest().collapsing > 0) {
+    if (e.member(0).mode().phase == Phase::kFullContact && e.forecaster().latest().collapsing > 0) {
       forecast_collapse_while_calm = true;
     }
   }
-  ASSERT_FALSE(e.members[0].mode().terminal());
+  ASSERT_FALSE(e.member(0).mode().terminal());
   EXPECT_TRUE(forecast_collapse_while_calm);
   for (; n < 200 * 25; ++n) e.push(0.0);
-  EXPECT_EQ(e.forecaster.latest().collapsing, 0);  // 0.6 g exp(-25 / 10): 0.05 g
+  EXPECT_EQ(e.forecaster().latest().collapsing, 0);  // 0.6 g exp(-25 / 10): 0.05 g
 }
 
-TEST(Forecaster, ResetForgetsTheMotionAndTheForecast) {
-  Ensemble e({make(paper_block())}, quick_settings());
+TEST(Forecaster, ARestartForgetsTheMotionAndTheForecast) {
+  Statues e({make(paper_block())}, quick_settings());
   for (int n = 0; n < 300; ++n) e.push(0.0);
-  ASSERT_TRUE(e.forecaster.latest().valid);
-  e.forecaster.reset();
-  EXPECT_FALSE(e.forecaster.latest().valid);
-  EXPECT_FALSE(e.forecaster.running());
+  ASSERT_TRUE(e.forecaster().latest().valid);
+  e.ensemble.restart({});
+  EXPECT_FALSE(e.forecaster().latest().valid);
+  EXPECT_FALSE(e.forecaster().running());
 }
 
 TEST(Forecaster, DisabledDoesNothing) {
   ForecastSettings fs = quick_settings();
   fs.enabled = false;
-  Ensemble e({make(paper_block())}, fs);
+  Statues e({make(paper_block())}, fs);
   for (int n = 0; n < 400; ++n) e.push(0.0);
-  EXPECT_FALSE(e.forecaster.latest().valid);
-  EXPECT_EQ(e.forecaster.steps_taken(), 0);
+  EXPECT_FALSE(e.forecaster().latest().valid);
+  EXPECT_EQ(e.forecaster().steps_taken(), 0);
 }
 
 TEST(ForecastSettings, RefusesWhatCannotWork) {

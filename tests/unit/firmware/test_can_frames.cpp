@@ -13,11 +13,15 @@
 #include "bundled_records.h"
 #include "dbc_file.h"
 #include "monitor_input.h"
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/record_io.h"
 #include "test_support.h"
 
 namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
 namespace {
 
 using monitor::AlarmCause;
@@ -59,7 +63,7 @@ std::string domain_name(const std::string& signal, unsigned raw) {
   } else if (signal == "Latched") {
     return raw == 0 ? "not_latched" : "latched";  // a flag: the DBC names its two values
   } else if (signal == "WorstMember" || signal == "CollapseIn") {
-    MonitorStatus s;  // a forecast in which no member collapses
+    BoxStatus s;  // a forecast in which no member collapses
     s.axes[0].forecast.valid = true;
     s.axes[0].forecast.members = 5;
     const can::CollapseForecast m = forecast_message(s, 0, 4.0, 0);
@@ -113,7 +117,7 @@ TEST(CanFrames, AlarmEventsKeepTheirFieldsAndWrapTheirMilliseconds) {
 }
 
 TEST(CanFrames, StatusCarriesPhaseCornerLevelRiskAndSampleAge) {
-  MonitorStatus s;
+  BoxStatus s;
   s.axis_count = 2;
   s.axes[1].mode = rocking_about(Corner::kRight);
   s.axes[1].risk.total = 0.4321;
@@ -142,7 +146,7 @@ TEST(CanFrames, StatusCarriesPhaseCornerLevelRiskAndSampleAge) {
 }
 
 TEST(CanFrames, ForecastCarriesProbabilityWorstMemberAndTimeToCollapse) {
-  MonitorStatus s;
+  BoxStatus s;
   s.axis_count = 2;
   s.time_ns = 12'000 * kMs;
   ForecastOutcome& f = s.axes[1].forecast;
@@ -261,16 +265,18 @@ TEST(CanFrames, UpdatesCarryTheFramesToSend) {
   EXPECT_GE(statuses, 25);
   EXPECT_LE(statuses, 27);
   EXPECT_EQ(alarm_frames, 2);
-  EXPECT_EQ(monitor.frames().not_encoded, 0U);
+  EXPECT_EQ(monitor.frames_not_encoded(), 0U);
 }
 
 TEST(CanFrames, AStatusIsDueBeforeTheFirstSample) {
   const Scene scene = plinth::testing::make(plinth::testing::paper_isolated(0.0));
   Monitor monitor;
   ASSERT_TRUE(monitor.start(MonitorConfig{}, {&scene, nullptr}).ok());
+  FrameDecoder decoder;
+  decoder.start(MonitorConfig{});
   can::CanFrame heartbeat;
   ASSERT_TRUE(can::encode(can::SensorHeartbeat{1, 1, 0, 1, 0, 0, 0}, heartbeat).ok());
-  const MonitorUpdate first = monitor.on_frame({heartbeat, 1000});
+  const MonitorUpdate first = on_frame(monitor, decoder, {heartbeat, 1000});
   EXPECT_TRUE(first.status_due);
   // The first evaluation's AlarmEvent (fault: no data yet), then the status: never the alarm
   // policy's initial normal (found by fuzz_monitor).
@@ -278,7 +284,7 @@ TEST(CanFrames, AStatusIsDueBeforeTheFirstSample) {
   EXPECT_EQ(first.events[0].level, monitor::AlarmLevel::kFault);
   EXPECT_EQ(first.frame_count, 2U);
   EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kFault);
-  EXPECT_FALSE(monitor.on_frame({heartbeat, 2000}).status_due);  // the time did not move
+  EXPECT_FALSE(on_frame(monitor, decoder, {heartbeat, 2000}).status_due);  // the time did not move
 }
 
 // An ensemble in an earthquake that overturns it: with each status a CollapseForecast (one axis)
@@ -310,7 +316,7 @@ ForecastFrames run_forecast_frames(bool enabled) {
   ForecastFrames out;
   for (long n = 0; n < input.size() && out.overturn_t < 0.0; ++n) {
     const MonitorUpdate u = monitor.on_sample(input.sample(n));
-    const MonitorStatus& st = monitor.status();
+    const BoxStatus& st = monitor.status();
     if (st.axes[0].mode.terminal()) out.overturn_t = static_cast<double>(st.time_ns) * 1e-9;
     if (!u.status_due) continue;
     ++out.statuses;
@@ -341,7 +347,7 @@ ForecastFrames run_forecast_frames(bool enabled) {
       out.first_collapse_forecast_t = static_cast<double>(st.time_ns) * 1e-9;
     }
   }
-  EXPECT_EQ(monitor.frames().not_encoded, 0U);
+  EXPECT_EQ(monitor.frames_not_encoded(), 0U);
   return out;
 }
 

@@ -122,10 +122,10 @@ TEST(ModbusMap, TheRunsIdentity) {
   EXPECT_EQ(read64(image, reg::kSceneSha256), 0xba7816bf8f01cfeaULL);
   EXPECT_EQ(at(reg::kSceneYGiven), 0);
   // The version: the numbers of kProjectVersion, the description two characters a register.
-  const std::string version = std::to_string(at(reg::kVersionMajor)) + "." +
+  const std::string numbers = std::to_string(at(reg::kVersionMajor)) + "." +
                               std::to_string(at(reg::kVersionMinor)) + "." +
                               std::to_string(at(reg::kVersionPatch));
-  EXPECT_EQ(version, kProjectVersion);
+  EXPECT_EQ(numbers, version::kProjectVersion);
   std::string description;
   for (int i = 0; i < reg::kGitDescriptionWords; ++i) {
     for (const int shift : {8, 0}) {
@@ -133,7 +133,7 @@ TEST(ModbusMap, TheRunsIdentity) {
       if (c != '\0') description += c;
     }
   }
-  EXPECT_EQ(description, std::string(kGitDescription).substr(0, 64));
+  EXPECT_EQ(description, std::string(version::kGitDescription).substr(0, 64));
 }
 
 TEST(ModbusMap, NoValueReads65535) {

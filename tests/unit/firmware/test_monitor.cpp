@@ -8,6 +8,7 @@
 
 #include "bundled_records.h"
 #include "monitor_input.h"
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/record_io.h"
 #include "test_paths.h"
@@ -17,6 +18,7 @@ namespace plinth {
 namespace {
 
 namespace fw = firmware;
+namespace can = hal::can;
 using testing::RecordingSink;
 
 using ::plinth::testing::kSource;
@@ -92,15 +94,18 @@ fw::MonitorConfig quick_config() {
   return config;
 }
 
-// Garbled, foreign and truncated frames are counted and refused; nothing reaches the solver.
+// Garbled, foreign and truncated frames are counted and refused (frame_decoder.h); nothing
+// reaches the solver.
 TEST(Monitor, FramesAreDecodedCountedOrRefused) {
   const Scene scene = testing::make(testing::paper_isolated(0.0));
   fw::Monitor monitor;
   ASSERT_TRUE(monitor.start(quick_config(), {&scene, nullptr}).ok());
+  fw::FrameDecoder decoder;
+  decoder.start(quick_config());
   std::int64_t t = 0;
   const auto feed = [&](const can::CanFrame& f) {
     t += ns(0.005);
-    return monitor.on_frame({f, t});
+    return fw::on_frame(monitor, decoder, {f, t});
   };
   for (int n = 0; n < 10; ++n) (void)feed(sensor_frame(1, static_cast<std::uint8_t>(n), 0.0));
   (void)feed(sensor_frame(2, 0, 0.0));  // another node
@@ -120,7 +125,7 @@ TEST(Monitor, FramesAreDecodedCountedOrRefused) {
   can::CanFrame status;
   ASSERT_TRUE(can::encode(can::MonitorStatus{}, status).ok());
   (void)feed(status);
-  const fw::FrameCounters& c = monitor.frames();
+  const fw::FrameCounters& c = decoder.counters();
   EXPECT_EQ(c.received, 16U);
   EXPECT_EQ(c.sensor_samples, 10U);
   EXPECT_EQ(c.other_nodes, 1U);
@@ -139,11 +144,13 @@ TEST(Monitor, SensorSilenceIsAFaultAndTheEstimatorRestartsAfterIt) {
   fw::MonitorConfig config = quick_config();
   fw::Monitor monitor;
   ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
+  fw::FrameDecoder decoder;
+  decoder.start(config);
   std::uint8_t sequence = 0;
   std::int64_t t = 0;
   const auto feed_for = [&](double seconds) {
     for (int n = 0; n < std::lround(seconds * 200.0); ++n) {
-      (void)monitor.on_frame({sensor_frame(1, sequence++, 0.0), t});
+      (void)fw::on_frame(monitor, decoder, {sensor_frame(1, sequence++, 0.0), t});
       t += ns(0.005);
     }
   };
@@ -189,13 +196,15 @@ TEST(Monitor, AcknowledgeFrameReleasesTheLatch) {
   const Scene scene = testing::make(testing::paper_block(0.0));
   fw::Monitor monitor;
   ASSERT_TRUE(monitor.start(quick_config(), {&scene, nullptr}).ok());
+  fw::FrameDecoder decoder;
+  decoder.start(quick_config());
   std::int64_t t = 0;
   std::uint8_t sequence = 0;
   std::uint8_t last_event = 0;
   // Quiet start-up, then a 1 s push of 0.6 g: the non-isolated block (b1/h = 1/3) overturns.
   for (int n = 0; n < 1400 && !monitor.status().axes[0].mode.terminal(); ++n) {
     const double a = n >= 400 && n < 600 ? 0.6 : 0.0;
-    const fw::MonitorUpdate u = monitor.on_frame({sensor_frame(1, sequence++, a), t});
+    const fw::MonitorUpdate u = fw::on_frame(monitor, decoder, {sensor_frame(1, sequence++, a), t});
     for (std::size_t i = 0; i < u.event_count; ++i) last_event = u.events[i].sequence;
     t += ns(0.005);
   }
@@ -205,12 +214,56 @@ TEST(Monitor, AcknowledgeFrameReleasesTheLatch) {
   can::CanFrame ack;
   ASSERT_TRUE(can::encode(can::Acknowledge{can::AlarmLevel::kAlarm, 7,
                                            static_cast<std::uint8_t>(last_event + 1)}, ack).ok());
-  EXPECT_EQ(monitor.on_frame({ack, t}).acknowledgement, monitor::AckOutcome::kStale);
+  EXPECT_EQ(fw::on_frame(monitor, decoder, {ack, t}).acknowledgement, monitor::AckOutcome::kStale);
   ASSERT_TRUE(can::encode(can::Acknowledge{can::AlarmLevel::kAlarm, 7, last_event}, ack).ok());
-  EXPECT_EQ(monitor.on_frame({ack, t}).acknowledgement,
+  EXPECT_EQ(fw::on_frame(monitor, decoder, {ack, t}).acknowledgement,
             monitor::AckOutcome::kReleasedConditionHolds);
   EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kAlarm);
-  EXPECT_EQ(monitor.frames().acknowledgements, 2U);
+  EXPECT_EQ(decoder.counters().acknowledgements, 2U);
+}
+
+// An operator's acknowledgement from Modbus or MQTT is a call (Monitor::acknowledge), not a
+// frame: the same update and status as the Acknowledge frame's, and no frame counted.
+TEST(Monitor, AcknowledgeIsACallAsTheFrameIs) {
+  const Scene scene = testing::make(testing::paper_block(0.0));
+  fw::Monitor by_frame;
+  fw::Monitor by_call;
+  ASSERT_TRUE(by_frame.start(quick_config(), {&scene, nullptr}).ok());
+  ASSERT_TRUE(by_call.start(quick_config(), {&scene, nullptr}).ok());
+  fw::FrameDecoder decoder;
+  decoder.start(quick_config());
+  std::int64_t t = 0;
+  std::uint8_t last_event = 0;
+  for (int n = 0; n < 1400 && !by_call.status().axes[0].mode.terminal(); ++n) {
+    const double a = n >= 400 && n < 600 ? 0.6 : 0.0;
+    const can::CanFrame f = sensor_frame(1, static_cast<std::uint8_t>(n & 0xFF), a);
+    (void)fw::on_frame(by_frame, decoder, {f, t});
+    const fw::MonitorUpdate u = by_call.on_sample(
+        {t, static_cast<std::uint8_t>(n & 0xFF), 0, Eigen::Vector3d(a, 0.0, 1.0)});
+    EXPECT_EQ(u.status, &by_call.status());
+    for (std::size_t i = 0; i < u.event_count; ++i) last_event = u.events[i].sequence;
+    t += ns(0.005);
+  }
+  ASSERT_EQ(by_call.status().latched, monitor::AlarmLevel::kAlarm);
+  const std::uint64_t frames_before = decoder.counters().received;
+  can::CanFrame ack;
+  ASSERT_TRUE(can::encode(can::Acknowledge{can::AlarmLevel::kAlarm, 7, last_event}, ack).ok());
+  const fw::MonitorUpdate from_frame = fw::on_frame(by_frame, decoder, {ack, t});
+  const fw::MonitorUpdate from_call =
+      by_call.acknowledge({monitor::AlarmLevel::kAlarm, last_event});
+  EXPECT_EQ(from_call.acknowledgement, monitor::AckOutcome::kReleasedConditionHolds);
+  EXPECT_EQ(from_call.acknowledgement, from_frame.acknowledgement);
+  ASSERT_EQ(from_call.event_count, from_frame.event_count);
+  ASSERT_EQ(from_call.event_count, 1U);
+  EXPECT_EQ(from_call.events[0].cause, monitor::AlarmCause::kAcknowledged);
+  ASSERT_EQ(from_call.frame_count, from_frame.frame_count);
+  for (std::size_t i = 0; i < from_call.frame_count; ++i) {
+    EXPECT_EQ(from_call.frames[i].id, from_frame.frames[i].id) << i;
+    EXPECT_EQ(from_call.frames[i].data, from_frame.frames[i].data) << i;
+  }
+  EXPECT_EQ(by_call.status().latched, monitor::AlarmLevel::kNormal);
+  EXPECT_EQ(by_call.status().alarm, by_frame.status().alarm);
+  EXPECT_EQ(decoder.counters().received, frames_before + 1);  // the frame path's one frame
 }
 
 TEST(Monitor, RefusesBadConfigurationNamingTheField) {
@@ -253,7 +306,7 @@ TEST(Monitor, EnsembleMembersFollowTheirOwnStatues) {
   fw::Monitor second;
   ASSERT_TRUE(first.start(config, {std::span<const Scene>(statues), {}}).ok());
   ASSERT_TRUE(second.start(config, {std::span<const Scene>(rotated), {}}).ok());
-  ASSERT_EQ(first.members(0), 3);
+  ASSERT_EQ(first.ensemble(0).size(), 3);
   testing::QuietThenQuake input(200.0, 10.0, brienza(), 12.0);
   testing::QuietThenQuake same(200.0, 10.0, brienza(), 12.0);  // the same samples again
   bool worst_not_nominal = false;
@@ -263,8 +316,8 @@ TEST(Monitor, EnsembleMembersFollowTheirOwnStatues) {
     double worst = 0.0;
     double nominal = 0.0;
     for (int m = 0; m < 3; ++m) {
-      const PlanarEstimator& e = first.member(0, m);
-      ASSERT_EQ(e.state(), second.member(0, (m + 2) % 3).state()) << n << " " << m;
+      const PlanarEstimator& e = first.ensemble(0).member(m);
+      ASSERT_EQ(e.state(), second.ensemble(0).member((m + 2) % 3).state()) << n << " " << m;
       const double r = overturning_risk(statues[static_cast<std::size_t>(m)], e.mode(),
                                         e.state(), config.risk).total;
       worst = std::fmax(worst, r);
@@ -272,7 +325,7 @@ TEST(Monitor, EnsembleMembersFollowTheirOwnStatues) {
     }
     const fw::AxisStatus& axis = first.status().axes[0];
     if (!first.status().estimating) continue;
-    ASSERT_EQ(axis.state, first.member(0, 0).state());
+    ASSERT_EQ(axis.state, first.ensemble(0).nominal().state());
     ASSERT_EQ(axis.risk.total, worst);
     ASSERT_EQ(axis.nominal_risk.total, nominal);
     ASSERT_EQ(axis.risk.total, second.status().axes[0].risk.total);

@@ -9,6 +9,7 @@
 
 #include "box_file_error.h"
 #include "monitor_config.h"
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/input_error.h"
 #include "test_support.h"
@@ -17,6 +18,7 @@ namespace plinth {
 namespace {
 
 namespace fw = firmware;
+namespace can = hal::can;
 
 constexpr double kRate = 200.0;                 // Hz
 constexpr std::int64_t kPeriodNs = 5'000'000;  // ns
@@ -104,7 +106,7 @@ TEST(MonitorSensors, TwoAgreeingGroundSensorsGiveTheSingleSensorResults) {
     (void)dual.on_sensor_sample(1, sample(n, a, delay));
     ASSERT_FALSE(dual.status().disagreement) << n;
   }
-  const fw::MonitorStatus& s = dual.status();
+  const fw::BoxStatus& s = dual.status();
   EXPECT_EQ(s.primary, 0);
   EXPECT_EQ(s.failovers, 0U);
   EXPECT_EQ(s.sensors_state, monitor::HealthState::kOk);
@@ -147,7 +149,7 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   ASSERT_GT(reported, drift_from);
   EXPECT_LT(reported - drift_from, std::lround(0.5 * kRate));
   EXPECT_TRUE(fault_event);
-  const fw::MonitorStatus& s = monitor.status();
+  const fw::BoxStatus& s = monitor.status();
   EXPECT_EQ(s.alarm, monitor::AlarmLevel::kFault);
   EXPECT_TRUE(s.sensors[1].disagreeing);
   EXPECT_EQ(s.sensors[1].disagreements, 1U);
@@ -196,7 +198,7 @@ TEST(MonitorSensors, PrimarySilentFailsOverAndTheEstimatorContinues) {
   // The estimate went on through the failover: the single sensor's (the second sensor's
   // conditioner tracked its offset on its own: 1e-9).
   expect_same_estimate(single, monitor, 1000, 1e-9);
-  fw::MonitorStatus s = monitor.status();
+  fw::BoxStatus s = monitor.status();
   EXPECT_FALSE(fault_after_start);
   EXPECT_EQ(s.primary, 1);
   EXPECT_EQ(s.failovers, 1U);
@@ -236,7 +238,7 @@ TEST(MonitorSensors, PrimarySilentFailsOverAndTheEstimatorContinues) {
 // drive the estimators (the estimate is the ground sensor's alone). Mounted backwards (x
 // reversed) or with a wrong horizontal gain: the residual passes its threshold, reported; with
 // plate.raises_fault also the fault level, cause kSensorDisagreement.
-double run_plate(double gain, bool raises_fault, fw::MonitorStatus& out, bool& fault_seen) {
+double run_plate(double gain, bool raises_fault, fw::BoxStatus& out, bool& fault_seen) {
   fw::Monitor single;
   EXPECT_TRUE(started(single, single_config()));
   fw::MonitorConfig config = sensors_config({fw::SensorRole::kGround, fw::SensorRole::kPlate});
@@ -251,7 +253,7 @@ double run_plate(double gain, bool raises_fault, fw::MonitorStatus& out, bool& f
     expect_same_estimate(single, monitor, n);
     double plate_g = ground_g(n);
     if (monitor.status().estimating) {
-      const PlanarEstimator& e = monitor.estimator(0);
+      const PlanarEstimator& e = monitor.ensemble(0).nominal();
       plate_g = (e.simulator().accelerations().u + e.ground().horizontal) / kStandardGravity;
     }
     const fw::MonitorUpdate u = monitor.on_sensor_sample(1, sample(n, gain * plate_g));
@@ -271,7 +273,7 @@ double run_plate(double gain, bool raises_fault, fw::MonitorStatus& out, bool& f
 }
 
 TEST(MonitorSensors, PlateSensorMatchingTheModelHasASmallResidual) {
-  fw::MonitorStatus s;
+  fw::BoxStatus s;
   bool fault = false;
   const double residual = run_plate(1.0, true, s, fault);
   EXPECT_LT(residual, 1e-3);
@@ -287,7 +289,7 @@ TEST(MonitorSensors, PlateSensorMatchingTheModelHasASmallResidual) {
 
 TEST(MonitorSensors, PlateSensorMountedBackwardsOrScaledIsAMismatch) {
   for (const double gain : {-1.0, 2.5}) {
-    fw::MonitorStatus s;
+    fw::BoxStatus s;
     bool fault = false;
     const double residual = run_plate(gain, false, s, fault);
     EXPECT_GT(residual, 0.5) << gain;
@@ -310,16 +312,18 @@ TEST(MonitorSensors, FramesGoToTheirSensor) {
   config.sensors[1].node = 9;
   fw::Monitor monitor;
   ASSERT_TRUE(started(monitor, config));
+  fw::FrameDecoder decoder;
+  decoder.start(config);
   for (const int node : {4, 9, 9, 2}) {
     can::SensorAcceleration m;
     m.node = static_cast<std::uint8_t>(node);
     m.az_g = 1.0;
     can::CanFrame f;
     ASSERT_TRUE(can::encode(m, f).ok());
-    (void)monitor.on_frame({f, 1000});
+    (void)fw::on_frame(monitor, decoder, {f, 1000});
   }
-  EXPECT_EQ(monitor.frames().sensor_samples, 3U);
-  EXPECT_EQ(monitor.frames().other_nodes, 1U);
+  EXPECT_EQ(decoder.counters().sensor_samples, 3U);
+  EXPECT_EQ(decoder.counters().other_nodes, 1U);
   EXPECT_EQ(monitor.status().sensors[0].health.counters.received, 1U);
   EXPECT_EQ(monitor.status().sensors[1].health.counters.received, 2U);
 }

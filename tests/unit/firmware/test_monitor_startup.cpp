@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/host/record_io.h"
 #include "test_paths.h"
@@ -22,7 +23,7 @@ namespace {
 namespace fw = firmware;
 using monitor::AlarmCause;
 using monitor::AlarmLevel;
-namespace can = plinth::can;
+namespace can = plinth::hal::can;
 
 using ::plinth::testing::kSource;
 constexpr double kRateHz = 200.0;  // the sensor rate of the candump log
@@ -109,7 +110,7 @@ struct BoxRun {
 };
 
 void check_update(const Case& c, std::size_t n, const fw::Monitor& box, BoxRun& run) {
-  const fw::MonitorStatus& st = box.status();
+  const fw::BoxStatus& st = box.status();
   const double t = static_cast<double>(n) / kRateHz;
   const bool before_collapse = c.collapse_s < 0.0 || t < c.collapse_s;
   if (st.alarm == AlarmLevel::kAlarm && before_collapse) run.alarm_before_collapse = true;
@@ -214,7 +215,9 @@ TEST(MonitorStartup, AFrameBeforeAnySampleReportsFault) {
   ASSERT_TRUE(box->start(box_config(), {&scene, nullptr}).ok());
   can::CanFrame heartbeat;
   ASSERT_TRUE(can::encode(can::SensorHeartbeat{1, 16, 0, 0, 0, 0, 0}, heartbeat).ok());
-  const fw::MonitorUpdate u = box->on_frame({heartbeat, 0});
+  fw::FrameDecoder decoder;
+  decoder.start(box_config());
+  const fw::MonitorUpdate u = fw::on_frame(*box, decoder, {heartbeat, 0});
   ASSERT_TRUE(u.status_due);
   EXPECT_EQ(box->status().alarm, AlarmLevel::kFault);
   ASSERT_EQ(u.event_count, 1U);

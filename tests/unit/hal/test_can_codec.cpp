@@ -18,7 +18,7 @@
 
 #include "dbc_file.h"
 
-namespace plinth::can {
+namespace plinth::hal::can {
 namespace {
 
 using testing::Dbc;
@@ -1105,4 +1105,4 @@ TEST(CanDbc, EveryMessageAndSignalIsDocumented) {
 }
 
 }  // namespace
-}  // namespace plinth::can
+}  // namespace plinth::hal::can

@@ -41,7 +41,7 @@ TEST(EvalMetrics, ClassifiesHitsMissesFalseAlarmsAndNearMisses) {
       standing(0.5, 2.0),       // past half the angle: a near miss, raised
       standing(0.9, -1.0),      // near miss, not raised
   };
-  const WarningOutcome o = level_outcome(runs, EvalLevel::kAlarm);
+  const WarningOutcome o = level_outcome(runs, monitor::AlarmLevel::kAlarm);
   EXPECT_EQ(o.collapses, 4);
   EXPECT_EQ(o.hits, 2);
   EXPECT_EQ(o.misses, 2);
@@ -54,7 +54,7 @@ TEST(EvalMetrics, ClassifiesHitsMissesFalseAlarmsAndNearMisses) {
   EXPECT_DOUBLE_EQ(o.lead_quantile(0.5), 0.25);
   EXPECT_DOUBLE_EQ(o.lead_quantile(0.0), 0.0);
   EXPECT_DOUBLE_EQ(o.lead_quantile(1.0), 2.0);
-  EXPECT_DOUBLE_EQ(level_outcome(runs, EvalLevel::kWarning).lead_quantile(0.5), 0.0);
+  EXPECT_DOUBLE_EQ(level_outcome(runs, monitor::AlarmLevel::kWarning).lead_quantile(0.5), 0.0);
   EXPECT_EQ(WarningOutcome{}.lead_quantile(0.5), -1.0);
   EXPECT_EQ(WarningOutcome{}.false_alarm_rate(), 0.0);
 }
@@ -209,7 +209,7 @@ TEST(EvalMetrics, TheCollapseMarginIsTheCasesLowestCollapseOverTheRunsPga) {
   EXPECT_EQ(runs[4].case_collapse_g, -1.0);
   EXPECT_TRUE(runs[4].margin_is_lower_bound());
   EXPECT_DOUBLE_EQ(runs[4].collapse_margin(), 5.0);
-  const WarningOutcome o = level_outcome(runs, EvalLevel::kAlarm);
+  const WarningOutcome o = level_outcome(runs, monitor::AlarmLevel::kAlarm);
   const MarginBands& m = o.margins;
   // Known: 1.33 (raised) in 1.25-1.5, 2 (raised) in 2-3, 4 (raised) and >= 5 (not) in >= 3.
   EXPECT_EQ(m.known[0].runs, 0);
@@ -240,7 +240,7 @@ TEST(EvalMetrics, TheCollapseMarginIsTheCasesLowestCollapseOverTheRunsPga) {
   EXPECT_EQ(o.collapses, 1);
   // Without the grid (a file of an earlier plinth-eval) no run has a margin.
   for (EvalRun& r : runs) r.grid = {};
-  EXPECT_EQ(level_outcome(runs, EvalLevel::kAlarm).unneeded().runs, 0);
+  EXPECT_EQ(level_outcome(runs, monitor::AlarmLevel::kAlarm).unneeded().runs, 0);
 }
 
 TEST(EvalMetrics, TheCalibrationCountsTheFalseAlarmsItIsTold) {
@@ -323,7 +323,7 @@ TEST(EvalMetrics, ACasesRowsMustRunUpItsGrid) {
   assign_case_collapses(all_scales, "f.csv");
   EXPECT_DOUBLE_EQ(all_scales[0].case_collapse_g, 1.5);  // the 2.5 g row, standing again
   EXPECT_DOUBLE_EQ(all_scales[0].collapse_margin(), 0.6);
-  EXPECT_EQ(level_outcome(all_scales, EvalLevel::kAlarm).margins.below_one.runs, 2);
+  EXPECT_EQ(level_outcome(all_scales, monitor::AlarmLevel::kAlarm).margins.below_one.runs, 2);
 }
 
 std::string temp_path(const std::string& name) {

@@ -541,5 +541,19 @@ TEST(AlarmPolicy, NamesReadBothWays) {
   EXPECT_STREQ(input_problem_name(InputProblem::kTimeWentBack), "time went back");
 }
 
+// The risk levels: advisory, warning, alarm, lowest first, each at its own index (plinth-eval's
+// per-level columns).
+TEST(AlarmLevels, RiskLevelsAreTheRisksInOrder) {
+  ASSERT_EQ(kRiskLevels.size(), 3U);
+  EXPECT_STREQ(alarm_level_name(kRiskLevels[0]), "advisory");
+  EXPECT_STREQ(alarm_level_name(kRiskLevels[2]), "alarm");
+  for (std::size_t i = 0; i < kRiskLevels.size(); ++i) {
+    EXPECT_EQ(risk_level_index(kRiskLevels[i]), i);
+    if (i > 0) {
+      EXPECT_GT(kRiskLevels[i], kRiskLevels[i - 1]);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace plinth::monitor

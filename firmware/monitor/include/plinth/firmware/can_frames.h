@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "plinth/core/state.h"
-#include "plinth/firmware/monitor.h"
+#include "plinth/firmware/box_status.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
@@ -17,37 +17,37 @@
 namespace plinth::firmware {
 
 // Domain -> wire.
-[[nodiscard]] can::Phase to_wire(Phase phase);
+[[nodiscard]] hal::can::Phase to_wire(Phase phase);
 // kNone unless the mode rocks (a mode's corner means nothing outside the rocking phases).
-[[nodiscard]] can::Corner wire_corner(const Mode& mode);
-[[nodiscard]] can::AlarmLevel to_wire(monitor::AlarmLevel level);
-[[nodiscard]] can::AlarmCause to_wire(monitor::AlarmCause cause);
+[[nodiscard]] hal::can::Corner wire_corner(const Mode& mode);
+[[nodiscard]] hal::can::AlarmLevel to_wire(monitor::AlarmLevel level);
+[[nodiscard]] hal::can::AlarmCause to_wire(monitor::AlarmCause cause);
 
 // Wire -> domain. The codec's decode() accepts only values in the DBC's VAL_ tables.
-[[nodiscard]] monitor::AlarmLevel from_wire(can::AlarmLevel level);
+[[nodiscard]] monitor::AlarmLevel from_wire(hal::can::AlarmLevel level);
 
 // The MonitorStatus of axis `axis` of `status`: phase, corner, alarm level, risk, and the age of
 // the newest sample the estimate used (65535 ms, the most the frame says, before estimating).
-[[nodiscard]] can::MonitorStatus status_message(const MonitorStatus& status, int axis,
+[[nodiscard]] hal::can::MonitorStatus status_message(const BoxStatus& status, int axis,
                                                 std::uint8_t sequence);
 // The CollapseForecast of axis `axis` of `status`, whose forecast must be valid: probability,
 // worst member (none: kNoWorstMember), members, the time from status.time_ns to the worst
 // member's collapse (whole ms, 0 when that time has passed, capped at 65534 ms), the horizon
 // `horizon_s` and the `sequence` of the MonitorStatus it goes out with.
-[[nodiscard]] can::CollapseForecast forecast_message(const MonitorStatus& status, int axis,
+[[nodiscard]] hal::can::CollapseForecast forecast_message(const BoxStatus& status, int axis,
                                                      double horizon_s, std::uint8_t sequence);
 // The AlarmEvent of an alarm policy event: its time in whole ms since start, wrapping after
 // 2^32 ms as the frame's counter does.
-[[nodiscard]] can::AlarmEvent alarm_event_message(const monitor::AlarmEventRecord& record);
+[[nodiscard]] hal::can::AlarmEvent alarm_event_message(const monitor::AlarmEventRecord& record);
 // A SensorAcceleration of node `node` from a sample in g (its flags as they are: the protocol's
 // status bits are sensor_flags).
-[[nodiscard]] can::SensorAcceleration sensor_message(std::uint8_t node,
+[[nodiscard]] hal::can::SensorAcceleration sensor_message(std::uint8_t node,
                                                      const monitor::SensorSample& sample_g);
 
 // An operator's Acknowledge as the alarm policy takes it (without its source id).
-[[nodiscard]] monitor::Acknowledgement acknowledgement_of(const can::Acknowledge& message);
+[[nodiscard]] monitor::Acknowledgement acknowledgement_of(const hal::can::Acknowledge& message);
 // A decoded SensorAcceleration as the sensor's health tracker takes it.
-[[nodiscard]] monitor::SensorSample sample_of(const can::SensorAcceleration& message,
+[[nodiscard]] monitor::SensorSample sample_of(const hal::can::SensorAcceleration& message,
                                               std::int64_t receive_time_ns);
 
 }  // namespace plinth::firmware

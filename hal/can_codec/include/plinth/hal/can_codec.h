@@ -21,7 +21,7 @@
 #include <cstdint>
 #include <span>
 
-namespace plinth::can {
+namespace plinth::hal::can {
 
 // ---------------------------------------------------------------------------------------------
 // Frames and identifiers
@@ -266,4 +266,4 @@ void store_le64(std::uint64_t word, std::array<std::uint8_t, 8>& bytes);
 // Two's complement sign extension of a `length`-bit raw value.
 [[nodiscard]] std::int64_t sign_extend(std::uint64_t raw, unsigned length);
 
-}  // namespace plinth::can
+}  // namespace plinth::hal::can

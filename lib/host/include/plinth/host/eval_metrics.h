@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include "plinth/monitor/alarm_level.h"
+
 namespace plinth::host {
 
 inline constexpr double kQuietPeakRatio = 0.5;  // of the overturning angle: below it, quiet
@@ -55,10 +57,6 @@ struct PgaGrid {
   friend bool operator==(const PgaGrid&, const PgaGrid&) = default;
 };
 
-enum class EvalLevel : std::size_t { kAdvisory = 0, kWarning = 1, kAlarm = 2 };
-inline constexpr std::size_t kEvalLevels = 3;
-[[nodiscard]] const char* eval_level_name(EvalLevel level);
-
 // The threshold grids of the first-crossing times (every run of a file shares them).
 struct CrossingGrids {
   std::vector<double> risk;         // reactive risk of the worst member, dimensionless
@@ -85,8 +83,8 @@ struct EvalRun {
   bool collapsed = false;
   double collapse_time_s = -1.0;  // -1: none
   double peak_ratio = 0.0;        // max |theta| / alpha over the run (1 at a collapse)
-  // The box: first time each level was shown (-1: never).
-  std::array<double, kEvalLevels> first_shown_s{-1.0, -1.0, -1.0};
+  // The box: first time each risk level was shown (-1: never), in monitor::kRiskLevels' order.
+  std::array<double, monitor::kRiskLevels.size()> first_shown_s{-1.0, -1.0, -1.0};
   // First time each grid threshold was reached (-1: never), same order as the grids.
   std::vector<double> risk_crossing_s;
   std::vector<double> probability_crossing_s;
@@ -177,7 +175,9 @@ template <class FirstTime>
   return o;
 }
 
-[[nodiscard]] WarningOutcome level_outcome(const std::vector<EvalRun>& runs, EvalLevel level);
+// `level`: one of monitor::kRiskLevels.
+[[nodiscard]] WarningOutcome level_outcome(const std::vector<EvalRun>& runs,
+                                           monitor::AlarmLevel level);
 
 // Which reactive risk a rule reads: the worst member's (the box's) or the nominal statue's alone
 // (today's box, EvalRun::nominal_risk_crossing_s).

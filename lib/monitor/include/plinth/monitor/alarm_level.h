@@ -3,6 +3,8 @@
 // its static_asserts: firmware/monitor/src/can_frames.cpp). Freestanding.
 #pragma once
 
+#include <array>
+#include <cstddef>
 #include <cstdint>
 
 #include "plinth/core/name_table.h"
@@ -59,6 +61,15 @@ inline constexpr NameTable<AlarmCause, 13> kAlarmCauseNames{{{
     {AlarmCause::kNotCalibrated, "not_calibrated"},
     {AlarmCause::kPWave, "p_wave"},
 }}};
+
+// The levels the risk raises, lowest first (neither normal nor fault): the ones plinth-eval
+// scores (lib/host eval_metrics.h).
+inline constexpr std::array<AlarmLevel, 3> kRiskLevels{AlarmLevel::kAdvisory, AlarmLevel::kWarning,
+                                                       AlarmLevel::kAlarm};
+// The position of a risk level in kRiskLevels.
+[[nodiscard]] constexpr std::size_t risk_level_index(AlarmLevel level) {
+  return static_cast<std::size_t>(level) - static_cast<std::size_t>(AlarmLevel::kAdvisory);
+}
 
 [[nodiscard]] constexpr const char* alarm_level_name(AlarmLevel level) {
   return kAlarmLevelNames.name(level);

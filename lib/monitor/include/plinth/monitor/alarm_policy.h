@@ -1,58 +1,7 @@
-// Alarm policy: turns the estimator's risk and phase, the collapse detector and the fault
-// state into alarm levels and events for the building's alarm system (CAN AlarmEvent frames,
-// status lines). Levels and causes: alarm_level.h.
-//
-// Conditions, each with on/off thresholds on the risk and on the forecast's probability of a
-// collapse (hysteresis: the condition starts at risk >= on or probability >= on, and ends when
-// both are below their off, off < on) and minimum durations (a condition must hold for
-// raise_hold_s before its level is raised, and be absent for lower_hold_s before it is lowered):
-//   advisory  risk >= advisory.on, probability >= advisory_forecast.on, or the block is out of
-//             full contact (motion started)
-//   warning   risk >= warning.on, or probability >= warning_forecast.on, or the P-wave
-//             stage's probability of collapse >= warning_pwave.on
-//   alarm     risk >= alarm.on, or probability >= alarm_forecast.on; or a collapse (overturned,
-//             fell): alarm at once, no hold, latched
-// The risk is the margin used up now (risk.h), the probability what the forecast says of the
-// next seconds (forecast.h); today's margins running out raise the level whatever the forecast.
-// The P-wave stage (p_wave.h) forecasts the shaking still to come from its first seconds: a
-// guess about the ground, not the statue's physics, so it raises `warning` and never `alarm`.
-// The condition level is the highest level whose condition is active.
-//
-// Latching: when the condition level rises to warning (latch_warning) or alarm (latch_alarm,
-// or any collapse), that level latches: the level shown stays at least there until an operator
-// acknowledges it. An acknowledgement names the latched level and quotes the sequence of the
-// latest event; otherwise it changes nothing and the outcome says why (stale sequence, wrong
-// level, nothing latched). An accepted acknowledgement releases the latch: the level then
-// follows its condition, so acknowledging an alarm whose condition still holds keeps the
-// alarm (it lowers later without another acknowledgement), and a condition already active is
-// not latched again until it ends and rises anew.
-//
-// Fault: fault_active (sensor or bus trouble; an invalid risk input counts as an internal
-// fault) raises the fault level at once; it ends lower_hold_s after fault_active clears. The
-// level shown is: alarm if the risk level (condition or latched) is alarm, else fault while a
-// fault is active, else the risk level. A fault never hides an alarm; it does hide a warning or
-// advisory (the risk behind them is stale while the input is not trusted), which show again,
-// with an event, when the fault ends; their conditions and latches keep evolving beneath.
-//
-// Not calibrated: not_calibrated (the caller has no trusted sensor offset or initial state,
-// so its risk vouches for nothing) shows the fault level, cause kNotCalibrated, at once and for
-// exactly as long as it lasts: it is a state of knowledge, not a flickering input, so no hold
-// keeps it after the caller has earned its estimate. While fault_active is set too, that
-// fault's cause is reported; like every fault it never hides an alarm.
-//
-// Events: one each time the level shown or its latched flag changes (at most two per update:
-// the acknowledgement is applied first, against what the operator saw, then the new input).
-// Sequence numbers start at 0 and increment by one per event, wrapping 255 -> 0. Cause: why the
-// new level holds (kRiskThreshold; kCollapseForecast when the forecast alone holds it;
-// kPhaseChange, kOverturnDetected, the fault's cause), kNone
-// back to normal, kAcknowledged for a change an acknowledgement made. kPWave when the P-wave
-// stage alone holds the warning.
-//
-// Heartbeat: a status is due every heartbeat_period_s, and at once after an event;
-// next_heartbeat_ns() says when, heartbeat_sent() records that one went out.
-//
-// Times are int64 ns of monitor time since start, never decreasing (an update with an earlier
-// time is refused and reported). Freestanding: no heap, no exceptions.
+// Alarm policy: the risk, the forecast's probability, the block's phase and the fault state in;
+// alarm levels, events and the heartbeat out, for the building's alarm system (the AlarmEvent
+// frames, the status lines). Levels and causes: alarm_level.h; every rule and default:
+// docs/monitor-components.md, Alarm policy. Freestanding: no heap, no exceptions.
 #pragma once
 
 #include <array>
@@ -120,7 +69,7 @@ struct AlarmInput {
   bool collapse_detected = false;    // the block overturned or fell
   bool fault_active = false;         // sensor or bus trouble
   AlarmCause fault_cause = AlarmCause::kSensorFault;  // reported while fault_active
-  bool not_calibrated = false;  // no trusted offset or initial state (above)
+  bool not_calibrated = false;  // no trusted offset or initial state (AlarmPolicy, below)
   bool acknowledged = false;  // `acknowledgement` arrived since the last update
   Acknowledgement acknowledgement;
 };
@@ -193,6 +142,36 @@ struct HeldCondition {
 };
 }  // namespace detail
 
+// Conditions, each with on/off thresholds on the risk and on the forecast's probability
+// (hysteresis: a condition starts at risk >= on or probability >= on, ends when both are below
+// their off) and holds (raise_hold_s before its level rises, lower_hold_s absent before it
+// lowers); the condition level is the highest level whose condition is active:
+//   advisory  risk >= advisory.on, probability >= advisory_forecast.on, or out of full contact
+//   warning   risk >= warning.on, or probability >= warning_forecast.on, or the P-wave
+//             stage's probability of collapse >= warning_pwave.on (a guess about the coming
+//             ground, not the statue's physics: it never raises alarm; p_wave.h)
+//   alarm     risk >= alarm.on, or probability >= alarm_forecast.on; or a collapse (overturned,
+//             fell): alarm at once, no hold, latched
+// Latching: a rise of the condition level into warning (latch_warning) or alarm (latch_alarm,
+// any collapse) latches it: the level shown stays at least there until acknowledged. An
+// acknowledgement names the latched level and quotes the latest event's sequence, else it
+// changes nothing and the outcome says why; an accepted one releases the latch and the level
+// follows its condition (an alarm whose condition holds stays, and lowers later by itself).
+// Fault: fault_active (or an invalid risk input: an internal fault) shows the fault level at
+// once, until lower_hold_s after it clears. Not calibrated: not_calibrated shows the fault
+// level, cause kNotCalibrated, exactly while it lasts (no hold: a state of knowledge); an
+// active fault's own cause is reported instead. The level shown: alarm if the risk level
+// (condition or latch) is alarm, else fault while a fault or not_calibrated holds, else the
+// risk level: a fault never hides an alarm, it hides a warning or advisory (stale while the
+// input is not trusted), which show again with an event when it ends.
+// Events: one each time the level shown or its latched flag changes, at most two per update
+// (the acknowledgement first, against what the operator saw, then the new input); sequences
+// from 0, wrapping 255 -> 0. Cause: why the new level holds (risk_threshold; collapse_forecast
+// when the forecast alone holds it; p_wave when the P-wave stage alone holds the warning;
+// phase_change, overturn_detected, the fault's cause), none
+// back to normal, acknowledged for a change an acknowledgement made.
+// Times are int64 ns of monitor time since start, never decreasing: an update with an earlier
+// time is refused (InputProblem::kTimeWentBack).
 class AlarmPolicy {
  public:
   AlarmPolicy() = default;
@@ -204,7 +183,8 @@ class AlarmPolicy {
 
   [[nodiscard]] AlarmLevel level() const { return level_; }
   [[nodiscard]] AlarmLevel latched_level() const { return latched_level_; }
-  // When the next status / heartbeat is due, ns (the lowest int64 before the first one: due).
+  // Heartbeat: a status is due every heartbeat_period_s after the last heartbeat_sent(), and at
+  // once after an event. When the next is due, ns (the lowest int64 before the first: due).
   [[nodiscard]] std::int64_t next_heartbeat_ns() const { return next_heartbeat_ns_; }
   [[nodiscard]] bool heartbeat_due(std::int64_t now_ns) const {
     return now_ns >= next_heartbeat_ns_;

@@ -1,36 +1,6 @@
-// Conditioning: one per sensor, between sensor health and the estimator. Turns the sensor's
-// samples (its units, its mounting) into the ground acceleration in the statue frame, m/s2:
-// x, y the statue's first and second principal horizontal axes, z up, z relative to gravity
-// (the vertical channel is v_G'' = a_z - g, so g + v_G'' is the normal-force term of the model).
-//
-//   statue = R * (unit_scale * sensor)             R = sensor_to_statue, unit_scale 1 or g0
-//   ground = statue - (0, 0, g0) - offset          g0 = 9.80665 m/s2 (kStandardGravity)
-//
-// Offset: the sensor's bias, in the statue frame. A start-up window of startup_window_s of
-// samples gives its estimate, the window's mean of statue - (0, 0, g0); until the window is
-// full the output is not ready. The window is accepted only when it shows the ground was quiet
-// (the quietness test, in this order; the first failed check is the rejection's reason):
-//   spread   the standard deviation of every axis <= startup_max_std_m_s2
-//   drift    the mean of the window's second half minus that of its first half, every axis,
-//            within startup_max_drift_m_s2 (a slow onset, a warming sensor)
-//   gravity  the mean's norm within startup_gravity_tolerance_m_s2 of g0 (a wrong unit or gain)
-//   offset   every offset component within startup_max_offset_m_s2 (a wrong mounting rotation)
-// A rejected window is counted with its reason and a new one begins: while the ground shakes
-// the output stays not ready, however long that lasts.
-//
-// Verification: begin_verification() (the monitor calls it when its estimators start again
-// without a quiet window just before, after a sensor fault) runs the same test on a new window
-// while the output stays ready on the current offset; a passing window sets window_passed on
-// the sample that completes it and leaves the offset as it is (slow tracking follows it).
-//
-// Slow tracking: once ready, a first-order low-pass with time constant tracking_time_constant_s
-// follows the offset (temperature drift), applied to a sample only when the caller says the
-// block is at rest and the ground quiet, and only when every component of that sample's output
-// stays within tracking_gate_m_s2: an earthquake (even one the caller has not noticed yet)
-// is never averaged into the offset. A persistent jump beyond the gate is not followed either:
-// status().consecutive_gated counts quiet samples refused by the gate, for the caller to judge.
-//
-// Non-finite input is refused (not ready for that sample, counted); the state is unchanged.
+// Conditioning: one per sensor, between sensor health and the estimators. Turns the sensor's
+// samples (its unit, its mounting) into the ground acceleration in the statue frame, m/s2, with
+// its offset from a quiet start-up window (docs/monitor-components.md, Conditioning).
 // Freestanding: no heap, no exceptions; Eigen fixed-size types.
 #pragma once
 
@@ -143,6 +113,28 @@ struct ConditioningStatus {
   Vector3r window_drift_m_s2 = Vector3r::Zero();  // of the last completed window
 };
 
+// The output: x, y the statue's first and second principal horizontal axes, z up and relative
+// to gravity (the vertical channel is v_G'' = a_z - g, so g + v_G'' is the model's normal-force
+// term):
+//   statue = R * (unit_scale * sensor)             R = sensor_to_statue, unit_scale 1 or g0
+//   ground = statue - (0, 0, g0) - offset          g0 = 9.80665 m/s2 (kStandardGravity)
+//
+// Offset: the sensor's bias in the statue frame, the mean of statue - (0, 0, g0) over a
+// start-up window of startup_window_s; not ready until a window passes the quietness test (in
+// this order, the first failed check the rejection's reason):
+//   spread   the standard deviation of every axis <= startup_max_std_m_s2
+//   drift    the mean of the window's second half minus its first half's, every axis, within
+//            startup_max_drift_m_s2 (a slow onset, a warming sensor)
+//   gravity  the mean's norm within startup_gravity_tolerance_m_s2 of g0 (a wrong unit or gain)
+//   offset   every offset component within startup_max_offset_m_s2 (a wrong mounting rotation)
+// A rejected window is counted with its reason and a new one begins: while the ground shakes
+// the output stays not ready, however long that lasts.
+//
+// Slow tracking: once ready, a first-order low-pass (tracking_time_constant_s) follows the
+// offset, on a sample only when the caller says the block is at rest and the ground quiet and
+// every component of the sample's output stays within tracking_gate_m_s2: an earthquake, even
+// one not noticed yet, is never averaged into the offset; nor is a lasting jump beyond the
+// gate (status().consecutive_gated counts the quiet samples it refused).
 class Conditioner {
  public:
   Conditioner() = default;
@@ -152,11 +144,14 @@ class Conditioner {
 
   // One sample in the sensor frame and the declared unit. `quiet`: the caller's estimate that
   // the block is at rest in full contact and the ground quiet (allows offset tracking).
+  // Non-finite input is refused (not ready for that sample, counted); the state is unchanged.
   [[nodiscard]] ConditionedSample condition(const Vector3r& sensor_sample, bool quiet);
 
   // Forgets the offset and starts a new start-up window (for example after a sensor fault).
   void restart_startup();
-  // Once ready: tests a new window for quietness while the output stays ready (above).
+  // Once ready: tests a new window for quietness while the output stays ready on the current
+  // offset (the monitor's estimators started again without a quiet window just before); the
+  // sample completing a passing one is marked window_passed, the offset left as it is.
   void begin_verification();
 
   // Unit and rotation alone, m/s2 in the statue frame (gravity and offset still in).

@@ -1,47 +1,7 @@
-// Sensor health: one tracker per accelerometer node, between the CAN decoder and conditioning.
-//
-// Input: every SensorAcceleration sample of the node as received (receive time, 8-bit sequence
-// counter, status flags, ax/ay/az in g), and a periodic tick(now). Output per sample: the
-// samples to feed the solver, in order (0 to max_bridge_samples + 1 of them), the health state
-// and its cause, and counters. Nothing bad passes silently: every sample is fed, fed with a
-// mark, bridged, or dropped with a counter and a cause.
-//
-// Per sample, in this order:
-//   - timeout first: if no sample was accepted for timeout_s, the silence is a timeout fault and
-//     the stream is re-synchronised (this sample starts it afresh, no gap is counted across).
-//   - sequence (against the last sample that passed this check; 8-bit serial arithmetic,
-//     d = (seq - last) mod 256): d = 0 duplicate, d >= 128 out of order; both dropped, counted,
-//     degraded. More than max_bridge_samples out-of-order samples in a row mean the node
-//     restarted its counter: fault, and the next sample re-synchronises. 1 < d < 128: d - 1
-//     sequence numbers were missed (counted).
-//   - values: non-finite, |a| > max_valid_g on an axis, or status bits the protocol does not
-//     define: rejected (counted); the sample's slot becomes part of the gap to bridge.
-//   - gap: the slots between the last accepted sample and this one (missed and rejected). Up to
-//     max_bridge_samples slots are bridged by linear interpolation (values and receive times)
-//     between the two accepted samples, each bridged sample marked: degraded. More is a fault
-//     (and a rejected sample that takes the open gap past the limit is a fault at once).
-//   - status flags: self-test failed or calibration invalid: fault (the values cannot be
-//     trusted); over-temperature: degraded, fed. Saturation (the flag, or |a| >= full_scale_g on
-//     an axis): degraded, fed marked `saturated` (the true |a| is at least the value fed).
-//   - stuck: stuck_samples consecutive accepted samples with all three axes bit-identical:
-//     fault. The first stuck_samples - 1 of them were fed (they could not be told from noise).
-//
-// Health state and recovery: every condition above marks the sample unclean and raises the
-// state to the condition's severity (ok < degraded < fault; the cause is the latest condition
-// of the highest severity held). The state returns to ok after recovery_samples consecutive
-// clean samples (accepted, valid, no flags, not saturated, not stuck; a dropped or rejected
-// sample breaks the run). A gap or a timeout belongs to the time before the sample that ends
-// it: that sample, if clean itself, is the first of the run (so with recovery_samples = 1
-// feeding restarts at the very sample that ends a long gap or a timeout).
-//
-// Stream across a fault: while the state is fault nothing is fed (accepted samples are counted
-// as held_in_fault) and nothing is bridged across it. The sample that completes recovery is
-// fed with `restart` set: the stream before it does not connect to it (the estimator restarts
-// its input interpolation there; what happened meanwhile is unknown). A tracker starts in fault
-// (cause no_data), so the first fed sample of all is also a restart.
-//
-// Times are int64 ns on the receive clock (hal::TimedFrame::timestamp_ns); they must not go
-// backwards (a decrease counts as no time elapsed). Freestanding: no heap, no exceptions.
+// Sensor health: one tracker per accelerometer node, between the frame decoder and
+// conditioning. Nothing bad passes silently: every sample is fed, fed with a mark, bridged, or
+// dropped with a counter and a cause (docs/monitor-components.md, Sensor health).
+// Freestanding: no heap, no exceptions.
 #pragma once
 
 #include <Eigen/Core>
@@ -192,6 +152,20 @@ struct SensorUpdate {
   SensorHealth health;  // after this sample
 };
 
+// Health state and recovery: every condition on_sample() finds marks the sample unclean and
+// raises the state to the condition's severity (ok < degraded < fault; the cause is the latest
+// condition of the highest severity held). The state returns to ok after recovery_samples
+// consecutive clean samples (accepted, valid, no flags, not saturated, not stuck; a dropped or
+// rejected sample breaks the run). A gap or a timeout belongs to the time before the sample
+// that ends it: that sample, if clean itself, is the first of the run.
+//
+// Stream across a fault: while the state is fault nothing is fed (accepted samples are counted
+// as held_in_fault) and nothing is bridged across it. The sample that completes recovery is
+// fed with `restart` set: the stream before it does not connect to it (what happened meanwhile
+// is unknown). A tracker starts in fault (cause no_data), so the first fed sample is a restart.
+//
+// Times are int64 ns on the receive clock (hal::TimedFrame::timestamp_ns); a time earlier than
+// the last counts as no time elapsed.
 class SensorHealthTracker {
  public:
   SensorHealthTracker() = default;
@@ -200,7 +174,25 @@ class SensorHealthTracker {
   [[nodiscard]] static Error create(const SensorHealthSettings& settings,
                                     SensorHealthTracker& out);
 
-  // One received sample of this node.
+  // One received sample of this node: the samples to feed, in order (0 to max_bridge_samples +
+  // 1 of them), the state and its cause. Its checks, in this order:
+  //   timeout   no sample accepted for timeout_s: a timeout fault; the stream re-synchronises
+  //             (this sample starts it afresh, no gap counted across).
+  //   sequence  against the last sample past this check, d = (seq - last) mod 256: d = 0 a
+  //             duplicate, d >= 128 out of order; both dropped, counted, degraded. More than
+  //             max_bridge_samples out of order in a row: the node restarted its counter, a
+  //             fault, and the next sample re-synchronises. 1 < d < 128: d - 1 missed.
+  //   values    non-finite, |a| > max_valid_g on an axis, undefined status bits: rejected
+  //             (counted); its slot becomes part of the gap.
+  //   gap       the slots since the last accepted sample (missed and rejected): up to
+  //             max_bridge_samples are bridged linearly (values and receive times), each
+  //             bridged sample marked: degraded; more is a fault (at once when a rejected
+  //             sample takes the open gap past the limit).
+  //   flags     self-test failed, calibration invalid: fault (the values cannot be trusted);
+  //             over-temperature: degraded, fed; saturation (the flag, or |a| >= full_scale_g
+  //             on an axis): degraded, fed marked `saturated`.
+  //   stuck     stuck_samples consecutive accepted samples bit-identical on all three axes:
+  //             fault; the first stuck_samples - 1 were fed (not told from noise).
   [[nodiscard]] SensorUpdate on_sample(const SensorSample& sample);
   // Call periodically (at least every timeout_s / 2): detects the timeout while no sample
   // arrives. Returns the health after the check.

@@ -2,7 +2,7 @@
 // MQTT state and captures report these (lib/version/CMakeLists.txt makes them at build time).
 #pragma once
 
-namespace plinth {
+namespace plinth::version {
 
 // The project's version, "MAJOR.MINOR.PATCH" (project() in the top CMakeLists.txt).
 extern const char kProjectVersion[];
@@ -12,4 +12,4 @@ extern const char kGitDescription[];
 // "VERSION (DESCRIPTION)": what --version prints after the program's name.
 extern const char kVersionText[];
 
-}  // namespace plinth
+}  // namespace plinth::version

@@ -1,0 +1,91 @@
+// What the monitor knows after each input (Monitor::status(), MonitorUpdate::status): the
+// time, the estimators and each axis's mode, state, risk and forecast, the alarm level, and
+// each sensor's health and cross-check. The outputs (the status and alarm frames, the JSON
+// lines, Modbus, MQTT, the relays) are written from it. Freestanding.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "plinth/core/ensemble.h"
+#include "plinth/core/forecast.h"
+#include "plinth/core/risk.h"
+#include "plinth/core/state.h"
+#include "plinth/firmware/config.h"
+#include "plinth/monitor/alarm_level.h"
+#include "plinth/monitor/sensor_health.h"
+
+namespace plinth::firmware {
+
+// One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box
+// without ensemble) and the rest.
+struct AxisStatus : EnsembleRisk {
+  Mode mode;  // the nominal statue's (member 0)
+  State state = State::Zero();
+  int members = 1;       // the ensemble's size
+  ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
+  // Monitor time, s, of that forecast's first collapse (its worst member's); -1: none forecast.
+  double collapse_forecast_s = -1.0;
+};
+
+// One sensor's part of the status.
+struct SensorStatus {
+  std::uint8_t node = 1;
+  SensorRole role = SensorRole::kGround;
+  bool primary = false;  // drives the estimators
+  bool ready = false;    // conditioning ready (offset estimated)
+  monitor::SensorHealth health;
+  // Cross-check (ground sensors but the primary: the RMS difference to the primary; the plate:
+  // the model-mismatch residual), m/s2, over the sliding window; valid once the window is full.
+  double rms_m_s2 = 0.0;
+  bool window_full = false;
+  bool disagreeing = false;   // rms_m_s2 beyond the tolerance (plate: the threshold)
+  double max_rms_m_s2 = 0.0;  // the largest full-window RMS so far
+  std::uint64_t pairs = 0;         // samples compared
+  std::uint64_t unpaired = 0;      // samples with no reference sample within one period
+  std::uint64_t disagreements = 0;  // entries into the disagreeing state
+};
+
+// The sensors' part of the box's status, which the SensorSet keeps (sensor_set.h).
+struct SensorSetStatus {
+  // The primary's health (before the first primary: the first sensor's).
+  monitor::SensorHealth sensor;
+  // The sensors, in configured order.
+  int sensor_count = 1;
+  std::array<SensorStatus, kMaxSensors> sensors{};
+  int primary = -1;  // index of the sensor driving the estimators; -1 before the first
+  std::uint64_t failovers = 0;            // switches of the primary after the first choice
+  std::uint64_t failovers_continued = 0;  // of which the estimators continued from their state
+  // ok; degraded: a sensor but the primary not ok (a redundant or the plate sensor lost), a
+  // disagreement or a plate mismatch; fault: no usable ground sensor (the primary's fault).
+  monitor::HealthState sensors_state = monitor::HealthState::kFault;
+  bool disagreement = false;     // a ground sensor disagrees with the primary (fault input)
+  bool plate_mismatch = false;   // the plate's residual is beyond its threshold
+  int plate = -1;                // index of the plate sensor; -1: none
+  double plate_residual_m_s2 = 0.0;  // the plate's RMS residual (valid when its window is full)
+};
+
+// The box: its sensors' part, the estimators' and the alarm policy's.
+struct BoxStatus : SensorSetStatus {
+  std::int64_t time_ns = 0;  // monitor time of the newest sample (or tick)
+  bool estimating = false;   // conditioning ready and the estimators running
+  // Their offset and initial state are trusted (the start-up rule, docs/monitor.md); else the
+  // level is fault, cause kNotCalibrated.
+  bool calibrated = false;
+  int axis_count = 1;
+  std::array<AxisStatus, kMaxAxes> axes{};
+  double risk = 0.0;  // the worst axis's total
+  // The forecast: the highest probability of a collapse within the horizon over the axes, the
+  // axis it is on (-1: no forecast yet), and the monitor time, s, at which the first member of
+  // any axis is forecast to collapse (-1: none is).
+  double probability = 0.0;
+  int forecast_axis = -1;
+  double collapse_forecast_s = -1.0;
+  monitor::AlarmLevel alarm = monitor::AlarmLevel::kNormal;
+  monitor::AlarmLevel latched = monitor::AlarmLevel::kNormal;
+  std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
+  std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
+  std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
+};
+
+}  // namespace plinth::firmware

@@ -1,0 +1,27 @@
+#include "plinth/firmware/alarm_inputs.h"
+
+namespace plinth::firmware {
+
+monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& config,
+                                bool bus_fault) {
+  monitor::AlarmInput input;
+  input.time_ns = status.time_ns;
+  input.risk = static_cast<Real>(status.risk);
+  input.probability = static_cast<Real>(status.probability);
+  for (int i = 0; i < status.axis_count; ++i) {
+    const Mode& mode = status.axes[static_cast<std::size_t>(i)].mode;
+    input.out_of_full_contact = input.out_of_full_contact || mode.phase != Phase::kFullContact;
+    input.collapse_detected = input.collapse_detected || mode.terminal();
+  }
+  const bool sensor_fault = status.sensor.state == monitor::HealthState::kFault;
+  const bool disagreement = status.disagreement;
+  const bool mismatch_fault = status.plate_mismatch && config.plate.raises_fault;
+  input.fault_active = sensor_fault || disagreement || mismatch_fault || bus_fault;
+  input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status.sensor.cause)
+                      : (disagreement || mismatch_fault) ? monitor::AlarmCause::kSensorDisagreement
+                                                         : monitor::AlarmCause::kBusError;
+  input.not_calibrated = !status.estimating || !status.calibrated;
+  return input;
+}
+
+}  // namespace plinth::firmware

@@ -1,0 +1,102 @@
+#include "plinth/firmware/frame_decoder.h"
+
+#include "plinth/firmware/can_frames.h"
+
+namespace plinth::firmware {
+
+// The CAN protocol (hal/can_codec).
+namespace can = hal::can;
+
+void FrameDecoder::start(const MonitorConfig& config) {
+  std::array<SensorConfig, kMaxSensors> sensors{};
+  count_ = resolved_sensors(config, sensors);
+  for (int i = 0; i < count_; ++i) {
+    nodes_[static_cast<std::size_t>(i)] = sensors[static_cast<std::size_t>(i)].node;
+  }
+  counters_ = FrameCounters{};
+}
+
+template <typename Message>
+bool FrameDecoder::decoded(const can::CanFrame& frame, Message& message) {
+  const can::DecodeResult r = can::decode(frame, message);
+  if (r.ok()) return true;
+  ++counters_.rejected;
+  counters_.last_error = r.error;
+  counters_.last_error_signal = r.signal;
+  return false;
+}
+
+int FrameDecoder::sensor_of_node(std::uint8_t node) const {
+  for (int i = 0; i < count_; ++i) {
+    if (nodes_[static_cast<std::size_t>(i)] == node) return i;
+  }
+  return -1;
+}
+
+FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
+  ++counters_.received;
+  FrameInput input;
+  const can::CanFrame& frame = timed.frame;
+  switch (can::classify(frame.id)) {
+    case can::MessageKind::kSensorAcceleration: {
+      can::SensorAcceleration message;
+      if (!decoded(frame, message)) break;
+      input.sensor = sensor_of_node(message.node);
+      if (input.sensor < 0) {
+        ++counters_.other_nodes;
+        break;
+      }
+      ++counters_.sensor_samples;
+      input.kind = FrameInput::Kind::kSensorSample;
+      input.sample = sample_of(message, timed.timestamp_ns);
+      break;
+    }
+    case can::MessageKind::kSensorHeartbeat: {
+      can::SensorHeartbeat message;
+      if (decoded(frame, message)) ++counters_.heartbeats;
+      break;
+    }
+    case can::MessageKind::kAcknowledge: {
+      can::Acknowledge message;
+      if (!decoded(frame, message)) break;
+      ++counters_.acknowledgements;
+      input.kind = FrameInput::Kind::kAcknowledgement;
+      input.acknowledgement = acknowledgement_of(message);
+      break;
+    }
+    case can::MessageKind::kMonitorStatus: {
+      can::MonitorStatus message;
+      if (decoded(frame, message)) ++counters_.monitor_frames;
+      break;
+    }
+    case can::MessageKind::kAlarmEvent: {
+      can::AlarmEvent message;
+      if (decoded(frame, message)) ++counters_.monitor_frames;
+      break;
+    }
+    case can::MessageKind::kCollapseForecast: {
+      can::CollapseForecast message;
+      if (decoded(frame, message)) ++counters_.monitor_frames;
+      break;
+    }
+    case can::MessageKind::kUnknown:
+      ++counters_.unknown_identifiers;
+      break;
+  }
+  return input;
+}
+
+MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::TimedFrame& frame) {
+  const FrameInput input = decoder.decode(frame);
+  switch (input.kind) {
+    case FrameInput::Kind::kSensorSample:
+      return monitor.on_sensor_sample(input.sensor, input.sample);
+    case FrameInput::Kind::kAcknowledgement:
+      return monitor.acknowledge(input.acknowledgement);
+    case FrameInput::Kind::kNone:
+      break;
+  }
+  return monitor.poll();
+}
+
+}  // namespace plinth::firmware
