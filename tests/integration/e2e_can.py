@@ -39,7 +39,8 @@ PHASES = ["full_contact", "sliding", "rocking", "slide_rocking", "overturned", "
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", None, None, None, "regional_alert"]
+          "collapse_forecast", "not_calibrated", None, "p_wave", None, "regional_alert"]
+# 12 and 14: outside_model's and statue_unexplained's (other branches), not on this wire.
 SCENARIOS = ("main", "stop", "garbage", "burst")
 # Sent by canplayer in the garbage case, each one refused by the DBC (or not for the monitor).
 GARBAGE = (
@@ -49,7 +50,7 @@ GARBAGE = (
     "320#00F0000000000000", "320#0600000000000000",  # MonitorStatus: bits 12-15; phase 6
     "320#0000112700000000", "320#0000000000000001",  # risk 10001 (> 1); bits 56-63
     "330#0000FE0000000000", "330#0500000000000000",  # AlarmEvent: bits 17-23; level 5
-    "330#000C000000000000",  # cause 12
+    "330#000C000000000000", "330#000E000000000000",  # cause 12, 14 (reserved)
     "350#1127000100000000", "351#E803050364002800",  # CollapseForecast: probability 10001;
     "350#0000110100000000",  # worst member 5 of 3 members; worst member 17
     "340#F000000000000000", "340#00",  # Acknowledge: bits 4-7; short
@@ -151,7 +152,7 @@ class Signal:
         self.factor, self.offset = factor, offset
         self.raw_min = round((minimum - offset) / factor)
         self.raw_max = round((maximum - offset) / factor)
-        # The VAL_ table's raw values: an enumeration's (its whole range), or a quantity's
+        # The VAL_ table's raw values: an enumeration's (within its range), or a quantity's
         # special value outside its range (255 "none")
         self.values = None
         self.reserved_mask = 0  # flag bits the comment reserves ("bits 4-7 reserved, must be 0")
@@ -160,7 +161,7 @@ class Signal:
 class Dbc:
     """The messages of plinth.dbc, read from the file itself, and a decoder that refuses what
     the DBC makes invalid: a length other than the message's, raw values outside [min|max] and
-    missing from the signal's VAL_ table (an enumeration's table is its range; a quantity's
+    missing from the signal's VAL_ table (an enumeration's table is within its range; a quantity's
     names a special value outside it), bits no signal covers, flag bits a comment reserves."""
 
     def __init__(self, path):
@@ -213,8 +214,9 @@ class Dbc:
             raw = (word >> s.start) & mask
             if s.signed and raw >> (s.length - 1):
                 raw -= 1 << s.length
+            # an enumeration's names lie in its range (Cause's skip 12 and 14, reserved)
             enumeration = s.values is not None and \
-                s.values == set(range(s.raw_min, s.raw_max + 1))
+                all(s.raw_min <= v <= s.raw_max for v in s.values)
             if enumeration and raw not in s.values:
                 return None, f"{s.name} {raw} not in its VAL_ table"
             if not s.raw_min <= raw <= s.raw_max and not (s.values and raw in s.values):

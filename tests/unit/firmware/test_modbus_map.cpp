@@ -86,7 +86,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 4);
+  EXPECT_EQ(at(reg::kMapVersion), 5);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";

@@ -109,7 +109,9 @@ enum class AlarmCause : std::uint8_t {
   kInternalFault = 9,       // the monitor's own self-check failed
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet
-  // 12-14: other branches' causes.
+  // 12 and 14: other branches' causes (outside_model, statue_unexplained); until they land,
+  // encode and decode refuse them.
+  kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
   kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
 };
 

@@ -33,7 +33,8 @@ enum class AlarmCause : std::uint8_t {
   kInternalFault = 9,       // the monitor's own self-check failed
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet: nothing to vouch for
-  // 12-14: other branches' causes (outside_model, p_wave, the statue's sensor).
+  // 12 and 14: other branches' causes (outside_model, statue_unexplained).
+  kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
   kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
 };
 
@@ -46,7 +47,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 13> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 14> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -59,6 +60,7 @@ inline constexpr NameTable<AlarmCause, 13> kAlarmCauseNames{{{
     {AlarmCause::kInternalFault, "internal_fault"},
     {AlarmCause::kCollapseForecast, "collapse_forecast"},
     {AlarmCause::kNotCalibrated, "not_calibrated"},
+    {AlarmCause::kPWave, "p_wave"},
     {AlarmCause::kRegionalAlert, "regional_alert"},
 }}};
 
