@@ -82,7 +82,7 @@ Error validate(const PWaveSettings& s) {
   }
   const double nyquist_hz = 0.5 / s.sample_period_s;
   PLINTH_TRY(detail::first_error({
-      check_order(s.lowpass_hz < nyquist_hz, "pwave.lowpass_hz",
+      check_order(static_cast<double>(s.lowpass_hz) < nyquist_hz, "pwave.lowpass_hz",
                   "must be below half the sample rate", nyquist_hz),
       check_order(s.highpass_hz < s.lowpass_hz, "pwave.highpass_hz",
                   "must be below pwave.lowpass_hz", s.lowpass_hz),
@@ -102,10 +102,11 @@ Error validate(const PWaveSettings& s) {
 }
 
 void detail::StateVariableFilter::design(Real corner_hz, Time period_s) {
-  g = static_cast<Real>(std::tan(static_cast<double>(kPi) * corner_hz * period_s));
+  g = static_cast<Real>(
+      std::tan(static_cast<double>(kPi) * static_cast<double>(corner_hz) * period_s));
   k = kButterworthDamping;
   h = Real(1) / (Real(1) + k * g + g * g);
-  w = static_cast<Real>(2.0 * g / period_s);
+  w = static_cast<Real>(2.0 * static_cast<double>(g) / period_s);
   clear();
 }
 
@@ -230,10 +231,10 @@ void PWaveStage::start_candidate() {
 void PWaveStage::judge_candidate() {
   const Real tau_c = window_tau_c();
   PWaveRejection rejection = PWaveRejection::kNone;
-  if (window_tau_p() < settings_.min_tau_p_s) {
+  if (static_cast<Time>(window_tau_p()) < settings_.min_tau_p_s) {
     rejection = PWaveRejection::kPeriodShort;
     ++status_.rejected_short;
-  } else if (tau_c > settings_.max_tau_c_s) {
+  } else if (static_cast<Time>(tau_c) > settings_.max_tau_c_s) {
     rejection = PWaveRejection::kPeriodLong;
     ++status_.rejected_long;
   } else if (settings_.channel == PWaveChannel::kVertical &&

@@ -93,25 +93,25 @@ inline constexpr std::size_t kMaxPWavePredictorPoints = 8;
 //   plinth-eval pwave-fit $(tools/pwave-records.sh sim/data/records/pwave) [--channel horizontal]
 inline constexpr std::array<PWavePredictorPoint, kMaxPWavePredictorPoints>
     kDefaultVerticalPredictor{{
-        {0.5, 3.091, 0.0, 0.649},
-        {1.0, 2.749, 0.0, 0.802},
-        {1.5, 2.588, 0.0, 0.767},
-        {2.0, 2.484, 0.0, 0.749},
-        {2.5, 2.290, 0.0, 0.962},
-        {3.0, 2.052, 0.0, 0.945},
-        {3.5, 1.877, 0.0, 1.003},
-        {4.0, 1.758, 0.0, 1.023},
+        {0.5, Real(3.091), Real(0.0), Real(0.649)},
+        {1.0, Real(2.749), Real(0.0), Real(0.802)},
+        {1.5, Real(2.588), Real(0.0), Real(0.767)},
+        {2.0, Real(2.484), Real(0.0), Real(0.749)},
+        {2.5, Real(2.290), Real(0.0), Real(0.962)},
+        {3.0, Real(2.052), Real(0.0), Real(0.945)},
+        {3.5, Real(1.877), Real(0.0), Real(1.003)},
+        {4.0, Real(1.758), Real(0.0), Real(1.023)},
     }};
 inline constexpr std::array<PWavePredictorPoint, kMaxPWavePredictorPoints>
     kDefaultHorizontalPredictor{{
-        {0.5, 3.357, 0.0, 0.821},
-        {1.0, 3.082, 0.0, 0.858},
-        {1.5, 2.750, 0.0, 0.943},
-        {2.0, 2.375, 0.0, 1.079},
-        {2.5, 2.004, 0.0, 1.041},
-        {3.0, 1.566, 0.0, 0.953},
-        {3.5, 1.227, 0.0, 0.806},
-        {4.0, 1.076, 0.0, 0.757},
+        {0.5, Real(3.357), Real(0.0), Real(0.821)},
+        {1.0, Real(3.082), Real(0.0), Real(0.858)},
+        {1.5, Real(2.750), Real(0.0), Real(0.943)},
+        {2.0, Real(2.375), Real(0.0), Real(1.079)},
+        {2.5, Real(2.004), Real(0.0), Real(1.041)},
+        {3.0, Real(1.566), Real(0.0), Real(0.953)},
+        {3.5, Real(1.227), Real(0.0), Real(0.806)},
+        {4.0, Real(1.076), Real(0.0), Real(0.757)},
     }};
 
 // The table fitted for a channel.
