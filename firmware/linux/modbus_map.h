@@ -23,10 +23,10 @@
 namespace plinth::firmware::modbus {
 
 inline constexpr std::uint16_t kNone = 0xFFFF;  // a register with no value (yet)
-inline constexpr std::uint16_t kMapVersion = 4;  // register 31; 2: holding registers, discrete
+inline constexpr std::uint16_t kMapVersion = 5;  // register 31; 2: holding registers, discrete
                                                  // inputs, causes 10-11, forecast, version;
                                                  // 3: the files' digests; 4: regional
-                                                 // alerts (86-101), cause 15
+                                                 // alerts (86-101), cause 15; 5: cause 13
 
 template <class Enum>
 struct Code {
@@ -54,7 +54,7 @@ inline constexpr CodeTable<monitor::AlarmLevel, 5> kAlarmLevelCodes{{{
     {monitor::AlarmLevel::kAlarm, 3},
     {monitor::AlarmLevel::kFault, 4},
 }}};
-inline constexpr CodeTable<monitor::AlarmCause, 14> kAlarmCauseCodes{{{
+inline constexpr CodeTable<monitor::AlarmCause, 15> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kNone, 0},
     {monitor::AlarmCause::kRiskThreshold, 1},
     {monitor::AlarmCause::kPhaseChange, 2},
@@ -68,7 +68,8 @@ inline constexpr CodeTable<monitor::AlarmCause, 14> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kCollapseForecast, 10},
     {monitor::AlarmCause::kNotCalibrated, 11},
     {monitor::AlarmCause::kOutsideModel, 12},
-    // 13-14: p_wave, the statue's sensor (other branches)
+    {monitor::AlarmCause::kPWave, 13},
+    // 14: statue_unexplained (another branch)
     {monitor::AlarmCause::kRegionalAlert, 15},
 }}};
 inline constexpr CodeTable<Phase, 7> kPhaseCodes{{{

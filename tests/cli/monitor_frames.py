@@ -22,8 +22,9 @@ CORNERS = ["none", "left", "right"]
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", "outside_model", None, None, "regional_alert"]
-# 13-14: other branches' causes, not on this wire (None: refused like a value beyond the table).
+          "collapse_forecast", "not_calibrated", "outside_model", "p_wave", None, "regional_alert"]
+# 14: another branch's cause (statue_unexplained), not on this wire (None: refused like a value
+# beyond the table).
 STATUS_ID, ALARM_ID = 0x320, 0x330
 
 

@@ -46,8 +46,9 @@ static_assert(same_number(AlarmCause::kInternalFault, can::AlarmCause::kInternal
 static_assert(same_number(AlarmCause::kCollapseForecast, can::AlarmCause::kCollapseForecast));
 static_assert(same_number(AlarmCause::kNotCalibrated, can::AlarmCause::kNotCalibrated));
 static_assert(same_number(AlarmCause::kOutsideModel, can::AlarmCause::kOutsideModel));
+static_assert(same_number(AlarmCause::kPWave, can::AlarmCause::kPWave));
 static_assert(same_number(AlarmCause::kRegionalAlert, can::AlarmCause::kRegionalAlert));
-static_assert(monitor::kAlarmCauseNames.size() == 14);
+static_assert(monitor::kAlarmCauseNames.size() == 15);
 
 // The sensors' status bits (SensorAcceleration.Status): passed through as they are.
 static_assert(monitor::sensor_flags::kSaturated == can::sensor_status::kSaturated);

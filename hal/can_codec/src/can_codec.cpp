@@ -120,9 +120,14 @@ constexpr std::array<SignalLayout, 5> kRegionalSignals{{
     {"SArrivalIn", 48, 16, true, 0.01, 0.0, -32768, 32767, "s", false, kNoSpecialRaw},
 }};
 
-// The AlarmCause VAL_ table has a gap (13-14: other branches' causes, not on the wire yet).
+// The AlarmCause VAL_ table's gap: another branch's cause, not on the wire until it lands (14
+// statue_unexplained); encode and decode refuse it.
+constexpr std::array<std::uint8_t, 1> kReservedCauses{14};
 constexpr bool in_cause_table(AlarmCause cause) {
-  return static_cast<unsigned>(cause) <= 12U || cause == AlarmCause::kRegionalAlert;
+  for (const std::uint8_t reserved : kReservedCauses) {
+    if (static_cast<std::uint8_t>(cause) == reserved) return false;
+  }
+  return true;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -477,7 +482,7 @@ EncodeResult encode(const AlarmEvent& message, CanFrame& frame) {
   packer.enumeration(message.level, s[kLevel]);
   packer.enumeration(message.previous_level, s[kPreviousLevel]);
   packer.enumeration(message.cause, s[kCause]);
-  if (!in_cause_table(message.cause)) packer.fail(CodecError::kInvalidEnum, "Cause");
+  if (!in_cause_table(message.cause)) packer.fail(CodecError::kInvalidEnum, s[kCause].name);
   packer.integer(message.latched ? 1U : 0U, s[kLatched]);
   packer.integer(message.time_since_start_ms, s[kTime]);
   packer.integer(message.sequence, s[kEvSequence]);
@@ -491,7 +496,7 @@ DecodeResult decode(const CanFrame& frame, AlarmEvent& message) {
   m.level = unpacker.enumeration<AlarmLevel>(s[kLevel]);
   m.previous_level = unpacker.enumeration<AlarmLevel>(s[kPreviousLevel]);
   m.cause = unpacker.enumeration<AlarmCause>(s[kCause]);
-  if (!in_cause_table(m.cause)) unpacker.fail(CodecError::kInvalidEnum, "Cause");
+  if (!in_cause_table(m.cause)) unpacker.fail(CodecError::kInvalidEnum, s[kCause].name);
   m.latched = unpacker.integer<std::uint8_t>(s[kLatched]) != 0;
   m.time_since_start_ms = unpacker.integer<std::uint32_t>(s[kTime]);
   m.sequence = unpacker.integer<std::uint8_t>(s[kEvSequence]);

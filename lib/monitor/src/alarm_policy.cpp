@@ -83,6 +83,8 @@ Error validate(const AlarmPolicySettings& s) {
                   "alarm_policy.warning_forecast.off"),
       check_order(s.warning_forecast, s.alarm_forecast, "alarm_policy.alarm_forecast.on",
                   "alarm_policy.alarm_forecast.off"),
+      check_thresholds(s.warning_pwave, "alarm_policy.warning_pwave.on",
+                       "alarm_policy.warning_pwave.off"),
       check_thresholds(s.warning_regional, "alarm_policy.warning_regional.on",
                        "alarm_policy.warning_regional.off"),
       detail::check_duration(s.raise_hold_s, "alarm_policy.raise_hold_s", true),
@@ -126,12 +128,15 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
     const bool warning_forecast = above(warning_, settings_.warning_forecast, in.probability);
     const bool alarm_risk = above(alarm_, settings_.alarm, in.risk);
     const bool alarm_forecast = above(alarm_, settings_.alarm_forecast, in.probability);
+    const bool warning_pwave = above(warning_, settings_.warning_pwave, in.pwave_probability);
     const bool warning_regional =
         above(warning_, settings_.warning_regional, in.regional_probability);
-    const bool warning = warning_risk || warning_forecast || warning_regional;
+    const bool warning = warning_risk || warning_forecast || warning_pwave || warning_regional;
     const bool alarm = alarm_risk || alarm_forecast;
     warning_by_forecast_ = warning_forecast && !warning_risk;
-    warning_by_regional_ = warning_regional && !warning_risk && !warning_forecast;
+    warning_by_pwave_ = warning_pwave && !warning_risk && !warning_forecast;
+    warning_by_regional_ =
+        warning_regional && !warning_risk && !warning_forecast && !warning_pwave;
     alarm_by_forecast_ = alarm_forecast && !alarm_risk;
     advisory_.update(advisory, in.time_ns, raise_hold_ns_, lower_hold_ns_);
     warning_.update(warning, in.time_ns, raise_hold_ns_, lower_hold_ns_);
@@ -200,12 +205,13 @@ AlarmCause AlarmPolicy::cause_of(AlarmLevel level) const {
 }
 
 // Which signal holds the warning or alarm condition: the risk, else the forecast, else (warning
-// only) the regional alert.
+// only) the P wave measured on site, else the regional alert.
 AlarmCause AlarmPolicy::condition_cause(AlarmLevel level) const {
   if (level == AlarmLevel::kAlarm) {
     return alarm_by_forecast_ ? AlarmCause::kCollapseForecast : AlarmCause::kRiskThreshold;
   }
   if (warning_by_forecast_) return AlarmCause::kCollapseForecast;
+  if (warning_by_pwave_) return AlarmCause::kPWave;
   return warning_by_regional_ ? AlarmCause::kRegionalAlert : AlarmCause::kRiskThreshold;
 }
 
@@ -249,6 +255,7 @@ AlarmOutput AlarmPolicy::update(const AlarmInput& in) {
       emit_if_changed(out, in.time_ns, true);
     }
     const bool risk_valid = valid_fraction(in.risk) && valid_fraction(in.probability) &&
+                            valid_fraction(in.pwave_probability) &&
                             valid_fraction(in.regional_probability);
     if (!risk_valid) out.input_problem = InputProblem::kRiskInvalid;
     evaluate_conditions(in, risk_valid);

@@ -19,24 +19,6 @@ std::int64_t seconds_to_ns(Real s) {
   return static_cast<std::int64_t>(std::llround(static_cast<double>(s) * 1e9));
 }
 
-Error check_positive_number(Real value, const char* field) {
-  if (!std::isfinite(value)) return {ErrorCode::kNotFinite, field, "must be finite"};
-  if (value <= Real(0)) return {ErrorCode::kOutOfRange, field, "must be greater than zero", 0.0};
-  return ok_error();
-}
-
-Error check_fragility(const RegionalAlertSettings& s) {
-  if (!s.fragility_known) return ok_error();
-  PLINTH_TRY(check_positive_number(s.fragility.median_g, "fragility.median_g"));
-  if (!std::isfinite(s.fragility.beta)) {
-    return {ErrorCode::kNotFinite, "fragility.beta", "must be finite"};
-  }
-  if (s.fragility.beta < Real(0)) {
-    return {ErrorCode::kOutOfRange, "fragility.beta", "must not be negative", 0.0};
-  }
-  return ok_error();
-}
-
 }  // namespace
 
 Error validate(const RegionalAlertSettings& s) {
@@ -44,8 +26,8 @@ Error validate(const RegionalAlertSettings& s) {
       detail::check_duration(s.max_origin_age_s, "regional_alert.max_origin_age_s", false),
       detail::check_duration(s.future_tolerance_s, "regional_alert.future_tolerance_s", true),
       detail::check_duration(s.expiry_margin_s, "regional_alert.expiry_margin_s", true),
-      check_positive_number(s.stress_drop_bar, "regional_alert.stress_drop_bar"),
-      check_positive_number(s.shear_wave_speed_km_s, "regional_alert.shear_wave_speed_km_s"),
+      check_positive(s.stress_drop_bar, "regional_alert.stress_drop_bar"),
+      check_positive(s.shear_wave_speed_km_s, "regional_alert.shear_wave_speed_km_s"),
   }));
   if (!std::isfinite(s.path_duration_s_per_km)) {
     return {ErrorCode::kNotFinite, "regional_alert.path_duration_s_per_km", "must be finite"};
@@ -54,7 +36,7 @@ Error validate(const RegionalAlertSettings& s) {
     return {ErrorCode::kOutOfRange, "regional_alert.path_duration_s_per_km",
             "must not be negative", 0.0};
   }
-  return check_fragility(s);
+  return s.fragility_known ? detail::check_fragility(s.fragility) : ok_error();
 }
 
 // Boore (2003), the stochastic method: M0 = 10^(1.5 M + 16.05) dyne cm, the Brune corner

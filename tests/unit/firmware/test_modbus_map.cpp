@@ -27,7 +27,8 @@ TEST(ModbusMap, TheShippedCsvIsTheCodesMap) {
 
 TEST(ModbusMap, EveryCauseHasItsCodeInTheCsv) {
   const std::string csv = map_csv();
-  EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model;15=regional_alert\""),
+  EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model;13=p_wave;"
+                     "15=regional_alert\""),
             std::string::npos);
   EXPECT_NE(csv.find("4=overturned;5=fell;6=lifted_off\""), std::string::npos);
   EXPECT_NE(csv.find("\"0=normal;1=advisory;2=warning;3=alarm;4=fault\""), std::string::npos);
@@ -39,6 +40,7 @@ TEST(ModbusMap, CodesArePinned) {
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kCollapseForecast), 10);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kNotCalibrated), 11);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kOutsideModel), 12);
+  EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kPWave), 13);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kRegionalAlert), 15);
   EXPECT_EQ(kAlarmLevelCodes.code(monitor::AlarmLevel::kFault), 4);
   EXPECT_EQ(kPhaseCodes.code(Phase::kFell), 5);
@@ -91,7 +93,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 4);
+  EXPECT_EQ(at(reg::kMapVersion), 5);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";

@@ -12,6 +12,7 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -810,8 +811,8 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
     EXPECT_STREQ(rk.signal, "Level");
   }
-  for (unsigned v = 13; v <= 255; ++v) {
-    if (v == 15) continue;  // regional_alert; 13-14 are other branches' causes
+  for (unsigned v = 14; v <= 255; ++v) {
+    if (v == 15) continue;  // regional_alert; 14 is reserved (statue_unexplained)
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -829,10 +830,12 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  e.cause = static_cast<AlarmCause>(13);
+  e.cause = static_cast<AlarmCause>(14);
   EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
   e.cause = static_cast<AlarmCause>(16);
   EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
+  e.cause = AlarmCause::kPWave;
+  EXPECT_TRUE(encode(e, f).ok());
   e.cause = AlarmCause::kRegionalAlert;
   EXPECT_TRUE(encode(e, f).ok());
   e = AlarmEvent{};
@@ -1158,11 +1161,14 @@ TEST(CanDbc, ValueTablesMatchTheCodecsEnumerations) {
       if (!c.has_value_table) continue;
       const auto& table = it->second;
       // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names. But
-      // AlarmEvent.Cause: 13-14 are other branches' causes, not on this branch's wire (a gap
-      // that decode refuses, CanReject.EnumValuesMissingFromTheValueTables).
+      // AlarmEvent.Cause: 14 is another branch's cause (statue_unexplained), not on this
+      // branch's wire (a gap that decode refuses, CanReject.EnumValuesMissingFromTheValueTables).
       const bool cause_gap = id == kAlarmEventId && std::string(c.name) == "Cause";
-      ASSERT_EQ(table.size() + (cause_gap ? 2U : 0U),
+      ASSERT_EQ(table.size() + (cause_gap ? 1U : 0U),
                 static_cast<std::size_t>(c.raw_max - c.raw_min + 1));
+      if (cause_gap) {
+        EXPECT_EQ(table.count(14), 0U);
+      }
       for (const auto& [value, name] : table) {
         EXPECT_GE(static_cast<std::int64_t>(value), c.raw_min);
         EXPECT_LE(static_cast<std::int64_t>(value), c.raw_max);

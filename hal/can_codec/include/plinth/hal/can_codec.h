@@ -111,7 +111,8 @@ enum class AlarmCause : std::uint8_t {
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet
   kOutsideModel = 12,       // the estimate left the model's validity (lift-off)
-  // 13-14: other branches' causes.
+  kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
+  // 14: another branch's cause (statue_unexplained); until it lands, encode and decode refuse it.
   kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
 };
 

@@ -34,7 +34,8 @@ enum class AlarmCause : std::uint8_t {
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet: nothing to vouch for
   kOutsideModel = 12,       // the estimate left the model (the block lifted off): nothing to vouch for
-  // 13-14: other branches' causes (p_wave, the statue's sensor).
+  kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
+  // 14: another branch's cause (statue_unexplained).
   kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
 };
 
@@ -47,7 +48,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 14> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 15> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -61,6 +62,7 @@ inline constexpr NameTable<AlarmCause, 14> kAlarmCauseNames{{{
     {AlarmCause::kCollapseForecast, "collapse_forecast"},
     {AlarmCause::kNotCalibrated, "not_calibrated"},
     {AlarmCause::kOutsideModel, "outside_model"},
+    {AlarmCause::kPWave, "p_wave"},
     {AlarmCause::kRegionalAlert, "regional_alert"},
 }}};
 

@@ -91,7 +91,7 @@ struct RegionalAlertSettings {
   // Brune corner frequency at this stress drop and shear-wave speed, plus the path's part.
   Real stress_drop_bar = 100.0;           // bar, > 0
   Real shear_wave_speed_km_s = 3.5;       // km/s, > 0
-  Real path_duration_s_per_km = 0.05;     // s/km, >= 0
+  Real path_duration_s_per_km = Real(0.05);  // s/km, >= 0
   // The statue's collapse fragility (the scene file's [fragility]); without it alerts are
   // taken and shown, and the probability of collapse stays 0.
   bool fragility_known = false;
