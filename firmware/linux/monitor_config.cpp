@@ -458,6 +458,13 @@ void check_relays(RelaySettings& relays, bool default_active_low, const KeyLines
   }
 }
 
+// The keys of the regional alerts: refused by a build without them (kRegionalAlertBuiltIn).
+bool regional_key(const std::string& key) {
+  return key.rfind("regional_alert.", 0) == 0 ||
+         key.rfind("alarm_policy.warning_regional", 0) == 0 || key == "mqtt.regional_alerts" ||
+         key == "mqtt.regional_topic";
+}
+
 // validate(MonitorConfig), its field named as the file's key.
 void check(const MonitorConfig& config, const KeyLines& lines) {
   int sensor_index = -1;
@@ -558,6 +565,9 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     lines.note(key, node_ptr->source().begin.line);
     if (key == "sensor" && sensor_tables) continue;
     lines.store(known, key, key, *node_ptr);
+    if (!monitor::kRegionalAlertBuiltIn && regional_key(key)) {
+      lines.fail(key, cat(key, ": ", monitor::kRegionalAlertNotBuilt));
+    }
   }
   if (node < 1 || node > 15) {
     lines.fail("monitor.ground_node", "monitor.ground_node: must lie in [1, 15]");

@@ -124,7 +124,7 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
   PLINTH_TRY(validate_monitor_fields(c));
   PLINTH_TRY(validate(c.risk));
   PLINTH_TRY(monitor::validate(c.alarm));
-  PLINTH_TRY(monitor::validate(c.regional));
+  if constexpr (monitor::kRegionalAlertBuiltIn) PLINTH_TRY(monitor::validate(c.regional));
   // The sensor's period is the estimator's sample period: checked with the values start() uses.
   if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz < 100.0 ||
       c.estimator.sample_rate_hz > 1000.0) {

@@ -81,6 +81,10 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
       break;
     }
     case can::MessageKind::kRegionalAlertOrigin: {
+      if constexpr (!monitor::kRegionalAlertBuiltIn) {
+        ++counters_.unknown_identifiers;
+        break;
+      }
       can::RegionalAlertOrigin message;
       have_origin_ = decoded(frame, message);
       if (have_origin_) {
@@ -94,6 +98,10 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
       break;
     }
     case can::MessageKind::kRegionalAlert:
+      if constexpr (!monitor::kRegionalAlertBuiltIn) {
+        ++counters_.unknown_identifiers;
+        break;
+      }
       decode_regional(timed, input);
       break;
     case can::MessageKind::kUnknown:

@@ -10,6 +10,36 @@ namespace plinth::firmware {
 // The CAN protocol (hal/can_codec).
 namespace can = hal::can;
 
+namespace {
+
+// The regional alerts' room (monitor::RegionalAlertRoom): the room's own calls, or, in a build
+// without it, nothing held and every alert refused (one of each pair is used).
+[[maybe_unused]] Error start_room(const monitor::RegionalAlertSettings& settings, monitor::RegionalAlertState& room) {
+  return monitor::RegionalAlertState::create(settings, room);
+}
+[[maybe_unused]] Error start_room(const monitor::RegionalAlertSettings&, monitor::NoRegionalAlertState&) {
+  return ok_error();
+}
+[[maybe_unused]] void tick_room(monitor::RegionalAlertState& room, BoxStatus& status) {
+  room.tick(status.time_ns);
+  status.regional = room.status();
+}
+[[maybe_unused]] void tick_room(monitor::NoRegionalAlertState&, BoxStatus&) {}
+[[maybe_unused]] monitor::RegionalOutcome receive_in(monitor::RegionalAlertState& room,
+                                    const monitor::RegionalAlert& alert, std::int64_t now_ns) {
+  return room.receive(alert, now_ns);
+}
+[[maybe_unused]] monitor::RegionalOutcome receive_in(monitor::NoRegionalAlertState&, const monitor::RegionalAlert&,
+                                    std::int64_t) {
+  return {monitor::RegionalRefusal::kMalformed, monitor::kRegionalAlertNotBuilt};
+}
+[[maybe_unused]] void refuse_malformed_in(monitor::RegionalAlertState& room, const char* field) {
+  room.refuse_malformed(field);
+}
+[[maybe_unused]] void refuse_malformed_in(monitor::NoRegionalAlertState&, const char*) {}
+
+}  // namespace
+
 Error Monitor::start(const MonitorConfig& config,
                      const std::array<const Scene*, kMaxAxes>& scenes) {
   std::array<std::span<const Scene>, kMaxAxes> ensembles{};
@@ -37,7 +67,7 @@ Error Monitor::start(const MonitorConfig& config,
   status_.axis_count = config.axis_count;
   PLINTH_TRY(sensors_.start(config_, status_));
   PLINTH_TRY(monitor::AlarmPolicy::create(config_.alarm, alarm_));
-  PLINTH_TRY(monitor::RegionalAlertState::create(config_.regional, regional_));
+  PLINTH_TRY(start_room(config_.regional, regional_));
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
@@ -186,8 +216,7 @@ void Monitor::update_axes_status() {
 void Monitor::evaluate(MonitorUpdate& update) {
   sensors_.update_status();
   update_axes_status();
-  regional_.tick(status_.time_ns);
-  status_.regional = regional_.status();
+  tick_room(regional_, status_);
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
@@ -280,14 +309,14 @@ MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert,
 MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert) {
   MonitorUpdate update = new_update();
   update.regional_received = true;
-  update.regional = regional_.receive(alert, status_.time_ns);
+  update.regional = receive_in(regional_, alert, status_.time_ns);
   evaluate(update);
   return update;
 }
 
 MonitorUpdate Monitor::regional_alert_malformed(const char* field) {
   MonitorUpdate update = new_update();
-  regional_.refuse_malformed(field);
+  refuse_malformed_in(regional_, field);
   update.regional_received = true;
   update.regional = {monitor::RegionalRefusal::kMalformed, field};
   evaluate(update);

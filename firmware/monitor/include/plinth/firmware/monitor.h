@@ -153,7 +153,7 @@ class Monitor {
   Vector3r last_ground_ = Vector3r::Zero();  // the estimators' newest input, m/s2
   std::array<Ensemble, kMaxAxes> ensembles_{};
   monitor::AlarmPolicy alarm_;
-  monitor::RegionalAlertState regional_;
+  monitor::RegionalAlertRoom regional_;  // nothing in a build without regional alerts
   BoxStatus status_;
   std::uint64_t frames_not_encoded_ = 0;
   bool have_epoch_ = false;

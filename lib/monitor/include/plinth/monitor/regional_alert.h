@@ -12,13 +12,27 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "plinth/core/error.h"
 #include "plinth/core/fragility.h"
 #include "plinth/core/name_table.h"
 #include "plinth/core/real.h"
 
+#ifndef PLINTH_REGIONAL_ALERT
+#define PLINTH_REGIONAL_ALERT 1
+#endif
+
 namespace plinth::monitor {
+
+// Whether this build has the room (CMake option PLINTH_REGIONAL_ALERT; OFF in the cortex-m4f
+// presets, whose 64 KiB of flash it outgrows). A build without ignores the alert frames like
+// identifiers it does not know, refuses every other alert, and refuses a box file that configures
+// regional alerts.
+inline constexpr bool kRegionalAlertBuiltIn = PLINTH_REGIONAL_ALERT != 0;
+// The message of a build without.
+inline constexpr const char* kRegionalAlertNotBuilt =
+    "this build has no regional alerts (PLINTH_REGIONAL_ALERT=OFF)";
 
 // Alerts held at once (distinct events); the versions seen of recent events, remembered past
 // their expiry so that a late duplicate is still told from a new event.
@@ -180,5 +194,10 @@ class RegionalAlertState {
   std::int64_t now_ns_ = 0;
   RegionalAlertStatus status_;
 };
+
+// What a Monitor holds for the room: the room, or nothing in a build without it.
+struct NoRegionalAlertState {};
+using RegionalAlertRoom =
+    std::conditional_t<kRegionalAlertBuiltIn, RegionalAlertState, NoRegionalAlertState>;
 
 }  // namespace plinth::monitor
