@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 #include "plinth/host/text_file.h"
 #include "plinth/host/toml_names.h"
 #include "status_outputs.h"
@@ -196,8 +197,32 @@ void output_bindings(std::vector<Binding>& b, ModbusSettings& modbus, MqttSettin
                "a string (topic levels)"});
 }
 
+// The [pwave] table's keys but its predictor (read_pwave_predictor); `channel` its name.
+void pwave_bindings(std::vector<Binding>& b, monitor::PWaveSettings& p, std::string& channel) {
+  b.push_back({"pwave.channel", string_into(channel), "a string, \"vertical\" or \"horizontal\""});
+  b.push_back({"pwave.predictor", [](const toml::node&) { return true; }, ""});  // read apart
+  const std::pair<const char*, double*> numbers[] = {
+      {"pwave.highpass_hz", &p.highpass_hz},
+      {"pwave.lowpass_hz", &p.lowpass_hz},
+      {"pwave.sta_s", &p.sta_s},
+      {"pwave.lta_s", &p.lta_s},
+      {"pwave.trigger_ratio", &p.trigger_ratio},
+      {"pwave.noise_floor_m_s2", &p.noise_floor_m_s2},
+      {"pwave.min_amplitude_m_s2", &p.min_amplitude_m_s2},
+      {"pwave.confirm_s", &p.confirm_s},
+      {"pwave.min_tau_p_s", &p.min_tau_p_s},
+      {"pwave.max_tau_c_s", &p.max_tau_c_s},
+      {"pwave.min_vertical_ratio", &p.min_vertical_ratio},
+      {"pwave.s_wave_ratio", &p.s_wave_ratio},
+      {"pwave.max_window_s", &p.max_window_s},
+      {"pwave.hold_s", &p.hold_s},
+  };
+  for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
+}
+
 std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
-                              std::array<bool, kRelayCount>& relay_active_low) {
+                              std::array<bool, kRelayCount>& relay_active_low,
+                              monitor::PWaveSettings& pwave, std::string& pwave_channel) {
   MonitorConfig& c = f.config;
   monitor::AlarmPolicySettings& alarm = c.alarm;
   std::vector<Binding> b = {
@@ -255,12 +280,14 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
   b.push_back({"recorder.test_pause_mid_write_s", number_into(f.recorder.test_pause_mid_write_s),
                "a number (s; test only)"});
   output_bindings(b, f.modbus, f.mqtt);
+  pwave_bindings(b, pwave, pwave_channel);
   for (auto [name, thresholds] : {std::pair<const char*, monitor::RiskThresholds*>{"advisory", &alarm.advisory},
                                   {"warning", &alarm.warning},
                                   {"alarm", &alarm.alarm},
                                   {"advisory_forecast", &alarm.advisory_forecast},
                                   {"warning_forecast", &alarm.warning_forecast},
                                   {"alarm_forecast", &alarm.alarm_forecast},
+                                  {"warning_pwave", &alarm.warning_pwave},
                                   {"warning_regional", &alarm.warning_regional}}) {
     b.push_back({cat("alarm_policy.", name, ".on"), number_into(thresholds->on), "a number"});
     b.push_back({cat("alarm_policy.", name, ".off"), number_into(thresholds->off), "a number"});
@@ -478,6 +505,100 @@ void check(const MonitorConfig& config, const KeyLines& lines) {
   lines.fail(at, cat(key, ": ", e.reason));
 }
 
+// [pwave]'s predictor: 1 to kMaxPWavePredictorPoints tables { window_s, ln_pga_over_pa,
+// tau_c_exponent (0 when left out), sigma_ln }, as plinth-eval pwave-fit prints them.
+void read_pwave_predictor(const toml::node& node, monitor::PWaveSettings& pwave,
+                          const KeyLines& lines) {
+  const char* key = "pwave.predictor";
+  const toml::array* points = node.as_array();
+  if (points == nullptr || (!points->empty() && !points->is_array_of_tables())) {
+    lines.fail(key, cat(key, ": expected an array of tables { window_s, ln_pga_over_pa, "
+                             "tau_c_exponent, sigma_ln } (plinth-eval pwave-fit prints one)"));
+  }
+  if (points->empty() || points->size() > monitor::kMaxPWavePredictorPoints) {
+    lines.fail(key, cat(key, ": must have 1 to ",
+                        std::to_string(monitor::kMaxPWavePredictorPoints), " points, has ",
+                        std::to_string(points->size())));
+  }
+  pwave.predictor_points = points->size();
+  for (std::size_t i = 0; i < points->size(); ++i) {
+    monitor::PWavePredictorPoint& point = pwave.predictor[i];
+    point = {};
+    const std::string head = cat(key, "[", std::to_string(i), "]");
+    std::vector<Binding> keys = {
+        {"window_s", number_into(point.window_s), "a number"},
+        {"ln_pga_over_pa", number_into(point.ln_pga_over_pa), "a number"},
+        {"tau_c_exponent", number_into(point.tau_c_exponent), "a number"},
+        {"sigma_ln", number_into(point.sigma_ln), "a number"},
+    };
+    std::vector<std::pair<std::string, const toml::node*>> leaves;
+    flatten(*(*points)[i].as_table(), "", leaves);
+    for (const char* required : {"window_s", "ln_pga_over_pa", "sigma_ln"}) {
+      if (std::none_of(leaves.begin(), leaves.end(),
+                       [&](const auto& leaf) { return leaf.first == required; })) {
+        lines.fail(key, cat(head, ": no ", required));
+      }
+    }
+    for (const auto& [leaf, leaf_node] : leaves) lines.store(keys, leaf, cat(head, ".", leaf), *leaf_node);
+  }
+}
+
+// validate(PWaveSettings) at the estimator's rate, its field named as the file's key (a
+// predictor point's with its index) and its limit given.
+void check_pwave(monitor::PWaveSettings pwave, double sample_period_s, const KeyLines& lines) {
+  pwave.sample_period_s = sample_period_s;
+  const Error e = monitor::validate(pwave);
+  if (e.ok()) return;
+  std::string key = e.field;
+  const std::string point_field = "pwave.predictor.";
+  if (key.rfind(point_field, 0) == 0) {
+    // The first point at fault: the shortest table that fails the same way.
+    std::size_t index = 0;
+    for (monitor::PWaveSettings prefix = pwave; prefix.predictor_points >= 1;) {
+      const std::size_t n = prefix.predictor_points;
+      prefix.predictor_points = n - 1;
+      if (n == 1 || monitor::validate(prefix).ok()) {
+        index = n - 1;
+        break;
+      }
+    }
+    key = cat("pwave.predictor[", std::to_string(index), "].", key.substr(point_field.size()));
+  }
+  std::string message = cat(key, ": ", e.reason);
+  if (e.limit != 0.0 && std::isfinite(e.limit)) {
+    message += cat(" (limit ", host::number_text(e.limit), ")");
+  }
+  lines.fail(lines.has(key) ? key : lines.has(e.field) ? e.field : "pwave", message);
+}
+
+// The [pwave] table: the stage on, its channel (and that channel's fitted table unless it gives
+// a predictor), checked; a build without the stage refuses it.
+void read_pwave(const toml::node& table, monitor::PWaveSettings& pwave, const std::string& channel,
+                MonitorConfig& config, KeyLines& lines) {
+  lines.note("pwave", table.source().begin.line);
+  if (!table.is_table()) lines.fail("pwave", "pwave: expected a table ([pwave])");
+  if (!channel.empty() && !monitor::kPWaveChannelNames.parse(channel, pwave.channel)) {
+    lines.fail("pwave.channel",
+               cat("pwave.channel: expected \"vertical\" or \"horizontal\", got \"", channel, "\""));
+  }
+  if (const toml::node* predictor = table.as_table()->get("predictor")) {
+    read_pwave_predictor(*predictor, pwave, lines);
+  } else if (!channel.empty()) {
+    const auto& fitted = monitor::default_predictor(pwave.channel);
+    std::copy(fitted.begin(), fitted.end(), pwave.predictor.begin());
+    pwave.predictor_points = fitted.size();
+  }
+  pwave.enabled = true;
+  monitor::PWaveSettings* built = monitor::pwave_part<monitor::PWaveSettings>(config.pwave);
+  if (built == nullptr) {
+    lines.fail("pwave", "pwave: this build has no P-wave stage (PLINTH_PWAVE_STAGE=OFF)");
+  }
+  check_pwave(pwave, config.estimator.sample_period(), lines);
+  pwave.fragility_known = built->fragility_known;  // the scene's, set by the application
+  pwave.fragility = built->fragility;
+  *built = pwave;
+}
+
 std::string number_text(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%g", value);
@@ -555,7 +676,13 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   int node = defaults.ground_node;
   std::string unit;
   std::array<bool, kRelayCount> relay_active_low{};  // [0]: relays.active_low
-  std::vector<Binding> known = bindings(file, node, unit, relay_active_low);
+  monitor::PWaveSettings pwave;  // [pwave], over the defaults' when the build has the stage
+  if (const auto* given = monitor::pwave_part<monitor::PWaveSettings>(defaults.pwave)) {
+    pwave = *given;
+  }
+  std::string pwave_channel;
+  std::vector<Binding> known =
+      bindings(file, node, unit, relay_active_low, pwave, pwave_channel);
   const toml::node* sensor_list = doc.get("sensor");
   const bool sensor_tables = sensor_list != nullptr && sensor_list->is_array();
   std::vector<std::pair<std::string, const toml::node*>> leaves;
@@ -592,6 +719,7 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     lines.fail("recorder.test_pause_mid_write_s",
                "recorder.test_pause_mid_write_s: must be a number of seconds in [0, 600]");
   }
+  if (const toml::node* table = doc.get("pwave")) read_pwave(*table, pwave, pwave_channel, file.config, lines);
   check(file.config, lines);
   check_outputs(file, lines, origin);
   return file;

@@ -485,14 +485,18 @@ std::string input_fault(fw::MonitorInput& input, bool estimated) {
   return "";
 }
 
-// The statue's fragility for regional alerts: the scene's [fragility]; with two scenes that
-// both give one, the more fragile (the lower median) of the two.
-void set_fragility(mon::RegionalAlertSettings& regional, const plinth::host::UncertainScene& x,
+// The statue's fragility for regional alerts and the P-wave stage: the scene's [fragility];
+// with two scenes that both give one, the more fragile (the lower median) of the two.
+void set_fragility(fw::MonitorConfig& config, const plinth::host::UncertainScene& x,
                    const std::optional<plinth::host::UncertainScene>& y) {
   std::optional<plinth::LognormalFragility> f = x.fragility;
   if (y && y->fragility && (!f || y->fragility->median_g < f->median_g)) f = y->fragility;
-  regional.fragility_known = f.has_value();
-  if (f) regional.fragility = *f;
+  config.regional.fragility_known = f.has_value();
+  if (f) config.regional.fragility = *f;
+  if (auto* pwave = mon::pwave_part<mon::PWaveSettings>(config.pwave)) {
+    pwave->fragility_known = f.has_value();
+    if (f) pwave->fragility = *f;
+  }
 }
 
 int run(const Options& opt, const CLI::App& app) {
@@ -511,7 +515,7 @@ int run(const Options& opt, const CLI::App& app) {
   }
   fw::MonitorConfig& config = file.config;
   config.axis_count = scene_y ? 2 : 1;
-  set_fragility(config.regional, scene_x, scene_y);
+  set_fragility(config, scene_x, scene_y);
   const std::unique_ptr<fw::MonitorInput> input = fw::open_input(input_settings, config, g_stop);
 
   fw::Monitor monitor;

@@ -231,7 +231,38 @@ std::string status_json(const BoxStatus& s, double t_origin) {
   line.raw("sensors", status_sensors(s));
   line.raw("state", per_axis(s, axis_state));
   if (s.regional.received > 0) line.raw("regional", regional_status_json(s.regional, t_origin));
+  const auto* pwave = monitor::pwave_part<monitor::PWaveStatus>(s.pwave);
+  if (pwave != nullptr && s.has_pwave) {
+    line.raw("pwave", pwave_status_json(*pwave, s.estimator_start_ns, t_origin));
+  }
   return line.close();
+}
+
+std::string pwave_status_json(const monitor::PWaveStatus& p, std::int64_t start_ns,
+                              double t_origin) {
+  JsonObject out;
+  out.text("state", monitor::kPWaveStateNames.name(p.state))
+      .fixed("probability", static_cast<double>(p.probability), 4)
+      .fixed("sta_lta", static_cast<double>(p.sta_lta), 2)
+      .count("candidates", p.candidates)
+      .count("triggers", p.triggers)
+      .raw("rejected", JsonObject()
+                           .count("period_short", p.rejected_short)
+                           .count("period_long", p.rejected_long)
+                           .count("horizontal", p.rejected_horizontal)
+                           .close());
+  if (p.triggers > 0) {  // the latest trigger's window
+    out.fixed("onset_t", seconds(start_ns, t_origin) + static_cast<double>(p.onset_s), 3)
+        .fixed("window_s", static_cast<double>(p.window_s), 3)
+        .text("window_end", monitor::kPWaveWindowEndNames.name(p.window_end))
+        .general("pa_m_s2", static_cast<double>(p.pa_m_s2), 4)
+        .general("pd_m", static_cast<double>(p.pd_m), 4)
+        .fixed("tau_c_s", static_cast<double>(p.tau_c_s), 3)
+        .fixed("tau_p_s", static_cast<double>(p.tau_p_s), 3)
+        .general("predicted_pga_g", static_cast<double>(p.predicted_pga_g), 4)
+        .fixed("sigma_ln", static_cast<double>(p.sigma_ln), 3);
+  }
+  return out.close();
 }
 
 std::string regional_status_json(const monitor::RegionalAlertStatus& r, double t_origin) {

@@ -148,7 +148,8 @@ int run_fit(const FitOptions& opt) {
   for (const host::PWaveFitPoint& p : table) {
     std::printf("        {%.1f, %.3f, %.3f, %.3f},\n", p.window_s, p.c0, p.c1, p.sigma);
   }
-  std::printf("predictor = [\n");
+  std::printf("[pwave]\nchannel = \"%s\"\npredictor = [\n",
+              monitor::kPWaveChannelNames.name(settings.channel));
   for (const host::PWaveFitPoint& p : table) {
     std::printf("  { window_s = %.1f, ln_pga_over_pa = %.3f, tau_c_exponent = %.3f, "
                 "sigma_ln = %.3f },\n",

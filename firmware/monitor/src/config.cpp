@@ -117,6 +117,19 @@ Error validate_sensors(const MonitorConfig& c, int* sensor_index) {
   return ok_error();
 }
 
+// The P-wave stage's settings at the estimator's sample period; refused by a build without it.
+Error validate_pwave(const MonitorConfig& c) {
+  if (!c.pwave.enabled) return ok_error();
+  const monitor::PWaveSettings* configured = monitor::pwave_part<monitor::PWaveSettings>(c.pwave);
+  if (configured == nullptr) {
+    return {ErrorCode::kOutOfRange, "pwave",
+            "this build has no P-wave stage (PLINTH_PWAVE_STAGE=OFF)"};
+  }
+  monitor::PWaveSettings settings = *configured;
+  settings.sample_period_s = c.estimator.sample_period();
+  return monitor::validate(settings);
+}
+
 }  // namespace
 
 Error validate(const MonitorConfig& c, int* sensor_index) {
@@ -136,6 +149,7 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
                             "redundancy.tolerance_m_s2"));
   PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
                             "plate.window_s", "plate.threshold_m_s2"));
+  PLINTH_TRY(validate_pwave(c));
   return validate_sensors(c, sensor_index);
 }
 

@@ -68,6 +68,16 @@ Error Monitor::start(const MonitorConfig& config,
   PLINTH_TRY(sensors_.start(config_, status_));
   PLINTH_TRY(monitor::AlarmPolicy::create(config_.alarm, alarm_));
   PLINTH_TRY(start_room(config_.regional, regional_));
+  if (monitor::PWaveSettings* pwave = monitor::pwave_part<monitor::PWaveSettings>(config_.pwave);
+      pwave != nullptr && pwave->enabled) {
+    pwave->sample_period_s = config.estimator.sample_period();
+    if (!pwave->fragility_known) {
+      return {ErrorCode::kInconsistent, "pwave",
+              "needs the statue's fragility (the scene file's [fragility]: median_g, beta)"};
+    }
+    PLINTH_TRY(monitor::PWaveStage::create(*pwave, pwave_room_[0]));
+  }
+  status_.has_pwave = pwave_present();
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
@@ -141,6 +151,7 @@ void Monitor::push_ensembles(const Vector3r& g) {
   for (int i = 0; i < status_.axis_count; ++i) {
     ensembles_[static_cast<std::size_t>(i)].push({g[i], g.z()});
   }
+  if (pwave_present()) (void)pwave_room_[0].update(g);
 }
 
 void Monitor::feed_estimators() {
@@ -150,6 +161,10 @@ void Monitor::feed_estimators() {
     if (in.start) {
       for (int i = 0; i < status_.axis_count; ++i) {
         ensembles_[static_cast<std::size_t>(i)].restart({g[i], g.z()});
+      }
+      if (pwave_present()) {  // its filters do not connect across the seam either
+        pwave_room_[0].restart();
+        (void)pwave_room_[0].update(g);
       }
       ++status_.estimator_restarts;
       status_.estimator_start_ns = in.time_ns - epoch_ns_;
@@ -217,6 +232,10 @@ void Monitor::evaluate(MonitorUpdate& update) {
   sensors_.update_status();
   update_axes_status();
   tick_room(regional_, status_);
+  if (auto* pwave = monitor::pwave_part<monitor::PWaveStatus>(status_.pwave);
+      pwave != nullptr && pwave_present()) {
+    *pwave = pwave_room_[0].status();
+  }
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;

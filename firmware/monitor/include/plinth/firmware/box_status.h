@@ -13,6 +13,7 @@
 #include "plinth/core/state.h"
 #include "plinth/firmware/config.h"
 #include "plinth/monitor/alarm_level.h"
+#include "plinth/monitor/p_wave.h"
 #include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
@@ -90,6 +91,11 @@ struct BoxStatus : SensorSetStatus {
   // Regional alerts: the worst held, its probability of collapse and time to the S arrival,
   // the counters (times in monitor time).
   monitor::RegionalAlertStatus regional;
+  // The on-site P-wave stage (MonitorConfig::pwave): running, and its status after the newest
+  // sample (its times count from estimator_start_ns: it restarts with the estimators). None in
+  // a build without the stage.
+  bool has_pwave = false;
+  monitor::PWaveStatusField pwave;
 };
 
 }  // namespace plinth::firmware

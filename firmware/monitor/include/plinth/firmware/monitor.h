@@ -23,6 +23,7 @@
 #include "plinth/hal/can_codec.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/conditioning.h"
+#include "plinth/monitor/p_wave.h"
 #include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
@@ -136,6 +137,10 @@ class Monitor {
   // The estimators take the inputs the sensors have for them (SensorSet::next_input).
   void feed_estimators();
   void push_ensembles(const Vector3r& ground_m_s2);
+  // The P-wave stage configured, in a build that has it (monitor::kPWaveStageBuiltIn).
+  [[nodiscard]] bool pwave_present() const {
+    return monitor::kPWaveStageBuiltIn && config_.pwave.enabled;
+  }
   [[nodiscard]] bool quiet() const;
   [[nodiscard]] MonitorUpdate new_update() const;
   void take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update);
@@ -154,6 +159,10 @@ class Monitor {
   std::array<Ensemble, kMaxAxes> ensembles_{};
   monitor::AlarmPolicy alarm_;
   monitor::RegionalAlertRoom regional_;  // nothing in a build without regional alerts
+  // The on-site P-wave stage, fed the samples the estimators take: none in a build without it,
+  // so that neither its code nor its data take a microcontroller's room (pwave_present() guards
+  // every use).
+  std::array<monitor::PWaveStage, monitor::kPWaveStageBuiltIn ? 1 : 0> pwave_room_{};
   BoxStatus status_;
   std::uint64_t frames_not_encoded_ = 0;
   bool have_epoch_ = false;
