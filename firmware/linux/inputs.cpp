@@ -305,7 +305,7 @@ std::unique_ptr<MonitorInput> open_input(const InputOptions& opt, MonitorConfig&
         {opt.replay_path, opt.replay_y_path, opt.vertical_path, opt.pga, opt.scale, opt.rate_hz},
         kStandardGravity);
     configure_record_replay(config, samples.rate_hz);
-    const auto* pwave = monitor::pwave_part<monitor::PWaveSettings>(config.pwave);
+    const auto* pwave = monitor::built_part<monitor::PWaveSettings>(config.pwave);
     if (pwave != nullptr && pwave->enabled && pwave->channel == monitor::PWaveChannel::kVertical &&
         !samples.vertical) {
       // The stage would watch a vertical channel that never moves.

@@ -197,6 +197,19 @@ void output_bindings(std::vector<Binding>& b, ModbusSettings& modbus, MqttSettin
                "a string (topic levels)"});
 }
 
+// The [regional_alert] table's keys (a build without regional alerts has none).
+void regional_bindings(std::vector<Binding>& b, monitor::RegionalAlertSettings& r) {
+  const std::pair<const char*, double*> numbers[] = {
+      {"regional_alert.max_origin_age_s", &r.max_origin_age_s},
+      {"regional_alert.future_tolerance_s", &r.future_tolerance_s},
+      {"regional_alert.expiry_margin_s", &r.expiry_margin_s},
+      {"regional_alert.stress_drop_bar", &r.stress_drop_bar},
+      {"regional_alert.shear_wave_speed_km_s", &r.shear_wave_speed_km_s},
+      {"regional_alert.path_duration_s_per_km", &r.path_duration_s_per_km},
+  };
+  for (const auto& [key, value] : numbers) b.push_back({key, number_into(*value), "a number"});
+}
+
 // The [pwave] table's keys but its predictor (read_pwave_predictor); `channel` its name.
 void pwave_bindings(std::vector<Binding>& b, monitor::PWaveSettings& p, std::string& channel) {
   b.push_back({"pwave.channel", string_into(channel), "a string, \"vertical\" or \"horizontal\""});
@@ -258,16 +271,10 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
       {"alarm_policy.latch_warning", flag_into(alarm.latch_warning), "true or false"},
       {"alarm_policy.latch_alarm", flag_into(alarm.latch_alarm), "true or false"},
       {"alarm_policy.heartbeat_period_s", number_into(alarm.heartbeat_period_s), "a number"},
-      {"regional_alert.max_origin_age_s", number_into(c.regional.max_origin_age_s), "a number"},
-      {"regional_alert.future_tolerance_s", number_into(c.regional.future_tolerance_s),
-       "a number"},
-      {"regional_alert.expiry_margin_s", number_into(c.regional.expiry_margin_s), "a number"},
-      {"regional_alert.stress_drop_bar", number_into(c.regional.stress_drop_bar), "a number"},
-      {"regional_alert.shear_wave_speed_km_s", number_into(c.regional.shear_wave_speed_km_s),
-       "a number"},
-      {"regional_alert.path_duration_s_per_km", number_into(c.regional.path_duration_s_per_km),
-       "a number"},
   };
+  if (auto* regional = monitor::built_part<monitor::RegionalAlertSettings>(c.regional)) {
+    regional_bindings(b, *regional);
+  }
   sensor_bindings(b, "conditioning.", c.conditioning, c.sensor_health, unit);
   relay_bindings(b, f.relays, relay_active_low);
   b.push_back({"watchdog.notify", flag_into(f.watchdog.notify), "true or false"});
@@ -281,14 +288,19 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, std::string& unit,
                "a number (s; test only)"});
   output_bindings(b, f.modbus, f.mqtt);
   pwave_bindings(b, pwave, pwave_channel);
+  using monitor::built_part;
+  using monitor::RiskThresholds;
   for (auto [name, thresholds] : {std::pair<const char*, monitor::RiskThresholds*>{"advisory", &alarm.advisory},
                                   {"warning", &alarm.warning},
                                   {"alarm", &alarm.alarm},
                                   {"advisory_forecast", &alarm.advisory_forecast},
                                   {"warning_forecast", &alarm.warning_forecast},
                                   {"alarm_forecast", &alarm.alarm_forecast},
-                                  {"warning_pwave", &alarm.warning_pwave},
-                                  {"warning_regional", &alarm.warning_regional}}) {
+                                  {"warning_pwave",
+                                   built_part<RiskThresholds>(alarm.warning_pwave)},
+                                  {"warning_regional",
+                                   built_part<RiskThresholds>(alarm.warning_regional)}}) {
+    if (thresholds == nullptr) continue;  // a part this build has not: its keys are unknown
     b.push_back({cat("alarm_policy.", name, ".on"), number_into(thresholds->on), "a number"});
     b.push_back({cat("alarm_policy.", name, ".off"), number_into(thresholds->off), "a number"});
   }
@@ -589,9 +601,10 @@ void read_pwave(const toml::node& table, monitor::PWaveSettings& pwave, const st
     pwave.predictor_points = fitted.size();
   }
   pwave.enabled = true;
-  monitor::PWaveSettings* built = monitor::pwave_part<monitor::PWaveSettings>(config.pwave);
+  monitor::PWaveSettings* built = monitor::built_part<monitor::PWaveSettings>(config.pwave);
   if (built == nullptr) {
     lines.fail("pwave", "pwave: this build has no P-wave stage (PLINTH_PWAVE_STAGE=OFF)");
+    return;
   }
   check_pwave(pwave, config.estimator.sample_period(), lines);
   pwave.fragility_known = built->fragility_known;  // the scene's, set by the application
@@ -677,7 +690,7 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   std::string unit;
   std::array<bool, kRelayCount> relay_active_low{};  // [0]: relays.active_low
   monitor::PWaveSettings pwave;  // [pwave], over the defaults' when the build has the stage
-  if (const auto* given = monitor::pwave_part<monitor::PWaveSettings>(defaults.pwave)) {
+  if (const auto* given = monitor::built_part<monitor::PWaveSettings>(defaults.pwave)) {
     pwave = *given;
   }
   std::string pwave_channel;

@@ -491,12 +491,13 @@ void set_fragility(fw::MonitorConfig& config, const plinth::host::UncertainScene
                    const std::optional<plinth::host::UncertainScene>& y) {
   std::optional<plinth::LognormalFragility> f = x.fragility;
   if (y && y->fragility && (!f || y->fragility->median_g < f->median_g)) f = y->fragility;
-  config.regional.fragility_known = f.has_value();
-  if (f) config.regional.fragility = *f;
-  if (auto* pwave = mon::pwave_part<mon::PWaveSettings>(config.pwave)) {
-    pwave->fragility_known = f.has_value();
-    if (f) pwave->fragility = *f;
-  }
+  const auto give = [&f](auto* part) {  // a part this build has not: nullptr
+    if (part == nullptr) return;
+    part->fragility_known = f.has_value();
+    if (f) part->fragility = *f;
+  };
+  give(mon::built_part<mon::RegionalAlertSettings>(config.regional));
+  give(mon::built_part<mon::PWaveSettings>(config.pwave));
 }
 
 int run(const Options& opt, const CLI::App& app) {

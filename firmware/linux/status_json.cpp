@@ -230,8 +230,11 @@ std::string status_json(const BoxStatus& s, double t_origin) {
   }
   line.raw("sensors", status_sensors(s));
   line.raw("state", per_axis(s, axis_state));
-  if (s.regional.received > 0) line.raw("regional", regional_status_json(s.regional, t_origin));
-  const auto* pwave = monitor::pwave_part<monitor::PWaveStatus>(s.pwave);
+  if (const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(s.regional);
+      regional != nullptr && regional->received > 0) {
+    line.raw("regional", regional_status_json(*regional, t_origin));
+  }
+  const auto* pwave = monitor::built_part<monitor::PWaveStatus>(s.pwave);
   if (pwave != nullptr && s.has_pwave) {
     line.raw("pwave", pwave_status_json(*pwave, s.estimator_start_ns, t_origin));
   }
@@ -305,8 +308,10 @@ std::string regional_json(const monitor::RegionalOutcome& o, const BoxStatus& s)
   } else {
     line.flag("replaced", o.replaced).flag("cancelled", o.cancelled);
   }
-  return line.count("held", static_cast<std::uint64_t>(s.regional.held))
-      .fixed("probability", static_cast<double>(s.regional.probability), 4)
+  const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(s.regional);
+  return line.count("held", regional != nullptr ? static_cast<std::uint64_t>(regional->held) : 0)
+      .fixed("probability", regional != nullptr ? static_cast<double>(regional->probability) : 0.0,
+             4)
       .close();
 }
 

@@ -42,7 +42,9 @@ void copy_status(const BoxStatus& s, double t_origin, StatusSnapshot& snapshot) 
   snapshot.sensors_state = s.sensors_state;
   snapshot.sensor_counters = s.sensor.counters;
   snapshot.estimator_restarts = s.estimator_restarts;
-  const monitor::RegionalAlertStatus& r = s.regional;
+  const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(s.regional);
+  if (regional == nullptr) return;  // a build without regional alerts: none
+  const monitor::RegionalAlertStatus& r = *regional;
   RegionalSnapshot& out = snapshot.regional;
   out.received = r.received;
   out.accepted = r.accepted;

@@ -9,8 +9,10 @@ monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& co
   input.time_ns = status.time_ns;
   input.risk = static_cast<Real>(status.risk);
   input.probability = static_cast<Real>(status.probability);
-  input.regional_probability = status.regional.probability;
-  if (const auto* pwave = monitor::pwave_part<monitor::PWaveStatus>(status.pwave)) {
+  if (const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(status.regional)) {
+    input.regional_probability = regional->probability;
+  }
+  if (const auto* pwave = monitor::built_part<monitor::PWaveStatus>(status.pwave)) {
     input.pwave_probability = status.has_pwave ? pwave->probability : Real(0);
   }
   for (int i = 0; i < status.axis_count; ++i) {

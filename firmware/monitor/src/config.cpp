@@ -117,14 +117,10 @@ Error validate_sensors(const MonitorConfig& c, int* sensor_index) {
   return ok_error();
 }
 
-// The P-wave stage's settings at the estimator's sample period; refused by a build without it.
+// The P-wave stage's settings at the estimator's sample period (a build without it holds none).
 Error validate_pwave(const MonitorConfig& c) {
-  if (!c.pwave.enabled) return ok_error();
-  const monitor::PWaveSettings* configured = monitor::pwave_part<monitor::PWaveSettings>(c.pwave);
-  if (configured == nullptr) {
-    return {ErrorCode::kOutOfRange, "pwave",
-            "this build has no P-wave stage (PLINTH_PWAVE_STAGE=OFF)"};
-  }
+  const monitor::PWaveSettings* configured = monitor::built_part<monitor::PWaveSettings>(c.pwave);
+  if (configured == nullptr || !configured->enabled) return ok_error();
   monitor::PWaveSettings settings = *configured;
   settings.sample_period_s = c.estimator.sample_period();
   return monitor::validate(settings);
@@ -137,7 +133,9 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
   PLINTH_TRY(validate_monitor_fields(c));
   PLINTH_TRY(validate(c.risk));
   PLINTH_TRY(monitor::validate(c.alarm));
-  if constexpr (monitor::kRegionalAlertBuiltIn) PLINTH_TRY(monitor::validate(c.regional));
+  if (const auto* regional = monitor::built_part<monitor::RegionalAlertSettings>(c.regional)) {
+    PLINTH_TRY(monitor::validate(*regional));
+  }
   // The sensor's period is the estimator's sample period: checked with the values start() uses.
   if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz < 100.0 ||
       c.estimator.sample_rate_hz > 1000.0) {

@@ -10,36 +10,6 @@ namespace plinth::firmware {
 // The CAN protocol (hal/can_codec).
 namespace can = hal::can;
 
-namespace {
-
-// The regional alerts' room (monitor::RegionalAlertRoom): the room's own calls, or, in a build
-// without it, nothing held and every alert refused (one of each pair is used).
-[[maybe_unused]] Error start_room(const monitor::RegionalAlertSettings& settings, monitor::RegionalAlertState& room) {
-  return monitor::RegionalAlertState::create(settings, room);
-}
-[[maybe_unused]] Error start_room(const monitor::RegionalAlertSettings&, monitor::NoRegionalAlertState&) {
-  return ok_error();
-}
-[[maybe_unused]] void tick_room(monitor::RegionalAlertState& room, BoxStatus& status) {
-  room.tick(status.time_ns);
-  status.regional = room.status();
-}
-[[maybe_unused]] void tick_room(monitor::NoRegionalAlertState&, BoxStatus&) {}
-[[maybe_unused]] monitor::RegionalOutcome receive_in(monitor::RegionalAlertState& room,
-                                    const monitor::RegionalAlert& alert, std::int64_t now_ns) {
-  return room.receive(alert, now_ns);
-}
-[[maybe_unused]] monitor::RegionalOutcome receive_in(monitor::NoRegionalAlertState&, const monitor::RegionalAlert&,
-                                    std::int64_t) {
-  return {monitor::RegionalRefusal::kMalformed, monitor::kRegionalAlertNotBuilt};
-}
-[[maybe_unused]] void refuse_malformed_in(monitor::RegionalAlertState& room, const char* field) {
-  room.refuse_malformed(field);
-}
-[[maybe_unused]] void refuse_malformed_in(monitor::NoRegionalAlertState&, const char*) {}
-
-}  // namespace
-
 Error Monitor::start(const MonitorConfig& config,
                      const std::array<const Scene*, kMaxAxes>& scenes) {
   std::array<std::span<const Scene>, kMaxAxes> ensembles{};
@@ -67,15 +37,20 @@ Error Monitor::start(const MonitorConfig& config,
   status_.axis_count = config.axis_count;
   PLINTH_TRY(sensors_.start(config_, status_));
   PLINTH_TRY(monitor::AlarmPolicy::create(config_.alarm, alarm_));
-  PLINTH_TRY(start_room(config_.regional, regional_));
-  if (monitor::PWaveSettings* pwave = monitor::pwave_part<monitor::PWaveSettings>(config_.pwave);
+  // The regional alerts' room, its settings and its status: all or none (kRegionalAlertBuiltIn).
+  auto* room = monitor::built_part<monitor::RegionalAlertState>(regional_);
+  if (const auto* regional = monitor::built_part<monitor::RegionalAlertSettings>(config_.regional);
+      room != nullptr && regional != nullptr) {
+    PLINTH_TRY(monitor::RegionalAlertState::create(*regional, *room));
+  }
+  if (monitor::PWaveSettings* pwave = monitor::built_part<monitor::PWaveSettings>(config_.pwave);
       pwave != nullptr && pwave->enabled) {
     pwave->sample_period_s = config.estimator.sample_period();
     if (!pwave->fragility_known) {
       return {ErrorCode::kInconsistent, "pwave",
               "needs the statue's fragility (the scene file's [fragility]: median_g, beta)"};
     }
-    PLINTH_TRY(monitor::PWaveStage::create(*pwave, pwave_room_[0]));
+    PLINTH_TRY(monitor::PWaveStage::create(*pwave, *pwave_stage()));
   }
   status_.has_pwave = pwave_present();
   for (int i = 0; i < config.axis_count; ++i) {
@@ -151,7 +126,7 @@ void Monitor::push_ensembles(const Vector3r& g) {
   for (int i = 0; i < status_.axis_count; ++i) {
     ensembles_[static_cast<std::size_t>(i)].push({g[i], g.z()});
   }
-  if (pwave_present()) (void)pwave_room_[0].update(g);
+  if (monitor::PWaveStage* stage = pwave_stage()) (void)stage->update(g);
 }
 
 void Monitor::feed_estimators() {
@@ -162,9 +137,10 @@ void Monitor::feed_estimators() {
       for (int i = 0; i < status_.axis_count; ++i) {
         ensembles_[static_cast<std::size_t>(i)].restart({g[i], g.z()});
       }
-      if (pwave_present()) {  // its filters do not connect across the seam either
-        pwave_room_[0].restart();
-        (void)pwave_room_[0].update(g);
+      // The P-wave stage's filters do not connect across the seam either.
+      if (monitor::PWaveStage* stage = pwave_stage()) {
+        stage->restart();
+        (void)stage->update(g);
       }
       ++status_.estimator_restarts;
       status_.estimator_start_ns = in.time_ns - epoch_ns_;
@@ -231,10 +207,16 @@ void Monitor::update_axes_status() {
 void Monitor::evaluate(MonitorUpdate& update) {
   sensors_.update_status();
   update_axes_status();
-  tick_room(regional_, status_);
-  if (auto* pwave = monitor::pwave_part<monitor::PWaveStatus>(status_.pwave);
-      pwave != nullptr && pwave_present()) {
-    *pwave = pwave_room_[0].status();
+  auto* room = monitor::built_part<monitor::RegionalAlertState>(regional_);
+  if (auto* shown = monitor::built_part<monitor::RegionalAlertStatus>(status_.regional);
+      room != nullptr && shown != nullptr) {
+    room->tick(status_.time_ns);
+    *shown = room->status();
+  }
+  const monitor::PWaveStage* stage = pwave_stage();
+  if (auto* shown = monitor::built_part<monitor::PWaveStatus>(status_.pwave);
+      stage != nullptr && shown != nullptr) {
+    *shown = stage->status();
   }
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
   input.acknowledged = pending_ack_;
@@ -328,14 +310,19 @@ MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert,
 MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert) {
   MonitorUpdate update = new_update();
   update.regional_received = true;
-  update.regional = receive_in(regional_, alert, status_.time_ns);
+  auto* room = monitor::built_part<monitor::RegionalAlertState>(regional_);
+  update.regional = room != nullptr ? room->receive(alert, status_.time_ns)
+                                    : monitor::RegionalOutcome{monitor::RegionalRefusal::kMalformed,
+                                                               monitor::kRegionalAlertNotBuilt};
   evaluate(update);
   return update;
 }
 
 MonitorUpdate Monitor::regional_alert_malformed(const char* field) {
   MonitorUpdate update = new_update();
-  refuse_malformed_in(regional_, field);
+  if (auto* room = monitor::built_part<monitor::RegionalAlertState>(regional_)) {
+    room->refuse_malformed(field);
+  }
   update.regional_received = true;
   update.regional = {monitor::RegionalRefusal::kMalformed, field};
   evaluate(update);

@@ -26,6 +26,8 @@ Error check_thresholds(const RiskThresholds& t, const char* on_field, const char
   }
   return ok_error();
 }
+// A warning-only input's thresholds in a build without its part: nothing to check.
+[[maybe_unused]] Error check_thresholds(NotBuilt, const char*, const char*) { return ok_error(); }
 
 // A level's thresholds must not lie below those of the level beneath it.
 Error check_order(const RiskThresholds& lower, const RiskThresholds& upper, const char* on_field,
@@ -45,6 +47,8 @@ Error check_order(const RiskThresholds& lower, const RiskThresholds& upper, cons
 bool above(const detail::HeldCondition& held, const RiskThresholds& t, Real value) {
   return value >= (held.active ? t.off : t.on);
 }
+// A warning-only input in a build without its part: never.
+constexpr bool above(const detail::HeldCondition&, NotBuilt, Real) { return false; }
 
 bool valid_fraction(Real v) { return std::isfinite(v) && v >= Real(0) && v <= Real(1); }
 
@@ -67,6 +71,11 @@ void detail::HeldCondition::update(bool wanted, std::int64_t now_ns, std::int64_
 }
 
 Error validate(const AlarmPolicySettings& s) {
+  // The warning-only inputs' thresholds (none to check in a build without their part).
+  PLINTH_TRY(check_thresholds(s.warning_pwave, "alarm_policy.warning_pwave.on",
+                              "alarm_policy.warning_pwave.off"));
+  PLINTH_TRY(check_thresholds(s.warning_regional, "alarm_policy.warning_regional.on",
+                              "alarm_policy.warning_regional.off"));
   return detail::first_error({
       check_thresholds(s.advisory, "alarm_policy.advisory.on", "alarm_policy.advisory.off"),
       check_thresholds(s.warning, "alarm_policy.warning.on", "alarm_policy.warning.off"),
@@ -83,10 +92,6 @@ Error validate(const AlarmPolicySettings& s) {
                   "alarm_policy.warning_forecast.off"),
       check_order(s.warning_forecast, s.alarm_forecast, "alarm_policy.alarm_forecast.on",
                   "alarm_policy.alarm_forecast.off"),
-      check_thresholds(s.warning_pwave, "alarm_policy.warning_pwave.on",
-                       "alarm_policy.warning_pwave.off"),
-      check_thresholds(s.warning_regional, "alarm_policy.warning_regional.on",
-                       "alarm_policy.warning_regional.off"),
       detail::check_duration(s.raise_hold_s, "alarm_policy.raise_hold_s", true),
       detail::check_duration(s.lower_hold_s, "alarm_policy.lower_hold_s", true),
       detail::check_duration(s.heartbeat_period_s, "alarm_policy.heartbeat_period_s", false),
@@ -211,8 +216,9 @@ AlarmCause AlarmPolicy::condition_cause(AlarmLevel level) const {
     return alarm_by_forecast_ ? AlarmCause::kCollapseForecast : AlarmCause::kRiskThreshold;
   }
   if (warning_by_forecast_) return AlarmCause::kCollapseForecast;
-  if (warning_by_pwave_) return AlarmCause::kPWave;
-  return warning_by_regional_ ? AlarmCause::kRegionalAlert : AlarmCause::kRiskThreshold;
+  if (kPWaveStageBuiltIn && warning_by_pwave_) return AlarmCause::kPWave;
+  return kRegionalAlertBuiltIn && warning_by_regional_ ? AlarmCause::kRegionalAlert
+                                                       : AlarmCause::kRiskThreshold;
 }
 
 void AlarmPolicy::emit_if_changed(AlarmOutput& out, std::int64_t time_ns,
@@ -254,9 +260,10 @@ AlarmOutput AlarmPolicy::update(const AlarmInput& in) {
       out.acknowledgement = acknowledge(in.acknowledgement);
       emit_if_changed(out, in.time_ns, true);
     }
-    const bool risk_valid = valid_fraction(in.risk) && valid_fraction(in.probability) &&
-                            valid_fraction(in.pwave_probability) &&
-                            valid_fraction(in.regional_probability);
+    const bool risk_valid =
+        valid_fraction(in.risk) && valid_fraction(in.probability) &&
+        (!kPWaveStageBuiltIn || valid_fraction(in.pwave_probability)) &&
+        (!kRegionalAlertBuiltIn || valid_fraction(in.regional_probability));
     if (!risk_valid) out.input_problem = InputProblem::kRiskInvalid;
     evaluate_conditions(in, risk_valid);
     emit_if_changed(out, in.time_ns, false);

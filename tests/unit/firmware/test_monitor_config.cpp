@@ -63,7 +63,7 @@ TEST(MonitorConfigFile, ThePWaveTable) {
     return;
   }
   const auto pwave = [](const MonitorFile& f) {
-    return *monitor::pwave_part<monitor::PWaveSettings>(f.config.pwave);
+    return *monitor::built_part<monitor::PWaveSettings>(f.config.pwave);
   };
   EXPECT_FALSE(load_monitor_text("", "/etc/plinth/box.toml", MonitorConfig{}).config.pwave.enabled);
   const MonitorFile empty = load_monitor_text("[pwave]\n", "/etc/plinth/box.toml", MonitorConfig{});

@@ -30,7 +30,7 @@ fw::MonitorConfig pwave_config(bool stage) {
   config.estimator.sample_rate_hz = kRateHz;
   config.conditioning.startup_window_s = 1.0;
   config.sensor_health.stuck_samples = 0;  // the quiet lead-in repeats itself
-  if (auto* p = monitor::pwave_part<monitor::PWaveSettings>(config.pwave); p != nullptr && stage) {
+  if (auto* p = monitor::built_part<monitor::PWaveSettings>(config.pwave); p != nullptr && stage) {
     p->enabled = true;
     p->fragility_known = true;
     p->fragility = {0.6, 0.3};  // median 0.6 g, beta 0.3
@@ -89,7 +89,7 @@ Shown run(const fw::MonitorConfig& config, const std::vector<Eigen::Vector3d>& m
     if (monitor.status().axes[0].mode.terminal()) break;
   }
   EXPECT_EQ(monitor.status().has_pwave, config.pwave.enabled);
-  if (const auto* p = monitor::pwave_part<monitor::PWaveStatus>(monitor.status().pwave)) {
+  if (const auto* p = monitor::built_part<monitor::PWaveStatus>(monitor.status().pwave)) {
     out.pwave = *p;
   }
   return out;
@@ -181,7 +181,7 @@ TEST(MonitorPWave, NuisanceSignalsDoNotTriggerThroughTheBox) {
 TEST(MonitorPWave, RefusesTheStageWithoutAFragility) {
   if (!monitor::kPWaveStageBuiltIn) GTEST_SKIP() << "PLINTH_PWAVE_STAGE=OFF";
   fw::MonitorConfig config = pwave_config(true);
-  monitor::pwave_part<monitor::PWaveSettings>(config.pwave)->fragility_known = false;
+  monitor::built_part<monitor::PWaveSettings>(config.pwave)->fragility_known = false;
   const Scene scene = testing::make(testing::paper_isolated(0.0));
   fw::Monitor monitor;
   const Error e = monitor.start(config, {&scene, nullptr});
@@ -189,7 +189,7 @@ TEST(MonitorPWave, RefusesTheStageWithoutAFragility) {
   EXPECT_STREQ(e.field, "pwave");
   // A bad setting is named by its key.
   config = pwave_config(true);
-  monitor::pwave_part<monitor::PWaveSettings>(config.pwave)->lowpass_hz = 150.0;  // > 100 Hz
+  monitor::built_part<monitor::PWaveSettings>(config.pwave)->lowpass_hz = 150.0;  // > 100 Hz
   EXPECT_STREQ(fw::validate(config).field, "pwave.lowpass_hz");
 }
 

@@ -90,12 +90,13 @@ struct BoxStatus : SensorSetStatus {
   std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
   // Regional alerts: the worst held, its probability of collapse and time to the S arrival,
   // the counters (times in monitor time).
-  monitor::RegionalAlertStatus regional;
+  // (Nothing in a build without regional alerts.)
+  [[no_unique_address]] monitor::RegionalAlertStatusField regional;
   // The on-site P-wave stage (MonitorConfig::pwave): running, and its status after the newest
   // sample (its times count from estimator_start_ns: it restarts with the estimators). None in
   // a build without the stage.
   bool has_pwave = false;
-  monitor::PWaveStatusField pwave;
+  [[no_unique_address]] monitor::PWaveStatusField pwave;
 };
 
 }  // namespace plinth::firmware

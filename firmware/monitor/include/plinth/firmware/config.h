@@ -106,12 +106,13 @@ struct MonitorConfig {
   PlateCheckSettings plate;
   // Regional early-warning alerts (regional_alert.h): their checks and expiry, and the statue's
   // fragility (plinth-monitor takes it from the scene file's [fragility]).
-  monitor::RegionalAlertSettings regional;
+  // (Nothing in a build without regional alerts.)
+  [[no_unique_address]] monitor::RegionalAlertConfig regional;
   // The on-site P-wave stage (p_wave.h, docs/pwave.md): runs when enabled (the box file's
   // [pwave] table), on the primary's conditioned samples; its sample period is the estimator's,
   // its fragility the statue's (plinth-monitor: the scene file's [fragility], which it needs).
   // A build without the stage (PLINTH_PWAVE_STAGE=OFF) holds only `enabled`, and refuses it.
-  monitor::PWaveConfig pwave = monitor::pwave_off();
+  [[no_unique_address]] monitor::PWaveConfig pwave = monitor::pwave_off();
 };
 
 // Checks every part; the Error names the field ("monitor.axis_count", "estimator....", ...).

@@ -139,7 +139,12 @@ class Monitor {
   void push_ensembles(const Vector3r& ground_m_s2);
   // The P-wave stage configured, in a build that has it (monitor::kPWaveStageBuiltIn).
   [[nodiscard]] bool pwave_present() const {
-    return monitor::kPWaveStageBuiltIn && config_.pwave.enabled;
+    const auto* pwave = monitor::built_part<monitor::PWaveSettings>(config_.pwave);
+    return pwave != nullptr && pwave->enabled;
+  }
+  // The stage when configured (pwave_present()); nullptr otherwise.
+  [[nodiscard]] monitor::PWaveStage* pwave_stage() {
+    return pwave_present() ? monitor::built_part<monitor::PWaveStage>(pwave_) : nullptr;
   }
   [[nodiscard]] bool quiet() const;
   [[nodiscard]] MonitorUpdate new_update() const;
@@ -158,11 +163,12 @@ class Monitor {
   Vector3r last_ground_ = Vector3r::Zero();  // the estimators' newest input, m/s2
   std::array<Ensemble, kMaxAxes> ensembles_{};
   monitor::AlarmPolicy alarm_;
-  monitor::RegionalAlertRoom regional_;  // nothing in a build without regional alerts
+  // The regional alerts' room: nothing in a build without regional alerts.
+  [[no_unique_address]] monitor::RegionalAlertRoom regional_;
   // The on-site P-wave stage, fed the samples the estimators take: none in a build without it,
-  // so that neither its code nor its data take a microcontroller's room (pwave_present() guards
-  // every use).
-  std::array<monitor::PWaveStage, monitor::kPWaveStageBuiltIn ? 1 : 0> pwave_room_{};
+  // so that neither its code nor its data take a microcontroller's room (pwave_stage()).
+  [[no_unique_address]] monitor::OptionalPart<monitor::PWaveStage, monitor::kPWaveStageBuiltIn>
+      pwave_{};
   BoxStatus status_;
   std::uint64_t frames_not_encoded_ = 0;
   bool have_epoch_ = false;

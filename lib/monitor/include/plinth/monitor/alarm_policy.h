@@ -13,6 +13,7 @@
 #include "plinth/core/name_table.h"
 #include "plinth/core/real.h"
 #include "plinth/monitor/alarm_level.h"
+#include "plinth/monitor/optional_part.h"
 
 namespace plinth::monitor {
 
@@ -37,10 +38,14 @@ struct AlarmPolicySettings {
   // On the P-wave stage's probability of collapse (warning only). Calibrated with plinth-eval on
   // the bundled three-component records (docs/pwave.md): the longest median lead where the P
   // wave comes 3 s early, within 5 points more unneeded warnings than the box without it.
-  RiskThresholds warning_pwave{Real(0.8), Real(0.6)};
+  // None in a build without the stage (kPWaveStageBuiltIn).
+  [[no_unique_address]] OptionalPart<RiskThresholds, kPWaveStageBuiltIn> warning_pwave =
+      part_if<kPWaveStageBuiltIn>(RiskThresholds{Real(0.8), Real(0.6)});
   // On the probability of collapse under the worst held regional alert (regional_alert.h;
-  // warning only): a guess about the coming ground motion, not the statue's physics.
-  RiskThresholds warning_regional{Real(0.5), Real(0.4)};
+  // warning only): a guess about the coming ground motion, not the statue's physics. None in a
+  // build without regional alerts (kRegionalAlertBuiltIn).
+  [[no_unique_address]] OptionalPart<RiskThresholds, kRegionalAlertBuiltIn> warning_regional =
+      part_if<kRegionalAlertBuiltIn>(RiskThresholds{Real(0.5), Real(0.4)});
   // s, >= 0: a condition holds this long before its level rises. 0: the sample it starts (a
   // margin run out is news at once), so plinth-eval's rules are exactly what the box applies;
   // 0.1 s missed a collapse they caught and cost 0.1-0.2 s of lead (docs/forecast.md).
@@ -69,6 +74,7 @@ struct AlarmInput {
   Real probability = 0.0;            // forecast probability of a collapse, [0, 1]
   Real pwave_probability = 0.0;      // the P-wave stage's probability of collapse, [0, 1]
   Real regional_probability = 0.0;   // under the worst held regional alert, [0, 1]
+  // (Both read only in a build with their part: kPWaveStageBuiltIn, kRegionalAlertBuiltIn.)
   bool out_of_full_contact = false;  // the block slides or rocks (motion started)
   bool collapse_detected = false;    // the block overturned or fell
   bool fault_active = false;         // sensor or bus trouble

@@ -61,22 +61,14 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <type_traits>
 
 #include "plinth/core/error.h"
 #include "plinth/core/fragility.h"
 #include "plinth/core/name_table.h"
 #include "plinth/core/real.h"
-
-#ifndef PLINTH_PWAVE_STAGE
-#define PLINTH_PWAVE_STAGE 1
-#endif
+#include "plinth/monitor/optional_part.h"  // kPWaveStageBuiltIn
 
 namespace plinth::monitor {
-
-// The monitor runs the stage (CMake option PLINTH_PWAVE_STAGE): off in a microcontroller build
-// whose flash it does not fit (docs/microcontroller.md); such a build refuses a [pwave] table.
-inline constexpr bool kPWaveStageBuiltIn = PLINTH_PWAVE_STAGE != 0;
 
 enum class PWaveChannel : std::uint8_t { kVertical = 0, kHorizontal = 1 };
 
@@ -320,31 +312,16 @@ class PWaveStage {
   std::uint64_t refused_ = 0;
 };
 
-// What a build without the stage (kPWaveStageBuiltIn false) keeps: whether a [pwave] table was
-// given (it refuses one), and no status. The monitor's configuration and status hold these.
-struct NoPWaveSettings {
-  bool enabled = false;
-};
-struct NoPWaveStatus {};
-using PWaveConfig = std::conditional_t<kPWaveStageBuiltIn, PWaveSettings, NoPWaveSettings>;
-using PWaveStatusField = std::conditional_t<kPWaveStageBuiltIn, PWaveStatus, NoPWaveStatus>;
+// The stage's settings and status as the monitor's configuration and status hold them: nothing
+// in a build without the stage (kPWaveStageBuiltIn false; the box file's reader refuses a
+// [pwave] table there).
+using PWaveConfig = OptionalPart<PWaveSettings, kPWaveStageBuiltIn>;
+using PWaveStatusField = OptionalPart<PWaveStatus, kPWaveStageBuiltIn>;
 // The stage's default settings, off (a box without a [pwave] table).
 [[nodiscard]] constexpr PWaveConfig pwave_off() {
-  PWaveConfig config;
-  config.enabled = false;
-  return config;
-}
-
-// `held` as the stage's `Part` (PWaveSettings, PWaveStatus) in a build that has the stage;
-// nullptr in one that has not, so that every use of it vanishes there.
-template <class Part, class Held>
-[[nodiscard]] constexpr auto* pwave_part(Held& held) {
-  using Out = std::conditional_t<std::is_const_v<Held>, const Part, Part>;
-  if constexpr (std::is_same_v<std::remove_const_t<Held>, Part>) {
-    return &held;
-  } else {
-    return static_cast<Out*>(nullptr);
-  }
+  PWaveSettings off;
+  off.enabled = false;
+  return part_if<kPWaveStageBuiltIn>(off);
 }
 
 }  // namespace plinth::monitor

@@ -12,24 +12,15 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <type_traits>
 
 #include "plinth/core/error.h"
 #include "plinth/core/fragility.h"
 #include "plinth/core/name_table.h"
 #include "plinth/core/real.h"
-
-#ifndef PLINTH_REGIONAL_ALERT
-#define PLINTH_REGIONAL_ALERT 1
-#endif
+#include "plinth/monitor/optional_part.h"  // kRegionalAlertBuiltIn
 
 namespace plinth::monitor {
 
-// Whether this build has the room (CMake option PLINTH_REGIONAL_ALERT; OFF in the cortex-m4f
-// presets, whose 64 KiB of flash it outgrows). A build without ignores the alert frames like
-// identifiers it does not know, refuses every other alert, and refuses a box file that configures
-// regional alerts.
-inline constexpr bool kRegionalAlertBuiltIn = PLINTH_REGIONAL_ALERT != 0;
 // The message of a build without.
 inline constexpr const char* kRegionalAlertNotBuilt =
     "this build has no regional alerts (PLINTH_REGIONAL_ALERT=OFF)";
@@ -196,8 +187,9 @@ class RegionalAlertState {
 };
 
 // What a Monitor holds for the room: the room, or nothing in a build without it.
-struct NoRegionalAlertState {};
-using RegionalAlertRoom =
-    std::conditional_t<kRegionalAlertBuiltIn, RegionalAlertState, NoRegionalAlertState>;
+using RegionalAlertRoom = OptionalPart<RegionalAlertState, kRegionalAlertBuiltIn>;
+// The room's settings (MonitorConfig) and status (BoxStatus): nothing in a build without.
+using RegionalAlertConfig = OptionalPart<RegionalAlertSettings, kRegionalAlertBuiltIn>;
+using RegionalAlertStatusField = OptionalPart<RegionalAlertStatus, kRegionalAlertBuiltIn>;
 
 }  // namespace plinth::monitor
