@@ -15,6 +15,8 @@
 #include "plinth/core/statue_filter.h"
 #include "plinth/firmware/config.h"
 #include "plinth/monitor/alarm_level.h"
+#include "plinth/monitor/p_wave.h"
+#include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
@@ -124,6 +126,15 @@ struct BoxStatus : SensorSetStatus {
   bool has_statue_sensor = false;
   [[no_unique_address]] StatueSensorStatusField statue_sensor;
   bool statue_unexplained = false;
+  // Regional alerts: the worst held, its probability of collapse and time to the S arrival,
+  // the counters (times in monitor time).
+  // (Nothing in a build without regional alerts.)
+  [[no_unique_address]] monitor::RegionalAlertStatusField regional;
+  // The on-site P-wave stage (MonitorConfig::pwave): running, and its status after the newest
+  // sample (its times count from estimator_start_ns: it restarts with the estimators). None in
+  // a build without the stage.
+  bool has_pwave = false;
+  [[no_unique_address]] monitor::PWaveStatusField pwave;
 };
 
 }  // namespace plinth::firmware
