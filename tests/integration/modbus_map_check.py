@@ -173,7 +173,7 @@ def main():
         elif name == "alarm_events":
             expected = len(alarms)
         elif name == "map_version":
-            expected = 5
+            expected = 6  # map 6: regional 86-101 and statue 102-108
         elif name == "forecast_axis":  # one axis: x once a forecast ran
             expected = 0 if status["collapse_forecast_t"] is not None else value
         elif name == "forecast_worst_member":  # one member: member 0 is the first to collapse
