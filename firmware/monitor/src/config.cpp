@@ -126,7 +126,8 @@ Error validate_statue_sensor(const MonitorConfig& c) {
     return {ErrorCode::kOutOfRange, "statue_sensor",
             "this build has no statue sensor (PLINTH_STATUE_SENSOR=OFF)"};
   } else {
-    const StatueSensorSettings& statue = *statue_settings(c.statue_sensor);
+    const StatueSensorSettings& statue =
+        *monitor::built_part<StatueSensorSettings>(c.statue_sensor);
     PLINTH_TRY(validate(statue, c.estimator.sample_period()));
     std::array<SensorConfig, kMaxSensors> sensors{};
     const int count = resolved_sensors(c, sensors);

@@ -13,7 +13,8 @@ void FrameDecoder::start(const MonitorConfig& config) {
   for (int i = 0; i < count_; ++i) {
     nodes_[static_cast<std::size_t>(i)] = sensors[static_cast<std::size_t>(i)].node;
   }
-  const StatueSensorSettings* statue = statue_settings(config.statue_sensor);
+  const StatueSensorSettings* statue =
+      monitor::built_part<StatueSensorSettings>(config.statue_sensor);
   statue_node_ = statue != nullptr && statue->present ? statue->node : -1;
   counters_ = FrameCounters{};
   have_origin_ = false;

@@ -56,7 +56,8 @@ Error Monitor::start(const MonitorConfig& config,
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
-  const StatueSensorSettings* statue = statue_settings(config.statue_sensor);
+  const StatueSensorSettings* statue =
+      monitor::built_part<StatueSensorSettings>(config.statue_sensor);
   status_.has_statue_sensor = statue != nullptr && statue->present;
   if (status_.has_statue_sensor) {
     PLINTH_TRY(room().sensor.start(*statue, config.estimator.sample_period()));
@@ -210,7 +211,7 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   axis.state = statues.nominal().state();
   statues.risk(axis);
   axis.forecast = statues.forecaster().latest();
-  StatueAxisStatus* statue = statue_part<StatueAxisStatus>(axis.statue);
+  StatueAxisStatus* statue = monitor::built_part<StatueAxisStatus>(axis.statue);
   if (statue == nullptr || !statue_present()) return;
   *statue = StatueAxisStatus{};
   if (!room().measured[k]) return;
@@ -236,7 +237,7 @@ void Monitor::update_axes_status() {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
     if (status_.estimating) update_axis(i, axis);
-    if (const StatueAxisStatus* statue = statue_part<StatueAxisStatus>(axis.statue);
+    if (const StatueAxisStatus* statue = monitor::built_part<StatueAxisStatus>(axis.statue);
         statue != nullptr && statue_present()) {
       status_.statue_unexplained = status_.statue_unexplained || statue->unexplained;
     }
@@ -338,7 +339,7 @@ void Monitor::report(MonitorUpdate& update) {
 }
 
 void Monitor::note_statue_health() {
-  if (StatueSensorStatus* s = statue_part<StatueSensorStatus>(status_.statue_sensor)) {
+  if (StatueSensorStatus* s = monitor::built_part<StatueSensorStatus>(status_.statue_sensor)) {
     *s = {room().sensor.rate_health(), room().sensor.acceleration_health(), room().sensor.ready()};
   }
 }

@@ -106,7 +106,7 @@ struct MonitorConfig {
   RedundancySettings redundancy;
   PlateCheckSettings plate;
   // The IMU on the statue (statue_sensor.h): absent unless `present`; a build without the
-  // statue sensor holds `present` alone (statue_settings() gives the rest when built).
+  // statue sensor holds `present` alone (built_part<StatueSensorSettings> gives the rest).
   StatueSensorConfig statue_sensor;
   // Regional early-warning alerts (regional_alert.h): their checks and expiry, and the statue's
   // fragility (plinth-monitor takes it from the scene file's [fragility]).
