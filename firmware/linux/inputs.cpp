@@ -305,6 +305,14 @@ std::unique_ptr<MonitorInput> open_input(const InputOptions& opt, MonitorConfig&
         {opt.replay_path, opt.replay_y_path, opt.vertical_path, opt.pga, opt.scale, opt.rate_hz},
         kStandardGravity);
     configure_record_replay(config, samples.rate_hz);
+    const auto* pwave = monitor::built_part<monitor::PWaveSettings>(config.pwave);
+    if (pwave != nullptr && pwave->enabled && pwave->channel == monitor::PWaveChannel::kVertical &&
+        !samples.vertical) {
+      // The stage would watch a vertical channel that never moves.
+      throw InputError(opt.replay_path +
+                       ": no vertical record for the P-wave stage's vertical channel: give "
+                       "--vertical V.AT2, or pwave.channel = \"horizontal\" in the box file");
+    }
     return std::make_unique<RecordInput>(opt.replay_path, std::move(samples), config, opt.speed,
                                          opt.recorder_frames, stop);
   }

@@ -87,7 +87,7 @@ constexpr std::array<Point, kPointCount> kPoints = {{
     word(reg::kCommands, "commands", "",
          "operator commands carried out (acknowledge and reset), modulo 65536"),
     word(reg::kAlarmEvents, "alarm_events", "", "alarm events so far, modulo 65536"),
-    word(reg::kMapVersion, "map_version", "", "the version of this map: 5"),
+    word(reg::kMapVersion, "map_version", "", "the version of this map: 6"),
     scaled(reg::kProbability, "probability", "0.0001", "", false, "status.probability",
            "the forecast's probability of a collapse within its horizon, 0 .. 1"),
     word(reg::kForecastAxis, "forecast_axis", "",
@@ -122,6 +122,33 @@ constexpr std::array<Point, kPointCount> kPoints = {{
     file_digest(reg::kConfigSha256, "config_sha256", "first_status.config_sha256",
                 "the box's configuration file's SHA-256 (--config), its leading 64 bits, high "
                 "word first; 65535 in each register without one"),
+    word(reg::kRegionalHeld, "regional_held", "status.regional.held",
+         "regional alerts held (docs/regional.md)"),
+    scaled(reg::kRegionalProbability, "regional_probability", "0.0001", "", false,
+           "status.regional.probability",
+           "the statue's probability of collapse under the worst held regional alert, 0 .. 1"),
+    scaled(reg::kRegionalSArrivalIn, "regional_s_arrival_in", "0.1", "s", true,
+           "status.regional.time_to_s_arrival_s",
+           "time to that alert's expected S arrival, 0 once due; 65535: none held"),
+    scaled(reg::kRegionalPga, "regional_pga", "0.001", "g", true, "status.regional.pga_g",
+           "that alert's expected PGA at the site (median); 65535: none held"),
+    scaled(reg::kRegionalMagnitude, "regional_magnitude", "0.01", "", true,
+           "status.regional.magnitude", "that alert's magnitude; 65535: none held"),
+    scaled(reg::kRegionalDistance, "regional_distance", "1", "km", true,
+           "status.regional.distance_km", "that alert's epicentral distance; 65535: none held"),
+    {Table::kRegister, reg::kRegionalEventId, 2, Type::kUint32, "regional_event_id", "1", "",
+     false, Codes::kPlain, -1, "status.regional.event_id",
+     "that alert's event id (the bridge's number); 0 when none is held"},
+    word(reg::kRegionalVersion, "regional_version", "status.regional.version",
+         "that alert's version; 65535: none held", Codes::kPlain, true),
+    counter(reg::kRegionalReceived, "regional_received", "status.regional.received",
+            "regional alerts received (accepted or refused)"),
+    counter(reg::kRegionalAccepted, "regional_accepted", "status.regional.accepted",
+            "regional alerts accepted"),
+    counter(reg::kRegionalRefused, "regional_refused", "",
+            "regional alerts refused, every reason (status.regional.refused)"),
+    word(reg::kRegionalLastRefusal, "regional_last_refusal", "status.regional.last_refusal",
+         "why the latest refused regional alert was refused", Codes::kRegionalRefusal),
     word(reg::kStatueRateHealth, "statue_rate_health", "status.statue_sensor.rate.health",
          "health of the statue sensor's gyroscope; 65535: no statue sensor", Codes::kHealthState,
          true),
@@ -157,14 +184,12 @@ constexpr std::array<Point, kPointCount> kPoints = {{
                "write 1: the monitor starts again as at power-up; needs modbus.writes"),
 }};
 
-// The registers follow each other without gaps up to reg::kCount but the reserved ones, the
-// discrete inputs are the level codes 0 .. discrete::kCount - 1.
+// The registers follow each other without gaps up to reg::kCount, the discrete inputs are the level codes 0 .. discrete::kCount - 1.
 constexpr bool contiguous() {
   int next = 0;
   int bits = 0;
   for (const Point& p : kPoints) {
     if (p.table == Table::kRegister) {
-      if (next == reg::kRegionalReserved) next += reg::kRegionalReservedWords;
       if (p.address != next) return false;
       next += p.words;
     } else if (p.table == Table::kDiscreteInput) {
@@ -174,7 +199,7 @@ constexpr bool contiguous() {
   return next == reg::kCount && bits == discrete::kCount;
 }
 static_assert(contiguous());
-static_assert(kMapVersion == 5, "the map_version row says 5");
+static_assert(kMapVersion == 6, "the map_version row says 6");
 
 void put16(std::uint16_t* r, int address, std::uint64_t value) {
   r[address] = static_cast<std::uint16_t>(value & 0xFFFFU);
@@ -253,6 +278,8 @@ std::string codes_text(const Point& p) {
       return "0=x;1=y";
     case Codes::kStatueWeights:
       return "0=not_measured;1=uninformative;2=weighted;3=unexplained";
+    case Codes::kRegionalRefusal:
+      return codes_text(kRegionalRefusalCodes, monitor::kRegionalRefusalNames);
   }
   return "";
 }
@@ -333,7 +360,24 @@ void fill(const StatusSnapshot& s, std::uint64_t alarm_events, Image& out) {
                              : static_cast<std::uint16_t>(std::clamp(collapse_in_ms, 0.0,
                                                                      kNone - 1.0)));
   put16(r, reg::kForecastWorstMember, index_or_none(s.forecast_worst_member));
-  for (int i = 0; i < reg::kRegionalReservedWords; ++i) put16(r, reg::kRegionalReserved + i, kNone);
+  const RegionalSnapshot& g = s.regional;
+  const bool held = g.held > 0;
+  const auto scaled_or_none = [held](double value, double unit) {
+    return held ? static_cast<std::uint16_t>(std::clamp(std::round(value / unit), 0.0, kNone - 1.0))
+                : kNone;
+  };
+  put16(r, reg::kRegionalHeld, static_cast<std::uint64_t>(g.held));
+  put16(r, reg::kRegionalProbability, fraction(g.probability));
+  put16(r, reg::kRegionalSArrivalIn, scaled_or_none(g.time_to_s_arrival_s, 0.1));
+  put16(r, reg::kRegionalPga, scaled_or_none(g.pga_g, 0.001));
+  put16(r, reg::kRegionalMagnitude, scaled_or_none(g.magnitude, 0.01));
+  put16(r, reg::kRegionalDistance, scaled_or_none(g.distance_km, 1.0));
+  put32(r, reg::kRegionalEventId, held ? g.event_id : 0);
+  put16(r, reg::kRegionalVersion, held ? g.version : kNone);
+  put32(r, reg::kRegionalReceived, g.received);
+  put32(r, reg::kRegionalAccepted, g.accepted);
+  put32(r, reg::kRegionalRefused, g.refused);
+  put16(r, reg::kRegionalLastRefusal, kRegionalRefusalCodes.code(g.last_refusal));
   const bool statue = s.has_statue_sensor;
   put16(r, reg::kStatueRateHealth, statue ? kHealthStateCodes.code(s.statue_rate) : kNone);
   put16(r, reg::kStatueAccelerationHealth,

@@ -15,6 +15,7 @@
 #include "plinth/core/state.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
+#include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 #include "run_identity.h"
 #include "status_outputs.h"
@@ -22,10 +23,13 @@
 namespace plinth::firmware::modbus {
 
 inline constexpr std::uint16_t kNone = 0xFFFF;  // a register with no value (yet)
-inline constexpr std::uint16_t kMapVersion = 5;  // register 31; 2: holding registers, discrete
+inline constexpr std::uint16_t kMapVersion = 6;  // register 31; 2: holding registers, discrete
                                                  // inputs, causes 10-11, forecast, version;
-                                                 // 3: the files' digests; 4: issue 26's regional
-                                                 // alert (86-101); 5: the statue sensor
+                                                 // 3: the files' digests; 4 (issue 26's branch):
+                                                 // regional alerts (86-101), cause 15; 5: two
+                                                 // maps, cause 13 on issue 26's branch, the
+                                                 // statue sensor (102-108, cause 14; 86-101
+                                                 // reserved) on main; 6: both, no gap
 
 template <class Enum>
 struct Code {
@@ -53,7 +57,7 @@ inline constexpr CodeTable<monitor::AlarmLevel, 5> kAlarmLevelCodes{{{
     {monitor::AlarmLevel::kAlarm, 3},
     {monitor::AlarmLevel::kFault, 4},
 }}};
-inline constexpr CodeTable<monitor::AlarmCause, 14> kAlarmCauseCodes{{{
+inline constexpr CodeTable<monitor::AlarmCause, 16> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kNone, 0},
     {monitor::AlarmCause::kRiskThreshold, 1},
     {monitor::AlarmCause::kPhaseChange, 2},
@@ -67,7 +71,9 @@ inline constexpr CodeTable<monitor::AlarmCause, 14> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kCollapseForecast, 10},
     {monitor::AlarmCause::kNotCalibrated, 11},
     {monitor::AlarmCause::kOutsideModel, 12},
+    {monitor::AlarmCause::kPWave, 13},
     {monitor::AlarmCause::kStatueUnexplained, 14},
+    {monitor::AlarmCause::kRegionalAlert, 15},
 }}};
 inline constexpr CodeTable<Phase, 7> kPhaseCodes{{{
     {Phase::kFullContact, 0},
@@ -92,6 +98,20 @@ inline constexpr CodeTable<monitor::AckOutcome, 6> kAckOutcomeCodes{{{
     {monitor::AckOutcome::kNothingLatched, 5},
 }}};
 
+inline constexpr CodeTable<monitor::RegionalRefusal, monitor::kRegionalRefusalCount>
+    kRegionalRefusalCodes{{{
+        {monitor::RegionalRefusal::kNone, 0},
+        {monitor::RegionalRefusal::kMalformed, 1},
+        {monitor::RegionalRefusal::kNotFinite, 2},
+        {monitor::RegionalRefusal::kOutOfRange, 3},
+        {monitor::RegionalRefusal::kInconsistent, 4},
+        {monitor::RegionalRefusal::kFutureDated, 5},
+        {monitor::RegionalRefusal::kStale, 6},
+        {monitor::RegionalRefusal::kDuplicate, 7},
+        {monitor::RegionalRefusal::kOutOfOrder, 8},
+        {monitor::RegionalRefusal::kNoRoom, 9},
+    }}};
+
 // Every value the domain names has exactly one code, and no two values share one.
 template <class Enum, std::size_t N, std::size_t M>
 [[nodiscard]] constexpr bool pins_every_value(const CodeTable<Enum, N>& table,
@@ -114,6 +134,7 @@ static_assert(pins_every_value(kAlarmCauseCodes, monitor::kAlarmCauseNames));
 static_assert(pins_every_value(kPhaseCodes, kPhaseNames));
 static_assert(pins_every_value(kHealthStateCodes, monitor::kHealthStateNames));
 static_assert(pins_every_value(kAckOutcomeCodes, monitor::kAckOutcomeNames));
+static_assert(pins_every_value(kRegionalRefusalCodes, monitor::kRegionalRefusalNames));
 
 // Registers (functions 03 and 04 read the same values), 0-based addresses. 32-bit values: two
 // registers, the high word first; 64-bit values: four, the highest word first; text: two ASCII
@@ -161,9 +182,19 @@ inline constexpr int kSceneYSha256 = 77;
 inline constexpr int kConfigGiven = 81;
 inline constexpr int kConfigSha256 = 82;
 inline constexpr int kDigestWords = 4;
-// Reserved for the regional alert (issue 26, map 4): no point of this map; they read kNone.
-inline constexpr int kRegionalReserved = 86;
-inline constexpr int kRegionalReservedWords = 16;  // 86-101
+// Regional alerts (docs/regional.md): the worst held alert and the counters.
+inline constexpr int kRegionalHeld = 86;         // alerts held
+inline constexpr int kRegionalProbability = 87;  // of collapse under the worst, x 10000
+inline constexpr int kRegionalSArrivalIn = 88;   // 0.1 s to its S arrival, 0 once due; kNone
+inline constexpr int kRegionalPga = 89;          // its expected PGA, 0.001 g; kNone
+inline constexpr int kRegionalMagnitude = 90;    // its magnitude x 100; kNone
+inline constexpr int kRegionalDistance = 91;     // its epicentral distance, km; kNone
+inline constexpr int kRegionalEventId = 92;      // its event id (32 bits; 0 when none held)
+inline constexpr int kRegionalVersion = 94;      // its version; kNone
+inline constexpr int kRegionalReceived = 95;     // alerts received (32 bits)
+inline constexpr int kRegionalAccepted = 97;     // accepted (32 bits)
+inline constexpr int kRegionalRefused = 99;      // refused, every reason (32 bits)
+inline constexpr int kRegionalLastRefusal = 101;  // kRegionalRefusalCodes
 // The statue sensor (kNone in each without one): its gyroscope's and accelerometer's health
 // (kHealthStateCodes), 1 once its rate offset is known, and per axis what its weights say
 // (kStatueWeightsCodes; y kNone with one axis) and the effective members x 100.
@@ -201,6 +232,7 @@ enum class Codes : std::uint8_t {
   kAckOutcome,
   kAxis,
   kStatueWeights,
+  kRegionalRefusal,
 };
 
 // What the statue sensor's weights say of an axis (StatueAxisStatus), pinned like the others.
@@ -229,7 +261,7 @@ struct Point {
 };
 
 // The rows, in the CSV's order: registers, discrete inputs, coils, each by address.
-inline constexpr std::size_t kPointCount = 52;
+inline constexpr std::size_t kPointCount = 64;
 [[nodiscard]] const std::array<Point, kPointCount>& points();
 
 // The values the server answers with.

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "plinth/host/input_error.h"
+#include "plinth/host/limits.h"
 #include "plinth/host/text_file.h"
 #include "plinth/host/toml_names.h"
 #include "status_outputs.h"
@@ -233,13 +234,52 @@ void output_bindings(std::vector<Binding>& b, ModbusSettings& modbus, MqttSettin
   b.push_back({"mqtt.reconnect_min_s", number_into(mqtt.reconnect_min_s), "a number"});
   b.push_back({"mqtt.reconnect_max_s", number_into(mqtt.reconnect_max_s), "a number"});
   b.push_back({"mqtt.commands", flag_into(mqtt.commands), "true or false"});
+  b.push_back({"mqtt.regional_alerts", flag_into(mqtt.regional_alerts), "true or false"});
+  b.push_back({"mqtt.regional_topic", string_into(mqtt.regional_topic), "a string (a topic)"});
   b.push_back({"mqtt.discovery", flag_into(mqtt.discovery), "true or false"});
   b.push_back({"mqtt.discovery_prefix", string_into(mqtt.discovery_prefix),
                "a string (topic levels)"});
 }
 
+// The [regional_alert] table's keys (a build without regional alerts has none).
+void regional_bindings(std::vector<Binding>& b, monitor::RegionalAlertSettings& r) {
+  const std::pair<const char*, double*> numbers[] = {
+      {"regional_alert.max_origin_age_s", &r.max_origin_age_s},
+      {"regional_alert.future_tolerance_s", &r.future_tolerance_s},
+      {"regional_alert.expiry_margin_s", &r.expiry_margin_s},
+      {"regional_alert.stress_drop_bar", &r.stress_drop_bar},
+      {"regional_alert.shear_wave_speed_km_s", &r.shear_wave_speed_km_s},
+      {"regional_alert.path_duration_s_per_km", &r.path_duration_s_per_km},
+  };
+  for (const auto& [key, value] : numbers) b.push_back({key, number_into(*value), "a number"});
+}
+
+// The [pwave] table's keys but its predictor (read_pwave_predictor); `channel` its name.
+void pwave_bindings(std::vector<Binding>& b, monitor::PWaveSettings& p, std::string& channel) {
+  b.push_back({"pwave.channel", string_into(channel), "a string, \"vertical\" or \"horizontal\""});
+  b.push_back({"pwave.predictor", [](const toml::node&) { return true; }, ""});  // read apart
+  const std::pair<const char*, double*> numbers[] = {
+      {"pwave.highpass_hz", &p.highpass_hz},
+      {"pwave.lowpass_hz", &p.lowpass_hz},
+      {"pwave.sta_s", &p.sta_s},
+      {"pwave.lta_s", &p.lta_s},
+      {"pwave.trigger_ratio", &p.trigger_ratio},
+      {"pwave.noise_floor_m_s2", &p.noise_floor_m_s2},
+      {"pwave.min_amplitude_m_s2", &p.min_amplitude_m_s2},
+      {"pwave.confirm_s", &p.confirm_s},
+      {"pwave.min_tau_p_s", &p.min_tau_p_s},
+      {"pwave.max_tau_c_s", &p.max_tau_c_s},
+      {"pwave.min_vertical_ratio", &p.min_vertical_ratio},
+      {"pwave.s_wave_ratio", &p.s_wave_ratio},
+      {"pwave.max_window_s", &p.max_window_s},
+      {"pwave.hold_s", &p.hold_s},
+  };
+  for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
+}
+
 std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::string& unit,
-                              std::array<bool, kRelayCount>& relay_active_low) {
+                              std::array<bool, kRelayCount>& relay_active_low,
+                              monitor::PWaveSettings& pwave, std::string& pwave_channel) {
   MonitorConfig& c = f.config;
   monitor::AlarmPolicySettings& alarm = c.alarm;
   std::vector<Binding> b = {
@@ -276,6 +316,9 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::
       {"alarm_policy.latch_alarm", flag_into(alarm.latch_alarm), "true or false"},
       {"alarm_policy.heartbeat_period_s", number_into(alarm.heartbeat_period_s), "a number"},
   };
+  if (auto* regional = monitor::built_part<monitor::RegionalAlertSettings>(c.regional)) {
+    regional_bindings(b, *regional);
+  }
   sensor_bindings(b, "conditioning.", c.conditioning, c.sensor_health, unit);
   statue_bindings(b, c.statue_sensor, statue_node);
   relay_bindings(b, f.relays, relay_active_low);
@@ -289,12 +332,20 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::
   b.push_back({"recorder.test_pause_mid_write_s", number_into(f.recorder.test_pause_mid_write_s),
                "a number (s; test only)"});
   output_bindings(b, f.modbus, f.mqtt);
+  pwave_bindings(b, pwave, pwave_channel);
+  using monitor::built_part;
+  using monitor::RiskThresholds;
   for (auto [name, thresholds] : {std::pair<const char*, monitor::RiskThresholds*>{"advisory", &alarm.advisory},
                                   {"warning", &alarm.warning},
                                   {"alarm", &alarm.alarm},
                                   {"advisory_forecast", &alarm.advisory_forecast},
                                   {"warning_forecast", &alarm.warning_forecast},
-                                  {"alarm_forecast", &alarm.alarm_forecast}}) {
+                                  {"alarm_forecast", &alarm.alarm_forecast},
+                                  {"warning_pwave",
+                                   built_part<RiskThresholds>(alarm.warning_pwave)},
+                                  {"warning_regional",
+                                   built_part<RiskThresholds>(alarm.warning_regional)}}) {
+    if (thresholds == nullptr) continue;  // a part this build has not: its keys are unknown
     b.push_back({cat("alarm_policy.", name, ".on"), number_into(thresholds->on), "a number"});
     b.push_back({cat("alarm_policy.", name, ".off"), number_into(thresholds->off), "a number"});
   }
@@ -515,6 +566,13 @@ void check_relays(RelaySettings& relays, bool default_active_low, const KeyLines
   }
 }
 
+// The keys of the regional alerts: refused by a build without them (kRegionalAlertBuiltIn).
+bool regional_key(const std::string& key) {
+  return key.rfind("regional_alert.", 0) == 0 ||
+         key.rfind("alarm_policy.warning_regional", 0) == 0 || key == "mqtt.regional_alerts" ||
+         key == "mqtt.regional_topic";
+}
+
 // validate(MonitorConfig), its field named as the file's key.
 void check(const MonitorConfig& config, const KeyLines& lines) {
   int sensor_index = -1;
@@ -526,6 +584,101 @@ void check(const MonitorConfig& config, const KeyLines& lines) {
   const std::string head = cat("sensor[", std::to_string(sensor_index), "]");
   const std::string at = lines.has(key) ? key : lines.has(e.field) ? e.field : head;
   lines.fail(at, cat(key, ": ", e.reason));
+}
+
+// [pwave]'s predictor: 1 to kMaxPWavePredictorPoints tables { window_s, ln_pga_over_pa,
+// tau_c_exponent (0 when left out), sigma_ln }, as plinth-eval pwave-fit prints them.
+void read_pwave_predictor(const toml::node& node, monitor::PWaveSettings& pwave,
+                          const KeyLines& lines) {
+  const char* key = "pwave.predictor";
+  const toml::array* points = node.as_array();
+  if (points == nullptr || (!points->empty() && !points->is_array_of_tables())) {
+    lines.fail(key, cat(key, ": expected an array of tables { window_s, ln_pga_over_pa, "
+                             "tau_c_exponent, sigma_ln } (plinth-eval pwave-fit prints one)"));
+  }
+  if (points->empty() || points->size() > monitor::kMaxPWavePredictorPoints) {
+    lines.fail(key, cat(key, ": must have 1 to ",
+                        std::to_string(monitor::kMaxPWavePredictorPoints), " points, has ",
+                        std::to_string(points->size())));
+  }
+  pwave.predictor_points = points->size();
+  for (std::size_t i = 0; i < points->size(); ++i) {
+    monitor::PWavePredictorPoint& point = pwave.predictor[i];
+    point = {};
+    const std::string head = cat(key, "[", std::to_string(i), "]");
+    std::vector<Binding> keys = {
+        {"window_s", number_into(point.window_s), "a number"},
+        {"ln_pga_over_pa", number_into(point.ln_pga_over_pa), "a number"},
+        {"tau_c_exponent", number_into(point.tau_c_exponent), "a number"},
+        {"sigma_ln", number_into(point.sigma_ln), "a number"},
+    };
+    std::vector<std::pair<std::string, const toml::node*>> leaves;
+    flatten(*(*points)[i].as_table(), "", leaves);
+    for (const char* required : {"window_s", "ln_pga_over_pa", "sigma_ln"}) {
+      if (std::none_of(leaves.begin(), leaves.end(),
+                       [&](const auto& leaf) { return leaf.first == required; })) {
+        lines.fail(key, cat(head, ": no ", required));
+      }
+    }
+    for (const auto& [leaf, leaf_node] : leaves) lines.store(keys, leaf, cat(head, ".", leaf), *leaf_node);
+  }
+}
+
+// validate(PWaveSettings) at the estimator's rate, its field named as the file's key (a
+// predictor point's with its index) and its limit given.
+void check_pwave(monitor::PWaveSettings pwave, double sample_period_s, const KeyLines& lines) {
+  pwave.sample_period_s = sample_period_s;
+  const Error e = monitor::validate(pwave);
+  if (e.ok()) return;
+  std::string key = e.field;
+  const std::string point_field = "pwave.predictor.";
+  if (key.rfind(point_field, 0) == 0) {
+    // The first point at fault: the shortest table that fails the same way.
+    std::size_t index = 0;
+    for (monitor::PWaveSettings prefix = pwave; prefix.predictor_points >= 1;) {
+      const std::size_t n = prefix.predictor_points;
+      prefix.predictor_points = n - 1;
+      if (n == 1 || monitor::validate(prefix).ok()) {
+        index = n - 1;
+        break;
+      }
+    }
+    key = cat("pwave.predictor[", std::to_string(index), "].", key.substr(point_field.size()));
+  }
+  std::string message = cat(key, ": ", e.reason);
+  if (e.limit != 0.0 && std::isfinite(e.limit)) {
+    message += cat(" (limit ", host::number_text(e.limit), ")");
+  }
+  lines.fail(lines.has(key) ? key : lines.has(e.field) ? e.field : "pwave", message);
+}
+
+// The [pwave] table: the stage on, its channel (and that channel's fitted table unless it gives
+// a predictor), checked; a build without the stage refuses it.
+void read_pwave(const toml::node& table, monitor::PWaveSettings& pwave, const std::string& channel,
+                MonitorConfig& config, KeyLines& lines) {
+  lines.note("pwave", table.source().begin.line);
+  if (!table.is_table()) lines.fail("pwave", "pwave: expected a table ([pwave])");
+  if (!channel.empty() && !monitor::kPWaveChannelNames.parse(channel, pwave.channel)) {
+    lines.fail("pwave.channel",
+               cat("pwave.channel: expected \"vertical\" or \"horizontal\", got \"", channel, "\""));
+  }
+  if (const toml::node* predictor = table.as_table()->get("predictor")) {
+    read_pwave_predictor(*predictor, pwave, lines);
+  } else if (!channel.empty()) {
+    const auto& fitted = monitor::default_predictor(pwave.channel);
+    std::copy(fitted.begin(), fitted.end(), pwave.predictor.begin());
+    pwave.predictor_points = fitted.size();
+  }
+  pwave.enabled = true;
+  monitor::PWaveSettings* built = monitor::built_part<monitor::PWaveSettings>(config.pwave);
+  if (built == nullptr) {
+    lines.fail("pwave", "pwave: this build has no P-wave stage (PLINTH_PWAVE_STAGE=OFF)");
+    return;
+  }
+  check_pwave(pwave, config.estimator.sample_period(), lines);
+  pwave.fragility_known = built->fragility_known;  // the scene's, set by the application
+  pwave.fragility = built->fragility;
+  *built = pwave;
 }
 
 std::string number_text(double value) {
@@ -606,7 +759,13 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   int statue_node = defaults.statue_sensor.node;
   std::string unit;
   std::array<bool, kRelayCount> relay_active_low{};  // [0]: relays.active_low
-  std::vector<Binding> known = bindings(file, node, statue_node, unit, relay_active_low);
+  monitor::PWaveSettings pwave;  // [pwave], over the defaults' when the build has the stage
+  if (const auto* given = monitor::built_part<monitor::PWaveSettings>(defaults.pwave)) {
+    pwave = *given;
+  }
+  std::string pwave_channel;
+  std::vector<Binding> known =
+      bindings(file, node, statue_node, unit, relay_active_low, pwave, pwave_channel);
   const toml::node* sensor_list = doc.get("sensor");
   const bool sensor_tables = sensor_list != nullptr && sensor_list->is_array();
   std::vector<std::pair<std::string, const toml::node*>> leaves;
@@ -616,6 +775,9 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     lines.note(key, node_ptr->source().begin.line);
     if (key == "sensor" && sensor_tables) continue;
     lines.store(known, key, key, *node_ptr);
+    if (!monitor::kRegionalAlertBuiltIn && regional_key(key)) {
+      lines.fail(key, cat(key, ": ", monitor::kRegionalAlertNotBuilt));
+    }
   }
   if (node < 1 || node > 15) {
     lines.fail("monitor.ground_node", "monitor.ground_node: must lie in [1, 15]");
@@ -641,6 +803,7 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     lines.fail("recorder.test_pause_mid_write_s",
                "recorder.test_pause_mid_write_s: must be a number of seconds in [0, 600]");
   }
+  if (const toml::node* table = doc.get("pwave")) read_pwave(*table, pwave, pwave_channel, file.config, lines);
   check(file.config, lines);
   check_outputs(file, lines, origin);
   return file;

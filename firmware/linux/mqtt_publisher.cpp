@@ -16,6 +16,7 @@
 #include "plinth/host/json_text.h"
 #include "plinth/host/text_file.h"
 #include "plinth/version/version.h"
+#include "regional_json.h"
 #include "status_json.h"
 
 namespace plinth::firmware {
@@ -141,6 +142,8 @@ MqttPublisher::MqttPublisher(const MqttSettings& settings, const RunIdentity& id
   availability_topic_ = base + "availability";
   command_topic_ = base + "command";
   reply_topic_ = command_topic_ + "/reply";
+  regional_topic_ = settings_.regional_topic.empty() ? settings_.topic_prefix + "/regional_alert"
+                                                     : settings_.regional_topic;
 
   std::string password = settings_.password;
   if (!settings_.password_file.empty()) {
@@ -221,6 +224,10 @@ void MqttPublisher::on_connect(int rc) {
   // Also while commands are off: the reply says so.
   if (mosquitto_subscribe(client_, nullptr, command_topic_.c_str(), kQos) != MOSQ_ERR_SUCCESS) {
     say("cannot subscribe to " + command_topic_);
+  }
+  if (settings_.regional_alerts &&
+      mosquitto_subscribe(client_, nullptr, regional_topic_.c_str(), kQos) != MOSQ_ERR_SUCCESS) {
+    say("cannot subscribe to " + regional_topic_);
   }
   publish_discovery();
   state_due_ = have_state_;
@@ -365,6 +372,7 @@ void MqttPublisher::publish_head(std::int64_t now_ns) {
 // "level": .., "sequence": .., "id": ..}; level and sequence default to what the box shows.
 // A well-formed acknowledgement goes to the loop; the reply waits for its outcome.
 void MqttPublisher::on_message(const std::string& topic, const std::string& payload) {
+  if (settings_.regional_alerts && topic == regional_topic_) return on_regional_alert(payload);
   if (topic != command_topic_) return;
   ++commands_received_;
   nlohmann::json command = nlohmann::json::parse(payload, nullptr, false);
@@ -423,6 +431,26 @@ void MqttPublisher::on_message(const std::string& topic, const std::string& payl
                                        .text("level", monitor::alarm_level_name(request.level))
                                        .count("sequence", request.event_sequence)
                                        .close()};
+}
+
+// A regional alert (docs/regional.md, "MQTT"), its UTC times made relative to now: to the loop,
+// which checks its values (or counts it malformed when it is no alert at all).
+void MqttPublisher::on_regional_alert(const std::string& payload) {
+  ++regional_received_;
+  const RegionalJson parsed = parse_regional_json(payload, wall_clock_ns());
+  RegionalRequest request;
+  request.alert = parsed.alert;
+  if (!parsed.ok) {
+    ++regional_malformed_;
+    request.malformed = true;
+    request.field = parsed.field;
+    say("regional alert malformed: " + parsed.problem + ": " + payload.substr(0, 200));
+  }
+  if (!mailbox_.post_regional(request)) {
+    ++regional_lost_;
+    say("regional alert lost: the loop has not taken the " +
+        std::to_string(OutputMailbox::kRegionalSlots) + " before it");
+  }
 }
 
 // {"id": .., "command": "acknowledge", "result": "accepted" | "refused", "reason": ..,
@@ -530,6 +558,38 @@ void MqttPublisher::publish_discovery() {
   }
 }
 
+namespace {
+
+// The state's "regional": null before any alert; the worst held alert (null: none held) with
+// its time to the S arrival, and the counters.
+std::string regional_state_json(const RegionalSnapshot& r) {
+  if (r.received == 0) return "null";
+  std::string alert = "null";
+  if (r.held > 0) {
+    alert = JsonObject()
+                .count("event_id", r.event_id)
+                .count("version", r.version)
+                .fixed("magnitude", r.magnitude, 2)
+                .fixed("distance_km", r.distance_km, 1)
+                .fixed("pga_g", r.pga_g, 4)
+                .fixed("sigma_ln", r.sigma_ln, 2)
+                .fixed("probability", r.probability, 4)
+                .fixed("time_to_s_arrival_s", r.time_to_s_arrival_s, 1)
+                .fixed("s_arrival_t", r.s_arrival_t, 3)
+                .close();
+  }
+  return JsonObject()
+      .count("held", static_cast<std::uint64_t>(r.held))
+      .raw("alert", alert)
+      .count("received", r.received)
+      .count("accepted", r.accepted)
+      .count("refused", r.refused)
+      .text("last_refusal", monitor::regional_refusal_name(r.last_refusal))
+      .close();
+}
+
+}  // namespace
+
 std::string MqttPublisher::state_json() const {
   const StatusSnapshot& s = state_;
   JsonObject phase;
@@ -575,6 +635,7 @@ std::string MqttPublisher::state_json() const {
       .raw("sensor_counters", counters)
       .raw("statue_sensor", statue_sensor_state(s, axes))
       .count("estimator_restarts", s.estimator_restarts)
+      .raw("regional", regional_state_json(s.regional))
       .count("heartbeat", s.statuses)
       .count("events_dropped", events_dropped_ + mailbox_.events_dropped())
       .raw("version", JsonObject()
@@ -662,6 +723,9 @@ std::string MqttPublisher::summary_json() const {
       .count("commands_received", commands_received_)
       .count("commands_accepted", commands_accepted_)
       .count("commands_refused", commands_refused_)
+      .count("regional_received", regional_received_)
+      .count("regional_malformed", regional_malformed_)
+      .count("regional_lost", regional_lost_)
       .close();
 }
 

@@ -5,6 +5,8 @@
 //   PREFIX/BOX/availability   retained "online"; the Last Will, and a clean stop, say "offline"
 //   PREFIX/BOX/command        the operator's acknowledgement (subscribed; mqtt.commands)
 //   PREFIX/BOX/command/reply  accepted or refused, and why
+//   PREFIX/regional_alert     the site's regional early-warning alerts from the integrator's
+//                             bridge (subscribed; mqtt.regional_alerts, mqtt.regional_topic)
 //   DISCOVERY/.../config      retained Home Assistant discovery (mqtt.discovery)
 // Alarm events wait in a bounded queue while the broker is away (the oldest dropped and
 // counted when it is full) and go out one at a time, each once the broker acknowledged the one
@@ -49,6 +51,11 @@ struct MqttSettings {
   double reconnect_min_s = 0.5;   // mqtt.reconnect_min_s: first back-off, doubled to ...
   double reconnect_max_s = 30.0;  // mqtt.reconnect_max_s
   bool commands = false;          // mqtt.commands: acknowledgements on PREFIX/BOX/command
+  // mqtt.regional_alerts: take regional alerts (docs/regional.md) from mqtt.regional_topic
+  // (default PREFIX/regional_alert: one bridge for the site's boxes, each with its statue's
+  // fragility; PREFIX/BOX/regional_alert or any other topic for a box of its own).
+  bool regional_alerts = false;
+  std::string regional_topic;
   bool discovery = true;          // mqtt.discovery: Home Assistant discovery configs
   std::string discovery_prefix = "homeassistant";  // mqtt.discovery_prefix
 };
@@ -99,6 +106,7 @@ class MqttPublisher final : public StatusOutput {
   void reply(const std::string& id_json, const std::string& result, const std::string& why,
              const std::string& details);
   void take_results();
+  void on_regional_alert(const std::string& payload);
   [[nodiscard]] bool publish(const std::string& topic, const std::string& payload, bool retain,
                              int* mid);
   [[nodiscard]] std::string state_json() const;
@@ -114,6 +122,7 @@ class MqttPublisher final : public StatusOutput {
   std::string host_;
   int port_ = 0;
   std::string state_topic_, events_topic_, availability_topic_, command_topic_, reply_topic_;
+  std::string regional_topic_;
   mosquitto* client_ = nullptr;
   OutputMailbox mailbox_;
   std::atomic<bool> stopping_{false};
@@ -161,6 +170,9 @@ class MqttPublisher final : public StatusOutput {
   std::uint64_t commands_accepted_ = 0;  // acknowledgements the monitor released a latch with
   std::uint64_t commands_refused_ = 0;
   std::uint64_t discovery_configs_ = 0;  // config messages published
+  std::uint64_t regional_received_ = 0;   // messages on the regional topic
+  std::uint64_t regional_malformed_ = 0;  // of which not an alert (handed on as malformed)
+  std::uint64_t regional_lost_ = 0;       // not handed on: the loop had not taken the earlier
 };
 
 }  // namespace plinth::firmware

@@ -143,6 +143,7 @@ class Outputs {
         ++totals.bus_send_errors;
       }
     }
+    if (u.regional_received) print_line(fw::regional_json(u.regional, s));  // before its events
     for (std::size_t i = 0; i < u.event_count; ++i) {
       const mon::AlarmEventRecord& e = u.events[i];
       print_line(fw::alarm_json(e, t_origin_));
@@ -173,6 +174,12 @@ class Outputs {
   template <typename Restart>
   void carry_out_commands(fw::Monitor& monitor, Restart restart) {
     for (fw::StatusOutput* output : outputs_) {
+      // Regional alerts (MQTT): at the loop's time now, relative to their receipt.
+      fw::RegionalRequest r;
+      while (output->mailbox().take_regional(r)) {
+        handle(r.malformed ? monitor.regional_alert_malformed(r.field)
+                           : monitor.on_regional_alert(r.alert));
+      }
       fw::CommandRequest c;
       while (output->mailbox().take_command(c)) {
         ++snapshot_.commands;
@@ -478,6 +485,21 @@ std::string input_fault(fw::MonitorInput& input, bool estimated) {
   return "";
 }
 
+// The statue's fragility for regional alerts and the P-wave stage: the scene's [fragility];
+// with two scenes that both give one, the more fragile (the lower median) of the two.
+void set_fragility(fw::MonitorConfig& config, const plinth::host::UncertainScene& x,
+                   const std::optional<plinth::host::UncertainScene>& y) {
+  std::optional<plinth::LognormalFragility> f = x.fragility;
+  if (y && y->fragility && (!f || y->fragility->median_g < f->median_g)) f = y->fragility;
+  const auto give = [&f](auto* part) {  // a part this build has not: nullptr
+    if (part == nullptr) return;
+    part->fragility_known = f.has_value();
+    if (f) part->fragility = *f;
+  };
+  give(mon::built_part<mon::RegionalAlertSettings>(config.regional));
+  give(mon::built_part<mon::PWaveSettings>(config.pwave));
+}
+
 int run(const Options& opt, const CLI::App& app) {
   const int sources = (opt.replay_path.empty() ? 0 : 1) + (opt.can_interface.empty() ? 0 : 1);
   if (sources != 1) throw InputError("give exactly one input: --replay FILE or --can INTERFACE");
@@ -494,6 +516,7 @@ int run(const Options& opt, const CLI::App& app) {
   }
   fw::MonitorConfig& config = file.config;
   config.axis_count = scene_y ? 2 : 1;
+  set_fragility(config, scene_x, scene_y);
   const std::unique_ptr<fw::MonitorInput> input = fw::open_input(input_settings, config, g_stop);
 
   fw::Monitor monitor;

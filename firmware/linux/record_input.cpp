@@ -32,6 +32,7 @@ RecordSamples record_samples(const RecordReplayOptions& opt, double gravity) {
   const std::vector<double> az = v                    ? read(v->horizontal_signal())
                                  : h.vertical.empty() ? std::vector<double>()
                                                       : read(h.vertical_signal());
+  out.vertical = !az.empty();
   out.samples.reserve(count);
   for (std::size_t k = 0; k < count; ++k) {
     out.samples.emplace_back(gamma * ax[k], ay.empty() ? 0.0 : gamma * ay[k],

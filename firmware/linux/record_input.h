@@ -23,6 +23,7 @@ struct RecordReplayOptions {
 struct RecordSamples {
   double rate_hz = 0.0;
   std::vector<Eigen::Vector3d> samples;  // m/s2; z = gravity + the vertical acceleration
+  bool vertical = false;  // a vertical record was read (--vertical or the x file's column)
 };
 
 // Sample k is each record at k / rate_hz (host::resample), times the scale; from 0 to the x

@@ -252,6 +252,14 @@ std::string status_json(const BoxStatus& s, double t_origin) {
   line.raw("sensors", status_sensors(s));
   if (s.has_statue_sensor) line.raw("statue_sensor", status_statue_sensor(s));
   line.raw("state", per_axis(s, axis_state));
+  if (const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(s.regional);
+      regional != nullptr && regional->received > 0) {
+    line.raw("regional", regional_status_json(*regional, t_origin));
+  }
+  const auto* pwave = monitor::built_part<monitor::PWaveStatus>(s.pwave);
+  if (pwave != nullptr && s.has_pwave) {
+    line.raw("pwave", pwave_status_json(*pwave, s.estimator_start_ns, t_origin));
+  }
   return line.close();
 }
 
@@ -265,6 +273,80 @@ std::string statue_weights_json(const StatueAxisStatus& a) {
       .count("best_member", static_cast<std::uint64_t>(a.best_member))
       .general("best_score", a.best_score, 4)
       .count("ruled_out", static_cast<std::uint64_t>(a.ruled_out))
+      .close();
+}
+
+std::string pwave_status_json(const monitor::PWaveStatus& p, std::int64_t start_ns,
+                              double t_origin) {
+  JsonObject out;
+  out.text("state", monitor::kPWaveStateNames.name(p.state))
+      .fixed("probability", static_cast<double>(p.probability), 4)
+      .fixed("sta_lta", static_cast<double>(p.sta_lta), 2)
+      .count("candidates", p.candidates)
+      .count("triggers", p.triggers)
+      .raw("rejected", JsonObject()
+                           .count("period_short", p.rejected_short)
+                           .count("period_long", p.rejected_long)
+                           .count("horizontal", p.rejected_horizontal)
+                           .close());
+  if (p.triggers > 0) {  // the latest trigger's window
+    out.fixed("onset_t", seconds(start_ns, t_origin) + static_cast<double>(p.onset_s), 3)
+        .fixed("window_s", static_cast<double>(p.window_s), 3)
+        .text("window_end", monitor::kPWaveWindowEndNames.name(p.window_end))
+        .general("pa_m_s2", static_cast<double>(p.pa_m_s2), 4)
+        .general("pd_m", static_cast<double>(p.pd_m), 4)
+        .fixed("tau_c_s", static_cast<double>(p.tau_c_s), 3)
+        .fixed("tau_p_s", static_cast<double>(p.tau_p_s), 3)
+        .general("predicted_pga_g", static_cast<double>(p.predicted_pga_g), 4)
+        .fixed("sigma_ln", static_cast<double>(p.sigma_ln), 3);
+  }
+  return out.close();
+}
+
+std::string regional_status_json(const monitor::RegionalAlertStatus& r, double t_origin) {
+  JsonObject refused;
+  for (const NamedValue<monitor::RegionalRefusal>& named : monitor::kRegionalRefusalNames) {
+    if (named.value == monitor::RegionalRefusal::kNone) continue;
+    refused.count(named.name, r.refused[static_cast<std::size_t>(named.value)]);
+  }
+  JsonObject out;
+  out.count("held", static_cast<std::uint64_t>(r.held));
+  if (r.held > 0) {
+    const monitor::RegionalAlert& a = r.worst.alert;
+    out.count("event_id", a.event_id)
+        .count("version", a.version)
+        .fixed("magnitude", static_cast<double>(a.magnitude), 2)
+        .fixed("distance_km", static_cast<double>(a.distance_km), 1)
+        .fixed("pga_g", static_cast<double>(a.pga_g), 4)
+        .fixed("sigma_ln", static_cast<double>(a.sigma_ln), 2)
+        .fixed("probability", static_cast<double>(r.probability), 4)
+        .fixed("time_to_s_arrival_s", static_cast<double>(r.time_to_s_arrival_s), 3)
+        .fixed("s_arrival_t", seconds(r.worst.s_arrival_ns, t_origin), 3)
+        .fixed("expires_t", seconds(r.worst.expires_ns, t_origin), 3);
+  }
+  return out.count("received", r.received)
+      .count("accepted", r.accepted)
+      .count("replaced", r.replaced)
+      .count("cancelled", r.cancelled)
+      .count("expired", r.expired)
+      .raw("refused", refused.close())
+      .text("last_refusal", monitor::regional_refusal_name(r.last_refusal))
+      .text("last_refusal_field", r.last_refusal_field)
+      .close();
+}
+
+std::string regional_json(const monitor::RegionalOutcome& o, const BoxStatus& s) {
+  JsonObject line;
+  line.text("type", "regional").text("result", o.accepted() ? "accepted" : "refused");
+  if (!o.accepted()) {
+    line.text("reason", monitor::regional_refusal_name(o.refusal)).text("field", o.field);
+  } else {
+    line.flag("replaced", o.replaced).flag("cancelled", o.cancelled);
+  }
+  const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(s.regional);
+  return line.count("held", regional != nullptr ? static_cast<std::uint64_t>(regional->held) : 0)
+      .fixed("probability", regional != nullptr ? static_cast<double>(regional->probability) : 0.0,
+             4)
       .close();
 }
 

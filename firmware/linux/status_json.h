@@ -44,6 +44,18 @@ class JsonObject {
 
 // {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
 [[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);
+// The P-wave stage's part of a status line ("pwave", when it runs): state, probability,
+// counters, and the latest trigger's window (onset_t in the lines' time: the stage counts from
+// `start_ns`, monitor time).
+[[nodiscard]] std::string pwave_status_json(const monitor::PWaveStatus& pwave,
+                                            std::int64_t start_ns, double t_origin);
+// The regional room's part of a status line ("regional", when an alert was ever received): the
+// worst held alert, its probability of collapse and time to the S arrival, the counters.
+[[nodiscard]] std::string regional_status_json(const monitor::RegionalAlertStatus& regional,
+                                               double t_origin);
+// {"type": "regional", "result": "accepted" | "refused", ...}: what came of one regional alert.
+[[nodiscard]] std::string regional_json(const monitor::RegionalOutcome& outcome,
+                                        const BoxStatus& status);
 
 // {"type": "event", "axis": "x", "t": .., "event": .., ...}: a phase event of axis `axis`, its
 // time already in the output's time.

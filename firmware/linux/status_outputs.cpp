@@ -50,6 +50,25 @@ void copy_status(const BoxStatus& s, double t_origin, StatusSnapshot& snapshot) 
   for (std::size_t i = 0; i < snapshot.statue_axes.size(); ++i) {
     snapshot.statue_axes[i] = s.axes[i].statue;
   }
+  const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(s.regional);
+  if (regional == nullptr) return;  // a build without regional alerts: none
+  const monitor::RegionalAlertStatus& r = *regional;
+  RegionalSnapshot& out = snapshot.regional;
+  out.received = r.received;
+  out.accepted = r.accepted;
+  out.refused = 0;
+  for (const std::uint64_t n : r.refused) out.refused += n;
+  out.held = r.held;
+  out.event_id = r.worst.alert.event_id;
+  out.version = r.worst.alert.version;
+  out.magnitude = static_cast<double>(r.worst.alert.magnitude);
+  out.distance_km = static_cast<double>(r.worst.alert.distance_km);
+  out.pga_g = static_cast<double>(r.worst.alert.pga_g);
+  out.sigma_ln = static_cast<double>(r.worst.alert.sigma_ln);
+  out.probability = static_cast<double>(r.probability);
+  out.time_to_s_arrival_s = static_cast<double>(r.time_to_s_arrival_s);
+  out.s_arrival_t = static_cast<double>(r.worst.s_arrival_ns) * 1e-9 - t_origin;
+  out.last_refusal = r.last_refusal;
 }
 
 std::string Endpoint::text() const {

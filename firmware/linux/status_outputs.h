@@ -20,6 +20,24 @@
 
 namespace plinth::firmware {
 
+// The regional room's status as the outputs show it (regional_alert.h): valid when received > 0.
+struct RegionalSnapshot {
+  std::uint64_t received = 0;
+  std::uint64_t accepted = 0;
+  std::uint64_t refused = 0;  // every reason
+  int held = 0;
+  std::uint32_t event_id = 0;  // the worst held alert's (held > 0)
+  std::uint32_t version = 0;
+  double magnitude = 0.0;
+  double distance_km = 0.0;
+  double pga_g = 0.0;
+  double sigma_ln = 0.0;
+  double probability = 0.0;       // of collapse under it
+  double time_to_s_arrival_s = 0.0;
+  double s_arrival_t = 0.0;       // the JSON lines' time of its S arrival
+  monitor::RegionalRefusal last_refusal = monitor::RegionalRefusal::kNone;
+};
+
 // What the box shows after one update of the loop.
 struct StatusSnapshot {
   std::uint64_t updates = 0;   // updates of the loop so far
@@ -60,6 +78,7 @@ struct StatusSnapshot {
   monitor::AckOutcome last_ack = monitor::AckOutcome::kNone;  // of the latest command
   std::uint64_t commands = 0;  // operator commands the loop carried out
   std::uint64_t resets = 0;
+  RegionalSnapshot regional;
 };
 
 // One alarm event as the JSON alarm line writes it.
@@ -71,6 +90,14 @@ struct AlarmNotice {
 enum class OperatorCommand : std::uint8_t {
   kAcknowledge,  // the latched level, quoting the latest event's sequence
   kReset,        // the monitor starts again as at power-up
+};
+
+// A regional alert an output received (MQTT), for the loop: the alert, or malformed (`field`,
+// a string literal, names what).
+struct RegionalRequest {
+  monitor::RegionalAlert alert;
+  bool malformed = false;
+  const char* field = "";
 };
 
 struct CommandRequest {
@@ -145,6 +172,7 @@ class OutputMailbox {
  public:
   static constexpr std::size_t kEventSlots = 256;
   static constexpr std::size_t kCommandSlots = 16;
+  static constexpr std::size_t kRegionalSlots = 16;
 
   // Loop side.
   void post_status(const StatusSnapshot& snapshot) noexcept { status_.publish(snapshot); }
@@ -155,6 +183,7 @@ class OutputMailbox {
   // Dropped when the ring is full: an output that reads the results (MqttPublisher) keeps at
   // most kCommandSlots commands under way; one that does not (ModbusServer) loses nothing.
   void post_result(const CommandResult& result) noexcept { (void)results_.push(result); }
+  [[nodiscard]] bool take_regional(RegionalRequest& out) noexcept { return regional_.pop(out); }
 
   // Output side.
   [[nodiscard]] bool take_status(StatusSnapshot& out) noexcept { return status_.take(out); }
@@ -162,6 +191,8 @@ class OutputMailbox {
   // False when the ring is full (the loop has not polled): the command is refused.
   [[nodiscard]] bool post_command(const CommandRequest& c) noexcept { return commands_.push(c); }
   [[nodiscard]] bool take_result(CommandResult& out) noexcept { return results_.pop(out); }
+  // False when the ring is full (the loop has not polled): the output counts the alert lost.
+  [[nodiscard]] bool post_regional(const RegionalRequest& r) noexcept { return regional_.push(r); }
   // Alarm events the loop could not hand over (the ring was full).
   [[nodiscard]] std::uint64_t events_dropped() const noexcept {
     return events_dropped_.load(std::memory_order_relaxed);
@@ -172,6 +203,7 @@ class OutputMailbox {
   SpscRing<AlarmNotice, kEventSlots> events_;
   SpscRing<CommandRequest, kCommandSlots> commands_;
   SpscRing<CommandResult, 2 * kCommandSlots> results_;
+  SpscRing<RegionalRequest, kRegionalSlots> regional_;
   std::atomic<std::uint64_t> events_dropped_{0};
 };
 

@@ -15,6 +15,7 @@
 #include "plinth/firmware/record_replay.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/record_sampling.h"
+#include "plinth/monitor/p_wave.h"
 
 namespace plinth::sim {
 namespace {
@@ -160,6 +161,22 @@ void note_level(monitor::AlarmLevel shown, double t,
   }
 }
 
+// The P-wave stage the box would run, with the scene's fragility (docs/pwave.md).
+monitor::PWaveStage pwave_stage(const EvalCase& c, double rate_hz) {
+  if (!c.scene->fragility) {
+    throw InputError(c.scene_name + ": --pwave on needs the scene's [fragility] table (median_g, "
+                     "beta: plinth-eval fragility fits them; docs/scene-format.md)");
+  }
+  monitor::PWaveSettings s;
+  s.sample_period_s = 1.0 / rate_hz;
+  s.fragility_known = true;
+  s.fragility = *c.scene->fragility;
+  monitor::PWaveStage stage;
+  const Error e = monitor::PWaveStage::create(s, stage);
+  if (!e.ok()) throw InputError(c.scene_name + ": the P-wave stage: " + e.field + " " + e.reason);
+  return stage;
+}
+
 // The box on the case's motion; stops at the true collapse (what comes after cannot make a hit)
 // or the true statue's lift-off (nothing after it is known), else at the end of the record and
 // its tail.
@@ -187,6 +204,14 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
   run.nominal_risk_crossing_s.assign(grids.risk.size(), -1.0);
   std::optional<StatueImu> imu;
   if (box.statue_sensor) imu.emplace(c, rate, StatueImuModel{});
+  std::optional<monitor::PWaveStage> stage;
+  if (box.pwave) {
+    stage = pwave_stage(c, rate);
+    run.pwave_crossing_s.assign(grids.pwave.size(), -1.0);
+    run.p_pick_s = c.phases.p_pick_s;
+    run.strong_motion_s = c.phases.strong_motion_s;
+  }
+  const double lead_in_s = static_cast<double>(lead_in) / rate;
   for (std::size_t n = 0; n < lead_in + count; ++n) {
     const std::size_t k = n < lead_in ? 0 : n - lead_in;
     const Eigen::Vector3d ground(gamma * h[k], 0.0,
@@ -199,6 +224,20 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
       (void)monitor->on_statue_sample(imu->sample(config, static_cast<std::int64_t>(n), rate_now));
     }
     const fw::MonitorUpdate update = monitor->on_sample(s);
+    if (stage) {
+      // What the box's conditioning gives an ideal sensor: the ground's acceleration less the
+      // offset its start-up window estimated, the lead-in's (the record's first sample).
+      const Vector3r conditioned(gamma * (h[k] - h[0]), 0.0,
+                                 v.empty() ? 0.0 : gamma * (v[k] - v[0]));
+      const monitor::PWaveStatus& p = stage->update(conditioned);
+      if (p.triggers > 0 && run.pwave_trigger_s < 0.0 && n >= lead_in) {
+        run.pwave_trigger_s = std::max(0.0, p.onset_s - lead_in_s);
+      }
+      if (n >= lead_in) {
+        note_crossings(grids.pwave, p.probability, static_cast<double>(k) / rate,
+                       run.pwave_crossing_s);
+      }
+    }
     if (n < lead_in) continue;
     if (stop_s >= 0.0 && t >= stop_s) break;
     const fw::BoxStatus& status = *update.status;

@@ -12,6 +12,7 @@
 #include "plinth/core/forecast.h"
 #include "plinth/core/scene.h"
 #include "plinth/host/eval_metrics.h"
+#include "plinth/host/pwave_records.h"
 #include "plinth/host/record_io.h"
 #include "plinth/host/scene_toml.h"
 #include "plinth/monitor/alarm_policy.h"
@@ -27,6 +28,10 @@ struct BoxSettings {
   // A box given the true statue (one member, no uncertainty) instead of the scene file: what
   // knowing the statue exactly would buy, against the same truth (docs/forecast.md).
   bool knows_true_statue = false;
+  // The on-site P-wave stage (docs/pwave.md) beside the box, fed the same samples; its
+  // probability's first crossings of grids.pwave go to the runs file. The scene must give its
+  // [fragility].
+  bool pwave = false;
   // A statue sensor (firmware statue_sensor.h) simulated from the truth: its gyroscope as
   // StatueImuModel says, at the box's rate.
   bool statue_sensor = false;
@@ -58,6 +63,7 @@ struct EvalCase {
   host::PgaGrid grid;      // the grid the case runs up
   const Scene* true_statue = nullptr;
   double scale_g = 0.0;  // the record's PGA in this run, g
+  host::RecordPhases phases;  // the record's (the same at every scale)
 };
 
 // The truth and the box's timeline for one case (times from the record's t = 0, s). Throws

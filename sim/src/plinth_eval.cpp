@@ -17,6 +17,8 @@
 
 #include "eval_case.h"
 #include "eval_fragility.h"
+#include "eval_pwave.h"
+#include "eval_pwave_report.h"
 #include "eval_report.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/eval_metrics.h"
@@ -41,6 +43,8 @@ constexpr int kMaxPgaSteps = 200;
 struct RunOptions {
   std::vector<std::string> scene_paths;
   std::vector<std::string> record_paths;
+  std::vector<std::string> vertical_paths;  // the i-th for the i-th record (eval_pwave.h)
+  std::string pwave = "off";
   std::string out_path;
   std::string pga_from = "0.2g";
   std::string pga_to = "2.5g";
@@ -67,6 +71,7 @@ struct ReportOptions {
   std::string json_path;
   std::string plot_path;
   bool frontier = false;  // also the frontier of the rules (make_report)
+  std::string pwave_calibrate_on;  // choose the P-wave threshold on this runs file
   std::string calibration_path;  // choose the rules on this other runs file
   std::string false_alarm =
       plinth::host::false_alarm_name(plinth::sim::CalibrationTargets{}.false_alarm);
@@ -132,6 +137,10 @@ plinth::sim::BoxSettings box_settings(const RunOptions& opt) {
   box.forecast.horizon_s = opt.horizon_s;
   box.raise_hold_s = opt.raise_hold_s;
   box.forecast.rate_hz = std::min(box.forecast.rate_hz, opt.rate_hz);
+  if (opt.pwave != "on" && opt.pwave != "off") {
+    throw InputError("--pwave: expected on or off, got '" + opt.pwave + "'");
+  }
+  box.pwave = opt.pwave == "on";
   return box;
 }
 
@@ -204,10 +213,10 @@ int run_eval(const RunOptions& opt) {
     scenes.push_back(plinth::host::load_uncertain_scene_file(opt.scene_paths[s]));
     statues.push_back(draw_statues(scenes.back(), opt.statues, opt.seed + 7919U * static_cast<unsigned>(s)));
   }
-  std::vector<plinth::host::Record> records;
-  for (const std::string& path : opt.record_paths) {
-    records.push_back(plinth::host::read_record(path, plinth::kStandardGravity));
-  }
+  const std::vector<plinth::host::Record> records =
+      plinth::sim::read_records(opt.record_paths, opt.vertical_paths);
+  std::vector<plinth::host::RecordPhases> phases;
+  for (const plinth::host::Record& r : records) phases.push_back(plinth::host::record_phases(r));
   plinth::host::JobRun run;
   plinth::host::parse_shard(opt.shard, run.shard_index, run.shard_count);
   run.jobs = opt.jobs ? *opt.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -216,7 +225,8 @@ int run_eval(const RunOptions& opt) {
   const std::size_t per_record = scenes.size() * static_cast<std::size_t>(opt.statues);
   const std::size_t job_count = records.size() * per_record;
   const std::vector<std::size_t> indices = plinth::host::shard_indices(job_count, run);
-  const plinth::host::CrossingGrids grids = plinth::host::default_crossing_grids();
+  plinth::host::CrossingGrids grids = plinth::host::default_crossing_grids();
+  if (box.pwave) grids.pwave = plinth::host::default_pwave_grid();
   std::vector<std::vector<EvalRun>> results(job_count);
   const auto case_of = [&](std::size_t index, double pga) {
     const std::size_t r = index / per_record;
@@ -226,7 +236,7 @@ int run_eval(const RunOptions& opt) {
                                   &scenes[s],    file_name(opt.scene_paths[s]),
                                   j,             opt.seed,
                                   grid,          &statues[s][static_cast<std::size_t>(j)],
-                                  pga};
+                                  pga,           phases[r]};
   };
   run.stop = plinth::host::install_stop_handlers("plinth-eval");
   plinth::host::ProgressBar progress(indices.size(), 0, "cases");
@@ -302,6 +312,14 @@ int run_report(const ReportOptions& opt) {
   const plinth::sim::Report report = plinth::sim::make_report(
       table, targets, opt.frontier, opt.calibration_path.empty() ? nullptr : &calibration);
   std::fputs(plinth::sim::report_text(report, table.grids).c_str(), stdout);
+  if (!table.grids.pwave.empty() || !opt.pwave_calibrate_on.empty()) {
+    std::optional<EvalTable> other;
+    if (!opt.pwave_calibrate_on.empty()) other = plinth::host::read_eval_csv(opt.pwave_calibrate_on);
+    std::fputs(plinth::sim::pwave_report_text(
+                   plinth::sim::make_pwave_report(table, other ? &*other : nullptr))
+                   .c_str(),
+               stdout);
+  }
   if (!opt.json_path.empty()) {
     write_text(opt.json_path, plinth::sim::report_json(report, table.grids));
   }
@@ -365,6 +383,11 @@ int main(int argc, char** argv) {
   run->add_option("--scene", opt.scene_paths, "scene files with their [uncertainty] (repeat)")
       ->required();
   run->add_option("--record", opt.record_paths, "records: AT2, ESM or CSV (repeat)")->required();
+  run->add_option("--vertical", opt.vertical_paths,
+                  "their vertical components, the i-th for the i-th --record (repeat)");
+  run->add_option("--pwave", opt.pwave,
+                  "on: the P-wave stage beside the box, its crossings in the runs file (needs "
+                  "the scenes' [fragility]; default off)");
   run->add_option("--out", opt.out_path, "runs CSV")->required();
   run->add_option("--pga-from", opt.pga_from, "smallest PGA of the grid (default 0.2g)");
   run->add_option("--pga-to", opt.pga_to, "largest PGA of the grid (default 2.5g)");
@@ -401,6 +424,9 @@ int main(int argc, char** argv) {
   report_command->add_option("runs", report.runs_path, "a plinth-eval runs CSV")->required();
   report_command->add_option("--json", report.json_path, "also write the report as JSON");
   report_command->add_option("--plot", report.plot_path, "also draw the ROC as a PNG");
+  report_command->add_option("--pwave-calibrate-on", report.pwave_calibrate_on,
+                             "choose the P-wave stage's threshold on this runs file (default: "
+                             "on the one reported)");
   report_command->add_flag("--frontier", report.frontier,
                            "also the rule with the fewest false alarms under each of the alarm's "
                            "targets, on the worst member's and on the nominal statue's risk");
@@ -425,6 +451,7 @@ int main(int argc, char** argv) {
   CLI::App* merge_command = app.add_subcommand("merge", "join the runs CSVs of shards");
   merge_command->add_option("--out", merge.out_path, "merged CSV")->required();
   merge_command->add_option("inputs", merge.inputs, "the shards' CSV files")->required();
+  const plinth::sim::Subcommand pwave_fit = plinth::sim::add_pwave_fit(app);
   const auto checks = [&] {
     plinth::host::refuse_without_effect(*run, {"--horizon"}, opt.forecast != "off",
                                         "sets the forecast's horizon, and --forecast is off");
@@ -437,6 +464,7 @@ int main(int argc, char** argv) {
     if (report_command->parsed()) return run_report(report);
     if (fragility_command->parsed()) return run_fragility(fragility);
     if (merge_command->parsed()) return run_merge(merge);
+    if (pwave_fit.command->parsed()) return pwave_fit.run();
     return run_eval(opt);
   });
 }

@@ -22,7 +22,8 @@ CORNERS = ["none", "left", "right"]
 LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
-          "collapse_forecast", "not_calibrated", "outside_model", None, "statue_unexplained"]
+          "collapse_forecast", "not_calibrated", "outside_model", "p_wave", "statue_unexplained",
+          "regional_alert"]
 STATUS_ID, ALARM_ID = 0x320, 0x330
 
 

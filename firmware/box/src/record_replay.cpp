@@ -62,7 +62,8 @@ monitor::SensorSample record_replay_sample(const MonitorConfig& config, std::int
 
 void configure_replay_statue_sensor(MonitorConfig& config) {
   config.statue_sensor.present = true;  // refused by a build without the statue sensor
-  if (StatueSensorSettings* statue = statue_settings(config.statue_sensor)) {
+  if (StatueSensorSettings* statue =
+          monitor::built_part<StatueSensorSettings>(config.statue_sensor)) {
     statue->node = 2;
     statue->offset_window_s = config.conditioning.startup_window_s;
     statue->health.stuck_samples = 0;

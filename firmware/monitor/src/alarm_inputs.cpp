@@ -9,6 +9,12 @@ monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& co
   input.time_ns = status.time_ns;
   input.risk = static_cast<Real>(status.risk);
   input.probability = static_cast<Real>(status.probability);
+  if (const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(status.regional)) {
+    input.regional_probability = regional->probability;
+  }
+  if (const auto* pwave = monitor::built_part<monitor::PWaveStatus>(status.pwave)) {
+    input.pwave_probability = status.has_pwave ? pwave->probability : Real(0);
+  }
   for (int i = 0; i < status.axis_count; ++i) {
     const AxisStatus& axis = status.axes[static_cast<std::size_t>(i)];
     const Mode& mode = axis.mode;

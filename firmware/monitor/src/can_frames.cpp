@@ -46,8 +46,10 @@ static_assert(same_number(AlarmCause::kInternalFault, can::AlarmCause::kInternal
 static_assert(same_number(AlarmCause::kCollapseForecast, can::AlarmCause::kCollapseForecast));
 static_assert(same_number(AlarmCause::kNotCalibrated, can::AlarmCause::kNotCalibrated));
 static_assert(same_number(AlarmCause::kOutsideModel, can::AlarmCause::kOutsideModel));
+static_assert(same_number(AlarmCause::kPWave, can::AlarmCause::kPWave));
 static_assert(same_number(AlarmCause::kStatueUnexplained, can::AlarmCause::kStatueUnexplained));
-static_assert(monitor::kAlarmCauseNames.size() == 14);
+static_assert(same_number(AlarmCause::kRegionalAlert, can::AlarmCause::kRegionalAlert));
+static_assert(monitor::kAlarmCauseNames.size() == 16);
 
 // The sensors' status bits (SensorAcceleration.Status): passed through as they are.
 static_assert(monitor::sensor_flags::kSaturated == can::sensor_status::kSaturated);
@@ -79,6 +81,21 @@ can::AlarmCause to_wire(monitor::AlarmCause cause) { return static_cast<can::Ala
 
 monitor::AlarmLevel from_wire(can::AlarmLevel level) {
   return static_cast<monitor::AlarmLevel>(level);
+}
+
+monitor::RegionalAlert regional_alert_of(const can::RegionalAlertOrigin& origin,
+                                         const can::RegionalAlert& alert, double origin_before_s) {
+  monitor::RegionalAlert a;
+  a.event_id = alert.event_id;
+  a.version = alert.version;
+  a.cancelled = origin.cancelled;
+  a.magnitude = static_cast<Real>(origin.magnitude);
+  a.distance_km = static_cast<Real>(origin.distance_km);
+  a.origin_age_s = static_cast<Real>(origin.origin_age_s + origin_before_s);
+  a.pga_g = static_cast<Real>(alert.pga_g);
+  a.sigma_ln = static_cast<Real>(alert.sigma_ln);
+  a.s_arrival_in_s = static_cast<Real>(alert.s_arrival_in_s);
+  return a;
 }
 
 can::MonitorStatus status_message(const BoxStatus& status, int axis, std::uint8_t sequence) {

@@ -126,7 +126,8 @@ Error validate_statue_sensor(const MonitorConfig& c) {
     return {ErrorCode::kOutOfRange, "statue_sensor",
             "this build has no statue sensor (PLINTH_STATUE_SENSOR=OFF)"};
   } else {
-    const StatueSensorSettings& statue = *statue_settings(c.statue_sensor);
+    const StatueSensorSettings& statue =
+        *monitor::built_part<StatueSensorSettings>(c.statue_sensor);
     PLINTH_TRY(validate(statue, c.estimator.sample_period()));
     std::array<SensorConfig, kMaxSensors> sensors{};
     const int count = resolved_sensors(c, sensors);
@@ -140,6 +141,15 @@ Error validate_statue_sensor(const MonitorConfig& c) {
   }
 }
 
+// The P-wave stage's settings at the estimator's sample period (a build without it holds none).
+Error validate_pwave(const MonitorConfig& c) {
+  const monitor::PWaveSettings* configured = monitor::built_part<monitor::PWaveSettings>(c.pwave);
+  if (configured == nullptr || !configured->enabled) return ok_error();
+  monitor::PWaveSettings settings = *configured;
+  settings.sample_period_s = c.estimator.sample_period();
+  return monitor::validate(settings);
+}
+
 }  // namespace
 
 Error validate(const MonitorConfig& c, int* sensor_index) {
@@ -147,6 +157,9 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
   PLINTH_TRY(validate_monitor_fields(c));
   PLINTH_TRY(validate(c.risk));
   PLINTH_TRY(monitor::validate(c.alarm));
+  if (const auto* regional = monitor::built_part<monitor::RegionalAlertSettings>(c.regional)) {
+    PLINTH_TRY(monitor::validate(*regional));
+  }
   // The sensor's period is the estimator's sample period: checked with the values start() uses.
   if (!std::isfinite(c.estimator.sample_rate_hz) || c.estimator.sample_rate_hz < 100.0 ||
       c.estimator.sample_rate_hz > 1000.0) {
@@ -158,6 +171,7 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
                             "redundancy.tolerance_m_s2"));
   PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
                             "plate.window_s", "plate.threshold_m_s2"));
+  PLINTH_TRY(validate_pwave(c));
   PLINTH_TRY(validate_sensors(c, sensor_index));
   return validate_statue_sensor(c);
 }

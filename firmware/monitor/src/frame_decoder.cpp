@@ -13,9 +13,11 @@ void FrameDecoder::start(const MonitorConfig& config) {
   for (int i = 0; i < count_; ++i) {
     nodes_[static_cast<std::size_t>(i)] = sensors[static_cast<std::size_t>(i)].node;
   }
-  const StatueSensorSettings* statue = statue_settings(config.statue_sensor);
+  const StatueSensorSettings* statue =
+      monitor::built_part<StatueSensorSettings>(config.statue_sensor);
   statue_node_ = statue != nullptr && statue->present ? statue->node : -1;
   counters_ = FrameCounters{};
+  have_origin_ = false;
 }
 
 template <typename Message>
@@ -99,11 +101,56 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
       input.statue = sample_of(message, timed.timestamp_ns);
       break;
     }
+    case can::MessageKind::kRegionalAlertOrigin: {
+      if constexpr (!monitor::kRegionalAlertBuiltIn) {
+        ++counters_.unknown_identifiers;
+        break;
+      }
+      can::RegionalAlertOrigin message;
+      have_origin_ = decoded(frame, message);
+      if (have_origin_) {
+        origin_ = message;
+        origin_time_ns_ = timed.timestamp_ns;
+      } else {
+        ++counters_.regional_malformed;
+        input.kind = FrameInput::Kind::kRegionalMalformed;
+        input.malformed_field = counters_.last_error_signal;
+      }
+      break;
+    }
+    case can::MessageKind::kRegionalAlert:
+      if constexpr (!monitor::kRegionalAlertBuiltIn) {
+        ++counters_.unknown_identifiers;
+        break;
+      }
+      decode_regional(timed, input);
+      break;
     case can::MessageKind::kUnknown:
       ++counters_.unknown_identifiers;
       break;
   }
   return input;
+}
+
+void FrameDecoder::decode_regional(const hal::TimedFrame& timed, FrameInput& input) {
+  can::RegionalAlert message;
+  input.kind = FrameInput::Kind::kRegionalMalformed;
+  if (!decoded(timed.frame, message)) {
+    ++counters_.regional_malformed;
+    input.malformed_field = counters_.last_error_signal;
+    return;
+  }
+  const std::int64_t gap_ns = timed.timestamp_ns - origin_time_ns_;
+  if (!have_origin_ || origin_.event_id != message.event_id ||
+      origin_.version != message.version || gap_ns < 0 || gap_ns > kRegionalPairWindowNs) {
+    ++counters_.regional_malformed;
+    input.malformed_field = "RegionalAlertOrigin";  // missing, another alert's, or too old
+    return;
+  }
+  have_origin_ = false;
+  ++counters_.regional_alerts;
+  input.kind = FrameInput::Kind::kRegionalAlert;
+  input.regional = regional_alert_of(origin_, message, static_cast<double>(gap_ns) * 1e-9);
 }
 
 MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::TimedFrame& frame) {
@@ -117,6 +164,10 @@ MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::Timed
       return monitor.on_statue_sample(input.statue);
     case FrameInput::Kind::kStatueAcceleration:
       return monitor.on_statue_acceleration(input.sample);
+    case FrameInput::Kind::kRegionalAlert:
+      return monitor.on_regional_alert(input.regional, frame.timestamp_ns);
+    case FrameInput::Kind::kRegionalMalformed:
+      return monitor.regional_alert_malformed(input.malformed_field);
     case FrameInput::Kind::kNone:
       break;
   }

@@ -37,10 +37,27 @@ Error Monitor::start(const MonitorConfig& config,
   status_.axis_count = config.axis_count;
   PLINTH_TRY(sensors_.start(config_, status_));
   PLINTH_TRY(monitor::AlarmPolicy::create(config_.alarm, alarm_));
+  // The regional alerts' room, its settings and its status: all or none (kRegionalAlertBuiltIn).
+  auto* regional_state = monitor::built_part<monitor::RegionalAlertState>(regional_);
+  if (const auto* regional = monitor::built_part<monitor::RegionalAlertSettings>(config_.regional);
+      regional_state != nullptr && regional != nullptr) {
+    PLINTH_TRY(monitor::RegionalAlertState::create(*regional, *regional_state));
+  }
+  if (monitor::PWaveSettings* pwave = monitor::built_part<monitor::PWaveSettings>(config_.pwave);
+      pwave != nullptr && pwave->enabled) {
+    pwave->sample_period_s = config.estimator.sample_period();
+    if (!pwave->fragility_known) {
+      return {ErrorCode::kInconsistent, "pwave",
+              "needs the statue's fragility (the scene file's [fragility]: median_g, beta)"};
+    }
+    PLINTH_TRY(monitor::PWaveStage::create(*pwave, *pwave_stage()));
+  }
+  status_.has_pwave = pwave_present();
   for (int i = 0; i < config.axis_count; ++i) {
     status_.axes[static_cast<std::size_t>(i)].members = ensemble(i).size();
   }
-  const StatueSensorSettings* statue = statue_settings(config.statue_sensor);
+  const StatueSensorSettings* statue =
+      monitor::built_part<StatueSensorSettings>(config.statue_sensor);
   status_.has_statue_sensor = statue != nullptr && statue->present;
   if (status_.has_statue_sensor) {
     PLINTH_TRY(room().sensor.start(*statue, config.estimator.sample_period()));
@@ -141,6 +158,7 @@ void Monitor::push_ensembles(const Vector3r& g, std::int64_t receive_time_ns) {
       room().filters[k].on_sample(ensembles_[k], {g[i], g.z()}, {room().sensor.axis_rate(i)});
     }
   }
+  if (monitor::PWaveStage* stage = pwave_stage()) (void)stage->update(g);
 }
 
 void Monitor::feed_estimators() {
@@ -154,6 +172,11 @@ void Monitor::feed_estimators() {
           room().filters[static_cast<std::size_t>(i)].reset();
           room().measured[static_cast<std::size_t>(i)] = false;
         }
+      }
+      // The P-wave stage's filters do not connect across the seam either.
+      if (monitor::PWaveStage* stage = pwave_stage()) {
+        stage->restart();
+        (void)stage->update(g);
       }
       ++status_.estimator_restarts;
       status_.estimator_start_ns = in.time_ns - epoch_ns_;
@@ -188,7 +211,7 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   axis.state = statues.nominal().state();
   statues.risk(axis);
   axis.forecast = statues.forecaster().latest();
-  StatueAxisStatus* statue = statue_part<StatueAxisStatus>(axis.statue);
+  StatueAxisStatus* statue = monitor::built_part<StatueAxisStatus>(axis.statue);
   if (statue == nullptr || !statue_present()) return;
   *statue = StatueAxisStatus{};
   if (!room().measured[k]) return;
@@ -214,7 +237,7 @@ void Monitor::update_axes_status() {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
     if (status_.estimating) update_axis(i, axis);
-    if (const StatueAxisStatus* statue = statue_part<StatueAxisStatus>(axis.statue);
+    if (const StatueAxisStatus* statue = monitor::built_part<StatueAxisStatus>(axis.statue);
         statue != nullptr && statue_present()) {
       status_.statue_unexplained = status_.statue_unexplained || statue->unexplained;
     }
@@ -241,6 +264,17 @@ void Monitor::update_axes_status() {
 void Monitor::evaluate(MonitorUpdate& update) {
   sensors_.update_status();
   update_axes_status();
+  auto* regional_state = monitor::built_part<monitor::RegionalAlertState>(regional_);
+  if (auto* shown = monitor::built_part<monitor::RegionalAlertStatus>(status_.regional);
+      regional_state != nullptr && shown != nullptr) {
+    regional_state->tick(status_.time_ns);
+    *shown = regional_state->status();
+  }
+  const monitor::PWaveStage* stage = pwave_stage();
+  if (auto* shown = monitor::built_part<monitor::PWaveStatus>(status_.pwave);
+      stage != nullptr && shown != nullptr) {
+    *shown = stage->status();
+  }
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
@@ -305,7 +339,7 @@ void Monitor::report(MonitorUpdate& update) {
 }
 
 void Monitor::note_statue_health() {
-  if (StatueSensorStatus* s = statue_part<StatueSensorStatus>(status_.statue_sensor)) {
+  if (StatueSensorStatus* s = monitor::built_part<StatueSensorStatus>(status_.statue_sensor)) {
     *s = {room().sensor.rate_health(), room().sensor.acceleration_health(), room().sensor.ready()};
   }
 }
@@ -356,6 +390,36 @@ MonitorUpdate Monitor::acknowledge(const monitor::Acknowledgement& acknowledgeme
   MonitorUpdate update = new_update();
   pending_ack_ = true;
   ack_ = acknowledgement;
+  evaluate(update);
+  return update;
+}
+
+MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert,
+                                         std::int64_t receive_time_ns) {
+  status_.time_ns = monitor_time(receive_time_ns);
+  return on_regional_alert(alert);
+}
+
+MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert) {
+  MonitorUpdate update = new_update();
+  update.regional_received = true;
+  auto* regional_state = monitor::built_part<monitor::RegionalAlertState>(regional_);
+  update.regional =
+      regional_state != nullptr
+          ? regional_state->receive(alert, status_.time_ns)
+          : monitor::RegionalOutcome{monitor::RegionalRefusal::kMalformed,
+                                     monitor::kRegionalAlertNotBuilt};
+  evaluate(update);
+  return update;
+}
+
+MonitorUpdate Monitor::regional_alert_malformed(const char* field) {
+  MonitorUpdate update = new_update();
+  if (auto* regional_state = monitor::built_part<monitor::RegionalAlertState>(regional_)) {
+    regional_state->refuse_malformed(field);
+  }
+  update.regional_received = true;
+  update.regional = {monitor::RegionalRefusal::kMalformed, field};
   evaluate(update);
   return update;
 }

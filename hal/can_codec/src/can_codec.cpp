@@ -70,7 +70,7 @@ enum EventSignal : std::size_t { kLevel, kPreviousLevel, kCause, kLatched, kTime
 constexpr std::array<SignalLayout, 6> kEventSignals{{
     {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
-    {"Cause", 8, 8, false, 1.0, 0.0, 0, 14, "", true, kNoSpecialRaw},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 15, "", true, kNoSpecialRaw},
     {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true, kNoSpecialRaw},
     {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false, kNoSpecialRaw},
     {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
@@ -100,6 +100,34 @@ constexpr std::array<SignalLayout, 6> kForecastSignals{{
     {"CollapseIn", 32, 16, false, 1.0, 0.0, 0, kU16Max - 1, "ms", false, kNoCollapseForecast},
     {"Horizon", 48, 8, false, 0.1, 0.0, 0, kU8Max, "s", false, kNoSpecialRaw},
     {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+}};
+
+// RegionalAlertOrigin (0x361)
+enum OriginSignal : std::size_t {
+  kOrEventId,
+  kOrVersion,
+  kMagnitude,
+  kOriginAge,
+  kDistance,
+  kCancelled
+};
+constexpr std::array<SignalLayout, 6> kOriginSignals{{
+    {"EventId", 0, 16, false, 1.0, 0.0, 0, kU16Max, "", false, kNoSpecialRaw},
+    {"Version", 16, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"Magnitude", 24, 8, false, 0.05, 0.0, 0, 200, "", false, kNoSpecialRaw},
+    {"OriginAge", 32, 16, true, 0.02, 0.0, -32768, 32767, "s", false, kNoSpecialRaw},
+    {"Distance", 48, 12, false, 1.0, 0.0, 0, 4095, "km", false, kNoSpecialRaw},
+    {"Cancelled", 60, 1, false, 1.0, 0.0, 0, 1, "", true, kNoSpecialRaw},
+}};
+
+// RegionalAlert (0x360)
+enum RegionalSignal : std::size_t { kRaEventId, kRaVersion, kPga, kSigmaLn, kSArrivalIn };
+constexpr std::array<SignalLayout, 5> kRegionalSignals{{
+    {"EventId", 0, 16, false, 1.0, 0.0, 0, kU16Max, "", false, kNoSpecialRaw},
+    {"Version", 16, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"Pga", 24, 16, false, 0.0001, 0.0, 0, kU16Max, "g", false, kNoSpecialRaw},
+    {"SigmaLn", 40, 8, false, 0.01, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"SArrivalIn", 48, 16, true, 0.01, 0.0, -32768, 32767, "s", false, kNoSpecialRaw},
 }};
 
 // ---------------------------------------------------------------------------------------------
@@ -233,17 +261,12 @@ class Unpacker {
   CodecResult result_{};
 };
 
-// The AlarmCause VAL_ table has a gap: 13 is issue 26's p_wave, not on the wire yet.
-constexpr bool in_cause_table(AlarmCause cause) {
-  return static_cast<unsigned>(cause) <= 12U || cause == AlarmCause::kStatueUnexplained;
-}
-
 constexpr bool undefined_status_flags(std::uint8_t status) {
   return (status & static_cast<std::uint8_t>(~sensor_status::kDefinedMask)) != 0;
 }
 
 // The DBC message names, without node or axis suffix.
-constexpr NameTable<MessageKind, 7> kMessageKindNames{{{
+constexpr NameTable<MessageKind, 9> kMessageKindNames{{{
     {MessageKind::kSensorAcceleration, "SensorAcceleration"},
     {MessageKind::kSensorHeartbeat, "SensorHeartbeat"},
     {MessageKind::kMonitorStatus, "MonitorStatus"},
@@ -251,6 +274,8 @@ constexpr NameTable<MessageKind, 7> kMessageKindNames{{{
     {MessageKind::kAcknowledge, "Acknowledge"},
     {MessageKind::kCollapseForecast, "CollapseForecast"},
     {MessageKind::kStatueRotation, "StatueRotation"},
+    {MessageKind::kRegionalAlert, "RegionalAlert"},
+    {MessageKind::kRegionalAlertOrigin, "RegionalAlertOrigin"},
 }}};
 
 constexpr NameTable<CodecError, 8> kCodecErrorTexts{{{
@@ -288,6 +313,10 @@ MessageKind classify(std::uint32_t id) {
       return index < kMonitorAxisCount ? MessageKind::kCollapseForecast : MessageKind::kUnknown;
     case kStatueRotationBaseId:
       return index >= kFirstSensorNode ? MessageKind::kStatueRotation : MessageKind::kUnknown;
+    case kRegionalAlertId:
+      return index == 0   ? MessageKind::kRegionalAlert
+             : index == 1 ? MessageKind::kRegionalAlertOrigin
+                          : MessageKind::kUnknown;
     default:
       return MessageKind::kUnknown;
   }
@@ -308,6 +337,8 @@ std::span<const SignalLayout> signal_layouts(MessageKind kind) {
     case MessageKind::kAcknowledge: return kAcknowledgeSignals;
     case MessageKind::kCollapseForecast: return kForecastSignals;
     case MessageKind::kStatueRotation: return kRotationSignals;
+    case MessageKind::kRegionalAlert: return kRegionalSignals;
+    case MessageKind::kRegionalAlertOrigin: return kOriginSignals;
     case MessageKind::kUnknown: break;
   }
   return {};
@@ -496,7 +527,6 @@ EncodeResult encode(const AlarmEvent& message, CanFrame& frame) {
   packer.enumeration(message.level, s[kLevel]);
   packer.enumeration(message.previous_level, s[kPreviousLevel]);
   packer.enumeration(message.cause, s[kCause]);
-  if (!in_cause_table(message.cause)) packer.fail(CodecError::kInvalidEnum, "Cause");
   packer.integer(message.latched ? 1U : 0U, s[kLatched]);
   packer.integer(message.time_since_start_ms, s[kTime]);
   packer.integer(message.sequence, s[kEvSequence]);
@@ -510,7 +540,6 @@ DecodeResult decode(const CanFrame& frame, AlarmEvent& message) {
   m.level = unpacker.enumeration<AlarmLevel>(s[kLevel]);
   m.previous_level = unpacker.enumeration<AlarmLevel>(s[kPreviousLevel]);
   m.cause = unpacker.enumeration<AlarmCause>(s[kCause]);
-  if (!in_cause_table(m.cause)) unpacker.fail(CodecError::kInvalidEnum, "Cause");
   m.latched = unpacker.integer<std::uint8_t>(s[kLatched]) != 0;
   m.time_since_start_ms = unpacker.integer<std::uint32_t>(s[kTime]);
   m.sequence = unpacker.integer<std::uint8_t>(s[kEvSequence]);
@@ -591,6 +620,56 @@ DecodeResult decode(const CanFrame& frame, CollapseForecast& message) {
     const CodecResult agree = contradiction(m, m.probability == 0.0);
     if (!agree.ok()) unpacker.fail(agree.error, agree.signal);
   }
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+EncodeResult encode(const RegionalAlertOrigin& message, CanFrame& frame) {
+  const auto& s = kOriginSignals;
+  Packer packer;
+  packer.integer(message.event_id, s[kOrEventId]);
+  packer.integer(message.version, s[kOrVersion]);
+  packer.physical(message.magnitude, s[kMagnitude]);
+  packer.physical(message.origin_age_s, s[kOriginAge]);
+  packer.integer(message.distance_km, s[kDistance]);
+  packer.integer(message.cancelled ? 1U : 0U, s[kCancelled]);
+  return packer.finish(kRegionalAlertOriginId, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, RegionalAlertOrigin& message) {
+  const auto& s = kOriginSignals;
+  Unpacker unpacker(frame, MessageKind::kRegionalAlertOrigin, s);
+  RegionalAlertOrigin m;
+  m.event_id = unpacker.integer<std::uint16_t>(s[kOrEventId]);
+  m.version = unpacker.integer<std::uint8_t>(s[kOrVersion]);
+  m.magnitude = unpacker.physical(s[kMagnitude]);
+  m.origin_age_s = unpacker.physical(s[kOriginAge]);
+  m.distance_km = unpacker.integer<std::uint16_t>(s[kDistance]);
+  m.cancelled = unpacker.integer<std::uint8_t>(s[kCancelled]) != 0;
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+EncodeResult encode(const RegionalAlert& message, CanFrame& frame) {
+  const auto& s = kRegionalSignals;
+  Packer packer;
+  packer.integer(message.event_id, s[kRaEventId]);
+  packer.integer(message.version, s[kRaVersion]);
+  packer.physical(message.pga_g, s[kPga]);
+  packer.physical(message.sigma_ln, s[kSigmaLn]);
+  packer.physical(message.s_arrival_in_s, s[kSArrivalIn]);
+  return packer.finish(kRegionalAlertId, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, RegionalAlert& message) {
+  const auto& s = kRegionalSignals;
+  Unpacker unpacker(frame, MessageKind::kRegionalAlert, s);
+  RegionalAlert m;
+  m.event_id = unpacker.integer<std::uint16_t>(s[kRaEventId]);
+  m.version = unpacker.integer<std::uint8_t>(s[kRaVersion]);
+  m.pga_g = unpacker.physical(s[kPga]);
+  m.sigma_ln = unpacker.physical(s[kSigmaLn]);
+  m.s_arrival_in_s = unpacker.physical(s[kSArrivalIn]);
   if (unpacker.result().ok()) message = m;
   return unpacker.result();
 }

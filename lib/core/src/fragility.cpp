@@ -15,4 +15,9 @@ Real LognormalFragility::probability(Real pga_g) const {
   return standard_normal_cdf(std::log(pga_g / median_g) / beta);
 }
 
+Real LognormalFragility::probability(Real pga_g, Real sigma_ln) const {
+  return LognormalFragility{median_g, std::sqrt(beta * beta + sigma_ln * sigma_ln)}.probability(
+      pga_g);
+}
+
 }  // namespace plinth

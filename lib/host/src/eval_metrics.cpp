@@ -96,6 +96,11 @@ CrossingGrids default_crossing_grids() {
   return g;
 }
 
+std::vector<double> default_pwave_grid() {
+  return {0.01, 0.02, 0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5,
+          0.55, 0.6, 0.65, 0.7, 0.75, 0.8, 0.85, 0.9, 0.95, 0.99};
+}
+
 const char* false_alarm_name(FalseAlarm definition) {
   return definition == FalseAlarm::kPeak ? "peak" : "margin";
 }
@@ -434,6 +439,11 @@ void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with
     line += ",nominal_risk_ge_";
     line += format(v);
   }
+  if (!grids.pwave.empty()) line += ",p_pick_s,strong_motion_s,pwave_trigger_s";
+  for (double v : grids.pwave) {
+    line += ",pwave_ge_";
+    line += format(v);
+  }
   std::fprintf(out, "%s\n", line.c_str());
 }
 
@@ -460,6 +470,12 @@ void write_eval_csv_row(std::FILE* out, const EvalRun& r) {
   for (double t : r.risk_crossing_s) add(format(t));
   for (double t : r.probability_crossing_s) add(format(t));
   for (double t : r.nominal_risk_crossing_s) add(format(t));
+  if (!r.pwave_crossing_s.empty()) {
+    add(format(r.p_pick_s));
+    add(format(r.strong_motion_s));
+    add(format(r.pwave_trigger_s));
+  }
+  for (double t : r.pwave_crossing_s) add(format(t));
   std::fprintf(out, "%s\n", line.c_str());
 }
 
@@ -486,9 +502,20 @@ EvalTable read_eval_csv(const std::string& path) {
                    std::equal(kGridColumns.begin(), kGridColumns.end(),
                               f.begin() + static_cast<std::ptrdiff_t>(first_extra));
   const std::size_t first_grid = first_extra + (table.has_grid ? kGridColumns.size() : 0);
+  bool pwave_block = false;  // p_pick_s, strong_motion_s, pwave_trigger_s, then pwave_ge_
   for (std::size_t i = first_grid; i < f.size(); ++i) {
     double v = 0.0;
-    if (grid_value(f[i], "risk_ge_", v) && table.grids.probability.empty()) {
+    if (f[i] == "p_pick_s" && !pwave_block && i + 2 < f.size() && f[i + 1] == "strong_motion_s" &&
+        f[i + 2] == "pwave_trigger_s") {
+      pwave_block = true;
+      i += 2;
+    } else if (pwave_block && grid_value(f[i], "pwave_ge_", v)) {
+      table.grids.pwave.push_back(v);
+    } else if (pwave_block) {
+      throw InputError(path + ":1: column " + std::to_string(i + 1) +
+                       ": after the P-wave columns only pwave_ge_ columns may come, got \"" +
+                       f[i] + "\"");
+    } else if (grid_value(f[i], "risk_ge_", v) && table.grids.probability.empty()) {
       table.grids.risk.push_back(v);
     } else if (grid_value(f[i], "probability_ge_", v) && nominal_grid.empty()) {
       table.grids.probability.push_back(v);
@@ -501,6 +528,9 @@ EvalTable read_eval_csv(const std::string& path) {
   }
   if (nominal_grid != table.grids.risk) {
     throw InputError(path + ":1: the nominal_risk_ge_ columns must repeat the risk_ge_ grid");
+  }
+  if (pwave_block && table.grids.pwave.empty()) {
+    throw InputError(path + ":1: the P-wave columns need their pwave_ge_ columns");
   }
   const std::size_t columns = f.size();
   for (std::size_t n = 2; std::getline(in, line); ++n) {
@@ -570,6 +600,14 @@ EvalTable read_eval_csv(const std::string& path) {
     }
     for (std::size_t i = 0; i < table.grids.risk.size(); ++i, ++c) {
       r.nominal_risk_crossing_s.push_back(parse_time(f[c], where, "nominal risk crossing"));
+    }
+    if (pwave_block) {
+      r.p_pick_s = parse_time(f[c++], where, "p_pick_s");
+      r.strong_motion_s = parse_time(f[c++], where, "strong_motion_s");
+      r.pwave_trigger_s = parse_time(f[c++], where, "pwave_trigger_s");
+      for (std::size_t i = 0; i < table.grids.pwave.size(); ++i, ++c) {
+        r.pwave_crossing_s.push_back(parse_time(f[c], where, "P-wave crossing"));
+      }
     }
     table.runs.push_back(std::move(r));
   }

@@ -106,9 +106,9 @@ class Loader {
   // The scene a document describes; its [uncertainty] table, if any, is another reader's.
   Scene load(const toml::table& doc) {
     SceneParams params;
-    static constexpr std::array<std::string_view, 8> kTopLevel{
+    static constexpr std::array<std::string_view, 9> kTopLevel{
         "gravity", "block", "base", "friction", "base_stops", "support", "sliding_stops",
-        "uncertainty"};
+        "uncertainty", "fragility"};
     check_keys(doc, "", kTopLevel);
     if (std::optional<Number> g = number(doc, "", "gravity")) {
       params.gravity = g->value;
@@ -126,6 +126,23 @@ class Loader {
     Scene scene;
     if (const Error error = make_scene(params, scene); !error.ok()) report(error);
     return scene;
+  }
+
+  // The [fragility] table: the statue's lognormal collapse fragility in PGA.
+  std::optional<LognormalFragility> read_fragility(const toml::table& doc) const {
+    const toml::table* tbl = table(doc, "fragility");
+    if (tbl == nullptr) return std::nullopt;
+    static constexpr std::array<std::string_view, 2> kKeys{"median_g", "beta"};
+    check_keys(*tbl, "fragility", kKeys);
+    const Number median = required(*tbl, "fragility", "median_g");
+    const Number beta = required(*tbl, "fragility", "beta");
+    if (!std::isfinite(median.value) || median.value <= 0.0) {
+      fail(median.line, median.key, "must be a PGA above 0 g (got " + format_number(median.value) + ")");
+    }
+    if (!std::isfinite(beta.value) || beta.value < 0.0) {
+      fail(beta.line, beta.key, "must be a dispersion of 0 or more (got " + format_number(beta.value) + ")");
+    }
+    return LognormalFragility{static_cast<Real>(median.value), static_cast<Real>(beta.value)};
   }
 
   // The [uncertainty] table: sub-tables named as the scene's, each key as in its table with a
@@ -568,6 +585,7 @@ UncertainScene load_uncertain_scene_text(const std::string& text, const std::str
   out.origin_ = origin;
   out.nominal = loader.load(doc);
   out.uncertain = loader.read_uncertainty(doc);
+  out.fragility = loader.read_fragility(doc);
   const int d = static_cast<int>(out.uncertain.size());
   std::vector<DesignPoint> points(static_cast<std::size_t>(design_point_count(d)));
   points.resize(static_cast<std::size_t>(two_level_design(d, points)));

@@ -26,6 +26,8 @@ Error check_thresholds(const RiskThresholds& t, const char* on_field, const char
   }
   return ok_error();
 }
+// A warning-only input's thresholds in a build without its part: nothing to check.
+[[maybe_unused]] Error check_thresholds(NotBuilt, const char*, const char*) { return ok_error(); }
 
 // A level's thresholds must not lie below those of the level beneath it.
 Error check_order(const RiskThresholds& lower, const RiskThresholds& upper, const char* on_field,
@@ -45,6 +47,8 @@ Error check_order(const RiskThresholds& lower, const RiskThresholds& upper, cons
 bool above(const detail::HeldCondition& held, const RiskThresholds& t, Real value) {
   return value >= (held.active ? t.off : t.on);
 }
+// A warning-only input in a build without its part: never.
+constexpr bool above(const detail::HeldCondition&, NotBuilt, Real) { return false; }
 
 bool valid_fraction(Real v) { return std::isfinite(v) && v >= Real(0) && v <= Real(1); }
 
@@ -67,6 +71,11 @@ void detail::HeldCondition::update(bool wanted, std::int64_t now_ns, std::int64_
 }
 
 Error validate(const AlarmPolicySettings& s) {
+  // The warning-only inputs' thresholds (none to check in a build without their part).
+  PLINTH_TRY(check_thresholds(s.warning_pwave, "alarm_policy.warning_pwave.on",
+                              "alarm_policy.warning_pwave.off"));
+  PLINTH_TRY(check_thresholds(s.warning_regional, "alarm_policy.warning_regional.on",
+                              "alarm_policy.warning_regional.off"));
   return detail::first_error({
       check_thresholds(s.advisory, "alarm_policy.advisory.on", "alarm_policy.advisory.off"),
       check_thresholds(s.warning, "alarm_policy.warning.on", "alarm_policy.warning.off"),
@@ -124,9 +133,15 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
     const bool warning_forecast = above(warning_, settings_.warning_forecast, in.probability);
     const bool alarm_risk = above(alarm_, settings_.alarm, in.risk);
     const bool alarm_forecast = above(alarm_, settings_.alarm_forecast, in.probability);
-    const bool warning = warning_risk || warning_forecast;
+    const bool warning_pwave = above(warning_, settings_.warning_pwave, in.pwave_probability);
+    const bool warning_regional =
+        above(warning_, settings_.warning_regional, in.regional_probability);
+    const bool warning = warning_risk || warning_forecast || warning_pwave || warning_regional;
     const bool alarm = alarm_risk || alarm_forecast;
     warning_by_forecast_ = warning_forecast && !warning_risk;
+    warning_by_pwave_ = warning_pwave && !warning_risk && !warning_forecast;
+    warning_by_regional_ =
+        warning_regional && !warning_risk && !warning_forecast && !warning_pwave;
     alarm_by_forecast_ = alarm_forecast && !alarm_risk;
     advisory_.update(advisory, in.time_ns, raise_hold_ns_, lower_hold_ns_);
     warning_.update(warning, in.time_ns, raise_hold_ns_, lower_hold_ns_);
@@ -164,10 +179,7 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   }
   if (latch != AlarmLevel::kNormal && rank(latch) >= rank(latched_level_)) {
     latched_level_ = latch;
-    const bool by_forecast = latch == AlarmLevel::kAlarm ? alarm_by_forecast_ : warning_by_forecast_;
-    latched_cause_ = collapse_began ? AlarmCause::kOverturnDetected
-                     : by_forecast  ? AlarmCause::kCollapseForecast
-                                    : AlarmCause::kRiskThreshold;
+    latched_cause_ = collapse_began ? AlarmCause::kOverturnDetected : condition_cause(latch);
   }
 }
 
@@ -192,11 +204,21 @@ AlarmCause AlarmPolicy::cause_of(AlarmLevel level) const {
       if (collapse_) return AlarmCause::kOverturnDetected;
       // Held by its latch alone: the cause it latched with.
       if (rank(condition_level_) < rank(level) && latched_level_ == level) return latched_cause_;
-      return (level == AlarmLevel::kAlarm ? alarm_by_forecast_ : warning_by_forecast_)
-                 ? AlarmCause::kCollapseForecast
-                 : AlarmCause::kRiskThreshold;
+      return condition_cause(level);
   }
   return AlarmCause::kNone;
+}
+
+// Which signal holds the warning or alarm condition: the risk, else the forecast, else (warning
+// only) the P wave measured on site, else the regional alert.
+AlarmCause AlarmPolicy::condition_cause(AlarmLevel level) const {
+  if (level == AlarmLevel::kAlarm) {
+    return alarm_by_forecast_ ? AlarmCause::kCollapseForecast : AlarmCause::kRiskThreshold;
+  }
+  if (warning_by_forecast_) return AlarmCause::kCollapseForecast;
+  if (kPWaveStageBuiltIn && warning_by_pwave_) return AlarmCause::kPWave;
+  return kRegionalAlertBuiltIn && warning_by_regional_ ? AlarmCause::kRegionalAlert
+                                                       : AlarmCause::kRiskThreshold;
 }
 
 void AlarmPolicy::emit_if_changed(AlarmOutput& out, std::int64_t time_ns,
@@ -238,7 +260,10 @@ AlarmOutput AlarmPolicy::update(const AlarmInput& in) {
       out.acknowledgement = acknowledge(in.acknowledgement);
       emit_if_changed(out, in.time_ns, true);
     }
-    const bool risk_valid = valid_fraction(in.risk) && valid_fraction(in.probability);
+    const bool risk_valid =
+        valid_fraction(in.risk) && valid_fraction(in.probability) &&
+        (!kPWaveStageBuiltIn || valid_fraction(in.pwave_probability)) &&
+        (!kRegionalAlertBuiltIn || valid_fraction(in.regional_probability));
     if (!risk_valid) out.input_problem = InputProblem::kRiskInvalid;
     evaluate_conditions(in, risk_valid);
     emit_if_changed(out, in.time_ns, false);

@@ -7,6 +7,7 @@
 
 #include "plinth/core/checks.h"
 #include "plinth/core/error.h"
+#include "plinth/core/fragility.h"
 #include "plinth/core/real.h"
 
 namespace plinth::monitor::detail {
@@ -28,6 +29,19 @@ inline constexpr std::int64_t kNanosecondsPerSecond = 1'000'000'000;
   }
   if (seconds > kMaxDurationS) {
     return {ErrorCode::kOutOfRange, field, "must not exceed 1e6 s", kMaxDurationS};
+  }
+  return ok_error();
+}
+
+// A statue's fragility (the scene's [fragility], "fragility.median_g" and "fragility.beta"):
+// median_g finite and > 0, beta finite and >= 0 (0: a step at the median).
+[[nodiscard]] inline Error check_fragility(const LognormalFragility& fragility) {
+  PLINTH_TRY(check_positive(fragility.median_g, "fragility.median_g"));
+  if (!std::isfinite(fragility.beta)) {
+    return {ErrorCode::kNotFinite, "fragility.beta", "must be finite"};
+  }
+  if (fragility.beta < Real(0)) {
+    return {ErrorCode::kOutOfRange, "fragility.beta", "must not be negative", 0.0};
   }
   return ok_error();
 }

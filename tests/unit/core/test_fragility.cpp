@@ -35,5 +35,31 @@ TEST(Fragility, HalfTheStatuesFallAtTheMedianAndOneSigmaAboveIsPhiOfOne) {
   EXPECT_EQ(step.probability(1.2), 1.0);
 }
 
+// A guessed PGA: the curve under the guess's scatter, the dispersions in quadrature. Checked
+// against the integral of the curve over the guess's lognormal density (midpoint rule in ln PGA).
+TEST(LognormalFragility, UnderAGuessesScatterIsTheCurveIntegratedOverIt) {
+  const LognormalFragility f{0.6, 0.4};
+  for (const double sigma : {0.0, 0.3, 0.65}) {
+    for (const double guess : {0.2, 0.6, 1.5}) {
+      double integral = 0.0;
+      if (sigma == 0.0) {
+        integral = f.probability(guess);
+      } else {
+        constexpr int kSteps = 4000;
+        const double dz = 16.0 / kSteps;  // z in [-8, 8]
+        for (int i = 0; i < kSteps; ++i) {
+          const double z = -8.0 + (i + 0.5) * dz;
+          const double density = std::exp(-0.5 * z * z) / std::sqrt(2.0 * 3.14159265358979323846);
+          integral += f.probability(guess * std::exp(sigma * z)) * density * dz;
+        }
+      }
+      EXPECT_NEAR(f.probability(guess, sigma), integral, 1e-6) << guess << " " << sigma;
+    }
+  }
+  // A median guess at the curve's median: one half, whatever the scatter.
+  EXPECT_DOUBLE_EQ(f.probability(0.6, 0.7), 0.5);
+  EXPECT_EQ(f.probability(0.0, 0.5), 0.0);
+}
+
 }  // namespace
 }  // namespace plinth

@@ -42,6 +42,15 @@ TEST(AlarmInputs, RiskProbabilityAndTimeAreTheStatussOwn) {
 }
 
 // Motion and collapse of any modelled axis; an axis beyond axis_count is not modelled.
+// The regional room's probability of collapse under its worst held alert (regional_alert.h).
+TEST(AlarmInputs, TheRegionalProbabilityIsTheRegionalRooms) {
+  BoxStatus s = healthy();
+  EXPECT_EQ(alarm_input(s, MonitorConfig{}, false).regional_probability, Real(0));
+  s.regional.held = 1;
+  s.regional.probability = Real(0.75);
+  EXPECT_EQ(alarm_input(s, MonitorConfig{}, false).regional_probability, Real(0.75));
+}
+
 TEST(AlarmInputs, MotionAndCollapseOfAnyModelledAxis) {
   BoxStatus s = healthy();
   s.axes[1].mode.phase = Phase::kOverturned;

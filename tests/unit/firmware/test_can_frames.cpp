@@ -64,6 +64,10 @@ std::string domain_name(const std::string& signal, unsigned raw) {
     }
   } else if (signal == "Latched") {
     return raw == 0 ? "not_latched" : "latched";  // a flag: the DBC names its two values
+  } else if (signal == "Cancelled") {
+    can::RegionalAlertOrigin origin;
+    origin.cancelled = raw != 0;
+    return regional_alert_of(origin, can::RegionalAlert{}, 0.0).cancelled ? "cancelled" : "alert";
   } else if (signal == "WorstMember" || signal == "CollapseIn") {
     BoxStatus s;  // a forecast in which no member collapses
     s.axes[0].forecast.valid = true;
@@ -95,6 +99,32 @@ TEST(CanFrames, TheDbcsValueNamesAreTheDomainNames) {
     EXPECT_EQ(table.size(), values);
   }
   EXPECT_GT(tables, 5);  // MonitorStatus x2 (Phase, Corner, AlarmLevel), AlarmEvent, Acknowledge
+}
+
+// A regional alert's two frames: every field, the origin's age counted from the alert frame.
+TEST(CanFrames, ARegionalAlertsFramesMakeOneAlert) {
+  can::RegionalAlertOrigin o;
+  o.event_id = 300;
+  o.version = 4;
+  o.magnitude = 6.85;
+  o.origin_age_s = 7.5;
+  o.distance_km = 95;
+  can::RegionalAlert a;
+  a.event_id = 300;
+  a.version = 4;
+  a.pga_g = 0.25;
+  a.sigma_ln = 0.7;
+  a.s_arrival_in_s = 12.3;
+  const monitor::RegionalAlert r = regional_alert_of(o, a, 0.02);
+  EXPECT_EQ(r.event_id, 300U);
+  EXPECT_EQ(r.version, 4U);
+  EXPECT_FALSE(r.cancelled);
+  EXPECT_DOUBLE_EQ(r.magnitude, 6.85);
+  EXPECT_DOUBLE_EQ(r.distance_km, 95.0);
+  EXPECT_DOUBLE_EQ(r.origin_age_s, 7.52);
+  EXPECT_DOUBLE_EQ(r.pga_g, 0.25);
+  EXPECT_DOUBLE_EQ(r.sigma_ln, 0.7);
+  EXPECT_DOUBLE_EQ(r.s_arrival_in_s, 12.3);
 }
 
 TEST(CanFrames, AlarmEventsKeepTheirFieldsAndWrapTheirMilliseconds) {

@@ -146,5 +146,51 @@ TEST(FrameDecoder, OtherFramesAreNoInputAndCounted) {
   EXPECT_EQ(decoder.counters().received, 0U);
 }
 
+// A regional alert is its RegionalAlertOrigin then its RegionalAlert frame (same event and
+// version, within 100 ms); an alert frame without its origin frame is a malformed alert.
+TEST(FrameDecoder, ARegionalAlertIsItsTwoFrames) {
+  FrameDecoder decoder;
+  decoder.start(two_sensors());
+  can::RegionalAlertOrigin origin;
+  origin.event_id = 77;
+  origin.version = 2;
+  origin.magnitude = 7.0;
+  origin.origin_age_s = 10.0;
+  origin.distance_km = 120;
+  can::RegionalAlert alert;
+  alert.event_id = 77;
+  alert.version = 2;
+  alert.pga_g = 0.3;
+  alert.sigma_ln = 0.6;
+  alert.s_arrival_in_s = 20.0;
+  EXPECT_EQ(decoder.decode({encoded(origin), 1000 * kMs}).kind, FrameInput::Kind::kNone);
+  const FrameInput in = decoder.decode({encoded(alert), 1020 * kMs});
+  ASSERT_EQ(in.kind, FrameInput::Kind::kRegionalAlert);
+  EXPECT_EQ(in.regional.event_id, 77U);
+  EXPECT_NEAR(in.regional.origin_age_s, 10.02, 1e-9);
+  EXPECT_NEAR(in.regional.pga_g, 0.3, 1e-12);
+  // The origin frame is used once: the same alert frame again has none.
+  FrameInput again = decoder.decode({encoded(alert), 1030 * kMs});
+  EXPECT_EQ(again.kind, FrameInput::Kind::kRegionalMalformed);
+  EXPECT_STREQ(again.malformed_field, "RegionalAlertOrigin");
+  // Another event's origin, and an origin too long before.
+  can::RegionalAlertOrigin other = origin;
+  other.event_id = 78;
+  (void)decoder.decode({encoded(other), 2000 * kMs});
+  EXPECT_EQ(decoder.decode({encoded(alert), 2001 * kMs}).kind,
+            FrameInput::Kind::kRegionalMalformed);
+  (void)decoder.decode({encoded(origin), 3000 * kMs});
+  EXPECT_EQ(decoder.decode({encoded(alert), 3101 * kMs}).kind,
+            FrameInput::Kind::kRegionalMalformed);
+  // A frame the codec refuses (a magnitude raw above 200): malformed, naming the signal.
+  can::CanFrame bad = encoded(origin);
+  bad.data[3] = 250;
+  const FrameInput refused = decoder.decode({bad, 4000 * kMs});
+  EXPECT_EQ(refused.kind, FrameInput::Kind::kRegionalMalformed);
+  EXPECT_STREQ(refused.malformed_field, "Magnitude");
+  EXPECT_EQ(decoder.counters().regional_alerts, 1U);
+  EXPECT_EQ(decoder.counters().regional_malformed, 4U);
+}
+
 }  // namespace
 }  // namespace plinth::firmware

@@ -27,8 +27,8 @@ TEST(ModbusMap, TheShippedCsvIsTheCodesMap) {
 
 TEST(ModbusMap, EveryCauseHasItsCodeInTheCsv) {
   const std::string csv = map_csv();
-  EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model;"
-                     "14=statue_unexplained\""),
+  EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model;13=p_wave;"
+                     "14=statue_unexplained;15=regional_alert\""),
             std::string::npos);
   EXPECT_NE(csv.find("4=overturned;5=fell;6=lifted_off\""), std::string::npos);
   EXPECT_NE(csv.find("\"0=normal;1=advisory;2=warning;3=alarm;4=fault\""), std::string::npos);
@@ -40,7 +40,9 @@ TEST(ModbusMap, CodesArePinned) {
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kCollapseForecast), 10);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kNotCalibrated), 11);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kOutsideModel), 12);
+  EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kPWave), 13);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kStatueUnexplained), 14);
+  EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kRegionalAlert), 15);
   EXPECT_EQ(kAlarmLevelCodes.code(monitor::AlarmLevel::kFault), 4);
   EXPECT_EQ(kPhaseCodes.code(Phase::kFell), 5);
   EXPECT_EQ(kPhaseCodes.code(Phase::kLiftedOff), 6);
@@ -92,7 +94,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 5);
+  EXPECT_EQ(at(reg::kMapVersion), 6);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";
@@ -112,7 +114,7 @@ TEST(ModbusMap, TheStatueSensorsRegisters) {
   for (int r = reg::kStatueRateHealth; r <= reg::kStatueEffectiveMembersY; ++r) {
     EXPECT_EQ(at(r), kNone) << r;
   }
-  EXPECT_EQ(reg::kStatueRateHealth, 102) << "after 86-101, the regional alert's (issue 26)";
+  EXPECT_EQ(reg::kStatueRateHealth, 102) << "after 86-101, the regional alerts'";
   EXPECT_EQ(reg::kCount, 109);
   s.has_statue_sensor = true;
   s.axis_count = 1;
@@ -139,16 +141,16 @@ TEST(ModbusMap, TheStatueSensorsRegisters) {
   s.statue_axes[1].measured = false;
   fill(s, 0, image);
   EXPECT_EQ(at(reg::kStatueWeightsY), 0) << "not measured";
-  // The registers reserved for the regional alert read kNone, and no point of the map is there.
-  for (int r = reg::kRegionalReserved; r < reg::kStatueRateHealth; ++r) {
-    EXPECT_EQ(at(r), kNone) << r;
-  }
+  // Map 6: the regional alerts' registers (86-101) end where the statue sensor's begin, and
+  // every register up to reg::kCount is one point's (5 had 86-101 reserved on main).
+  EXPECT_EQ(reg::kRegionalHeld, 86);
+  EXPECT_EQ(reg::kRegionalLastRefusal + 1, reg::kStatueRateHealth);
+  std::array<int, reg::kCount> owners{};
   for (const Point& p : points()) {
     if (p.table != Table::kRegister) continue;
-    EXPECT_TRUE(p.address + p.words <= reg::kRegionalReserved ||
-                p.address >= reg::kRegionalReserved + reg::kRegionalReservedWords)
-        << p.name;
+    for (int r = p.address; r < p.address + p.words; ++r) ++owners[static_cast<std::size_t>(r)];
   }
+  for (int r = 0; r < reg::kCount; ++r) EXPECT_EQ(owners[static_cast<std::size_t>(r)], 1) << r;
 }
 
 std::uint64_t read64(const Image& image, int address) {

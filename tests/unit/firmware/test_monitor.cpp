@@ -431,5 +431,64 @@ void quiet_then_quake(double quiet_s) {
 
 TEST(Monitor, QuietThenQuakeFiveMinutes) { quiet_then_quake(300.0); }
 
+// A regional alert through the monitor: as the bus's frames and as a call (MQTT's), the same
+// update; warning with cause regional_alert while quiet; the time to the S arrival counts down
+// with the samples; the alert expires and the warning stays latched.
+TEST(Monitor, ARegionalAlertRaisesWarningAndExpires) {
+  const Scene scene = testing::make(testing::paper_isolated(0.0));
+  fw::MonitorConfig config = quick_config();
+  config.regional.fragility_known = true;
+  config.regional.fragility = {0.6, 0.5};
+  config.regional.expiry_margin_s = 1.0;
+  fw::Monitor by_frame;
+  fw::Monitor by_call;
+  ASSERT_TRUE(by_frame.start(config, {&scene, nullptr}).ok());
+  ASSERT_TRUE(by_call.start(config, {&scene, nullptr}).ok());
+  fw::FrameDecoder decoder;
+  decoder.start(config);
+  std::int64_t t = 0;
+  const auto quiet = [&](int samples) {
+    for (int n = 0; n < samples; ++n) {
+      const auto sequence = static_cast<std::uint8_t>((t / ns(0.005)) & 0xFF);
+      const can::CanFrame f = sensor_frame(1, sequence, 0.0);
+      (void)fw::on_frame(by_frame, decoder, {f, t});
+      (void)by_call.on_sample({t, sequence, 0, Eigen::Vector3d(0.0, 0.0, 1.0)});
+      t += ns(0.005);
+    }
+  };
+  quiet(800);  // 4 s: calibrated, the start-up fault cleared (lower_hold_s 2 s), normal
+  ASSERT_EQ(by_call.status().alarm, monitor::AlarmLevel::kNormal);
+  // M 5 at 30 km, 1.2 g expected (sigma 0.5), S in 2 s.
+  can::RegionalAlertOrigin origin{9, 1, 5.0, 3.0, 30, false};
+  can::RegionalAlert alert{9, 1, 1.2, 0.5, 2.0};
+  can::CanFrame fo;
+  can::CanFrame fa;
+  ASSERT_TRUE(can::encode(origin, fo).ok());
+  ASSERT_TRUE(can::encode(alert, fa).ok());
+  (void)fw::on_frame(by_frame, decoder, {fo, t - ns(0.001)});
+  const fw::MonitorUpdate from_frame = fw::on_frame(by_frame, decoder, {fa, t - ns(0.001)});
+  const fw::MonitorUpdate from_call =
+      by_call.on_regional_alert(monitor::RegionalAlert{9, 1, false, 5.0, 30.0, 3.0, 1.2, 0.5, 2.0});
+  for (const fw::MonitorUpdate* u : {&from_frame, &from_call}) {
+    EXPECT_TRUE(u->regional_received);
+    EXPECT_TRUE(u->regional.accepted());
+    ASSERT_EQ(u->event_count, 1U);
+    EXPECT_EQ(u->events[0].level, monitor::AlarmLevel::kWarning);
+    EXPECT_EQ(u->events[0].cause, monitor::AlarmCause::kRegionalAlert);
+    // Phi(ln(1.2 / 0.6) / sqrt(0.5^2 + 0.5^2)) = 0.8365
+    EXPECT_NEAR(u->status->regional.probability, 0.8365, 1e-4);
+    EXPECT_NEAR(u->status->regional.time_to_s_arrival_s, 2.0, 1e-3);
+  }
+  quiet(200);  // 1 s
+  EXPECT_NEAR(by_call.status().regional.time_to_s_arrival_s, 1.0, 0.01);
+  // Expiry: S arrival (2 s) + M 5's 1.1 s at 30 km (+1.5 s) + the 1 s margin = 5.6 s after.
+  quiet(1000);
+  EXPECT_EQ(by_call.status().regional.held, 0);
+  EXPECT_EQ(by_frame.status().regional.held, 0);
+  EXPECT_EQ(by_call.status().regional.expired, 1U);
+  EXPECT_EQ(by_call.status().alarm, monitor::AlarmLevel::kWarning);  // latched
+  EXPECT_EQ(by_call.status().latched, monitor::AlarmLevel::kWarning);
+}
+
 }  // namespace
 }  // namespace plinth

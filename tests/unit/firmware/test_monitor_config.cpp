@@ -55,6 +55,66 @@ TEST(MonitorConfigFile, TheForecastsKeys) {
             std::string::npos);
 }
 
+// [pwave] (docs/monitor.md): absent, the stage is off; present, on with its keys, the channel's
+// fitted table unless it gives one; every bad value named with its key, line and limit.
+TEST(MonitorConfigFile, ThePWaveTable) {
+  if (!monitor::kPWaveStageBuiltIn) {
+    EXPECT_NE(box_file_error("[pwave]\n").find("PLINTH_PWAVE_STAGE=OFF"), std::string::npos);
+    return;
+  }
+  const auto pwave = [](const MonitorFile& f) {
+    return *monitor::built_part<monitor::PWaveSettings>(f.config.pwave);
+  };
+  EXPECT_FALSE(load_monitor_text("", "/etc/plinth/box.toml", MonitorConfig{}).config.pwave.enabled);
+  const MonitorFile empty = load_monitor_text("[pwave]\n", "/etc/plinth/box.toml", MonitorConfig{});
+  EXPECT_TRUE(pwave(empty).enabled);
+  EXPECT_EQ(pwave(empty).channel, monitor::PWaveChannel::kVertical);
+  EXPECT_EQ(pwave(empty).predictor[0].ln_pga_over_pa, monitor::kDefaultVerticalPredictor[0].ln_pga_over_pa);
+  // A horizontal box takes the horizontal table.
+  const MonitorFile h = load_monitor_text("[pwave]\nchannel = \"horizontal\"\nhold_s = 20\n"
+                                          "[alarm_policy]\nwarning_pwave = { on = 0.7, off = 0.5 }\n",
+                                          "/etc/plinth/box.toml", MonitorConfig{});
+  EXPECT_EQ(pwave(h).channel, monitor::PWaveChannel::kHorizontal);
+  EXPECT_EQ(pwave(h).predictor[3].sigma_ln, monitor::kDefaultHorizontalPredictor[3].sigma_ln);
+  EXPECT_EQ(pwave(h).hold_s, 20.0);
+  EXPECT_EQ(h.config.alarm.warning_pwave.on, 0.7);
+  // The table plinth-eval pwave-fit prints.
+  const MonitorFile fitted = load_monitor_text(
+      "[pwave]\nchannel = \"vertical\"\npredictor = [\n"
+      "  { window_s = 0.5, ln_pga_over_pa = 3.1, tau_c_exponent = 0.0, sigma_ln = 0.65 },\n"
+      "  { window_s = 1.0, ln_pga_over_pa = 2.7, tau_c_exponent = 0.1, sigma_ln = 0.8 },\n]\n",
+      "/etc/plinth/box.toml", MonitorConfig{});
+  EXPECT_EQ(pwave(fitted).predictor_points, 2U);
+  EXPECT_EQ(pwave(fitted).predictor[1].tau_c_exponent, 0.1);
+  EXPECT_EQ(pwave(fitted).predictor[1].sigma_ln, 0.8);
+
+  const auto refused = [](const std::string& text, const std::string& message) {
+    const std::string error = box_file_error(text);
+    EXPECT_NE(error.find(message), std::string::npos) << text << " gave: " << error;
+  };
+  refused("[pwave]\nsta_s = 12\n", "box.toml:2: pwave.sta_s: must be shorter than pwave.lta_s (limit 10)");
+  refused("[pwave]\n\nlowpass_hz = 150\n", "box.toml:3: pwave.lowpass_hz: must be below half the sample rate (limit 100)");
+  refused("[pwave]\ntrigger_ratio = -1\n", "box.toml:2: pwave.trigger_ratio: must be greater than zero");
+  refused("[pwave]\ntrigger_ratio = 1\n", "pwave.trigger_ratio: must exceed 1 (limit 1)");
+  refused("[pwave]\nchannel = \"diagonal\"\n",
+          "box.toml:2: pwave.channel: expected \"vertical\" or \"horizontal\", got \"diagonal\"");
+  refused("[pwave]\nhold_s = \"long\"\n", "box.toml:2: pwave.hold_s: expected a number");
+  refused("[pwave]\nenabled = true\n", "box.toml:2: pwave.enabled: unknown key");
+  refused("[pwave]\npredictor = 3\n", "pwave.predictor: expected an array of tables");
+  refused("[pwave]\npredictor = []\n", "pwave.predictor: must have 1 to 8 points, has 0");
+  refused("[pwave]\npredictor = [\n { window_s = 0.5, ln_pga_over_pa = 3, sigma_ln = 0.6 },\n"
+          " { window_s = 1.0, ln_pga_over_pa = 2, sigma_ln = -1 },\n]\n",
+          "pwave.predictor[1].sigma_ln: must be greater than zero");
+  refused("[pwave]\npredictor = [\n { window_s = 1.0, ln_pga_over_pa = 3, sigma_ln = 0.6 },\n"
+          " { window_s = 0.5, ln_pga_over_pa = 2, sigma_ln = 0.6 },\n]\n",
+          "pwave.predictor[1].window_s: must increase from point to point (limit 1)");
+  refused("[pwave]\npredictor = [ { window_s = 0.5, sigma_ln = 0.6 } ]\n",
+          "pwave.predictor[0]: no ln_pga_over_pa");
+  refused("[pwave]\npredictor = [ { window_s = 0.5, ln_pga_over_pa = 3, sigma_ln = 0.6, c2 = 1 } ]\n",
+          "pwave.predictor[0].c2: unknown key");
+  refused("[alarm_policy]\nwarning_pwave.on = 1.5\n", "alarm_policy.warning_pwave.on");
+}
+
 TEST(MonitorConfigFile, ValuesOverTheDefaults) {
   const MonitorFile f = load_monitor_text(
       "[estimator]\nsample_rate_hz = 1000\nsteps_per_sample = 2\nstepper = \"heun_located\"\n"

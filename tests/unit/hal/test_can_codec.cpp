@@ -12,6 +12,7 @@
 #include <random>
 #include <set>
 #include <sstream>
+#include <string_view>
 #include <string>
 #include <vector>
 
@@ -184,6 +185,68 @@ TEST(CanGolden, AlarmEvent) {
   EXPECT_TRUE(d.latched);
   EXPECT_EQ(d.time_since_start_ms, 0xDEADBEEFU);
   EXPECT_EQ(d.sequence, 0x42);
+}
+
+TEST(CanGolden, RegionalAlert) {
+  // Identifier 0x360. EventId 0|16 = 0x1234 -> 34 12; Version 16|8 = 5 -> 05;
+  // Pga 24|16 (0.0001 g): 0.4 g = 4000 = 0x0FA0 -> A0 0F; SigmaLn 40|8 (0.01): 0.6 = 60 -> 3C;
+  // SArrivalIn 48|16 signed (0.01 s): -1.5 s = -150 = 0xFF6A -> 6A FF.
+  const Bytes golden{0x34, 0x12, 0x05, 0xA0, 0x0F, 0x3C, 0x6A, 0xFF};
+  RegionalAlert m;
+  m.event_id = 0x1234;
+  m.version = 5;
+  m.pga_g = 0.4;
+  m.sigma_ln = 0.6;
+  m.s_arrival_in_s = -1.5;
+  RegionalAlert d;
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x360, golden, d));
+  EXPECT_EQ(d.event_id, 0x1234);
+  EXPECT_EQ(d.version, 5);
+  EXPECT_NEAR(d.pga_g, 0.4, 1e-12);
+  EXPECT_NEAR(d.sigma_ln, 0.6, 1e-12);
+  EXPECT_NEAR(d.s_arrival_in_s, -1.5, 1e-12);
+  // Beyond the ranges: refused, never clamped.
+  CanFrame f;
+  m.s_arrival_in_s = 400.0;
+  EXPECT_STREQ(encode(m, f).signal, "SArrivalIn");
+  m.s_arrival_in_s = 0.0;
+  m.pga_g = -0.1;
+  EXPECT_STREQ(encode(m, f).signal, "Pga");
+  m.pga_g = 0.1;
+  m.sigma_ln = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(encode(m, f).error, CodecError::kNotFinite);
+}
+
+TEST(CanGolden, RegionalAlertOrigin) {
+  // Identifier 0x361. EventId 0|16 = 0x1234 -> 34 12; Version 16|8 = 5 -> 05;
+  // Magnitude 24|8 (0.05): 7.1 = 142 -> 8E; OriginAge 32|16 signed (0.02 s): 12.34 s = 617 =
+  // 0x0269 -> 69 02; Distance 48|12 = 60 km = 0x03C, Cancelled 60|1 = 1 -> bits 48-63 0x103C ->
+  // 3C 10.
+  const Bytes golden{0x34, 0x12, 0x05, 0x8E, 0x69, 0x02, 0x3C, 0x10};
+  RegionalAlertOrigin m;
+  m.event_id = 0x1234;
+  m.version = 5;
+  m.magnitude = 7.1;
+  m.origin_age_s = 12.34;
+  m.distance_km = 60;
+  m.cancelled = true;
+  RegionalAlertOrigin d;
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x361, golden, d));
+  EXPECT_EQ(d.event_id, 0x1234);
+  EXPECT_EQ(d.version, 5);
+  EXPECT_NEAR(d.magnitude, 7.1, 1e-12);
+  EXPECT_NEAR(d.origin_age_s, 12.34, 1e-12);
+  EXPECT_EQ(d.distance_km, 60);
+  EXPECT_TRUE(d.cancelled);
+  CanFrame f;
+  m.magnitude = 10.5;
+  EXPECT_STREQ(encode(m, f).signal, "Magnitude");
+  m.magnitude = 7.0;
+  m.distance_km = 4096;
+  EXPECT_STREQ(encode(m, f).signal, "Distance");
+  // Magnitude raw values above 200 (10) are refused on decode.
+  EXPECT_STREQ(decode(make_frame(0x361, Bytes{0, 0, 0, 201, 0, 0, 0, 0}), d).signal,
+               "Magnitude");
 }
 
 TEST(CanGolden, Acknowledge) {
@@ -624,7 +687,7 @@ TEST(CanRoundTrip, CollapseForecastEveryProbabilityCollapseInHorizonAndSequence)
 
 // A valid frame of every message kind.
 std::vector<CanFrame> valid_frames() {
-  std::vector<CanFrame> frames(7);
+  std::vector<CanFrame> frames(9);
   SensorAcceleration a;
   a.ax_g = 0.1;
   EXPECT_TRUE(encode(a, frames[0]).ok());
@@ -645,12 +708,19 @@ std::vector<CanFrame> valid_frames() {
   r.node = 3;
   r.wy_rad_s = -0.25;
   EXPECT_TRUE(encode(r, frames[6]).ok());
+  RegionalAlert g;
+  g.pga_g = 0.3;
+  EXPECT_TRUE(encode(g, frames[7]).ok());
+  RegionalAlertOrigin o;
+  o.magnitude = 6.5;
+  EXPECT_TRUE(encode(o, frames[8]).ok());
   return frames;
 }
 
 // Decodes `f` as every message type; the result of the one `f.id` classifies as, or of all.
 struct AllDecodes {
-  DecodeResult acceleration, heartbeat, status, event, acknowledge, forecast, rotation;
+  DecodeResult acceleration, heartbeat, status, event, acknowledge, forecast, rotation, regional,
+      origin;
 };
 AllDecodes decode_all(const CanFrame& f) {
   SensorAcceleration a;
@@ -660,8 +730,10 @@ AllDecodes decode_all(const CanFrame& f) {
   Acknowledge k;
   CollapseForecast c;
   StatueRotation r;
-  return {decode(f, a), decode(f, h), decode(f, s), decode(f, e),
-          decode(f, k), decode(f, c), decode(f, r)};
+  RegionalAlert g;
+  RegionalAlertOrigin o;
+  return {decode(f, a), decode(f, h), decode(f, s), decode(f, e), decode(f, k),
+          decode(f, c), decode(f, r), decode(f, g), decode(f, o)};
 }
 DecodeResult decode_as_own_kind(const CanFrame& f) {
   const AllDecodes all = decode_all(f);
@@ -673,6 +745,8 @@ DecodeResult decode_as_own_kind(const CanFrame& f) {
     case MessageKind::kAcknowledge: return all.acknowledge;
     case MessageKind::kCollapseForecast: return all.forecast;
     case MessageKind::kStatueRotation: return all.rotation;
+    case MessageKind::kRegionalAlert: return all.regional;
+    case MessageKind::kRegionalAlertOrigin: return all.origin;
     case MessageKind::kUnknown: break;
   }
   ADD_FAILURE() << "unknown identifier " << f.id;
@@ -696,7 +770,7 @@ TEST(CanReject, EveryLengthButEight) {
 TEST(CanReject, UnknownIdentifiers) {
   std::set<std::uint32_t> known;
   for (std::uint32_t n = 1; n <= 15; ++n) known.insert({0x300 + n, 0x310 + n, 0x370 + n});
-  known.insert({0x320, 0x321, 0x330, 0x340, 0x350, 0x351});
+  known.insert({0x320, 0x321, 0x330, 0x340, 0x350, 0x351, 0x360, 0x361});
   std::vector<std::uint32_t> ids;
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) ids.push_back(id);
   // Identifiers with flag bits (SocketCAN's extended / RTR flags) or beyond 11 bits.
@@ -716,8 +790,10 @@ TEST(CanReject, UnknownIdentifiers) {
     EXPECT_EQ(all.acknowledge.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.forecast.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.rotation.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.regional.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.origin.error, CodecError::kUnknownIdentifier) << id;
   }
-  EXPECT_EQ(known.size(), 51U);
+  EXPECT_EQ(known.size(), 53U);
 }
 
 TEST(CanReject, AnotherMessagesIdentifier) {
@@ -736,6 +812,10 @@ TEST(CanReject, AnotherMessagesIdentifier) {
               kind != MessageKind::kCollapseForecast);
     EXPECT_EQ(all.rotation.error == CodecError::kWrongMessage,
               kind != MessageKind::kStatueRotation);
+    EXPECT_EQ(all.regional.error == CodecError::kWrongMessage,
+              kind != MessageKind::kRegionalAlert);
+    EXPECT_EQ(all.origin.error == CodecError::kWrongMessage,
+              kind != MessageKind::kRegionalAlertOrigin);
   }
 }
 
@@ -819,8 +899,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
     EXPECT_STREQ(rk.signal, "Level");
   }
-  for (unsigned v = 13; v <= 255; ++v) {
-    if (v == 14) continue;  // statue_unexplained; 13 and 15 are a gap (issue 26's causes)
+  for (unsigned v = 16; v <= 255; ++v) {
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -838,9 +917,12 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  for (const unsigned gap : {13U, 15U}) {
-    e.cause = static_cast<AlarmCause>(gap);
-    EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum) << gap;
+  e.cause = static_cast<AlarmCause>(16);
+  EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
+  for (const AlarmCause cause :
+       {AlarmCause::kPWave, AlarmCause::kStatueUnexplained, AlarmCause::kRegionalAlert}) {
+    e.cause = cause;
+    EXPECT_TRUE(encode(e, f).ok()) << static_cast<unsigned>(cause);
   }
   e = AlarmEvent{};
   e.previous_level = static_cast<AlarmLevel>(255);
@@ -1082,7 +1164,7 @@ TEST(CanReject, ErrorTexts) {
 
 TEST(CanDbc, EveryIdentifierTheCodecKnowsIsAMessageAndNoOther) {
   const Dbc& dbc = plinth_dbc();
-  ASSERT_EQ(dbc.messages.size(), 51U);
+  ASSERT_EQ(dbc.messages.size(), 53U);
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) {
     const MessageKind kind = classify(id);
     const auto it = dbc.messages.find(id);
@@ -1164,15 +1246,8 @@ TEST(CanDbc, ValueTablesMatchTheCodecsEnumerations) {
       }
       if (!c.has_value_table) continue;
       const auto& table = it->second;
-      // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names; the
-      // causes have a gap (13: issue 26's p_wave), which decode refuses as well.
-      const bool cause_gap = std::string(c.name) == "Cause";
-      ASSERT_EQ(table.size(), static_cast<std::size_t>(c.raw_max - c.raw_min + 1) -
-                                  (cause_gap ? 1U : 0U));
-      if (cause_gap) {
-        EXPECT_EQ(table.count(12), 1U);
-        EXPECT_EQ(table.count(13), 0U);
-      }
+      // The table is exactly raw_min..raw_max: what decode accepts is what the DBC names.
+      ASSERT_EQ(table.size(), static_cast<std::size_t>(c.raw_max - c.raw_min + 1));
       for (const auto& [value, name] : table) {
         EXPECT_GE(static_cast<std::int64_t>(value), c.raw_min);
         EXPECT_LE(static_cast<std::int64_t>(value), c.raw_max);

@@ -511,5 +511,69 @@ TEST(EvalMetrics, RunsOutsideTheModelCountNowhere) {
             std::string::npos);
 }
 
+// The runs file's P-wave block: after the other grids, read back, refused when malformed.
+EvalRun run_with(double p_pick, double trigger, std::vector<double> crossings) {
+  EvalRun r;
+  r.record = "RSN1_X-UP.AT2";
+  r.scene = "s.toml";
+  r.scale_g = 0.6;
+  r.peak_ratio = 0.2;
+  r.risk_crossing_s = {-1.0};
+  r.probability_crossing_s = {-1.0};
+  r.nominal_risk_crossing_s = {-1.0};
+  r.p_pick_s = p_pick;
+  r.strong_motion_s = 7.25;
+  r.pwave_trigger_s = trigger;
+  r.pwave_crossing_s = std::move(crossings);
+  return r;
+}
+
+TEST(EvalPWaveColumns, RoundTripAfterTheOtherGrids) {
+  CrossingGrids grids{{0.5}, {0.5}};
+  grids.pwave = {0.1, 0.5};
+  const std::string path = temp_path("pwave_roundtrip.csv");
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  write_eval_csv_header(f, grids, false);
+  write_eval_csv_row(f, run_with(1.5, 2.25, {3.0, -1.0}));
+  write_eval_csv_row(f, run_with(-1.0, -1.0, {-1.0, -1.0}));
+  std::fclose(f);
+  std::ifstream in(path);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_NE(header.find(",nominal_risk_ge_0.5,p_pick_s,strong_motion_s,pwave_trigger_s,"
+                        "pwave_ge_0.1,pwave_ge_0.5"),
+            std::string::npos)
+      << header;
+  const EvalTable t = read_eval_csv(path);
+  EXPECT_EQ(t.grids.pwave, grids.pwave);
+  ASSERT_EQ(t.runs.size(), 2U);
+  EXPECT_DOUBLE_EQ(t.runs[0].p_pick_s, 1.5);
+  EXPECT_DOUBLE_EQ(t.runs[0].strong_motion_s, 7.25);
+  EXPECT_DOUBLE_EQ(t.runs[0].pwave_trigger_s, 2.25);
+  EXPECT_EQ(t.runs[0].pwave_crossing_s, (std::vector<double>{3.0, -1.0}));
+  EXPECT_DOUBLE_EQ(t.runs[1].p_pick_s, -1.0);
+  std::filesystem::remove(path);
+}
+
+TEST(EvalPWaveColumns, AMalformedBlockIsRefusedNamingWhy) {
+  const std::string fixed =
+      "record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,first_advisory_s,"
+      "first_warning_s,first_alarm_s,risk_ge_0.5,nominal_risk_ge_0.5";
+  EXPECT_NE(error_reading(fixed + ",p_pick_s,strong_motion_s,pwave_trigger_s\n")
+                .find(":1: the P-wave columns need their pwave_ge_ columns"),
+            std::string::npos);
+  EXPECT_NE(error_reading(fixed + ",p_pick_s,strong_motion_s,pwave_trigger_s,pwave_ge_0.5,"
+                                "risk_ge_0.7\n")
+                .find(":1: column 17: after the P-wave columns only pwave_ge_ columns may come"),
+            std::string::npos);
+  EXPECT_NE(error_reading(fixed + ",p_pick_s,pwave_ge_0.5\n").find("unknown column \"p_pick_s\""),
+            std::string::npos);
+  EXPECT_NE(error_reading(fixed + ",p_pick_s,strong_motion_s,pwave_trigger_s,pwave_ge_0.5\n" +
+                        "r,s,0,0.3,0,-1,0.1,-1,-1,-1,-1,-1,1,2,-3,-1\n")
+                .find(":2: pwave_trigger_s: expected a time >= 0 or -1, got -3"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace plinth::host

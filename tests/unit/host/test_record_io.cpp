@@ -77,6 +77,15 @@ TEST_P(BundledRecordTest, MatchesSourcesTable) {
   EXPECT_NEAR(record.duration(), static_cast<double>(expected.npts - 1) * expected.dt, 1e-9);
 }
 
+// The file's stem, as a test name.
+std::string bundled_record_name(const ::testing::TestParamInfo<BundledRecord>& param_info) {
+  std::string name = std::filesystem::path(param_info.param.file).stem().string();
+  for (char& c : name) {
+    if (std::isalnum(static_cast<unsigned char>(c)) == 0) c = '_';
+  }
+  return name;
+}
+
 INSTANTIATE_TEST_SUITE_P(
     SimDataRecords, BundledRecordTest,
     ::testing::Values(
@@ -103,13 +112,7 @@ INSTANTIATE_TEST_SUITE_P(
         BundledRecord{"elcentro1940_180.AT2",
                       "Imperial Valley-02, 5/19/1940, El Centro Array #9, 180", 5372, 0.0100,
                       0.2808, 2.18}),
-    [](const ::testing::TestParamInfo<BundledRecord>& param_info) {
-      std::string name = std::filesystem::path(param_info.param.file).stem().string();
-      for (char& c : name) {
-        if (std::isalnum(static_cast<unsigned char>(c)) == 0) c = '_';
-      }
-      return name;
-    });
+    bundled_record_name);
 
 // plinth-eval's records from other earthquakes (sim/data/records/eval/SOURCES.md).
 INSTANTIATE_TEST_SUITE_P(
@@ -125,13 +128,58 @@ INSTANTIATE_TEST_SUITE_P(
         BundledRecord{"eval/RSN4107_PARK2004_COW360.AT2", "Parkfield-02 CA, 9/28/2004, Parkfield - Fault Zone 1, 360", 4195, 0.005, 0.8332, 3.60},
         BundledRecord{"eval/RSN723_SUPER.B_B-PTS225.AT2", "Superstition Hills-02, 11/24/1987, Parachute Test Site, 225", 2235, 0.01, 0.4318, 12.59},
         BundledRecord{"eval/RSN700_WHITTIER.A_A-TAR090.AT2", "Whittier Narrows-01, 10/1/1987, Tarzana - Cedar Hill, 90", 7998, 0.005, 0.5988, 6.97}),
-    [](const ::testing::TestParamInfo<BundledRecord>& param_info) {
-      std::string name = std::filesystem::path(param_info.param.file).stem().string();
-      for (char& c : name) {
-        if (std::isalnum(static_cast<unsigned char>(c)) == 0) c = '_';
-      }
-      return name;
-    });
+    bundled_record_name);
+
+// The P-wave stage's three-component records (sim/data/records/pwave/SOURCES.md).
+INSTANTIATE_TEST_SUITE_P(
+    SimDataPWaveRecords, BundledRecordTest,
+    ::testing::Values(
+        BundledRecord{"pwave/RSN963_NORTHR_ORR090.AT2", "Northridge-01, 1/17/1994, Castaic - Old Ridge Route, 90", 2000, 0.02, 0.5683, 8.24},
+        BundledRecord{"pwave/RSN963_NORTHR_ORR360.AT2", "Northridge-01, 1/17/1994, Castaic - Old Ridge Route, 360", 2000, 0.02, 0.5142, 7.28},
+        BundledRecord{"pwave/RSN963_NORTHR_ORR-UP.AT2", "Northridge-01, 1/17/1994, Castaic - Old Ridge Route, UP", 2000, 0.02, 0.2173, 3.84},
+        BundledRecord{"pwave/RSN987_NORTHR_CEN155.AT2", "Northridge-01, 1/17/1994, LA - Centinela St, 155", 2999, 0.01, 0.4490, 10.48},
+        BundledRecord{"pwave/RSN987_NORTHR_CEN245.AT2", "Northridge-01, 1/17/1994, LA - Centinela St, 245", 2999, 0.01, 0.3185, 11.18},
+        BundledRecord{"pwave/RSN987_NORTHR_CEN-UP.AT2", "Northridge-01, 1/17/1994, LA - Centinela St, UP", 2999, 0.01, 0.1062, 7.20},
+        BundledRecord{"pwave/RSN1003_NORTHR_STN020.AT2", "Northridge-01, 1/17/1994, LA - Saturn St, 20", 3159, 0.01, 0.4678, 10.62},
+        BundledRecord{"pwave/RSN1003_NORTHR_STN110.AT2", "Northridge-01, 1/17/1994, LA - Saturn St, 110", 3159, 0.01, 0.4308, 10.54},
+        BundledRecord{"pwave/RSN1003_NORTHR_STN-UP.AT2", "Northridge-01, 1/17/1994, LA - Saturn St, UP", 3159, 0.01, 0.1065, 10.13},
+        BundledRecord{"pwave/RSN1080_NORTHR_KAT000.AT2", "Northridge-01, 1/17/1994, Simi Valley - Katherine Rd, 0", 2499, 0.01, 0.8043, 5.46},
+        BundledRecord{"pwave/RSN1080_NORTHR_KAT090.AT2", "Northridge-01, 1/17/1994, Simi Valley - Katherine Rd, 90", 2499, 0.01, 0.5354, 4.29},
+        BundledRecord{"pwave/RSN1080_NORTHR_KAT-UP.AT2", "Northridge-01, 1/17/1994, Simi Valley - Katherine Rd, UP", 2499, 0.01, 0.4007, 2.90},
+        BundledRecord{"pwave/RSN1049_NORTHR_SUN190.AT2", "Northridge-01, 1/17/1994, Pacific Palisades - Sunset, 190", 2499, 0.01, 0.4605, 9.83},
+        BundledRecord{"pwave/RSN1049_NORTHR_SUN280.AT2", "Northridge-01, 1/17/1994, Pacific Palisades - Sunset, 280", 2499, 0.01, 0.1979, 8.65},
+        BundledRecord{"pwave/RSN1049_NORTHR_SUN-UP.AT2", "Northridge-01, 1/17/1994, Pacific Palisades - Sunset, UP", 2499, 0.01, 0.1685, 9.81},
+        BundledRecord{"pwave/RSN1044_NORTHR_NWH090.AT2", "Northridge-01, 1/17/1994, Newhall - Fire Sta, 90", 2000, 0.02, 0.5830, 5.34},
+        BundledRecord{"pwave/RSN1044_NORTHR_NWH360.AT2", "Northridge-01, 1/17/1994, Newhall - Fire Sta, 360", 2000, 0.02, 0.5904, 4.32},
+        BundledRecord{"pwave/RSN1044_NORTHR_NWH-UP.AT2", "Northridge-01, 1/17/1994, Newhall - Fire Sta, UP", 2000, 0.02, 0.5482, 5.38},
+        BundledRecord{"pwave/RSN1063_NORTHR_RRS228.AT2", "Northridge-01, 1/17/1994, Rinaldi Receiving Sta, 228", 1991, 0.01, 0.8741, 2.56},
+        BundledRecord{"pwave/RSN1063_NORTHR_RRS318.AT2", "Northridge-01, 1/17/1994, Rinaldi Receiving Sta, 318", 1991, 0.01, 0.4723, 4.22},
+        BundledRecord{"pwave/RSN1063_NORTHR_RRS-UP.AT2", "Northridge-01, 1/17/1994, Rinaldi Receiving Sta, UP", 1991, 0.01, 0.9582, 2.97},
+        BundledRecord{"pwave/RSN990_NORTHR_LAC090.AT2", "Northridge-01, 1/17/1994, LA - City Terrace, 90", 4000, 0.01, 0.2631, 16.94},
+        BundledRecord{"pwave/RSN990_NORTHR_LAC180.AT2", "Northridge-01, 1/17/1994, LA - City Terrace, 180", 4000, 0.01, 0.3163, 17.27},
+        BundledRecord{"pwave/RSN990_NORTHR_LAC-UP.AT2", "Northridge-01, 1/17/1994, LA - City Terrace, UP", 4000, 0.01, 0.1346, 17.21},
+        BundledRecord{"pwave/RSN174_IMPVALL.H_H-E11140.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #11, 140", 7815, 0.005, 0.3668, 10.56},
+        BundledRecord{"pwave/RSN174_IMPVALL.H_H-E11230.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #11, 230", 7893, 0.005, 0.3794, 10.46},
+        BundledRecord{"pwave/RSN174_IMPVALL.H_H-E11-UP.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #11, UP", 7818, 0.005, 0.1438, 6.96},
+        BundledRecord{"pwave/RSN179_IMPVALL.H_H-E04140.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #4, 140", 7818, 0.005, 0.4843, 5.35},
+        BundledRecord{"pwave/RSN179_IMPVALL.H_H-E04230.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #4, 230", 7818, 0.005, 0.3704, 5.27},
+        BundledRecord{"pwave/RSN179_IMPVALL.H_H-E04-UP.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #4, UP", 7808, 0.005, 0.2916, 2.14},
+        BundledRecord{"pwave/RSN181_IMPVALL.H_H-E06140.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #6, 140", 7817, 0.005, 0.4473, 2.58},
+        BundledRecord{"pwave/RSN181_IMPVALL.H_H-E06230.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #6, 230", 7818, 0.005, 0.4490, 5.95},
+        BundledRecord{"pwave/RSN181_IMPVALL.H_H-E06-UP.AT2", "Imperial Valley-06, 10/15/1979, El Centro Array #6, UP", 7815, 0.005, 1.8950, 2.58},
+        BundledRecord{"pwave/RSN2622_CHICHI.03_TCU071N.AT2", "Chi-Chi Taiwan-03, 9/20/1999, TCU071, N", 11250, 0.005, 0.3823, 26.30},
+        BundledRecord{"pwave/RSN2622_CHICHI.03_TCU071E.AT2", "Chi-Chi Taiwan-03, 9/20/1999, TCU071, E", 11250, 0.005, 0.1934, 26.28},
+        BundledRecord{"pwave/RSN2622_CHICHI.03_TCU071V.AT2", "Chi-Chi Taiwan-03, 9/20/1999, TCU071, V", 11250, 0.005, 0.1430, 26.41},
+        BundledRecord{"pwave/RSN214_LIVERMOR_A-KOD180.AT2", "Livermore-01, 1/24/1980, San Ramon - Eastman Kodak, 180", 4196, 0.005, 0.1497, 5.58},
+        BundledRecord{"pwave/RSN214_LIVERMOR_A-KOD270.AT2", "Livermore-01, 1/24/1980, San Ramon - Eastman Kodak, 270", 4196, 0.005, 0.0638, 5.62},
+        BundledRecord{"pwave/RSN214_LIVERMOR_A-KOD-UP.AT2", "Livermore-01, 1/24/1980, San Ramon - Eastman Kodak, UP", 4196, 0.005, 0.0367, 5.42},
+        BundledRecord{"pwave/RSN412_COALINGA_D-PVY045.AT2", "Coalinga-05, 7/22/1983, Pleasant Valley P.P. - yard, 45", 4347, 0.005, 0.5752, 6.43},
+        BundledRecord{"pwave/RSN412_COALINGA_D-PVY135.AT2", "Coalinga-05, 7/22/1983, Pleasant Valley P.P. - yard, 135", 4353, 0.005, 0.3238, 6.54},
+        BundledRecord{"pwave/RSN412_COALINGA_D-PVY-UP.AT2", "Coalinga-05, 7/22/1983, Pleasant Valley P.P. - yard, UP", 4342, 0.005, 0.2956, 6.46},
+        BundledRecord{"pwave/RSN410_COALINGA_D-PLM270.AT2", "Coalinga-05, 7/22/1983, Palmer Ave, 270", 4317, 0.005, 0.2809, 3.44},
+        BundledRecord{"pwave/RSN410_COALINGA_D-PLM360.AT2", "Coalinga-05, 7/22/1983, Palmer Ave, 360", 4326, 0.005, 0.3097, 4.62},
+        BundledRecord{"pwave/RSN410_COALINGA_D-PLM-UP.AT2", "Coalinga-05, 7/22/1983, Palmer Ave, UP", 4315, 0.005, 0.2267, 3.35}),
+    bundled_record_name);
 
 TEST(BundledRecords, BrienzaFirstAndLastValuesConvertFromG) {
   const Record record = read_at2(kRecordsDir + "irpinia1980_brienza_000.AT2", kStandardGravity);

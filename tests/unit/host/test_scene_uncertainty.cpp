@@ -204,5 +204,32 @@ clearance = [0.09, 0.11]
   EXPECT_EQ(load_uncertain_scene_text(text, "s.toml").uncertain.size(), 15U);
 }
 
+
+// [fragility]: the statue's collapse fragility, for the box's P-wave stage (docs/pwave.md).
+TEST(SceneFragility, IsReadWhenGivenAndCheckedKeyByKey) {
+  EXPECT_FALSE(load_uncertain_scene_text(kIsolated, "s.toml").fragility.has_value());
+  const UncertainScene s =
+      load_uncertain_scene_text(kIsolated + "[fragility]\nmedian_g = 0.62\nbeta = 0.35\n", "s.toml");
+  ASSERT_TRUE(s.fragility.has_value());
+  EXPECT_DOUBLE_EQ(s.fragility->median_g, 0.62);
+  EXPECT_DOUBLE_EQ(s.fragility->beta, 0.35);
+  // The nominal statue is the same with or without it.
+  EXPECT_DOUBLE_EQ(s.nominal.h, load_uncertain_scene_text(kIsolated, "s.toml").nominal.h);
+  const std::string missing = error_of(kIsolated + "[fragility]\nmedian_g = 0.6\n");
+  EXPECT_NE(missing.find("fragility.beta: required key missing"), std::string::npos) << missing;
+  const std::string zero = error_of(kIsolated + "[fragility]\nmedian_g = 0\nbeta = 0.3\n");
+  EXPECT_NE(zero.find("s.toml:13: fragility.median_g: must be a PGA above 0 g (got 0)"),
+            std::string::npos)
+      << zero;
+  const std::string negative = error_of(kIsolated + "[fragility]\nmedian_g = 0.6\nbeta = -0.1\n");
+  EXPECT_NE(negative.find("fragility.beta: must be a dispersion of 0 or more"), std::string::npos)
+      << negative;
+  const std::string unknown =
+      error_of(kIsolated + "[fragility]\nmedian_g = 0.6\nbeta = 0.3\nmedian = 0.5\n");
+  EXPECT_NE(unknown.find("fragility.median: unknown key"), std::string::npos) << unknown;
+  const std::string text = error_of(kIsolated + "[fragility]\nmedian_g = \"0.6g\"\nbeta = 0.3\n");
+  EXPECT_NE(text.find("fragility.median_g: expected a number"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace plinth::host

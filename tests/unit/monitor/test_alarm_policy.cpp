@@ -25,6 +25,8 @@ AlarmPolicySettings immediate() {
   s.advisory_forecast = {0.2, 0.1};
   s.warning_forecast = {0.5, 0.4};
   s.alarm_forecast = {0.9, 0.8};
+  s.warning_pwave = {0.6, 0.3};
+  s.warning_regional = {0.6, 0.3};
   s.raise_hold_s = 0.0;
   s.lower_hold_s = 0.0;
   s.latch_warning = false;
@@ -120,6 +122,20 @@ TEST(AlarmPolicySettings, DefaultsAreValidAndThresholdsAreChecked) {
   s = {};
   s.advisory_forecast.off = 0.2;  // equal to its on
   expect_refused(s, "alarm_policy.advisory_forecast.off", ErrorCode::kInconsistent);
+  s = {};
+  s.warning_pwave = {0.3, 0.3};
+  expect_refused(s, "alarm_policy.warning_pwave.off", ErrorCode::kInconsistent);
+  s.warning_pwave = {1.2, 0.3};
+  expect_refused(s, "alarm_policy.warning_pwave.on", ErrorCode::kOutOfRange);
+  s.warning_pwave = {0.05, 0.01};  // below the other warnings: a level of its own, not ordered
+  EXPECT_TRUE(validate(s).ok());
+  s = {};
+  s.warning_regional = {0.3, 0.3};
+  expect_refused(s, "alarm_policy.warning_regional.off", ErrorCode::kInconsistent);
+  s.warning_regional = {1.2, 0.3};
+  expect_refused(s, "alarm_policy.warning_regional.on", ErrorCode::kOutOfRange);
+  s.warning_regional = {0.05, 0.01};  // below the other warnings: a level of its own
+  EXPECT_TRUE(validate(s).ok());
   s = {};
   s.alarm.on = 1.0;  // the edges of [0, 1] are allowed
   s.advisory.off = 0.0;
@@ -426,6 +442,85 @@ TEST(AlarmPolicy, ALevelLatchedByTheForecastKeepsItsCause) {
   const AlarmOutput held = p.at(10, 0.0);
   EXPECT_EQ(held.level, AlarmLevel::kAlarm);
   EXPECT_EQ(held.latched_level, AlarmLevel::kAlarm);
+}
+
+// A probability of collapse that guesses the coming ground (the P-wave stage's, a regional
+// alert's: `probability`, a member of AlarmInput) raises `warning`, never `alarm`, with its own
+// cause; the risk and the forecast name the cause when they hold the level too.
+void expect_warning_only_with_its_cause(decltype(AlarmInput::risk) AlarmInput::*probability,
+                                        AlarmCause cause) {
+  Policy p(immediate());
+  const auto at = [&p, probability](std::int64_t ms, double risk, double value) {
+    p.base.*probability = value;
+    return p.at(ms, risk);
+  };
+  EXPECT_EQ(at(0, 0.0, 0.5999).level, AlarmLevel::kNormal);
+  expect_change(at(1, 0.0, 0.6), AlarmLevel::kWarning, AlarmLevel::kNormal, cause, false);
+  EXPECT_EQ(at(2, 0.0, 1.0).level, AlarmLevel::kWarning);  // never alarm
+  EXPECT_EQ(at(3, 0.0, 0.3).level, AlarmLevel::kWarning);  // at off: still on
+  EXPECT_EQ(at(4, 0.0, 0.2999).level, AlarmLevel::kNormal);
+  // With the risk at warning too, the risk is the cause; the guess holds it once the risk falls.
+  expect_change(at(5, 0.55, 0.9), AlarmLevel::kWarning, AlarmLevel::kNormal,
+                AlarmCause::kRiskThreshold, false);
+  expect_change(at(6, 0.85, 0.9), AlarmLevel::kAlarm, AlarmLevel::kWarning,
+                AlarmCause::kRiskThreshold, false);
+  expect_change(at(7, 0.0, 0.9), AlarmLevel::kWarning, AlarmLevel::kAlarm, cause, false);
+  // With the forecast at warning (the statue's own forecast comes first), it is the cause.
+  p.base.probability = 0.6;
+  expect_change(at(8, 0.85, 0.9), AlarmLevel::kAlarm, AlarmLevel::kWarning,
+                AlarmCause::kRiskThreshold, false);
+  expect_change(at(9, 0.0, 0.9), AlarmLevel::kWarning, AlarmLevel::kAlarm,
+                AlarmCause::kCollapseForecast, false);
+  p.base.probability = 0.0;
+  // An invalid probability is an internal fault, as an invalid risk is.
+  EXPECT_EQ(at(10, 0.0, std::numeric_limits<double>::quiet_NaN()).input_problem,
+            InputProblem::kRiskInvalid);
+  EXPECT_EQ(at(11, 0.0, -0.1).input_problem, InputProblem::kRiskInvalid);
+  EXPECT_EQ(at(12, 0.0, 1.5).input_problem, InputProblem::kRiskInvalid);
+}
+
+TEST(AlarmPolicy, ThePWaveRaisesTheWarningAloneWithItsOwnCause) {
+  expect_warning_only_with_its_cause(&AlarmInput::pwave_probability, AlarmCause::kPWave);
+}
+
+TEST(AlarmPolicy, ARegionalAlertRaisesTheWarningAloneWithItsOwnCause) {
+  expect_warning_only_with_its_cause(&AlarmInput::regional_probability,
+                                     AlarmCause::kRegionalAlert);
+}
+
+// Both guesses holding the warning: the P wave, measured on site, is the cause.
+TEST(AlarmPolicy, ThePWaveNamesTheCauseBeforeARegionalAlert) {
+  Policy p(immediate());
+  p.base.pwave_probability = 0.9;
+  p.base.regional_probability = 0.9;
+  expect_change(p.at(0, 0.0), AlarmLevel::kWarning, AlarmLevel::kNormal, AlarmCause::kPWave,
+                false);
+  expect_change(p.at(1, 0.85), AlarmLevel::kAlarm, AlarmLevel::kWarning,
+                AlarmCause::kRiskThreshold, false);
+  p.base.pwave_probability = 0.0;
+  expect_change(p.at(2, 0.0), AlarmLevel::kWarning, AlarmLevel::kAlarm,
+                AlarmCause::kRegionalAlert, false);
+}
+
+// A warning latched by either guess keeps its cause after the guess falls.
+void expect_latched_with_its_cause(decltype(AlarmInput::risk) AlarmInput::*probability,
+                                   AlarmCause cause) {
+  Policy p(latching(true, true));
+  p.base.*probability = 0.7;
+  expect_change(p.at(0, 0.0), AlarmLevel::kWarning, AlarmLevel::kNormal, cause, true);
+  p.base.*probability = 0.0;
+  const AlarmOutput held = p.at(10, 0.0);
+  EXPECT_EQ(held.level, AlarmLevel::kWarning);
+  EXPECT_EQ(held.latched_level, AlarmLevel::kWarning);
+  EXPECT_EQ(held.event_count, 0U);
+}
+
+TEST(AlarmPolicy, AWarningLatchedByThePWaveKeepsItsCause) {
+  expect_latched_with_its_cause(&AlarmInput::pwave_probability, AlarmCause::kPWave);
+}
+
+TEST(AlarmPolicy, AWarningLatchedByARegionalAlertKeepsItsCause) {
+  expect_latched_with_its_cause(&AlarmInput::regional_probability, AlarmCause::kRegionalAlert);
 }
 
 TEST(AlarmPolicy, AnUpdateFromThePastIsRefused) {

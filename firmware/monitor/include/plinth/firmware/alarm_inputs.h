@@ -12,6 +12,8 @@ namespace plinth::firmware {
 
 // The alarm policy's input from `status` (after the axes and the sensors were updated):
 //  - risk and probability: the worst axis's risk and forecast probability;
+//  - regional probability: the statue's probability of collapse under the worst held regional
+//    alert (regional_alert);
 //  - out of full contact (phase_change), collapse (overturn_detected): any axis's nominal statue;
 //  - fault, by the first that holds: the primary sensor's fault (its cause: sensor_timeout,
 //    sensor_fault), a ground sensor that disagrees with the primary or, with

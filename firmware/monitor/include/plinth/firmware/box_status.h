@@ -6,7 +6,6 @@
 
 #include <array>
 #include <cstdint>
-#include <type_traits>
 
 #include "plinth/core/ensemble.h"
 #include "plinth/core/forecast.h"
@@ -15,6 +14,9 @@
 #include "plinth/core/statue_filter.h"
 #include "plinth/firmware/config.h"
 #include "plinth/monitor/alarm_level.h"
+#include "plinth/monitor/optional_part.h"
+#include "plinth/monitor/p_wave.h"
+#include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
@@ -38,12 +40,8 @@ struct StatueSensorStatus {
   monitor::SensorHealth acceleration;
   bool ready = false;
 };
-struct NoStatueSensorStatus {};
-using StatueSensorStatusField =
-    std::conditional_t<kStatueSensorBuiltIn, StatueSensorStatus, NoStatueSensorStatus>;
-struct NoStatueAxisStatus {};
-using StatueAxisStatusField =
-    std::conditional_t<kStatueSensorBuiltIn, StatueAxisStatus, NoStatueAxisStatus>;
+using StatueSensorStatusField = monitor::OptionalPart<StatueSensorStatus, kStatueSensorBuiltIn>;
+using StatueAxisStatusField = monitor::OptionalPart<StatueAxisStatus, kStatueSensorBuiltIn>;
 
 // One axis: its ensemble's risk (the worst member's, the nominal statue's alone, as a box
 // without ensemble) and the rest.
@@ -52,7 +50,7 @@ struct AxisStatus : EnsembleRisk {
   // tilt and rotation rate.
   Mode mode;
   State state = State::Zero();
-  // The statue sensor's view (nothing in a build without it: statue_part).
+  // The statue sensor's view (nothing in a build without it: built_part).
   [[no_unique_address]] StatueAxisStatusField statue;
   int members = 1;       // the ensemble's size
   ForecastOutcome forecast;  // the latest completed forecast (valid: false before the first)
@@ -119,11 +117,20 @@ struct BoxStatus : SensorSetStatus {
   std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
   std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
   // The statue sensor (statue_sensor.h): configured, its streams (none in a build without it:
-  // statue_part), and unexplained: on some axis no member explains its motion (fault,
+  // built_part), and unexplained: on some axis no member explains its motion (fault,
   // kStatueUnexplained).
   bool has_statue_sensor = false;
   [[no_unique_address]] StatueSensorStatusField statue_sensor;
   bool statue_unexplained = false;
+  // Regional alerts: the worst held, its probability of collapse and time to the S arrival,
+  // the counters (times in monitor time).
+  // (Nothing in a build without regional alerts.)
+  [[no_unique_address]] monitor::RegionalAlertStatusField regional;
+  // The on-site P-wave stage (MonitorConfig::pwave): running, and its status after the newest
+  // sample (its times count from estimator_start_ns: it restarts with the estimators). None in
+  // a build without the stage.
+  bool has_pwave = false;
+  [[no_unique_address]] monitor::PWaveStatusField pwave;
 };
 
 }  // namespace plinth::firmware

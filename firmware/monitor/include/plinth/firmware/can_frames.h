@@ -13,6 +13,7 @@
 #include "plinth/hal/can_codec.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
+#include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
@@ -51,6 +52,12 @@ namespace plinth::firmware {
 
 // An operator's Acknowledge as the alarm policy takes it (without its source id).
 [[nodiscard]] monitor::Acknowledgement acknowledgement_of(const hal::can::Acknowledge& message);
+// A regional alert's two frames as the regional room takes them: the origin frame (received
+// `origin_before_s` before the alert frame) and the alert frame, its times relative to the
+// alert frame's receipt.
+[[nodiscard]] monitor::RegionalAlert regional_alert_of(const hal::can::RegionalAlertOrigin& origin,
+                                                       const hal::can::RegionalAlert& alert,
+                                                       double origin_before_s);
 // A decoded SensorAcceleration as the sensor's health tracker takes it.
 [[nodiscard]] monitor::SensorSample sample_of(const hal::can::SensorAcceleration& message,
                                               std::int64_t receive_time_ns);

@@ -15,6 +15,8 @@
 #include "plinth/firmware/statue_sensor.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/conditioning.h"
+#include "plinth/monitor/p_wave.h"
+#include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
@@ -104,8 +106,17 @@ struct MonitorConfig {
   RedundancySettings redundancy;
   PlateCheckSettings plate;
   // The IMU on the statue (statue_sensor.h): absent unless `present`; a build without the
-  // statue sensor holds `present` alone (statue_settings() gives the rest when built).
+  // statue sensor holds `present` alone (built_part<StatueSensorSettings> gives the rest).
   StatueSensorConfig statue_sensor;
+  // Regional early-warning alerts (regional_alert.h): their checks and expiry, and the statue's
+  // fragility (plinth-monitor takes it from the scene file's [fragility]).
+  // (Nothing in a build without regional alerts.)
+  [[no_unique_address]] monitor::RegionalAlertConfig regional;
+  // The on-site P-wave stage (p_wave.h, docs/pwave.md): runs when enabled (the box file's
+  // [pwave] table), on the primary's conditioned samples; its sample period is the estimator's,
+  // its fragility the statue's (plinth-monitor: the scene file's [fragility], which it needs).
+  // A build without the stage (PLINTH_PWAVE_STAGE=OFF) holds only `enabled`, and refuses it.
+  [[no_unique_address]] monitor::PWaveConfig pwave = monitor::pwave_off();
 };
 
 // Checks every part; the Error names the field ("monitor.axis_count", "estimator....", ...).

@@ -1,8 +1,8 @@
 // The bus's frames (hal/can_codec) as the monitor's inputs: a configured sensor's
 // SensorAcceleration is its sample, the statue sensor's StatueRotation and SensorAcceleration
-// its gyroscope's and accelerometer's samples, an Acknowledge an operator's acknowledgement;
-// every other frame, and every frame the codec refuses, is counted and is no input.
-// Freestanding.
+// its gyroscope's and accelerometer's samples, an Acknowledge an operator's acknowledgement, a
+// RegionalAlert after its RegionalAlertOrigin a regional alert; every other frame, and every
+// frame the codec refuses, is counted and is no input. Freestanding.
 #pragma once
 
 #include <array>
@@ -27,6 +27,10 @@ struct FrameCounters {
   std::uint64_t heartbeats = 0;           // SensorHeartbeat of any node
   std::uint64_t acknowledgements = 0;     // Acknowledge frames, decoded
   std::uint64_t monitor_frames = 0;  // MonitorStatus / AlarmEvent / CollapseForecast (any box's)
+  std::uint64_t regional_alerts = 0;  // RegionalAlert frames taken with their origin frame
+  // RegionalAlert frames without their RegionalAlertOrigin (same event and version, within
+  // kRegionalPairWindowNs before), or refused by the codec: malformed alerts
+  std::uint64_t regional_malformed = 0;
   std::uint64_t rejected = 0;             // failed to decode (length, range, reserved bits)
   std::uint64_t unknown_identifiers = 0;  // not a plinth identifier
   hal::can::CodecError last_error = hal::can::CodecError::kOk;  // of the latest rejected frame
@@ -41,13 +45,21 @@ struct FrameInput {
     kAcknowledgement,  // `acknowledgement` (Monitor::acknowledge)
     kStatueRate,          // `statue` (Monitor::on_statue_sample)
     kStatueAcceleration,  // `sample` of the statue sensor (Monitor::on_statue_acceleration)
+    kRegionalAlert,       // `regional` (Monitor::on_regional_alert at the frame's time)
+    kRegionalMalformed,   // a regional alert that cannot be read (`malformed_field` says why)
   };
   Kind kind = Kind::kNone;
   int sensor = -1;  // its index in the configured order
   monitor::SensorSample sample;
   StatueSample statue;
   monitor::Acknowledgement acknowledgement;
+  monitor::RegionalAlert regional;
+  const char* malformed_field = "";
 };
+
+// The longest time from a RegionalAlertOrigin to its RegionalAlert frame (the bridge sends them
+// back to back).
+inline constexpr std::int64_t kRegionalPairWindowNs = 100'000'000;
 
 class FrameDecoder {
  public:
@@ -63,10 +75,16 @@ class FrameDecoder {
   [[nodiscard]] bool decoded(const hal::can::CanFrame& frame, Message& message);
   [[nodiscard]] int sensor_of_node(std::uint8_t node) const;  // -1: not configured
 
+  // A regional alert's two frames into one input.
+  void decode_regional(const hal::TimedFrame& timed, FrameInput& input);
+
   std::array<std::uint8_t, kMaxSensors> nodes_{};
   int count_ = 0;
   int statue_node_ = -1;  // -1: no statue sensor
   FrameCounters counters_;
+  bool have_origin_ = false;  // origin_ is the latest RegionalAlertOrigin, not yet used
+  hal::can::RegionalAlertOrigin origin_;
+  std::int64_t origin_time_ns_ = 0;
 };
 
 // One frame from the bus (or a candump log) into `monitor`: its input, or, for a frame that

@@ -24,6 +24,8 @@
 #include "plinth/hal/can_codec.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/conditioning.h"
+#include "plinth/monitor/p_wave.h"
+#include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
@@ -46,6 +48,10 @@ struct MonitorUpdate {
   bool status_due = false;
   // What came of an acknowledgement (Monitor::acknowledge); kNone for other inputs.
   monitor::AckOutcome acknowledgement = monitor::AckOutcome::kNone;
+  // What came of a regional alert (Monitor::on_regional_alert, regional_alert_malformed), when
+  // the input was one (regional_received).
+  bool regional_received = false;
+  monitor::RegionalOutcome regional;
   std::array<hal::can::CanFrame, kMaxFramesPerUpdate> frames{};  // frames[0 .. frame_count)
   std::size_t frame_count = 0;
 };
@@ -98,6 +104,14 @@ class Monitor {
   // Modbus or MQTT): evaluated at once, at the current monitor time; the update says what came
   // of it (MonitorUpdate::acknowledgement).
   [[nodiscard]] MonitorUpdate acknowledge(const monitor::Acknowledgement& acknowledgement);
+  // A regional alert (docs/regional.md), its times relative to its receipt at
+  // `receive_time_ns` (the bus's frames) or, without one, now (the newest input's time: an alert
+  // from MQTT); the update says what came of it (MonitorUpdate::regional).
+  [[nodiscard]] MonitorUpdate on_regional_alert(const monitor::RegionalAlert& alert,
+                                                std::int64_t receive_time_ns);
+  [[nodiscard]] MonitorUpdate on_regional_alert(const monitor::RegionalAlert& alert);
+  // A regional alert the host could not read (counted as malformed; `field` names what).
+  [[nodiscard]] MonitorUpdate regional_alert_malformed(const char* field);
   // No input (a frame that is none of the monitor's): the status, if one is due; the alarm
   // policy's first evaluation if none happened since start() (so that no status says the
   // policy's initial `normal`).
@@ -135,6 +149,15 @@ class Monitor {
   // The estimators take the inputs the sensors have for them (SensorSet::next_input).
   void feed_estimators();
   void push_ensembles(const Vector3r& ground_m_s2, std::int64_t receive_time_ns);
+  // The P-wave stage configured, in a build that has it (monitor::kPWaveStageBuiltIn).
+  [[nodiscard]] bool pwave_present() const {
+    const auto* pwave = monitor::built_part<monitor::PWaveSettings>(config_.pwave);
+    return pwave != nullptr && pwave->enabled;
+  }
+  // The stage when configured (pwave_present()); nullptr otherwise.
+  [[nodiscard]] monitor::PWaveStage* pwave_stage() {
+    return pwave_present() ? monitor::built_part<monitor::PWaveStage>(pwave_) : nullptr;
+  }
   [[nodiscard]] bool quiet() const;
   // A statue sensor configured, in a build that has it (kStatueSensorBuiltIn).
   [[nodiscard]] bool statue_present() const {
@@ -168,6 +191,12 @@ class Monitor {
   [[nodiscard]] StatueRoom& room() { return statue_room_[0]; }
   [[nodiscard]] const StatueRoom& room() const { return statue_room_[0]; }
   monitor::AlarmPolicy alarm_;
+  // The regional alerts' room: nothing in a build without regional alerts.
+  [[no_unique_address]] monitor::RegionalAlertRoom regional_;
+  // The on-site P-wave stage, fed the samples the estimators take: none in a build without it,
+  // so that neither its code nor its data take a microcontroller's room (pwave_stage()).
+  [[no_unique_address]] monitor::OptionalPart<monitor::PWaveStage, monitor::kPWaveStageBuiltIn>
+      pwave_{};
   BoxStatus status_;
   std::uint64_t frames_not_encoded_ = 0;
   bool have_epoch_ = false;

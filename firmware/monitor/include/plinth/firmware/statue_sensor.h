@@ -13,11 +13,11 @@
 #pragma once
 
 #include <cstdint>
-#include <type_traits>
 
 #include "plinth/core/error.h"
 #include "plinth/core/real.h"
 #include "plinth/core/statue_filter.h"
+#include "plinth/monitor/optional_part.h"
 #include "plinth/monitor/sensor_health.h"
 
 namespace plinth::firmware {
@@ -63,17 +63,13 @@ struct StatueSensorSettings {
 };
 
 // A build without the statue sensor (kStatueSensorBuiltIn false) keeps only whether one is
-// configured (it refuses it); MonitorConfig holds StatueSensorConfig.
+// configured (it refuses it); MonitorConfig holds StatueSensorConfig, the rest reached through
+// built_part<StatueSensorSettings> (nullptr in such a build).
 struct NoStatueSensorSettings {
   bool present = false;
 };
 using StatueSensorConfig =
-    std::conditional_t<kStatueSensorBuiltIn, StatueSensorSettings, NoStatueSensorSettings>;
-// The statue sensor's settings in a build that has it; nullptr in one that has not.
-template <class Held>
-[[nodiscard]] constexpr auto* statue_settings(Held& config) {
-  return statue_part<StatueSensorSettings>(config);
-}
+    monitor::OptionalPart<StatueSensorSettings, kStatueSensorBuiltIn, NoStatueSensorSettings>;
 
 // Checks the settings; the Error names the field ("statue_sensor.node", ...). The first
 // leaves out the streams' health, which the second checks at the estimator's sample period.

@@ -45,7 +45,11 @@ inline constexpr std::uint32_t kMonitorStatusBaseId = 0x320;       // + axis (0.
 inline constexpr std::uint32_t kAlarmEventId = 0x330;
 inline constexpr std::uint32_t kAcknowledgeId = 0x340;
 inline constexpr std::uint32_t kCollapseForecastBaseId = 0x350;  // + axis (0..1)
-inline constexpr std::uint32_t kStatueRotationBaseId = 0x370;    // + node (1..15)
+// A regional early-warning alert from the integrator's bridge: its origin part, then its
+// intensity part (docs/regional.md).
+inline constexpr std::uint32_t kRegionalAlertId = 0x360;
+inline constexpr std::uint32_t kRegionalAlertOriginId = 0x361;
+inline constexpr std::uint32_t kStatueRotationBaseId = 0x370;     // + node (1..15)
 
 inline constexpr std::uint8_t kFirstSensorNode = 1;
 inline constexpr std::uint8_t kLastSensorNode = 15;
@@ -60,6 +64,8 @@ enum class MessageKind : std::uint8_t {
   kAcknowledge,
   kCollapseForecast,
   kStatueRotation,
+  kRegionalAlert,
+  kRegionalAlertOrigin,
 };
 
 // Which plinth message an identifier carries; kUnknown outside the table (node 0, axis 2, ...).
@@ -107,10 +113,10 @@ enum class AlarmCause : std::uint8_t {
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet
   kOutsideModel = 12,       // the estimate left the model's validity (lift-off)
+  kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
   kStatueUnexplained = 14,  // no member of the ensemble explains the statue sensor's motion
+  kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
 };
-// 13 (p_wave) and 15 (regional_alert) are issue 26's causes: gaps in the VAL_ table, refused on
-// encode and decode until they land.
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.
 namespace sensor_status {
@@ -204,6 +210,26 @@ struct CollapseForecast {
   std::uint8_t sequence = 0;  // the MonitorStatus.Sequence it goes out with
 };
 
+// 0x361: the origin part of a regional alert (the bridge sends it just before the alert's 0x360
+// frame, with the same event and version). Times relative to the frame's sending.
+struct RegionalAlertOrigin {
+  std::uint16_t event_id = 0;  // the bridge's number for the operator's event
+  std::uint8_t version = 0;    // a higher version replaces the event's earlier ones
+  double magnitude = 0.0;      // 0..10 at 0.05
+  double origin_age_s = 0.0;   // s since the origin time, -655.36..655.34 at 0.02 s
+  std::uint16_t distance_km = 0;  // epicentral distance, km, 0..4095
+  bool cancelled = false;      // the operator withdrew the event
+};
+
+// 0x360: the intensity part of a regional alert; the box takes the alert with it.
+struct RegionalAlert {
+  std::uint16_t event_id = 0;
+  std::uint8_t version = 0;
+  double pga_g = 0.0;         // expected PGA at the site (median), g, 0..6.5535 at 1e-4 g
+  double sigma_ln = 0.0;      // its lognormal sigma, 0..2.55 at 0.01
+  double s_arrival_in_s = 0.0;  // s to the expected S arrival, -327.68..327.67 at 0.01 s
+};
+
 // ---------------------------------------------------------------------------------------------
 // Results
 
@@ -238,6 +264,8 @@ using DecodeResult = CodecResult;
 [[nodiscard]] EncodeResult encode(const Acknowledge& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const CollapseForecast& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const StatueRotation& message, CanFrame& frame);
+[[nodiscard]] EncodeResult encode(const RegionalAlertOrigin& message, CanFrame& frame);
+[[nodiscard]] EncodeResult encode(const RegionalAlert& message, CanFrame& frame);
 
 // On success `message` holds the decoded values (node / axis from the identifier); on failure
 // it is left untouched.
@@ -248,6 +276,8 @@ using DecodeResult = CodecResult;
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, Acknowledge& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, CollapseForecast& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, StatueRotation& message);
+[[nodiscard]] DecodeResult decode(const CanFrame& frame, RegionalAlertOrigin& message);
+[[nodiscard]] DecodeResult decode(const CanFrame& frame, RegionalAlert& message);
 
 // ---------------------------------------------------------------------------------------------
 // Signal layouts (as in the DBC) and Intel bit packing

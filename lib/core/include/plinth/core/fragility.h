@@ -19,6 +19,10 @@ struct LognormalFragility {
 
   // P(collapse | pga_g): 0 at pga_g <= 0; with beta <= 0 a step at the median (1 from it on).
   [[nodiscard]] Real probability(Real pga_g) const;
+  // P(collapse) when the PGA is itself a lognormal guess (median pga_g, scatter sigma_ln, the
+  // standard deviation of ln PGA): the curve under that scatter is lognormal again, the
+  // dispersions added in quadrature, Phi(ln(pga_g / median) / sqrt(beta^2 + sigma_ln^2)).
+  [[nodiscard]] Real probability(Real pga_g, Real sigma_ln) const;
 };
 
 }  // namespace plinth

@@ -47,7 +47,6 @@
 
 #include <array>
 #include <cstdint>
-#include <type_traits>
 
 #include "plinth/core/ensemble.h"
 #include "plinth/core/error.h"
@@ -66,19 +65,6 @@ namespace plinth {
 // A build without the statue sensor (a microcontroller's with 64 KB of flash: its filter takes
 // about 10 KB) refuses one in its settings; the monitor's code for it is left out.
 inline constexpr bool kStatueSensorBuiltIn = PLINTH_STATUE_SENSOR != 0;
-
-// A field that only a build with the statue sensor fills holds `Full` there and an empty
-// stand-in elsewhere: statue_part gives the Full object, or nullptr in a build without, so that
-// its uses compile in both and vanish from the latter.
-template <class Full, class Held>
-[[nodiscard]] constexpr auto* statue_part(Held& held) {
-  using Target = std::conditional_t<std::is_const_v<Held>, const Full, Full>;
-  if constexpr (std::is_same_v<std::remove_const_t<Held>, Full>) {
-    return static_cast<Target*>(&held);
-  } else {
-    return static_cast<Target*>(nullptr);
-  }
-}
 
 struct StatueFilterSettings {
   Real rate_noise_rad_s = Real(0.003);  // rad/s: one measured rate's noise (gyro noise, bias left)

@@ -61,8 +61,12 @@ struct PgaGrid {
 struct CrossingGrids {
   std::vector<double> risk;         // reactive risk of the worst member, dimensionless
   std::vector<double> probability;  // forecast probability, dimensionless
+  // The P-wave stage's probability of collapse (plinth-eval run --pwave on; empty: off).
+  std::vector<double> pwave{};
 };
 [[nodiscard]] CrossingGrids default_crossing_grids();
+// The P-wave stage's grid: fine at the small probabilities where its threshold is chosen.
+[[nodiscard]] std::vector<double> default_pwave_grid();
 
 struct EvalRun {
   std::string record;  // file name
@@ -92,6 +96,13 @@ struct EvalRun {
   std::vector<double> probability_crossing_s;
   // The nominal statue's reactive risk alone (today's box), on the risk grid.
   std::vector<double> nominal_risk_crossing_s;
+  // With the P-wave stage (grids.pwave not empty): the record's reference phases (pwave_records.h,
+  // s from its first sample; p_pick_s -1 when there is none), the stage's first trigger (its
+  // onset, s; -1: none) and the first time its probability reached each grid value (-1: never).
+  double p_pick_s = -1.0;
+  double strong_motion_s = -1.0;
+  double pwave_trigger_s = -1.0;
+  std::vector<double> pwave_crossing_s;
 
   [[nodiscard]] bool outside_model() const { return model_valid_until_s >= 0.0; }
   [[nodiscard]] bool quiet() const { return !collapsed && peak_ratio < kQuietPeakRatio; }
@@ -251,6 +262,8 @@ void assign_case_collapses(std::vector<EvalRun>& runs, const std::string& where)
 // every field and throws InputError naming the file and line. The columns seed, pga_from_g,
 // pga_to_g and pga_steps (the case's draw and grid, after first_alarm_s) are read when present:
 // a file of an earlier plinth-eval has none, and its runs have no known grid (has_grid false).
+// With the P-wave stage the row ends with p_pick_s, strong_motion_s, pwave_trigger_s and the
+// pwave_ge_<p> crossings; a file without them reads as runs without the stage.
 void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with_grid);
 // with_grid: the seed and grid columns. A row has them when run.grid is known (as the header must).
 void write_eval_csv_row(std::FILE* out, const EvalRun& run);

@@ -8,6 +8,9 @@
 #include <string>
 #include <vector>
 
+#include <optional>
+
+#include "plinth/core/fragility.h"
 #include "plinth/core/scene.h"
 
 namespace plinth::host {
@@ -44,6 +47,9 @@ struct UncertainScene {
   // point's keys at low (z = -1), the scene's value (0) or high (+1); members[0] is nominal.
   // Each member is validated as a scene of its own.
   std::vector<Scene> members;
+  // The statue's collapse fragility, when the file gives it ([fragility]: median_g, beta; what
+  // plinth-eval fragility fits for the scene): the box's P-wave stage needs it (docs/pwave.md).
+  std::optional<LognormalFragility> fragility;
 
   // A statue inside the ranges: key i at low + u[i] (high - low), u[i] in [0, 1] (missing
   // entries: the middle). Throws InputError naming the values when they make no valid scene.
@@ -60,7 +66,8 @@ struct UncertainScene {
 // key for everything load_scene_file refuses, and for: an uncertainty sub-table the scene does
 // not have, a key its table does not know or the scene does not give (unless it has a constant
 // default), a range that is not two finite numbers [low, high] holding the scene's value, more
-// than kMaxUncertainParameters keys, and a member of the ensemble that is not a valid scene.
+// than kMaxUncertainParameters keys, a member of the ensemble that is not a valid scene, and a
+// [fragility] table without both keys, with others, a median_g not above 0 or a beta below 0.
 [[nodiscard]] UncertainScene load_uncertain_scene_file(const std::string& path);
 [[nodiscard]] UncertainScene load_uncertain_scene_text(const std::string& text,
                                                        const std::string& origin);

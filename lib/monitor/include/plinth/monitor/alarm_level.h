@@ -34,8 +34,9 @@ enum class AlarmCause : std::uint8_t {
   kCollapseForecast = 10,   // the forecast's probability of a collapse crossed the threshold
   kNotCalibrated = 11,      // no trusted sensor offset or initial state yet: nothing to vouch for
   kOutsideModel = 12,       // the estimate left the model (the block lifted off): nothing to vouch for
-  // 13 is p_wave's, 15 regional_alert's (issue 26) on the wire.
+  kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
   kStatueUnexplained = 14,  // no member of the ensemble explains the statue sensor's motion
+  kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
 };
 
 // The names in status and alarm lines (also the DBC's VAL_ names).
@@ -47,7 +48,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 14> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 16> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -61,7 +62,9 @@ inline constexpr NameTable<AlarmCause, 14> kAlarmCauseNames{{{
     {AlarmCause::kCollapseForecast, "collapse_forecast"},
     {AlarmCause::kNotCalibrated, "not_calibrated"},
     {AlarmCause::kOutsideModel, "outside_model"},
+    {AlarmCause::kPWave, "p_wave"},
     {AlarmCause::kStatueUnexplained, "statue_unexplained"},
+    {AlarmCause::kRegionalAlert, "regional_alert"},
 }}};
 
 // The levels the risk raises, lowest first (neither normal nor fault): the ones plinth-eval

@@ -13,6 +13,7 @@
 #include "plinth/core/name_table.h"
 #include "plinth/core/real.h"
 #include "plinth/monitor/alarm_level.h"
+#include "plinth/monitor/optional_part.h"
 
 namespace plinth::monitor {
 
@@ -34,6 +35,17 @@ struct AlarmPolicySettings {
   RiskThresholds advisory_forecast{Real(0.125), Real(0.0625)};
   RiskThresholds warning_forecast{Real(0.25), Real(0.1875)};
   RiskThresholds alarm_forecast{Real(0.375), Real(0.3125)};
+  // On the P-wave stage's probability of collapse (warning only). Calibrated with plinth-eval on
+  // the bundled three-component records (docs/pwave.md): the longest median lead where the P
+  // wave comes 3 s early, within 5 points more unneeded warnings than the box without it.
+  // None in a build without the stage (kPWaveStageBuiltIn).
+  [[no_unique_address]] OptionalPart<RiskThresholds, kPWaveStageBuiltIn> warning_pwave =
+      part_if<kPWaveStageBuiltIn>(RiskThresholds{Real(0.8), Real(0.6)});
+  // On the probability of collapse under the worst held regional alert (regional_alert.h;
+  // warning only): a guess about the coming ground motion, not the statue's physics. None in a
+  // build without regional alerts (kRegionalAlertBuiltIn).
+  [[no_unique_address]] OptionalPart<RiskThresholds, kRegionalAlertBuiltIn> warning_regional =
+      part_if<kRegionalAlertBuiltIn>(RiskThresholds{Real(0.5), Real(0.4)});
   // s, >= 0: a condition holds this long before its level rises. 0: the sample it starts (a
   // margin run out is news at once), so plinth-eval's rules are exactly what the box applies;
   // 0.1 s missed a collapse they caught and cost 0.1-0.2 s of lead (docs/forecast.md).
@@ -45,8 +57,9 @@ struct AlarmPolicySettings {
 };
 
 // Checks the settings; the Error names the field at fault ("alarm_policy.warning.off", ...).
-// Thresholds (risk and forecast alike): finite, in [0, 1], off < on per level, and ordered across
-// levels (advisory <= warning <= alarm, for on and for off).
+// Thresholds (risk, forecast, P wave and regional alike): finite, in [0, 1], off < on per level,
+// and ordered across levels (advisory <= warning <= alarm, for on and for off; warning_pwave and
+// warning_regional have no other level to be ordered with).
 [[nodiscard]] Error validate(const AlarmPolicySettings& settings);
 
 // An operator's acknowledgement (on the bus: the Acknowledge frame, without its source id).
@@ -59,6 +72,9 @@ struct AlarmInput {
   std::int64_t time_ns = 0;          // monitor time since start, ns
   Real risk = 0.0;                   // overturning risk, dimensionless, [0, 1]
   Real probability = 0.0;            // forecast probability of a collapse, [0, 1]
+  Real pwave_probability = 0.0;      // the P-wave stage's probability of collapse, [0, 1]
+  Real regional_probability = 0.0;   // under the worst held regional alert, [0, 1]
+  // (Both read only in a build with their part: kPWaveStageBuiltIn, kRegionalAlertBuiltIn.)
   bool out_of_full_contact = false;  // the block slides or rocks (motion started)
   bool collapse_detected = false;    // the block overturned or fell
   bool fault_active = false;         // sensor or bus trouble
@@ -79,7 +95,7 @@ enum class AckOutcome : std::uint8_t {
 
 enum class InputProblem : std::uint8_t {
   kNone = 0,
-  kRiskInvalid,   // risk or probability not finite or outside [0, 1]: an internal fault
+  kRiskInvalid,   // risk or a probability not finite or outside [0, 1]: an internal fault
   kTimeWentBack,  // time earlier than the last update's: the update was refused
 };
 
@@ -141,7 +157,10 @@ struct HeldCondition {
 // their off) and holds (raise_hold_s before its level rises, lower_hold_s absent before it
 // lowers); the condition level is the highest level whose condition is active:
 //   advisory  risk >= advisory.on, probability >= advisory_forecast.on, or out of full contact
-//   warning   risk >= warning.on, or probability >= warning_forecast.on
+//   warning   risk >= warning.on, or probability >= warning_forecast.on, or the P-wave
+//             stage's probability of collapse >= warning_pwave.on (p_wave.h), or the regional
+//             alert's probability of collapse >= warning_regional.on (never more than warning:
+//             both guess the coming ground, not the statue's physics)
 //   alarm     risk >= alarm.on, or probability >= alarm_forecast.on; or a collapse (overturned,
 //             fell): alarm at once, no hold, latched
 // Latching: a rise of the condition level into warning (latch_warning) or alarm (latch_alarm,
@@ -159,8 +178,9 @@ struct HeldCondition {
 // Events: one each time the level shown or its latched flag changes, at most two per update
 // (the acknowledgement first, against what the operator saw, then the new input); sequences
 // from 0, wrapping 255 -> 0. Cause: why the new level holds (risk_threshold; collapse_forecast
-// when the forecast alone holds it; phase_change, overturn_detected, the fault's cause), none
-// back to normal, acknowledged for a change an acknowledgement made.
+// when the forecast alone holds it; p_wave when the P-wave stage alone holds the warning, else
+// regional_alert when the regional alert alone holds it; phase_change, overturn_detected, the
+// fault's cause), none back to normal, acknowledged for a change an acknowledgement made.
 // Times are int64 ns of monitor time since start, never decreasing: an update with an earlier
 // time is refused (InputProblem::kTimeWentBack).
 class AlarmPolicy {
@@ -189,6 +209,7 @@ class AlarmPolicy {
   void evaluate_conditions(const AlarmInput& input, bool risk_valid);
   [[nodiscard]] AlarmLevel shown_level() const;
   [[nodiscard]] AlarmCause cause_of(AlarmLevel level) const;
+  [[nodiscard]] AlarmCause condition_cause(AlarmLevel level) const;
   void emit_if_changed(AlarmOutput& out, std::int64_t time_ns, bool by_acknowledgement);
 
   AlarmPolicySettings settings_;
@@ -201,8 +222,11 @@ class AlarmPolicy {
   detail::HeldCondition alarm_;
   detail::HeldCondition fault_;
   bool collapse_ = false;      // the latest input's collapse_detected
-  // The forecast alone holds the warning / alarm condition (for the cause).
+  // The forecast alone holds the warning / alarm condition; the P wave alone, else the regional
+  // alert alone, the warning (for the cause).
   bool warning_by_forecast_ = false;
+  bool warning_by_pwave_ = false;
+  bool warning_by_regional_ = false;
   bool alarm_by_forecast_ = false;
   bool out_of_contact_ = false;  // the latest input's out_of_full_contact
   bool not_calibrated_ = false;  // the latest input's not_calibrated

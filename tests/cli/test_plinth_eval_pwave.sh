@@ -1,0 +1,143 @@
+#!/usr/bin/env bash
+# plinth-eval's P-wave parts as a user runs them (docs/pwave.md), kept short: pwave-fit prints
+# its table from two bundled stations; run --pwave on with three-component records writes the
+# stage's columns (the record's phases, its trigger, its crossings, monotone in the threshold);
+# the report's P-wave section is recounted here from the CSV (the warning with the stage is the
+# earlier of the box's and the stage's crossing); and bad inputs end with exit code 1 or 2 and a
+# message naming the problem. Prints "ok - <name>" or "not ok - <name>: <why>" per check, then
+# "N passed, M failed".
+#
+# Environment: PLINTH_EVAL, the plinth-eval binary; PLINTH_SOURCE_DIR, the repository root.
+set -u
+
+PLINTH_SIM=${PLINTH_EVAL:-}
+# shellcheck source=tests/cli/harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
+PW=$SRC/sim/data/records/pwave
+# Two stations: the P wave 5 s before the strong motion (LA - City Terrace), and near the source
+# (Rinaldi, no P wave before it).
+STATIONS=(--record "$PW/RSN990_NORTHR_LAC090.AT2" --vertical "$PW/RSN990_NORTHR_LAC-UP.AT2"
+  --record "$PW/RSN1063_NORTHR_RRS228.AT2" --vertical "$PW/RSN1063_NORTHR_RRS-UP.AT2")
+# The isolated block without its fragility, and with one (the numbers are this test's).
+sed -e '/^\[fragility\]/,/^\[/{/^\[fragility\]/d;/^median_g/d;/^beta/d}' \
+  "$SRC/sim/scenes/eval/isolated.toml" > no-fragility.toml
+grep -q "median_g" no-fragility.toml && { echo "no-fragility.toml kept its fragility" >&2; exit 1; }
+cp no-fragility.toml isolated.toml
+printf '\n[fragility]\nmedian_g = 0.8\nbeta = 0.3\n' >> isolated.toml
+CASES=(--scene isolated.toml "${STATIONS[@]}" --statues 2 --pga-from 0.4g --pga-to 1.6g
+  --pga-steps 4 --jobs 2)
+
+ok_if() {
+  local name=$1
+  shift
+  if "$@"; then pass "$name"; else fail "$name" "$(head -c 300 "$TMP/stderr")"; fi
+}
+
+expect_success "pwave-fit on two stations" pwave-fit "${STATIONS[@]}"
+ok_if "pwave-fit prints a line per record and scale, and its table" python3 - "$TMP/stdout" <<'PY'
+import sys
+lines = open(sys.argv[1]).read().splitlines()
+records = [l for l in lines if l.startswith("RSN")]
+assert len(records) == 6, records  # 2 stations x 3 scales
+table = lines[lines.index(next(l for l in lines if l.startswith("# window_s"))) + 1:][:8]
+windows = [float(l.split(",")[0]) for l in table]
+assert windows == [0.5 * i for i in range(1, 9)], windows
+assert any("predictor = [" == l for l in lines)
+PY
+
+expect_success "a run with the stage" run "${CASES[@]}" --pwave on --out pw.csv
+ok_if "the runs carry the stage's columns, its crossings monotone in the threshold" \
+  python3 - pw.csv <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+grid = [c for c in rows[0] if c.startswith("pwave_ge_")]
+assert len(grid) >= 10, grid
+for r in rows:
+    t = [float(r[c]) for c in grid]
+    # A higher threshold is crossed no sooner (never, -1, counts as last).
+    key = [x if x >= 0 else float("inf") for x in t]
+    assert key == sorted(key), (r["record"], t)
+    assert float(r["strong_motion_s"]) > 0
+by_record = {r["record"]: r for r in rows}
+lac = by_record["RSN990_NORTHR_LAC090.AT2"]
+assert float(lac["strong_motion_s"]) - float(lac["p_pick_s"]) >= 3.0, lac
+assert 0 <= float(lac["pwave_trigger_s"]) < float(lac["strong_motion_s"]), lac
+PY
+
+expect_success "a run without it" run "${CASES[@]}" --out off.csv
+ok_if "the stage changes nothing else: the same truth and box" python3 - pw.csv off.csv <<'PY'
+import csv, sys
+a = list(csv.DictReader(open(sys.argv[1])))
+b = list(csv.DictReader(open(sys.argv[2])))
+assert len(a) == len(b)
+assert "pwave_ge_0.5" not in b[0] and "p_pick_s" not in b[0]
+for x, y in zip(a, b):
+    for k in y:
+        assert x[k] == y[k], (k, x[k], y[k])
+PY
+
+expect_success "the report of a run with the stage" report pw.csv
+cp "$TMP/stdout" report.txt
+ok_if "the report's P-wave section, recounted from the rows" python3 - pw.csv report.txt <<'PY'
+import csv, re, sys, statistics
+rows = list(csv.DictReader(open(sys.argv[1])))
+text = open(sys.argv[2]).read()
+assert "P-wave stage (warning" in text, text[-500:]
+# Collapse margins from the case's rows (the grid's top for a case that never collapsed).
+cases = {}
+for r in rows:
+    cases.setdefault((r["record"], r["scene"], r["statue"]), []).append(r)
+def margin(r):
+    rs = cases[(r["record"], r["scene"], r["statue"])]
+    col = [float(x["scale_g"]) for x in rs if x["collapsed"] == "1"]
+    top = float(r["pga_to_g"])
+    return (min(col) if col else top) / float(r["scale_g"])
+def score(p):
+    leads, unneeded, warned = [], 0, 0
+    for r in rows:
+        box = float(r["first_warning_s"])
+        t = box
+        if p is not None:
+            s = float(r["pwave_ge_" + p])
+            if s >= 0:
+                t = s if box < 0 else min(box, s)
+        if r["collapsed"] == "1":
+            c = float(r["collapse_time_s"])
+            leads.append(c - t if 0 <= t < c else 0.0)
+        elif margin(r) >= 2.0 - 1e-9:
+            unneeded += 1
+            warned += t >= 0
+    return statistics.median(leads), 100.0 * warned / unneeded if unneeded else 0.0
+lines = {l.split()[0]: l for l in text.splitlines() if re.match(r"^    (without|\d)", l)}
+for key, line in lines.items():
+    p = None if key == "without" else key
+    median, unneeded = score(p)
+    fields = line.split()
+    got_all = float(fields[3])
+    got_unneeded = float(fields[4])
+    assert abs(got_all - median) < 0.006, (key, got_all, median)
+    assert abs(got_unneeded - unneeded) < 0.06, (key, got_unneeded, unneeded)
+PY
+
+expect_success "a report calibrated on another file" report pw.csv --pwave-calibrate-on pw.csv
+ok_if "it says where the threshold was chosen" grep -q "chosen on the calibration file" \
+  "$TMP/stdout"
+
+expect_failure "as many --vertical as --record" "i-th --vertical belongs to the i-th --record" \
+  -- run --scene isolated.toml --record "$PW/RSN990_NORTHR_LAC090.AT2" \
+  --vertical "$PW/RSN990_NORTHR_LAC-UP.AT2" --record "$PW/RSN1063_NORTHR_RRS228.AT2" --out x.csv
+expect_failure "the stage needs the scene's fragility" "needs the scene's \[fragility\]" \
+  -- run --scene no-fragility.toml "${STATIONS[@]}" --statues 1 \
+  --pga-steps 1 --pwave on --out x.csv
+expect_failure "--pwave is on or off" "--pwave: expected on or off" \
+  -- run "${CASES[@]}" --pwave yes --out x.csv
+expect_failure "a vertical at another rate" "sampling interval .* differs" \
+  -- run --scene isolated.toml --record "$PW/RSN990_NORTHR_LAC090.AT2" \
+  --vertical "$PW/RSN2622_CHICHI.03_TCU071V.AT2" --out x.csv
+expect_failure "pwave-fit needs the verticals" "--vertical" \
+  -- pwave-fit --record "$PW/RSN990_NORTHR_LAC090.AT2"
+expect_failure "a report without the stage's columns asked to calibrate them" "P-wave columns" \
+  -- report off.csv --pwave-calibrate-on off.csv
+
+echo "$PASSED passed, $FAILED failed"
+((FAILED == 0))
