@@ -37,11 +37,11 @@ struct BoxSettings {
   bool statue_sensor = false;
 };
 
-// A MEMS gyroscope a museum would mount on a statue: a Bosch BMI088's as usually quoted from its
-// data sheet (BST-BMI088-DS001 rev. 1.3; not verified here, docs/forecast.md): rate noise
-// density 0.014 deg/s/sqrt(Hz), zero-rate offset +-1 deg/s (each run draws one per axis,
-// uniformly), and a delay of one 200 Hz sample (its output filter's group delay at 200 Hz ODR
-// and the CAN frame's transit).
+// A MEMS gyroscope a museum would mount on a statue: a Bosch BMI088's typical figures as Bosch
+// Sensortec's application engineer gives them (the data sheet's table not found; source in
+// docs/forecast.md): rate noise density 0.014 deg/s/sqrt(Hz), zero-rate offset +-1 deg/s (each
+// run draws one per axis, uniformly), and a delay of one 200 Hz sample (its output filter's
+// group delay at 200 Hz ODR and the CAN frame's transit).
 struct StatueImuModel {
   double noise_density_deg_s_rthz = 0.014;  // deg/s/sqrt(Hz)
   double zero_rate_offset_deg_s = 1.0;      // deg/s, the offset's bound
