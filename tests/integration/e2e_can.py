@@ -542,7 +542,9 @@ def monitor_frames_checks(check, s, config):
                 or LEVELS[raw["PreviousLevel"]] != line["previous"]
                 or CAUSES[raw["Cause"]] != line["cause"] or bool(raw["Latched"]) != line["latched"]
                 or raw["Sequence"] != line["sequence"]
-                or abs(raw["TimeSinceStart"] - line["t"] * 1000) > 1.0):
+                # the frame floors the time to the ms, the line rounds it: 1 ms apart at most,
+                # with room for the product's rounding (2.023 * 1000 - 2022 is 1.0000000000002)
+                or abs(raw["TimeSinceStart"] - line["t"] * 1000) > 1.0 + 1e-6):
             mismatch.append(f"frame {raw} vs line {line}")
     check(not mismatch, "each AlarmEvent frame matches its JSON alarm line (level, previous, "
           "cause, latched, sequence, time in ms): " +
