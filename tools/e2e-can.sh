@@ -283,8 +283,10 @@ if [ "${1:-}" = "--guest" ]; then
   #    hostile frames, then a dangerous alert (warning), its duplicate and older version, a
   #    harmless alert and its cancellation; the monitor runs until the dangerous alert has
   #    expired (REGIONAL_WAIT), the sensor is stopped first (its timeout ends the run, as in 1).
-  #    Run again if the sensor timed out before: a starved guest's silence would hide the
-  #    warning behind a fault.
+  #    Run again if the sensor timed out before it was stopped (a starved guest's silence would
+  #    hide the warning behind a fault), or if the bridge's frames on the bus missed their gaps in
+  #    regional.in.log by more than 50 ms (a stall could pull a pair's frames 100 ms apart, or
+  #    push the late one's together).
   scenario_regional() {
     start_capture regional
     start_monitor regional "$REGIONAL_SCENE" --config "$REGIONAL_CONFIG"
@@ -298,7 +300,28 @@ if [ "${1:-}" = "--guest" ]; then
     stop_monitor regional INT
     stop_capture
   }
-  ! wanted regional || attempt regional single_timeout
+  regional_usable() {  # NAME
+    single_timeout "$1" || return 1
+    local line t last="" k=0 miss
+    local -a gaps
+    read -r -a gaps <<<"$REGIONAL_GAPS_US"
+    while IFS= read -r line; do
+      [[ $line == *" 360#"* || $line == *" 361#"* ]] || continue
+      t=${line%%)*}
+      t=${t#(}
+      t=${t/./}
+      if [ -n "$last" ]; then
+        miss=$((t - last - gaps[k]))
+        if ((miss > 50000 || miss < -50000)); then
+          echo "e2e-can (guest): $1, run $n: the bridge's frame $k came $miss us off its gap" >&2
+          return 1
+        fi
+      fi
+      last=$t
+      k=$((k + 1))
+    done <"$1.bus.log"
+  }
+  ! wanted regional || attempt regional regional_usable
   lap guest "$run_started"
   exit 0
 fi

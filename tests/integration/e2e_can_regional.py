@@ -136,10 +136,11 @@ def decoded_alert(dbc, alert):
 def prepare(work, dbc, scene, rate, lead_in_s):
     """regional.in.log (canplayer's input), regional.toml (the box file), quiet.csv (the quiet
     ground plinth-replay sends); returns config.env's values for the guest."""
-    lines, t = [], 0.0
+    lines, gaps, t = [], [], 0.0
     for _, frames, _ in cases(dbc):
         for ident, data, gap in frames:
             t += gap
+            gaps.append(str(round(gap * 1e6)))
             lines.append(f"({t:.6f}) vcan0 {ident:03X}#{data.hex().upper()}\n")
     (work / "regional.in.log").write_text("".join(lines))
     (work / "regional.toml").write_text(BOX_FILE)
@@ -159,7 +160,9 @@ def prepare(work, dbc, scene, rate, lead_in_s):
     e2e.write_csv(work / "quiet.csv", "quiet", rate, samples)
     return {"REGIONAL_SCENE": str(Path(scene).resolve()),
             "REGIONAL_CONFIG": str(work / "regional.toml"),
-            "REGIONAL_WAIT": f"{wait_s:.3f}"}
+            "REGIONAL_WAIT": f"{wait_s:.3f}",
+            # the gap before each frame, us (the guest's check that the bus kept them)
+            "REGIONAL_GAPS_US": " ".join(gaps)}
 
 
 def bus_index(s, ident, data, after=-1):
