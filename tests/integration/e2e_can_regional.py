@@ -282,15 +282,20 @@ def check(check, s, config):
     got = last and {k: last[k] for k in want}
     if got:
         got["refused"] = {k: v for k, v in got["refused"].items() if v}
+    summary = s.summary.get("regional")
+    final = summary and {k: summary[k] for k in want}
+    if final:
+        final["refused"] = {k: v for k, v in final["refused"].items() if v}
     # expired at expires_t: the first status line after it (status interval 0.02 s) says so
     on_time = bool(expired) and expires_t is not None and \
         expires_t <= expired[0]["t"] <= expires_t + 2 * config["status_interval_s"] + 0.005
-    check(on_time and got == want and
+    check(on_time and got == want and final == want and
           all(x["alarm"] == "warning" and x["latched"] == "warning" for x in expired),
           f"the alert expired at expires_t {expires_t} (first status line saying so at "
           f"{expired[0]['t'] if expired else None}); in the {len(expired)} status lines after, "
-          f"the level still warning and latched (until acknowledged); the last's counters "
-          f"{got}" + ("" if got == want else f", expected {want}"))
+          f"the level still warning and latched (until acknowledged); the counters of the last "
+          f"status line and of the summary: {got}" +
+          ("" if got == want and final == want else f", summary {final}, expected {want}"))
 
     # The sensor stream went on: every SensorAcceleration frame on the bus was a sample (the
     # common checks), and none was refused.
