@@ -240,8 +240,10 @@ def check(check, s, config):
 
     # The status lines: the alert held, its time to the S arrival counting down (negative while
     # the S waves pass), its expiry, the level latched after it.
-    status = [x for x in s.status_lines if "regional" in x and x["t"] * 1e6 + s.epoch_us <=
-              last_sensor]
+    # (until the sensor's stop: its timeout's fault, after the last warning, ends the run)
+    stopped_t = next((x["t"] for x in s.alarm_lines if x["cause"] == "sensor_timeout" and
+                      warnings and x["t"] > warnings[-1]["t"]), math.inf)
+    status = [x for x in s.status_lines if "regional" in x and x["t"] < stopped_t]
     held = [x for x in status if x["regional"]["held"] >= 1 and
             x["regional"]["event_id"] == DANGEROUS["EventId"]]
     raised_t = warnings[0]["t"] if warnings else None
