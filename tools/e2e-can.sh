@@ -6,10 +6,11 @@
 # what everyone saw and prints the figures. Four runs: the record (phase timeline against
 # plinth-sim), the sensor node killed mid-record (fault within the timeout), garbage on the
 # plinth identifiers (counted and rejected), a flood of unrelated traffic (no plinth frame
-# lost). See docs/can-e2e.md.
+# lost); and a fifth, run alone by ctest's regional_can test: regional alerts from the bridge,
+# hostile ones refused, a dangerous one raising warning until it expires. See docs/can-e2e.md.
 #
 # Usage: tools/e2e-can.sh [--build DIR] [--work DIR] [--speed S] [--keep] [--route R]
-#                        [--if-chosen FILE]
+#                        [--if-chosen FILE] [--scenarios LIST]
 #   --build DIR   the build tree with plinth-monitor, plinth-replay, plinth-sim (default
 #                 build/release; or give them as PLINTH_MONITOR, PLINTH_REPLAY, PLINTH_SIM)
 #   --work DIR    keep every file of the run there (bus logs, JSON lines, reports); default a
@@ -20,6 +21,8 @@
 #   --route R     tools/vcan-bus.sh's route: auto (default: $PLINTH_VCAN_ROUTE, else auto), uml,
 #                 qemu
 #   --if-chosen FILE  run only if FILE (vcan-bus.sh --choose) names the route given with --route
+#   --scenarios LIST  the runs, comma-separated, of main, stop, garbage, burst, regional
+#                 (default main,stop,garbage,burst: ctest's can_e2e; regional: regional_can)
 # Exit status: 0 all checks passed, 1 a check failed, 2 usage, 77 no route can start here or
 # FILE names another route (ctest's SKIP_RETURN_CODE).
 # shellcheck disable=SC2153,SC2317  # the guest's settings come from config.env; the scenario_*
@@ -78,13 +81,15 @@ if [ "${1:-}" = "--guest" ]; then
   }
   stop_capture() { kill -INT "$capture_pid"; wait "$capture_pid" || true; }
   # plinth-monitor listens once its start-up AlarmEvent (fault: no data yet) is on the bus.
-  start_monitor() {  # NAME
-    "$MONITOR" --scene "$SCENE" --can vcan0 --rate "$RATE" --steps "$STEPS" \
-      --startup-window "$STARTUP_WINDOW" --status-interval "$STATUS_INTERVAL" \
-      >"$1.monitor.jsonl" 2>"$1.monitor.err" &
+  start_monitor() {  # NAME [SCENE [ARG...]]
+    local name=$1 scene=${2:-$SCENE}
+    shift $(($# > 1 ? 2 : 1))
+    "$MONITOR" --scene "$scene" --can vcan0 --rate "$RATE" --steps "$STEPS" \
+      --startup-window "$STARTUP_WINDOW" --status-interval "$STATUS_INTERVAL" "$@" \
+      >"$name.monitor.jsonl" 2>"$name.monitor.err" &
     monitor_pid=$!
-    wait_line "$1.bus.log" '* 330#*' 1000 ||
-      fail "plinth-monitor did not start: $(cat "$1.monitor.err")"
+    wait_line "$name.bus.log" '* 330#*' 1000 ||
+      fail "plinth-monitor did not start: $(cat "$name.monitor.err")"
   }
   stop_monitor() {  # NAME SIGNAL
     echo "stop_signal=SIG$2" >>"$1.extra"
@@ -99,6 +104,23 @@ if [ "${1:-}" = "--guest" ]; then
     "$REPLAY" --record input.csv --can vcan0 --rate "$RATE" --speed "$SPEED" --report-json "$@" \
       >"$name.replay.json" 2>"$name.replay.err" || rc=$?
     echo "$rc" >"$name.replay.rc"
+  }
+  # plinth-replay sends RECORD in the background until it ends or stop_replay.
+  start_replay() {  # NAME RECORD SPEED
+    "$REPLAY" --record "$2" --can vcan0 --rate "$RATE" --speed "$3" --report-json \
+      >"$1.replay.json" 2>"$1.replay.err" &
+    replay_pid=$!
+  }
+  stop_replay() {  # NAME SIGNAL
+    kill "-$2" "$replay_pid" 2>/dev/null || true
+    local rc=0
+    wait "$replay_pid" 2>/dev/null || rc=$?
+    echo "$rc" >"$1.replay.rc"
+  }
+  # The monitor's level is back to normal after its start-up (the fault of "no data yet" is held
+  # 2 s), at most until 1 s before the input ends.
+  wait_normal() {  # NAME
+    wait_line "$1.bus.log" '* 330#40*' "$STOP_WAIT_POLLS" || echo "no_normal_level=1" >>"$1.extra"
   }
   lap() {  # NAME START_US
     us
@@ -170,7 +192,9 @@ if [ "${1:-}" = "--guest" ]; then
     stop_monitor main INT
     stop_capture
   }
-  attempt main estimated_throughout
+  # The runs config.env's SCENARIOS names (e2e-can.sh --scenarios).
+  wanted() { [[ " $SCENARIOS " == *" $1 "* ]]; }
+  ! wanted main || attempt main estimated_throughout
 
   # 2. The sensor node dies mid-record (SIGKILL: no goodbye), once the monitor's level is back
   #    to normal after its start-up (the fault of "no data yet" is held 2 s): the fault must
@@ -179,15 +203,10 @@ if [ "${1:-}" = "--guest" ]; then
   scenario_stop() {
     start_capture stop
     start_monitor stop
-    "$REPLAY" --record input.csv --can vcan0 --rate "$RATE" --speed "$SPEED" --report-json \
-      >stop.replay.json 2>stop.replay.err &
-    replay_pid=$!
-    wait_line stop.bus.log '* 330#40*' "$STOP_WAIT_POLLS" || echo "no_normal_level=1" >>stop.extra
+    start_replay stop input.csv "$SPEED"
+    wait_normal stop
     nap "$KILL_AFTER_NORMAL"
-    kill -KILL "$replay_pid" 2>/dev/null || true
-    rc=0
-    wait "$replay_pid" 2>/dev/null || rc=$?
-    echo "$rc" >stop.replay.rc
+    stop_replay stop KILL
     nap 0.3
     stop_monitor stop TERM
     stop_capture
@@ -197,7 +216,7 @@ if [ "${1:-}" = "--guest" ]; then
     echo "e2e-can (guest): $1, run $n: the sensor timed out before it was killed" >&2
     return 1
   }
-  attempt stop single_timeout
+  ! wanted stop || attempt stop single_timeout
 
   # 3. The monitor stalls (SIGSTOP for 150 ms: the frames wait in its socket) while the sensor
   #    sends, then garbage on the plinth identifiers (garbage.in.log, sent by canplayer: wrong
@@ -229,7 +248,7 @@ if [ "${1:-}" = "--guest" ]; then
     stop_monitor garbage INT
     stop_capture
   }
-  attempt garbage replay_on_time_and_witnessed 300000
+  ! wanted garbage || attempt garbage replay_on_time_and_witnessed 300000
 
   # 4. A flood of unrelated traffic (ids outside 0x300-0x37F, as fast as the guest sends) for
   #    the whole replay: no plinth frame may be lost. candump logs the plinth frames only (it
@@ -256,7 +275,60 @@ if [ "${1:-}" = "--guest" ]; then
     stop_monitor burst TERM
     stop_capture
   }
-  attempt burst replay_on_time_and_witnessed 300000
+  ! wanted burst || attempt burst replay_on_time_and_witnessed 300000
+
+  # 5. Regional alerts (tests/integration/e2e_can_regional.py, docs/regional.md): the monitor
+  #    on a scene with a [fragility], quiet ground in real time (--speed 1: the alerts' times are
+  #    the bus's), and once its level is normal, canplayer sends regional.in.log as timed there:
+  #    hostile frames, then a dangerous alert (warning), its duplicate and older version, a
+  #    harmless alert and its cancellation; the monitor runs until the dangerous alert has
+  #    expired (REGIONAL_WAIT), the sensor is stopped first (its timeout ends the run, as in 1).
+  #    Run again if the sensor timed out before it was stopped (a starved guest's silence would
+  #    hide the warning behind a fault), if candump dropped frames (as in 3 and 4), or if the
+  #    bridge's frames on the bus missed their gaps in regional.in.log by more than 50 ms (a
+  #    stall could pull a pair's frames 100 ms apart, or push the late one's together).
+  scenario_regional() {
+    start_capture regional
+    start_monitor regional "$REGIONAL_SCENE" --config "$REGIONAL_CONFIG"
+    start_replay regional quiet.csv 1
+    wait_normal regional
+    nap 0.1
+    canplayer -I regional.in.log || fail "canplayer could not send regional.in.log"
+    nap "$REGIONAL_WAIT"
+    stop_replay regional INT
+    nap 0.2
+    stop_monitor regional INT
+    stop_capture
+  }
+  regional_usable() {  # NAME
+    single_timeout "$1" || return 1
+    local line t last="" k=0 miss
+    local -a gaps
+    read -r -a gaps <<<"$REGIONAL_GAPS_US"
+    # grep's lines only (bash reading the whole log took up to 4 s in a loaded guest; no
+    # process substitution: the guest has no /dev/fd)
+    grep -E ' 36[01]#|DROPCOUNT' "$1.bus.log" >"$1.bridge.log" || true
+    while IFS= read -r line; do
+      if [[ $line == *DROPCOUNT* ]]; then  # the witness lost frames: it proves nothing
+        echo "e2e-can (guest): $1, run $n: candump dropped frames: $line" >&2
+        return 1
+      fi
+      [[ $line == *" 360#"* || $line == *" 361#"* ]] || continue
+      t=${line%%)*}
+      t=${t#(}
+      t=${t/./}
+      if [ -n "$last" ]; then
+        miss=$((t - last - gaps[k]))
+        if ((miss > 50000 || miss < -50000)); then
+          echo "e2e-can (guest): $1, run $n: the bridge's frame $k came $miss us off its gap" >&2
+          return 1
+        fi
+      fi
+      last=$t
+      k=$((k + 1))
+    done <"$1.bridge.log"
+  }
+  ! wanted regional || attempt regional regional_usable
   lap guest "$run_started"
   exit 0
 fi
@@ -275,6 +347,7 @@ build="$root/build/release"
 work=""
 speed=2
 keep=0
+scenarios=main,stop,garbage,burst
 bus=()  # tools/vcan-bus.sh's --route, --if-chosen
 usage() { sed -n '/^# Usage:/,/^# FILE names another/p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 while [ $# -gt 0 ]; do
@@ -283,6 +356,7 @@ while [ $# -gt 0 ]; do
     --work) work=${2:?}; shift 2 ;;
     --speed) speed=${2:?}; shift 2 ;;
     --keep) keep=1; shift ;;
+    --scenarios) scenarios=${2:?}; shift 2 ;;
     --route | --if-chosen) bus+=("$1" "${2:?}"); shift 2 ;;
     -h | --help) usage ;;
     *) echo "$me: unknown argument $1" >&2; usage ;;
@@ -329,7 +403,8 @@ python3 "$root/tests/integration/e2e_can.py" prepare --work "$work" \
   --record "$root/sim/data/records/irpinia1980_brienza_000.AT2" --scale 20 \
   --scene "$root/sim/scenes/paper-isolated.toml" --dbc "$root/hal/can_codec/plinth.dbc" \
   --monitor "$(realpath "$monitor")" --replay "$(realpath "$replay")" --sim "$(realpath "$sim")" \
-  --speed "$speed"
+  --speed "$speed" --scenarios "$scenarios" \
+  --regional-scene "$root/sim/scenes/eval/ground-slender.toml"
 
 started=$(date +%s%N)
 status=0

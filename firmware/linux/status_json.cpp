@@ -223,6 +223,19 @@ std::string json_array(const std::vector<std::string>& values) {
   return out + "]";
 }
 
+namespace {
+
+// The regional alerts' object (regional_status_json), once an alert came: a box without any
+// says nothing of them.
+void regional_once_received(JsonObject& line, const BoxStatus& s, double t_origin) {
+  if (const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(s.regional);
+      regional != nullptr && regional->received > 0) {
+    line.raw("regional", regional_status_json(*regional, t_origin));
+  }
+}
+
+}  // namespace
+
 std::string status_json(const BoxStatus& s, double t_origin) {
   JsonObject line;
   line.text("type", "status").fixed("t", seconds(s.time_ns, t_origin), 6);
@@ -252,10 +265,7 @@ std::string status_json(const BoxStatus& s, double t_origin) {
   line.raw("sensors", status_sensors(s));
   if (s.has_statue_sensor) line.raw("statue_sensor", status_statue_sensor(s));
   line.raw("state", per_axis(s, axis_state));
-  if (const auto* regional = monitor::built_part<monitor::RegionalAlertStatus>(s.regional);
-      regional != nullptr && regional->received > 0) {
-    line.raw("regional", regional_status_json(*regional, t_origin));
-  }
+  regional_once_received(line, s, t_origin);
   const auto* pwave = monitor::built_part<monitor::PWaveStatus>(s.pwave);
   if (pwave != nullptr && s.has_pwave) {
     line.raw("pwave", pwave_status_json(*pwave, s.estimator_start_ns, t_origin));
@@ -400,6 +410,7 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
       .count("failovers", s.failovers)
       .count("failovers_continued", s.failovers_continued)
       .raw("sensors", summary_sensors(s));
+  regional_once_received(line, s, t_origin);  // the refusals by reason (docs/regional.md)
   if (s.has_statue_sensor) {
     const StatueSensorStatus& statue = s.statue_sensor;
     line.raw("statue_sensor", JsonObject()

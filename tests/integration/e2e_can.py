@@ -41,7 +41,7 @@ CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
           "collapse_forecast", "not_calibrated", "outside_model", "p_wave", "statue_unexplained",
           "regional_alert"]
-SCENARIOS = ("main", "stop", "garbage", "burst")
+SCENARIOS = ("main", "stop", "garbage", "burst", "regional")  # regional: e2e_can_regional.py
 # Sent by canplayer in the garbage case, each one refused by the DBC (or not for the monitor).
 GARBAGE = (
     "301#", "301#00", "301#00112233445566",  # SensorAcceleration, lengths 0, 1, 7
@@ -119,7 +119,6 @@ def prepare(args):
         "scene": str(Path(args.scene).resolve()), "dbc": str(Path(args.dbc).resolve()),
         "monitor": args.monitor, "replay": args.replay, "sim": args.sim,
     }
-    (work / "config.json").write_text(json.dumps(config, indent=1) + "\n")
     # For the guest (bash): the values it needs, already in its units.
     env = {
         "MONITOR": args.monitor, "REPLAY": args.replay, "SCENE": config["scene"],
@@ -137,6 +136,21 @@ def prepare(args):
         # the stall and the garbage come once the record is on (the monitor estimating)
         "GARBAGE_AFTER": f"{(args.lead_in + 0.2) / args.speed:.3f}",
     }
+    scenarios = args.scenarios.split(",")
+    unknown = [name for name in scenarios if name not in SCENARIOS]
+    if unknown or not scenarios:
+        sys.exit(f"e2e_can.py: --scenarios: unknown {unknown}; the runs: {', '.join(SCENARIOS)}")
+    config["scenarios"] = scenarios
+    if "regional" in scenarios:
+        import e2e_can_regional
+        if not args.regional_scene:
+            sys.exit("e2e_can.py: the regional run needs --regional-scene (a scene with "
+                     "[fragility])")
+        config["regional_scene"] = str(Path(args.regional_scene).resolve())
+        env.update(e2e_can_regional.prepare(work, Dbc(args.dbc), args.regional_scene, args.rate,
+                                            args.lead_in))
+    env["SCENARIOS"] = " ".join(scenarios)
+    (work / "config.json").write_text(json.dumps(config, indent=1) + "\n")
     (work / "config.env").write_text("".join(f"{k}='{v}'\n" for k, v in env.items()))
     (work / "garbage.in.log").write_text("".join(f"(0.000000) vcan0 {frame}\n"
                                                  for frame in GARBAGE))
@@ -198,6 +212,30 @@ class Dbc:
 
     def signal(self, ident, name):
         return next(s for s in self.messages[ident][2] if s.name == name)
+
+    def ident(self, name):
+        return next(i for i, message in self.messages.items() if message[0] == name)
+
+    def encode(self, name, physical, raw=None):
+        """The 8 bytes of message `name` (every signal given, in its unit), as the DBC lays
+        them out: raw = round((value - offset) / factor), two's complement for a signed one.
+        A value outside the signal's range is an error; `raw` gives raw values as they are
+        (a hostile frame's, outside the range on purpose)."""
+        ident = self.ident(name)
+        _, length, signals = self.messages[ident]
+        raw = dict(raw or {})
+        if set(physical) | set(raw) != {s.name for s in signals}:
+            raise ValueError(f"{name}: signals {sorted(physical) + sorted(raw)}, the DBC has "
+                             f"{sorted(s.name for s in signals)}")
+        word = 0
+        for s in signals:
+            if s.name not in raw:
+                value = round((physical[s.name] - s.offset) / s.factor)
+                if not s.raw_min <= value <= s.raw_max:
+                    raise ValueError(f"{name}.{s.name} {physical[s.name]} outside its range")
+                raw[s.name] = value
+            word |= (raw[s.name] & ((1 << s.length) - 1)) << s.start
+        return word.to_bytes(length, "little")
 
     def decode(self, ident, data):
         """({signal: raw}, "") or (None, why not)."""
@@ -781,7 +819,7 @@ def run_checks(args):
     figures = {}
     timing = read_keys(work / "guest.times")
     runs = {}
-    for name in SCENARIOS:
+    for name in config["scenarios"]:
         try:
             runs[name] = Scenario(work, name, dbc)
         except (OSError, ValueError) as error:
@@ -800,6 +838,9 @@ def run_checks(args):
         check_garbage(checks, runs["garbage"], config, short_samples)
     if "burst" in runs and common_checks(checks, runs["burst"], config):
         check_burst(checks, runs["burst"], config, short_samples, figures)
+    if "regional" in runs and common_checks(checks, runs["regional"], config):
+        import e2e_can_regional
+        figures["regional_ms"] = e2e_can_regional.check(checks, runs["regional"], config)
 
     print("measured:")
     if "latency_us" in figures:
@@ -833,6 +874,9 @@ def run_checks(args):
         print(f"  burst: {foreign} unrelated frames in {seconds:.2f} s ({rate:.0f} frames/s); "
               f"latency {describe(latency)}; jitter median {report['jitter_median_us']:.0f} us, "
               f"p99 {report['jitter_p99_us']:.0f} us, max {report['jitter_max_us']:.0f} us")
+    if figures.get("regional_ms") is not None:
+        print(f"  regional: the dangerous alert's RegionalAlert frame -> the AlarmEvent (warning, "
+              f"cause regional_alert) on the bus: {figures['regional_ms']:.1f} ms")
     if timing:
         print("  guest wall time: " + ", ".join(f"{k} {float(v):.2f} s" for k, v in timing.items()))
     print(f"e2e-can: {checks.passed} checks passed, {checks.failed} failed")
@@ -861,6 +905,9 @@ def main():
     p.add_argument("--kill-after", type=float, default=0.1,
                    help="s after the monitor's level is normal again: the stop case")
     p.add_argument("--short", type=float, default=2.0, help="record s: the garbage and burst cases")
+    p.add_argument("--scenarios", default="main,stop,garbage,burst",
+                   help="the runs, comma-separated: " + ", ".join(SCENARIOS))
+    p.add_argument("--regional-scene", help="the regional run's scene (with [fragility])")
     c = sub.add_parser("check")
     c.add_argument("--work", required=True)
     args = parser.parse_args()

@@ -30,6 +30,12 @@ bool FrameDecoder::decoded(const can::CanFrame& frame, Message& message) {
   return false;
 }
 
+// What a regional frame the codec refused names: the signal at fault, else (its length, its
+// reserved bits) the frame itself, so that every refusal says what was wrong.
+const char* FrameDecoder::refused_regional(const char* message) const {
+  return counters_.last_error_signal[0] != '\0' ? counters_.last_error_signal : message;
+}
+
 int FrameDecoder::sensor_of_node(std::uint8_t node) const {
   for (int i = 0; i < count_; ++i) {
     if (nodes_[static_cast<std::size_t>(i)] == node) return i;
@@ -114,7 +120,7 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
       } else {
         ++counters_.regional_malformed;
         input.kind = FrameInput::Kind::kRegionalMalformed;
-        input.malformed_field = counters_.last_error_signal;
+        input.malformed_field = refused_regional("RegionalAlertOrigin");
       }
       break;
     }
@@ -137,7 +143,7 @@ void FrameDecoder::decode_regional(const hal::TimedFrame& timed, FrameInput& inp
   input.kind = FrameInput::Kind::kRegionalMalformed;
   if (!decoded(timed.frame, message)) {
     ++counters_.regional_malformed;
-    input.malformed_field = counters_.last_error_signal;
+    input.malformed_field = refused_regional("RegionalAlert");
     return;
   }
   const std::int64_t gap_ns = timed.timestamp_ns - origin_time_ns_;

@@ -188,8 +188,17 @@ TEST(FrameDecoder, ARegionalAlertIsItsTwoFrames) {
   const FrameInput refused = decoder.decode({bad, 4000 * kMs});
   EXPECT_EQ(refused.kind, FrameInput::Kind::kRegionalMalformed);
   EXPECT_STREQ(refused.malformed_field, "Magnitude");
+  // A refusal no signal explains (the length) names the frame: a short origin frame, a short
+  // alert frame after a good origin.
+  can::CanFrame short_origin = encoded(origin);
+  short_origin.length = 7;
+  EXPECT_STREQ(decoder.decode({short_origin, 5000 * kMs}).malformed_field, "RegionalAlertOrigin");
+  (void)decoder.decode({encoded(origin), 6000 * kMs});
+  can::CanFrame short_alert = encoded(alert);
+  short_alert.length = 5;
+  EXPECT_STREQ(decoder.decode({short_alert, 6001 * kMs}).malformed_field, "RegionalAlert");
   EXPECT_EQ(decoder.counters().regional_alerts, 1U);
-  EXPECT_EQ(decoder.counters().regional_malformed, 4U);
+  EXPECT_EQ(decoder.counters().regional_malformed, 6U);
 }
 
 }  // namespace

@@ -77,6 +77,9 @@ class FrameDecoder {
 
   // A regional alert's two frames into one input.
   void decode_regional(const hal::TimedFrame& timed, FrameInput& input);
+  // The field a refused regional frame names: the codec's signal, else `message` (its length
+  // or reserved bits were wrong).
+  [[nodiscard]] const char* refused_regional(const char* message) const;
 
   std::array<std::uint8_t, kMaxSensors> nodes_{};
   int count_ = 0;
