@@ -282,41 +282,55 @@ Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& targe
 
 std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points, FalseAlarm false_alarm) {
   using Allowed = bool (*)(const WarningOutcome&, FalseAlarm);
+  // Which rule of those a constraint allows is the best (lexicographic, see `better`).
+  enum class Order { kFewestFalseAlarms, kFewestMisses, kLongestLead };
   struct Constraint {
     const char* name;
     Allowed allowed;
-    bool fewest_misses_first;
+    Order order;
   };
   static constexpr Constraint kConstraints[] = {
-      {"no miss", [](const WarningOutcome& o, FalseAlarm) { return o.misses == 0; }, false},
+      {"no miss", [](const WarningOutcome& o, FalseAlarm) { return o.misses == 0; },
+       Order::kFewestFalseAlarms},
       {"no miss, median lead >= 1.5 s",
        [](const WarningOutcome& o, FalseAlarm) {
          return o.misses == 0 && o.lead_quantile(0.5) >= 1.5;
        },
-       false},
+       Order::kFewestFalseAlarms},
       {"no miss, 10th pct lead >= 0.5 s",
        [](const WarningOutcome& o, FalseAlarm) {
          return o.misses == 0 && o.lead_quantile(0.1) >= 0.5;
        },
-       false},
+       Order::kFewestFalseAlarms},
       {"no miss, median lead >= 3 s",
        [](const WarningOutcome& o, FalseAlarm) {
          return o.misses == 0 && o.lead_quantile(0.5) >= 3.0;
        },
-       false},
+       Order::kFewestFalseAlarms},
       {"false alarms <= 5 %",
-       [](const WarningOutcome& o, FalseAlarm f) { return o.false_alarm_rate(f) <= 0.05; }, true},
-      {"fewest false alarms", [](const WarningOutcome&, FalseAlarm) { return true; }, false},
+       [](const WarningOutcome& o, FalseAlarm f) { return o.false_alarm_rate(f) <= 0.05; },
+       Order::kFewestMisses},
+      {"fewest false alarms", [](const WarningOutcome&, FalseAlarm) { return true; },
+       Order::kFewestFalseAlarms},
+      // Issue 24's target at `alarm` read the other way: the longest lead it allows.
+      {"no miss, false alarms <= 9 %: longest lead",
+       [](const WarningOutcome& o, FalseAlarm f) {
+         return o.misses == 0 && o.false_alarm_rate(f) <= kIssue24MaxUnneededRate;
+       },
+       Order::kLongestLead},
   };
-  // Lexicographic: (false alarms, misses, -median lead), or (misses, false alarms, -median).
-  const auto better = [false_alarm](const WarningOutcome& a, const WarningOutcome& b,
-                                    bool misses_first) {
+  // Lexicographic: (false alarms, misses, -median lead), (misses, false alarms, -median lead) or
+  // (-median lead, false alarms, misses).
+  const auto better = [false_alarm](const WarningOutcome& a, const WarningOutcome& b, Order order) {
     const double fa = a.false_alarm_rate(false_alarm);
     const double fb = b.false_alarm_rate(false_alarm);
-    if (misses_first && a.misses != b.misses) return a.misses < b.misses;
+    const double la = a.lead_quantile(0.5);
+    const double lb = b.lead_quantile(0.5);
+    if (order == Order::kLongestLead && la != lb) return la > lb;
+    if (order == Order::kFewestMisses && a.misses != b.misses) return a.misses < b.misses;
     if (fa != fb) return fa < fb;
     if (a.misses != b.misses) return a.misses < b.misses;
-    return a.lead_quantile(0.5) > b.lead_quantile(0.5);
+    return la > lb;
   };
   std::vector<FrontierRow> rows;
   for (const Constraint& c : kConstraints) {
@@ -324,7 +338,7 @@ std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points, FalseAlar
     row.constraint = c.name;
     for (const RocPoint& p : points) {
       if (!c.allowed(p.outcome, false_alarm)) continue;
-      if (!row.found || better(p.outcome, row.point.outcome, c.fewest_misses_first)) {
+      if (!row.found || better(p.outcome, row.point.outcome, c.order)) {
         row.found = true;
         row.point = p;
       }

@@ -139,7 +139,7 @@ TEST(EvalMetrics, ChoosesTheLongestLeadWithinTheTarget) {
 TEST(EvalMetrics, FrontierIsTheFewestFalseAlarmsEachConstraintAllows) {
   const CrossingGrids grids{{0.2, 0.5, 0.8}, {0.5, 1.0}};
   const std::vector<FrontierRow> rows = frontier(roc(roc_runs(), grids), FalseAlarm::kPeak);
-  ASSERT_EQ(rows.size(), 6U);
+  ASSERT_EQ(rows.size(), 7U);
   for (std::size_t i = 0; i < 4; ++i) {  // the "no miss" constraints: all met by one rule
     SCOPED_TRACE(rows[i].constraint);
     ASSERT_TRUE(rows[i].found);
@@ -162,6 +162,44 @@ TEST(EvalMetrics, FrontierIsTheFewestFalseAlarmsEachConstraintAllows) {
   EXPECT_EQ(risk_only[3].point.rule.risk_index, 0);
   EXPECT_TRUE(frontier({})[0].constraint[0] != '\0');
   EXPECT_FALSE(frontier({})[0].found);
+  EXPECT_FALSE(rows[6].found);  // every rule that misses nothing: 50 % false alarms
+}
+
+// Issue 24's row: of the rules that miss nothing within 9 % false alarms, the longest lead. Two
+// collapses at 10 s, the risk reached at 8 s, the probability at 5 s; 20 quiet runs, the
+// probability reached in `probability_false` of them, the risk in none.
+TEST(EvalMetrics, FrontierGivesTheLongestLeadWithinNinePercent) {
+  const auto runs = [](int probability_false) {
+    std::vector<EvalRun> r(22);
+    for (int i = 0; i < 2; ++i) {
+      r[static_cast<std::size_t>(i)].collapsed = true;
+      r[static_cast<std::size_t>(i)].collapse_time_s = 10.0;
+      r[static_cast<std::size_t>(i)].risk_crossing_s = {8.0};
+      r[static_cast<std::size_t>(i)].probability_crossing_s = {5.0};
+    }
+    for (std::size_t i = 2; i < r.size(); ++i) {
+      r[i].peak_ratio = 0.1;
+      r[i].risk_crossing_s = {-1.0};
+      r[i].probability_crossing_s = {i < 2U + static_cast<std::size_t>(probability_false) ? 3.0
+                                                                                         : -1.0};
+    }
+    return r;
+  };
+  const CrossingGrids grids{{0.5}, {0.5}};
+  // 1 in 20 (5 %): the probability's 5 s lead, though the risk alone raises none.
+  std::vector<FrontierRow> rows = frontier(roc(runs(1), grids), FalseAlarm::kPeak);
+  ASSERT_EQ(rows.size(), 7U);
+  ASSERT_TRUE(rows[6].found);
+  EXPECT_EQ(rows[6].point.outcome.misses, 0);
+  EXPECT_DOUBLE_EQ(rows[6].point.outcome.lead_quantile(0.5), 5.0);
+  EXPECT_DOUBLE_EQ(rows[6].point.outcome.false_alarm_rate(), 0.05);
+  EXPECT_EQ(rows[6].point.rule.risk_index, -1);  // the probability alone: no extra alarm
+  EXPECT_DOUBLE_EQ(rows[0].point.outcome.lead_quantile(0.5), 2.0);  // "no miss": the risk
+  // 2 in 20 (10 %): over the 9 %, so the risk's 2 s.
+  rows = frontier(roc(runs(2), grids), FalseAlarm::kPeak);
+  ASSERT_TRUE(rows[6].found);
+  EXPECT_DOUBLE_EQ(rows[6].point.outcome.lead_quantile(0.5), 2.0);
+  EXPECT_DOUBLE_EQ(rows[6].point.outcome.false_alarm_rate(), 0.0);
 }
 
 TEST(EvalMetrics, TheNominalSignalReadsTheNominalStatuesCrossings) {
