@@ -315,7 +315,7 @@ std::vector<FrontierRow> frontier(const std::vector<RocPoint>& points, FalseAlar
       // Issue 24's target at `alarm` read the other way: the longest lead it allows.
       {"no miss, false alarms <= 9 %: longest lead",
        [](const WarningOutcome& o, FalseAlarm f) {
-         return o.misses == 0 && o.false_alarm_rate(f) <= kIssue24MaxUnneededRate;
+         return o.misses == 0 && o.false_alarm_rate(f) <= kStatueSensorMaxUnneededRate;
        },
        Order::kLongestLead},
   };

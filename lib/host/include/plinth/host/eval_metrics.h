@@ -227,12 +227,12 @@ struct Choice {
 [[nodiscard]] Choice choose_rule(const std::vector<RocPoint>& points, const LevelTarget& target);
 
 // Issue 24's target for `alarm` with the statue sensor: unneeded alarms at most 9 %.
-inline constexpr double kIssue24MaxUnneededRate = 0.09;
+inline constexpr double kStatueSensorMaxUnneededRate = 0.09;
 
 // The frontier of a set of rules: for each of the alarm's constraints (docs/forecast.md), the rule
 // that meets it with the fewest false alarms (then the fewest misses, the longest median lead),
 // for "false alarms <= 5 %" the fewest misses (then the fewest false alarms), and for "no miss,
-// false alarms <= 9 %" (kIssue24MaxUnneededRate) the longest median lead (then the fewest false
+// false alarms <= 9 %" (kStatueSensorMaxUnneededRate) the longest median lead (then the fewest false
 // alarms): what the signals of a runs file allow at best, whatever thresholds the box ships.
 struct FrontierRow {
   const char* constraint = "";
