@@ -161,7 +161,9 @@ std::string regional_report_text(const RegionalReport& r) {
              100.0 * kRegionalUnneededAllowance);
     table(title.substr(0, title.size() - 1).c_str(), *r.chosen);
   } else {
-    out += "  no threshold keeps the unneeded warnings within the allowance\n";
+    out += line("  no threshold keeps the unneeded warnings within %g points of the box's (%s)",
+                100.0 * kRegionalUnneededAllowance,
+                r.chosen_elsewhere ? "on the calibration file" : "on this file");
   }
   if (r.box_default) {
     const std::string title =

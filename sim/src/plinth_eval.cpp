@@ -521,7 +521,7 @@ int main(int argc, char** argv) {
         *run,
         {"--record-info", "--regional-latency", "--regional-latency-sd", "--regional-bias",
          "--regional-sigma"},
-        opt.regional == "on", "sets the simulated regional alerts, and --regional is off");
+        opt.regional != "off", "sets the simulated regional alerts, and --regional is off");
   };
   if (const std::optional<int> exit_code =
           plinth::host::parse_command_line(app, argc, argv, checks)) {
