@@ -104,13 +104,23 @@ fw::MonitorConfig box_config(const BoxSettings& box) {
   return config;
 }
 
+// A run's own seed: the case's key (record, scene, statue, scale) hashed, so that a run draws the
+// same in every shard.
+std::uint64_t run_seed(const EvalCase& c) {
+  std::uint64_t h = 1469598103934665603ULL;  // FNV-1a
+  const std::string key = c.record_name + "|" + c.scene_name + "|" + std::to_string(c.statue) +
+                          "|" + std::to_string(c.scale_g);
+  for (const char ch : key) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ULL;
+  return h;
+}
+
 // The statue sensor's samples of one run: the truth's theta' through StatueImuModel's noise,
 // offset and delay, as a gyroscope whose y axis points along the statue's y (theta'_0 =
 // -omega_y, statue_sensor.h). Seeded by the case, so a run is the same in every shard.
 class StatueImu {
  public:
   StatueImu(const EvalCase& c, double rate_hz, const StatueImuModel& model)
-      : model_(model), random_(seed_of(c)) {
+      : model_(model), random_(run_seed(c)) {
     const double to_rad = std::numbers::pi / 180.0;
     std::uniform_real_distribution<double> offset(-model.zero_rate_offset_deg_s,
                                                   model.zero_rate_offset_deg_s);
@@ -129,14 +139,6 @@ class StatueImu {
   [[nodiscard]] double delay_s() const { return model_.delay_s; }
 
  private:
-  static std::uint64_t seed_of(const EvalCase& c) {
-    std::uint64_t h = 1469598103934665603ULL;  // FNV-1a
-    const std::string key =
-        c.record_name + "|" + c.scene_name + "|" + std::to_string(c.statue) + "|" +
-        std::to_string(c.scale_g);
-    for (const char ch : key) h = (h ^ static_cast<unsigned char>(ch)) * 1099511628211ULL;
-    return h;
-  }
   StatueImuModel model_;
   std::mt19937_64 random_;
   std::normal_distribution<double> gauss_;
@@ -249,6 +251,21 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
   }
 }
 
+// The run's simulated regional alert (regional_eval.h), beside the box: it changes nothing of
+// the box's run; the report takes the earlier of the box's warning and the alert's.
+EvalRun::Regional regional_alert(const EvalCase& c, const host::RegionalAlertModel& model) {
+  if (!c.scene->fragility) {
+    throw InputError(c.scene_name + ": --regional on needs the scene's [fragility] table "
+                     "(median_g, beta: plinth-eval fragility fits them; docs/scene-format.md)");
+  }
+  if (c.source == nullptr) throw InputError(c.record_name + ": --regional on needs its source");
+  constexpr std::uint64_t kRegionalSalt = 0x9e3779b97f4a7c15ULL;  // not the gyroscope's draws
+  const host::SimulatedRegionalAlert a = host::simulate_regional_alert(
+      model, *c.source, c.phases, c.scale_g, *c.scene->fragility, run_seed(c) ^ kRegionalSalt);
+  return {c.source->magnitude, c.source->rhyp_km, a.origin_s,  a.alert_s,
+          a.s_arrival_s,       a.pga_g,           a.sigma_ln, a.probability};
+}
+
 }  // namespace
 
 EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings& truth_settings,
@@ -270,6 +287,7 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.model_valid_until_s = truth.lift_off_s;
   run.first_motion_s = truth.first_motion_s;
   run_box(c, gamma, box, grids, truth, run);
+  if (box.regional) run.regional = regional_alert(c, *box.regional);
   return run;
 }
 

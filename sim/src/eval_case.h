@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "plinth/host/eval_metrics.h"
 #include "plinth/host/pwave_records.h"
 #include "plinth/host/record_io.h"
+#include "plinth/host/regional_eval.h"
 #include "plinth/host/scene_toml.h"
 #include "plinth/monitor/alarm_policy.h"
 
@@ -35,6 +37,10 @@ struct BoxSettings {
   // A statue sensor (firmware statue_sensor.h) simulated from the truth: its gyroscope as
   // StatueImuModel says, at the box's rate.
   bool statue_sensor = false;
+  // Regional alerts simulated by this model (plinth-eval run --regional on; docs/regional.md,
+  // "Evaluation"): one alert per run, its probability from the box's regional room with the
+  // scene's [fragility]. Needs each case's source.
+  std::optional<host::RegionalAlertModel> regional;
 };
 
 // A MEMS gyroscope a museum would mount on a statue: a Bosch BMI088's typical figures as Bosch
@@ -64,6 +70,7 @@ struct EvalCase {
   const Scene* true_statue = nullptr;
   double scale_g = 0.0;  // the record's PGA in this run, g
   host::RecordPhases phases;  // the record's (the same at every scale)
+  const host::RecordSource* source = nullptr;  // the record's earthquake (--record-info)
 };
 
 // The truth and the box's timeline for one case (times from the record's t = 0, s). Throws

@@ -9,6 +9,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
@@ -19,6 +21,7 @@
 #include "eval_fragility.h"
 #include "eval_pwave.h"
 #include "eval_pwave_report.h"
+#include "eval_regional_report.h"
 #include "eval_report.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/eval_metrics.h"
@@ -45,6 +48,9 @@ struct RunOptions {
   std::vector<std::string> record_paths;
   std::vector<std::string> vertical_paths;  // the i-th for the i-th record (eval_pwave.h)
   std::string pwave = "off";
+  std::string regional = "off";  // regional alerts simulated (docs/regional.md, "Evaluation")
+  std::string record_info_path;  // each record's source, matched by RSN
+  plinth::host::RegionalAlertModel regional_model;
   std::string out_path;
   std::string pga_from = "0.2g";
   std::string pga_to = "2.5g";
@@ -72,6 +78,7 @@ struct ReportOptions {
   std::string plot_path;
   bool frontier = false;  // also the frontier of the rules (make_report)
   std::string pwave_calibrate_on;  // choose the P-wave threshold on this runs file
+  std::string regional_calibrate_on;  // choose the regional threshold on this runs file
   std::string calibration_path;  // choose the rules on this other runs file
   std::string false_alarm =
       plinth::host::false_alarm_name(plinth::sim::CalibrationTargets{}.false_alarm);
@@ -141,6 +148,18 @@ plinth::sim::BoxSettings box_settings(const RunOptions& opt) {
     throw InputError("--pwave: expected on or off, got '" + opt.pwave + "'");
   }
   box.pwave = opt.pwave == "on";
+  if (opt.regional != "on" && opt.regional != "off") {
+    throw InputError("--regional: expected on or off, got '" + opt.regional + "'");
+  }
+  if (opt.regional == "on") {
+    if (opt.record_info_path.empty()) {
+      throw InputError("--regional on needs --record-info FILE.csv: each record's magnitude and "
+                       "distance (tools/pwave-stations.py writes it; docs/regional.md)");
+    }
+    box.regional = opt.regional_model;
+    box.regional->declared_sigma_ln = box.regional->error_sigma_ln;  // the alert tells its scatter
+    plinth::host::validate(*box.regional);
+  }
   return box;
 }
 
@@ -217,6 +236,15 @@ int run_eval(const RunOptions& opt) {
       plinth::sim::read_records(opt.record_paths, opt.vertical_paths);
   std::vector<plinth::host::RecordPhases> phases;
   for (const plinth::host::Record& r : records) phases.push_back(plinth::host::record_phases(r));
+  std::map<int, plinth::host::RecordSource> record_info;
+  std::vector<const plinth::host::RecordSource*> sources(records.size(), nullptr);
+  if (box.regional) {
+    record_info = plinth::host::read_record_info(opt.record_info_path);
+    for (std::size_t r = 0; r < records.size(); ++r) {
+      sources[r] = &plinth::host::record_source(record_info, file_name(opt.record_paths[r]),
+                                                opt.record_info_path);
+    }
+  }
   plinth::host::JobRun run;
   plinth::host::parse_shard(opt.shard, run.shard_index, run.shard_count);
   run.jobs = opt.jobs ? *opt.jobs : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
@@ -227,6 +255,7 @@ int run_eval(const RunOptions& opt) {
   const std::vector<std::size_t> indices = plinth::host::shard_indices(job_count, run);
   plinth::host::CrossingGrids grids = plinth::host::default_crossing_grids();
   if (box.pwave) grids.pwave = plinth::host::default_pwave_grid();
+  grids.regional = box.regional.has_value();
   std::vector<std::vector<EvalRun>> results(job_count);
   const auto case_of = [&](std::size_t index, double pga) {
     const std::size_t r = index / per_record;
@@ -236,7 +265,8 @@ int run_eval(const RunOptions& opt) {
                                   &scenes[s],    file_name(opt.scene_paths[s]),
                                   j,             opt.seed,
                                   grid,          &statues[s][static_cast<std::size_t>(j)],
-                                  pga,           phases[r]};
+                                  pga,           phases[r],
+                                  sources[r]};
   };
   run.stop = plinth::host::install_stop_handlers("plinth-eval");
   plinth::host::ProgressBar progress(indices.size(), 0, "cases");
@@ -320,6 +350,16 @@ int run_report(const ReportOptions& opt) {
                    .c_str(),
                stdout);
   }
+  if (table.grids.regional || !opt.regional_calibrate_on.empty()) {
+    std::optional<EvalTable> other;
+    if (!opt.regional_calibrate_on.empty()) {
+      other = plinth::host::read_eval_csv(opt.regional_calibrate_on);
+    }
+    std::fputs(plinth::sim::regional_report_text(
+                   plinth::sim::make_regional_report(table, other ? &*other : nullptr))
+                   .c_str(),
+               stdout);
+  }
   if (!opt.json_path.empty()) {
     write_text(opt.json_path, plinth::sim::report_json(report, table.grids));
   }
@@ -351,7 +391,9 @@ int run_merge(const MergeOptions& opt) {
       merged.grids = part.grids;
       merged.has_grid = part.has_grid;
     } else if (part.grids.risk != merged.grids.risk ||
-               part.grids.probability != merged.grids.probability) {
+               part.grids.probability != merged.grids.probability ||
+               part.grids.pwave != merged.grids.pwave ||
+               part.grids.regional != merged.grids.regional) {
       throw InputError(opt.inputs[i] + ": its threshold columns differ from " + opt.inputs[0] +
                        "'s (another plinth-eval version)");
     } else if (part.has_grid != merged.has_grid) {
@@ -388,6 +430,23 @@ int main(int argc, char** argv) {
   run->add_option("--pwave", opt.pwave,
                   "on: the P-wave stage beside the box, its crossings in the runs file (needs "
                   "the scenes' [fragility]; default off)");
+  run->add_option("--regional", opt.regional,
+                  "on: a simulated regional alert per run (latency and intensity error of "
+                  "published early-warning performance, docs/regional.md), its columns in the "
+                  "runs file (needs --record-info and the scenes' [fragility]; default off)");
+  run->add_option("--record-info", opt.record_info_path,
+                  "CSV of each record's source by RSN (rsn,earthquake,station,magnitude,rrup_km,"
+                  "rjb_km,rhyp_km,vs30_m_s: tools/pwave-stations.py)");
+  run->add_option("--regional-latency", opt.regional_model.latency_median_s,
+                  "the alert's median time after the origin, s (default 6.9: ShakeAlert, "
+                  "Ridgecrest 2019)");
+  run->add_option("--regional-latency-sd", opt.regional_model.latency_sd_s,
+                  "its standard deviation, s (default 2, an assumption)");
+  run->add_option("--regional-bias", opt.regional_model.error_bias_ln,
+                  "mean of ln(predicted / true PGA) (default 0)");
+  run->add_option("--regional-sigma", opt.regional_model.error_sigma_ln,
+                  "standard deviation of ln(predicted / true PGA) (default ln 2: Minson et al. "
+                  "2019); the alert declares the same");
   run->add_option("--out", opt.out_path, "runs CSV")->required();
   run->add_option("--pga-from", opt.pga_from, "smallest PGA of the grid (default 0.2g)");
   run->add_option("--pga-to", opt.pga_to, "largest PGA of the grid (default 2.5g)");
@@ -427,6 +486,9 @@ int main(int argc, char** argv) {
   report_command->add_option("--pwave-calibrate-on", report.pwave_calibrate_on,
                              "choose the P-wave stage's threshold on this runs file (default: "
                              "on the one reported)");
+  report_command->add_option("--regional-calibrate-on", report.regional_calibrate_on,
+                             "choose the regional alerts' threshold on this runs file (default: "
+                             "on the one reported)");
   report_command->add_flag("--frontier", report.frontier,
                            "also the rule with the fewest false alarms under each of the alarm's "
                            "targets, on the worst member's and on the nominal statue's risk");
@@ -455,6 +517,11 @@ int main(int argc, char** argv) {
   const auto checks = [&] {
     plinth::host::refuse_without_effect(*run, {"--horizon"}, opt.forecast != "off",
                                         "sets the forecast's horizon, and --forecast is off");
+    plinth::host::refuse_without_effect(
+        *run,
+        {"--record-info", "--regional-latency", "--regional-latency-sd", "--regional-bias",
+         "--regional-sigma"},
+        opt.regional != "off", "sets the simulated regional alerts, and --regional is off");
   };
   if (const std::optional<int> exit_code =
           plinth::host::parse_command_line(app, argc, argv, checks)) {

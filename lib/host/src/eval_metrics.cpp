@@ -78,6 +78,26 @@ double parse_time(const std::string& text, const std::string& where, std::string
   return v;
 }
 
+// The regional columns from f[c] on (kRegionalColumns' order), each checked.
+EvalRun::Regional parse_regional(const std::vector<std::string>& f, std::size_t c,
+                                 const std::string& where) {
+  std::array<double, kRegionalColumns.size()> v{};
+  for (std::size_t i = 0; i < v.size(); ++i) v[i] = parse_number(f[c + i], where, kRegionalColumns[i]);
+  EvalRun::Regional g{v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7]};
+  const auto refuse = [&](std::size_t i, const char* expected) {
+    throw InputError(where + ": " + std::string(kRegionalColumns[i]) + ": expected " + expected +
+                     ", got " + f[c + i]);
+  };
+  if (!(g.magnitude > 0.0 && g.magnitude <= 10.0)) refuse(0, "a magnitude in (0, 10]");
+  if (!(g.rhyp_km > 0.0)) refuse(1, "a distance above 0 km");
+  if (!(g.s_arrival_s >= g.origin_s)) refuse(4, "an S arrival at or after the origin");
+  if (!(g.alert_s >= g.origin_s)) refuse(3, "an alert at or after the origin");
+  if (!(g.pga_g > 0.0)) refuse(5, "a PGA above 0 g");
+  if (!(g.sigma_ln >= 0.0)) refuse(6, "a sigma_ln >= 0");
+  if (!(g.probability >= 0.0 && g.probability <= 1.0)) refuse(7, "a probability in [0, 1]");
+  return g;
+}
+
 // The grid value in a column name "<prefix><value>".
 bool grid_value(std::string_view column, std::string_view prefix, double& value) {
   if (!column.starts_with(prefix)) return false;
@@ -458,6 +478,11 @@ void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with
     line += ",pwave_ge_";
     line += format(v);
   }
+  for (std::string_view c : grids.regional ? std::span<const std::string_view>(kRegionalColumns)
+                                           : std::span<const std::string_view>()) {
+    line += ',';
+    line += c;
+  }
   std::fprintf(out, "%s\n", line.c_str());
 }
 
@@ -490,6 +515,13 @@ void write_eval_csv_row(std::FILE* out, const EvalRun& r) {
     add(format(r.pwave_trigger_s));
   }
   for (double t : r.pwave_crossing_s) add(format(t));
+  if (r.regional) {
+    const EvalRun::Regional& g = *r.regional;
+    for (double v : {g.magnitude, g.rhyp_km, g.origin_s, g.alert_s, g.s_arrival_s, g.pga_g,
+                     g.sigma_ln, g.probability}) {
+      add(format(v));
+    }
+  }
   std::fprintf(out, "%s\n", line.c_str());
 }
 
@@ -517,7 +549,15 @@ EvalTable read_eval_csv(const std::string& path) {
                               f.begin() + static_cast<std::ptrdiff_t>(first_extra));
   const std::size_t first_grid = first_extra + (table.has_grid ? kGridColumns.size() : 0);
   bool pwave_block = false;  // p_pick_s, strong_motion_s, pwave_trigger_s, then pwave_ge_
-  for (std::size_t i = first_grid; i < f.size(); ++i) {
+  // The regional columns, when present, end the header.
+  std::size_t header_end = f.size();
+  if (f.size() >= first_grid + kRegionalColumns.size() &&
+      std::equal(kRegionalColumns.begin(), kRegionalColumns.end(),
+                 f.end() - static_cast<std::ptrdiff_t>(kRegionalColumns.size()))) {
+    table.grids.regional = true;
+    header_end -= kRegionalColumns.size();
+  }
+  for (std::size_t i = first_grid; i < header_end; ++i) {
     double v = 0.0;
     if (f[i] == "p_pick_s" && !pwave_block && i + 2 < f.size() && f[i + 1] == "strong_motion_s" &&
         f[i + 2] == "pwave_trigger_s") {
@@ -623,6 +663,7 @@ EvalTable read_eval_csv(const std::string& path) {
         r.pwave_crossing_s.push_back(parse_time(f[c], where, "P-wave crossing"));
       }
     }
+    if (table.grids.regional) r.regional = parse_regional(f, c, where);
     table.runs.push_back(std::move(r));
   }
   if (table.has_grid) assign_case_collapses(table.runs, path);

@@ -613,5 +613,67 @@ TEST(EvalPWaveColumns, AMalformedBlockIsRefusedNamingWhy) {
             std::string::npos);
 }
 
+// The runs file's regional block: last, read back (times before the record's start kept),
+// refused when a value is out of its range.
+TEST(EvalRegionalColumns, RoundTripAfterThePWaveBlock) {
+  CrossingGrids grids{{0.5}, {0.5}};
+  grids.pwave = {0.5};
+  grids.regional = true;
+  const std::string path = temp_path("regional_roundtrip.csv");
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  write_eval_csv_header(f, grids, false);
+  EvalRun r = run_with(1.5, 2.25, {3.0});
+  r.regional = EvalRun::Regional{6.69, 42.88, -4.0, -0.5, 8.25, 0.75, 0.693147, 0.4125};
+  write_eval_csv_row(f, r);
+  std::fclose(f);
+  std::ifstream in(path);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_NE(header.find(",pwave_ge_0.5,regional_magnitude,regional_rhyp_km,regional_origin_s,"
+                        "regional_alert_s,regional_s_arrival_s,regional_pga_g,regional_sigma_ln,"
+                        "regional_probability"),
+            std::string::npos)
+      << header;
+  const EvalTable t = read_eval_csv(path);
+  EXPECT_TRUE(t.grids.regional);
+  EXPECT_EQ(t.grids.pwave, grids.pwave);
+  ASSERT_EQ(t.runs.size(), 1U);
+  ASSERT_TRUE(t.runs[0].regional.has_value());
+  const EvalRun::Regional& g = *t.runs[0].regional;
+  EXPECT_DOUBLE_EQ(g.magnitude, 6.69);
+  EXPECT_DOUBLE_EQ(g.origin_s, -4.0);
+  EXPECT_DOUBLE_EQ(g.alert_s, -0.5);
+  EXPECT_DOUBLE_EQ(g.probability, 0.4125);
+  EXPECT_EQ(t.runs[0].pwave_crossing_s, (std::vector<double>{3.0}));
+  std::filesystem::remove(path);
+}
+
+TEST(EvalRegionalColumns, OutOfRangeValuesAreRefusedNamingTheColumn) {
+  const std::string header =
+      "record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,first_advisory_s,"
+      "first_warning_s,first_alarm_s,risk_ge_0.5,nominal_risk_ge_0.5,regional_magnitude,"
+      "regional_rhyp_km,regional_origin_s,regional_alert_s,regional_s_arrival_s,regional_pga_g,"
+      "regional_sigma_ln,regional_probability\n";
+  const std::string fixed = "r,s,0,0.3,0,-1,0.1,-1,-1,-1,-1,-1,";
+  const std::string good = temp_path("regional_good.csv");
+  std::ofstream(good) << header + fixed + "6.7,40,-2,5,9,0.3,0.7,0.5\n";
+  EXPECT_NO_THROW((void)read_eval_csv(good));
+  std::filesystem::remove(good);
+  EXPECT_NE(error_reading(header + fixed + "6.7,40,-2,5,9,0.3,0.7,1.5\n")
+                .find(":2: regional_probability: expected a probability in [0, 1], got 1.5"),
+            std::string::npos);
+  EXPECT_NE(error_reading(header + fixed + "6.7,40,-2,-3,9,0.3,0.7,0.5\n")
+                .find(":2: regional_alert_s: expected an alert at or after the origin"),
+            std::string::npos);
+  EXPECT_NE(error_reading(header + fixed + "6.7,40,-2,5,-9,0.3,0.7,0.5\n")
+                .find(":2: regional_s_arrival_s: expected an S arrival at or after the origin"),
+            std::string::npos);
+  EXPECT_NE(error_reading(header + fixed + "6.7,0,-2,5,9,0.3,0.7,0.5\n").find("regional_rhyp_km"),
+            std::string::npos);
+  EXPECT_NE(error_reading(header + fixed + "6.7,40,-2,5,9,nan,0.7,0.5\n").find("regional_pga_g"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace plinth::host

@@ -25,7 +25,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "plinth/monitor/alarm_level.h"
@@ -63,10 +65,16 @@ struct CrossingGrids {
   std::vector<double> probability;  // forecast probability, dimensionless
   // The P-wave stage's probability of collapse (plinth-eval run --pwave on; empty: off).
   std::vector<double> pwave{};
+  // Regional alerts simulated (plinth-eval run --regional on): the regional_ columns.
+  bool regional = false;
 };
 [[nodiscard]] CrossingGrids default_crossing_grids();
 // The P-wave stage's grid: fine at the small probabilities where its threshold is chosen.
 [[nodiscard]] std::vector<double> default_pwave_grid();
+// The regional alert's columns (EvalRun::Regional, in its order).
+inline constexpr std::array<std::string_view, 8> kRegionalColumns{
+    "regional_magnitude", "regional_rhyp_km", "regional_origin_s", "regional_alert_s",
+    "regional_s_arrival_s", "regional_pga_g", "regional_sigma_ln", "regional_probability"};
 
 struct EvalRun {
   std::string record;  // file name
@@ -103,6 +111,20 @@ struct EvalRun {
   double strong_motion_s = -1.0;
   double pwave_trigger_s = -1.0;
   std::vector<double> pwave_crossing_s;
+  // With regional alerts simulated (grids.regional; regional_eval.h, docs/regional.md): the
+  // record's source and the run's alert (times in s from the record's first sample, negative
+  // before it), the statue's probability of collapse under it in the box's regional room.
+  struct Regional {
+    double magnitude = 0.0;
+    double rhyp_km = 0.0;
+    double origin_s = 0.0;
+    double alert_s = 0.0;
+    double s_arrival_s = 0.0;
+    double pga_g = 0.0;
+    double sigma_ln = 0.0;
+    double probability = 0.0;
+  };
+  std::optional<Regional> regional;
 
   [[nodiscard]] bool outside_model() const { return model_valid_until_s >= 0.0; }
   [[nodiscard]] bool quiet() const { return !collapsed && peak_ratio < kQuietPeakRatio; }
@@ -267,7 +289,8 @@ void assign_case_collapses(std::vector<EvalRun>& runs, const std::string& where)
 // pga_to_g and pga_steps (the case's draw and grid, after first_alarm_s) are read when present:
 // a file of an earlier plinth-eval has none, and its runs have no known grid (has_grid false).
 // With the P-wave stage the row ends with p_pick_s, strong_motion_s, pwave_trigger_s and the
-// pwave_ge_<p> crossings; a file without them reads as runs without the stage.
+// pwave_ge_<p> crossings; a file without them reads as runs without the stage. With regional
+// alerts it ends with the regional_ columns (kRegionalColumns).
 void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with_grid);
 // with_grid: the seed and grid columns. A row has them when run.grid is known (as the header must).
 void write_eval_csv_row(std::FILE* out, const EvalRun& run);

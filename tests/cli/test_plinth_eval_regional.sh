@@ -1,0 +1,161 @@
+#!/usr/bin/env bash
+# plinth-eval's simulated regional alerts as a user runs them (docs/regional.md, "Evaluation"),
+# kept short: run --regional on --record-info writes the alert's columns (recomputed here from
+# the record's strong motion, its row of stations.csv and the box's fragility rule); the alert
+# changes nothing else of the run; the report's "Regional alerts" section is recounted from the
+# CSV (the warning with the alert is the earlier of the box's and the alert's, when the alert's
+# probability passes the threshold); and bad inputs end with exit code 1 or 2 and a message
+# naming the problem. Prints "ok - <name>" or "not ok - <name>: <why>" per check, then
+# "N passed, M failed".
+#
+# Environment: PLINTH_EVAL, the plinth-eval binary; PLINTH_SOURCE_DIR, the repository root.
+set -u
+
+PLINTH_SIM=${PLINTH_EVAL:-}
+# shellcheck source=tests/cli/harness.sh
+source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
+PW=$SRC/sim/data/records/pwave
+INFO=$PW/stations.csv
+# Two stations: LA - City Terrace (Rhyp 42.9 km: the alert comes before the S waves) and Rinaldi
+# (20.6 km: in the blind zone).
+STATIONS=(--record "$PW/RSN990_NORTHR_LAC090.AT2" --vertical "$PW/RSN990_NORTHR_LAC-UP.AT2"
+  --record "$PW/RSN1063_NORTHR_RRS228.AT2" --vertical "$PW/RSN1063_NORTHR_RRS-UP.AT2")
+sed -e '/^\[fragility\]/,/^\[/{/^\[fragility\]/d;/^median_g/d;/^beta/d}' \
+  "$SRC/sim/scenes/eval/isolated.toml" > no-fragility.toml
+grep -q "median_g" no-fragility.toml && { echo "no-fragility.toml kept its fragility" >&2; exit 1; }
+cp no-fragility.toml isolated.toml
+printf '\n[fragility]\nmedian_g = 0.8\nbeta = 0.3\n' >> isolated.toml
+GRID=(--scene isolated.toml "${STATIONS[@]}" --statues 2 --pga-from 0.4g --pga-to 1.6g
+  --pga-steps 4)
+CASES=("${GRID[@]}" --jobs 2)
+
+ok_if() {
+  local name=$1
+  shift
+  if "$@"; then pass "$name"; else fail "$name" "$(head -c 300 "$TMP/stderr")"; fi
+}
+
+# With the P-wave stage too: its strong_motion_s column is the S arrival the alert is built on.
+expect_success "a run with regional alerts" run "${CASES[@]}" --pwave on --regional on \
+  --record-info "$INFO" --out reg.csv
+ok_if "the alert's columns: its times, its PGA and the room's probability recomputed" \
+  python3 - reg.csv "$INFO" <<'PY'
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+info = {r["rsn"]: r for r in csv.DictReader(open(sys.argv[2]))}
+assert rows and "regional_probability" in rows[0], list(rows[0])
+phi = lambda z: 0.5 * math.erfc(-z / math.sqrt(2.0))
+blind = {}
+eps = set()
+for r in rows:
+    g = {k[len("regional_"):]: float(v) for k, v in r.items() if k.startswith("regional_")}
+    station = info[r["record"][3:r["record"].index("_")]]
+    assert g["magnitude"] == float(station["magnitude"]) and g["rhyp_km"] == float(station["rhyp_km"]), g
+    # The S arrival is the record's strong motion; the origin Rhyp / 3.5 km/s before it.
+    assert abs(g["s_arrival_s"] - float(r["strong_motion_s"])) < 1e-4, (g, r["strong_motion_s"])
+    assert abs(g["s_arrival_s"] - g["origin_s"] - g["rhyp_km"] / 3.5) < 1e-4, g
+    assert g["alert_s"] - g["origin_s"] >= 3.0 - 1e-9, g   # the latency's floor
+    assert abs(g["sigma_ln"] - math.log(2.0)) < 1e-5, g
+    eps.add(round(math.log(g["pga_g"] / float(r["scale_g"])), 4))
+    # The box's rule: Phi(ln(PGA / median) / sqrt(beta^2 + sigma^2)), median 0.8 g, beta 0.3.
+    p = phi(math.log(g["pga_g"] / 0.8) / math.sqrt(0.09 + g["sigma_ln"] ** 2))
+    assert abs(p - g["probability"]) < 1e-4, (p, g)
+    blind.setdefault(r["record"], set()).add(g["alert_s"] >= g["s_arrival_s"])
+assert len(eps) > 5, eps  # drawn per run
+assert blind["RSN990_NORTHR_LAC090.AT2"] == {False}, blind   # 42.9 km: 12.3 s of S travel
+PY
+
+expect_success "the same run without them" run "${CASES[@]}" --pwave on --out off.csv
+ok_if "the alert changes nothing else: the same truth, box and stage" python3 - reg.csv off.csv <<'PY'
+import csv, sys
+a = list(csv.DictReader(open(sys.argv[1])))
+b = list(csv.DictReader(open(sys.argv[2])))
+assert len(a) == len(b)
+assert not any(k.startswith("regional_") for k in b[0])
+for x, y in zip(a, b):
+    for k in y:
+        assert x[k] == y[k], (k, x[k], y[k])
+PY
+expect_success "the same run again" run "${GRID[@]}" --jobs 1 --pwave on --regional on \
+  --record-info "$INFO" --out again.csv
+ok_if "the alerts are drawn the same in another run (seeded per run)" cmp -s reg.csv again.csv
+
+expect_success "the report of a run with regional alerts" report reg.csv
+cp "$TMP/stdout" report.txt
+ok_if "the report's regional section, recounted from the rows" python3 - reg.csv report.txt <<'PY'
+import csv, re, sys, statistics
+rows = list(csv.DictReader(open(sys.argv[1])))
+text = open(sys.argv[2]).read()
+section = text[text.index("Regional alerts (warning"):]
+cases = {}
+for r in rows:
+    cases.setdefault((r["record"], r["scene"], r["statue"]), []).append(r)
+def margin(r):
+    rs = cases[(r["record"], r["scene"], r["statue"])]
+    col = [float(x["scale_g"]) for x in rs if x["collapsed"] == "1"]
+    return (min(col) if col else float(r["pga_to_g"])) / float(r["scale_g"])
+def score(p, rhyp=None):
+    leads, unneeded, warned = [], 0, 0
+    for r in rows:
+        if float(r["model_valid_until_s"]) >= 0:
+            continue
+        if rhyp and not rhyp[0] <= float(r["regional_rhyp_km"]) < rhyp[1]:
+            continue
+        t = float(r["first_warning_s"])
+        if p is not None and float(r["regional_probability"]) >= p:
+            a = max(0.0, float(r["regional_alert_s"]))
+            t = a if t < 0 else min(t, a)
+        if r["collapsed"] == "1":
+            c = float(r["collapse_time_s"])
+            leads.append(c - t if 0 <= t < c else 0.0)
+        elif margin(r) >= 2.0 - 1e-9:
+            unneeded += 1
+            warned += t >= 0
+    med = statistics.median(leads) if leads else 0.0
+    return med, 100.0 * warned / unneeded if unneeded else 0.0
+lines = [l for l in section.splitlines() if re.match(r"^    (without|0\.\d)\s", l)]
+assert len(lines) == 10, lines
+for line in lines:
+    key = line.split()[0]
+    p = None if key == "without" else float(key)
+    fields = line.split()
+    got = [float(x) for x in fields[1:] if x != "/"]
+    want_all, want_unneeded = score(p)
+    assert abs(got[0] - want_all) < 0.006, (key, got, want_all)
+    near, _ = score(p, (0, 25))
+    mid, _ = score(p, (25, 50))
+    assert abs(got[1] - near) < 0.006 and abs(got[2] - mid) < 0.006, (key, got, near, mid)
+    assert abs(got[4] - want_unneeded) < 0.06, (key, got, want_unneeded)
+blind = sum(float(r["regional_alert_s"]) >= float(r["regional_s_arrival_s"]) for r in rows)
+m = re.search(r"blind zone \(at or after the S arrival\): (\d+)", section)
+assert m and int(m.group(1)) == blind, (m and m.group(0), blind)
+PY
+
+expect_success "a report calibrated on another file" report reg.csv --regional-calibrate-on reg.csv
+ok_if "it says where the threshold was chosen" grep -Eq "(chosen |\()on the calibration file" \
+  "$TMP/stdout"
+
+printf 'rsn,earthquake,station,magnitude,rrup_km,rjb_km,rhyp_km,vs30_m_s\n990,N,LAC,6.69,36.62,35.03,42.88,365\n' \
+  > one.csv
+printf 'rsn,earthquake,station,magnitude,rrup_km,rjb_km,rhyp_km,vs30_m_s\n990,N,LAC,6.69,36.62,35.03,inf,365\n' \
+  > bad.csv
+expect_failure "--regional on needs --record-info" "--regional on needs --record-info" \
+  -- run "${CASES[@]}" --regional on --out x.csv
+expect_failure "a record without its row is named" "RSN1063_NORTHR_RRS228.AT2: no row for RSN 1063" \
+  -- run "${CASES[@]}" --regional on --record-info one.csv --out x.csv
+expect_failure "a bad row names file, line and field" "bad.csv:2: rhyp_km: not finite" \
+  -- run "${CASES[@]}" --regional on --record-info bad.csv --out x.csv
+expect_failure "--record-info without --regional on" "--record-info: .*--regional is off" \
+  -- run "${CASES[@]}" --record-info "$INFO" --out x.csv
+expect_failure "--regional is on or off" "--regional: expected on or off" \
+  -- run "${CASES[@]}" --regional yes --record-info "$INFO" --out x.csv
+expect_failure "a negative sigma" "--regional-sigma" \
+  -- run "${CASES[@]}" --regional on --record-info "$INFO" --regional-sigma -1 --out x.csv
+expect_failure "the alert needs the scene's fragility" "needs the scene's \[fragility\]" \
+  -- run --scene no-fragility.toml "${STATIONS[@]}" --statues 1 --pga-steps 1 --regional on \
+  --record-info "$INFO" --out x.csv
+expect_failure "a calibration file without regional columns" "no regional columns" \
+  -- report reg.csv --regional-calibrate-on off.csv
+
+echo "$PASSED passed, $FAILED failed"
+((FAILED == 0))
