@@ -42,10 +42,12 @@ struct AlarmPolicySettings {
   [[no_unique_address]] OptionalPart<RiskThresholds, kPWaveStageBuiltIn> warning_pwave =
       part_if<kPWaveStageBuiltIn>(RiskThresholds{Real(0.8), Real(0.6)});
   // On the probability of collapse under the worst held regional alert (regional_alert.h;
-  // warning only): a guess about the coming ground motion, not the statue's physics. None in a
-  // build without regional alerts (kRegionalAlertBuiltIn).
+  // warning only): a guess about the coming ground motion, not the statue's physics. Calibrated
+  // with plinth-eval --regional on the bundled three-component records (docs/regional.md): the
+  // longest median lead within 5 points more unneeded warnings (0.5 cost 8 points held out).
+  // None in a build without regional alerts (kRegionalAlertBuiltIn).
   [[no_unique_address]] OptionalPart<RiskThresholds, kRegionalAlertBuiltIn> warning_regional =
-      part_if<kRegionalAlertBuiltIn>(RiskThresholds{Real(0.5), Real(0.4)});
+      part_if<kRegionalAlertBuiltIn>(RiskThresholds{Real(0.7), Real(0.6)});
   // s, >= 0: a condition holds this long before its level rises. 0: the sample it starts (a
   // margin run out is news at once), so plinth-eval's rules are exactly what the box applies;
   // 0.1 s missed a collapse they caught and cost 0.1-0.2 s of lead (docs/forecast.md).
