@@ -243,6 +243,7 @@ void PWaveStage::start_or_refuse_candidate() {
     excited_ = true;
     excitation_refused_ = false;
     excitation_since_ = sample_;
+    status_.excitation_onset_s = static_cast<Time>(sample_ - 1) * settings_.sample_period_s;
   } else if (sample_ - excitation_since_ > max_retry_samples_) {
     if (!excitation_refused_) {
       excitation_refused_ = true;

@@ -217,6 +217,7 @@ struct PWaveStatus {
   // once; no candidate of theirs is counted in `candidates`).
   std::uint64_t rejected_not_after_quiet = 0;
   PWaveRejection last_rejection = PWaveRejection::kNone;
+  Time excitation_onset_s = 0.0;  // the latest excitation's first candidate (once candidates > 0)
   // The latest candidate that became a trigger (valid once triggers > 0):
   Time onset_s = 0.0;          // its first sample
   Time window_s = 0.0;         // W: the window so far (held after it closed)
