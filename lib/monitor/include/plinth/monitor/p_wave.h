@@ -19,7 +19,7 @@
 //              starts at the sample where STA >= trigger_ratio * max(LTA, noise_floor^2) and
 //              STA >= min_amplitude^2 (the start condition), provided it comes out of quiet:
 //              an excitation begins with a candidate, and lasts until the stage, idle, sees
-//              STA < detrigger_ratio * max(LTA, noise_floor^2) (quiet again: the classic
+//              STA < detrigger_ratio * max(LTA, noise_floor^2) (quiet again: an STA/LTA
 //              trigger's off ratio); its later candidates (retries after a rejection) may start
 //              up to max_retry_s after its first. Past that the signal has been loud against
 //              the pre-event LTA for longer than a P onset lasts: the shaking under way, most
@@ -166,8 +166,9 @@ struct PWaveSettings {
 // Checks the settings; the Error names the field at fault ("pwave.lowpass_hz", ...): periods,
 // durations (max_retry_s too) and amplitudes positive and finite; highpass_hz < lowpass_hz <
 // half the sample rate; trigger_ratio > 1; 0 < detrigger_ratio < trigger_ratio; confirm_s <=
-// max_window_s; min_tau_p_s < max_tau_c_s; the ratios positive; the table's windows increasing, its sigmas positive; the
-// fragility's median positive and its beta not negative when known.
+// max_window_s; min_tau_p_s < max_tau_c_s; the ratios positive; the table's windows
+// increasing, its sigmas positive; the fragility's median positive and its beta not negative
+// when known.
 [[nodiscard]] Error validate(const PWaveSettings& settings);
 
 enum class PWaveState : std::uint8_t { kIdle = 0, kCandidate, kWindow, kHolding };
