@@ -298,6 +298,7 @@ std::string pwave_status_json(const monitor::PWaveStatus& p, std::int64_t start_
                            .count("period_short", p.rejected_short)
                            .count("period_long", p.rejected_long)
                            .count("horizontal", p.rejected_horizontal)
+                           .count("not_after_quiet", p.rejected_not_after_quiet)
                            .close());
   if (p.triggers > 0) {  // the latest trigger's window
     out.fixed("onset_t", seconds(start_ns, t_origin) + static_cast<double>(p.onset_s), 3)

@@ -44,7 +44,36 @@ struct FitOptions {
   std::string channel = "vertical";
   bool fit_tau_c = false;
   double lead_in_s = 2.0;
+  bool trace = false;       // print every candidate's judgement and every refusal
+  double max_retry_s = 0.0;  // the stage's S-wave guard, s (0: its default)
 };
+
+// --trace: what the stage did at the sample of time `now_s` (from the lead-in's start), its
+// status `before` and after it; `candidate_s` keeps the latest candidate's start. Printed in
+// record time (from the record's first sample).
+void print_trace(const monitor::PWaveStatus& before, const monitor::PWaveStatus& s,
+                 double lead_in_s, double now_s, double& candidate_s) {
+  if (s.rejected_not_after_quiet > before.rejected_not_after_quiet) {
+    std::printf("#   %.3f s: excitation refused (not after quiet), %.3f s after its first "
+                "candidate\n",
+                now_s - lead_in_s, now_s - s.excitation_onset_s);
+  }
+  if (s.candidates > before.candidates) candidate_s = now_s;
+  if (before.state != monitor::PWaveState::kCandidate ||
+      s.state == monitor::PWaveState::kCandidate) {
+    return;
+  }
+  std::printf("#   candidate %.3f s (excitation +%.3f s): ", candidate_s - lead_in_s,
+              candidate_s - s.excitation_onset_s);
+  if (s.triggers > before.triggers) {
+    std::printf("trigger, tau_p %.2f s, tau_c %.2f s, Pa %.3g m/s2, peak |a_h| / Pa %.2f, "
+                "predicted %.3g g\n",
+                s.tau_p_s, s.tau_c_s, s.pa_m_s2, s.horizontal_m_s2 / s.pa_m_s2,
+                s.predicted_pga_g);
+  } else {
+    std::printf("rejected, %s\n", monitor::kPWaveRejectionNames.name(s.last_rejection));
+  }
+}
 
 // The box's 2 s of quiet before a record (plinth-eval run's lead-in), then the record scaled by
 // gamma at the box's rate, through the stage; what it saw of its first trigger.
@@ -68,11 +97,21 @@ StageTrace trace_stage(const host::Record& record, double gamma, const FitOption
   const double pga = record.peak_horizontal() * gamma;
   StageTrace trace;
   std::size_t next_window = 0;
+  double candidate_s = 0.0;
   for (std::size_t n = 0; n < lead + count; ++n) {
     const std::size_t k = n < lead ? count : n - lead;  // count: the quiet lead-in
-    const Vector3r ground = k < count ? Vector3r(gamma * h[k], 0.0, gamma * v[k])
+    // --trace: less the record's first sample, as plinth-eval run gives the stage (the box's
+    // conditioning takes the lead-in's offset away); the fit has always read the record as is.
+    const double h0 = opt.trace ? h[0] : 0.0;
+    const double v0 = opt.trace ? v[0] : 0.0;
+    const Vector3r ground = k < count ? Vector3r(gamma * (h[k] - h0), 0.0, gamma * (v[k] - v0))
                                       : Vector3r::Zero();
+    const monitor::PWaveStatus before = stage.status();
     const monitor::PWaveStatus& s = stage.update(ground);
+    if (opt.trace) {
+      print_trace(before, s, opt.lead_in_s, static_cast<double>(n) * settings.sample_period_s,
+                  candidate_s);
+    }
     if (s.triggers == 0) continue;
     if (!trace.triggered) {
       trace.triggered = true;
@@ -103,6 +142,7 @@ int run_fit(const FitOptions& opt) {
     throw InputError("--channel: expected vertical or horizontal, got '" + opt.channel + "'");
   }
   settings.predictor = monitor::default_predictor(settings.channel);
+  if (opt.max_retry_s > 0.0) settings.max_retry_s = opt.max_retry_s;
   std::vector<double> windows;
   for (int i = 1; i <= static_cast<int>(monitor::kMaxPWavePredictorPoints); ++i) {
     windows.push_back(0.5 * i);
@@ -134,6 +174,7 @@ int run_fit(const FitOptions& opt) {
                   c.tau_c_s, c.tau_p_s, c.predicted_pga_g);
     }
   }
+  if (opt.trace) return 0;  // a trace, not a fit
   if (!opt.fit_tau_c) {
     for (host::PWaveWindowSample& s : samples) s.ln_tau_c = 0.0;  // c0 alone: the mean
   }
@@ -175,6 +216,14 @@ Subcommand add_pwave_fit(CLI::App& app) {
   fit->add_option("--channel", opt->channel, "vertical (default) or horizontal");
   fit->add_flag("--fit-tau-c", opt->fit_tau_c,
                 "also fit tau_c's exponent (default: 0, the mean ratio alone)");
+  fit->add_flag("--trace", opt->trace,
+                "instead of the fit: each candidate's judgement and each excitation refused, up "
+                "to the second trigger ('#' lines), on the samples plinth-eval run gives the "
+                "stage (less the record's first sample)");
+  fit->add_option("--max-retry-s", opt->max_retry_s,
+                  "the stage's S-wave guard: retries up to this long after an excitation's "
+                  "first candidate, s (default: the stage's, 2)")
+      ->check(CLI::Range(0.01, 3600.0));
   return {fit, [opt] { return run_fit(*opt); }};
 }
 

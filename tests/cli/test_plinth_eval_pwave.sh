@@ -45,6 +45,33 @@ assert windows == [0.5 * i for i in range(1, 9)], windows
 assert any("predictor = [" == l for l in lines)
 PY
 
+# --trace on Kagel Canyon at 0.2 g: its first candidates are rejected again and again in its
+# strong motion; the S-wave guard refuses the excitation 2 s after its first candidate, and
+# without it (--max-retry-s 60) a candidate 10 s in, long after the strong motion, triggers.
+KAT=(--record "$PW/RSN1080_NORTHR_KAT000.AT2" --vertical "$PW/RSN1080_NORTHR_KAT-UP.AT2" --pga 0.2g)
+expect_success "pwave-fit --trace" pwave-fit "${KAT[@]}" --trace
+ok_if "the trace shows the candidates and the excitation refused, and no trigger" python3 - "$TMP/stdout" <<'PY'
+import sys
+lines = open(sys.argv[1]).read().splitlines()
+candidates = [l for l in lines if l.startswith("#   candidate")]
+refused = [l for l in lines if "excitation refused (not after quiet)" in l]
+assert len(candidates) == 4 and all("rejected" in l for l in candidates), candidates
+assert len(refused) == 1 and " 2.060 s after its first candidate" in refused[0], refused
+assert not any(l.startswith("#   window_s") for l in lines)  # a trace, not a fit
+record = [l for l in lines if l.startswith("RSN1080")]
+assert len(record) == 1 and record[0].split(", ")[4] == "none", record
+PY
+expect_success "pwave-fit --trace without the guard" pwave-fit "${KAT[@]}" --trace --max-retry-s 60
+ok_if "without the guard a candidate in the S waves triggers" python3 - "$TMP/stdout" <<'PY'
+import sys
+lines = open(sys.argv[1]).read().splitlines()
+assert not any("excitation refused" in l for l in lines)
+triggers = [l for l in lines if l.startswith("#   candidate") and ": trigger" in l]
+assert len(triggers) == 1 and triggers[0].startswith("#   candidate 10.100 s"), triggers
+record = [l for l in lines if l.startswith("RSN1080")][0].split(", ")
+assert float(record[4]) > float(record[3]), record  # after the strong motion
+PY
+
 expect_success "a run with the stage" run "${CASES[@]}" --pwave on --out pw.csv
 ok_if "the runs carry the stage's columns, its crossings monotone in the threshold" \
   python3 - pw.csv <<'PY'

@@ -67,9 +67,11 @@ Error validate(const PWaveSettings& s) {
       check_time(s.sta_s, "pwave.sta_s"),
       check_time(s.lta_s, "pwave.lta_s"),
       check_positive(s.trigger_ratio, "pwave.trigger_ratio"),
+      check_positive(s.detrigger_ratio, "pwave.detrigger_ratio"),
       check_positive(s.noise_floor_m_s2, "pwave.noise_floor_m_s2"),
       check_positive(s.min_amplitude_m_s2, "pwave.min_amplitude_m_s2"),
       check_time(s.confirm_s, "pwave.confirm_s"),
+      check_time(s.max_retry_s, "pwave.max_retry_s"),
       check_time(s.min_tau_p_s, "pwave.min_tau_p_s"),
       check_time(s.max_tau_c_s, "pwave.max_tau_c_s"),
       check_positive(s.min_vertical_ratio, "pwave.min_vertical_ratio"),
@@ -88,6 +90,8 @@ Error validate(const PWaveSettings& s) {
                   "must be below pwave.lowpass_hz", s.lowpass_hz),
       check_order(s.sta_s < s.lta_s, "pwave.sta_s", "must be shorter than pwave.lta_s", s.lta_s),
       check_order(s.trigger_ratio > Real(1), "pwave.trigger_ratio", "must exceed 1", 1.0),
+      check_order(s.detrigger_ratio < s.trigger_ratio, "pwave.detrigger_ratio",
+                  "must be below pwave.trigger_ratio", s.trigger_ratio),
       check_order(s.sta_s >= s.sample_period_s, "pwave.sta_s",
                   "must be at least one sample period", s.sample_period_s),
       check_order(s.confirm_s >= 2.0 * s.sample_period_s, "pwave.confirm_s",
@@ -163,6 +167,7 @@ Error PWaveStage::create(const PWaveSettings& settings, PWaveStage& out) {
   out.floor_energy_ = settings.noise_floor_m_s2 * settings.noise_floor_m_s2;
   out.min_energy_ = settings.min_amplitude_m_s2 * settings.min_amplitude_m_s2;
   out.confirm_samples_ = samples_in(settings.confirm_s, settings.sample_period_s);
+  out.max_retry_samples_ = samples_in(settings.max_retry_s, settings.sample_period_s);
   out.max_window_samples_ = samples_in(settings.max_window_s, settings.sample_period_s);
   out.hold_samples_ = samples_in(settings.hold_s, settings.sample_period_s);
   for (detail::PWaveChannelFilter& f : out.filters_) f.design(settings);
@@ -174,6 +179,8 @@ void PWaveStage::restart() {
   sta_ = lta_ = Real(0);
   sample_ = 0;
   state_since_ = 0;
+  excited_ = excitation_refused_ = false;
+  excitation_since_ = 0;
   sum_d2_ = sum_v2_ = sum_a2_ = peak_a_ = peak_v_ = peak_d_ = peak_h_ = Real(0);
   PWaveStatus fresh;
   fresh.candidates = status_.candidates;
@@ -181,6 +188,7 @@ void PWaveStage::restart() {
   fresh.rejected_short = status_.rejected_short;
   fresh.rejected_long = status_.rejected_long;
   fresh.rejected_horizontal = status_.rejected_horizontal;
+  fresh.rejected_not_after_quiet = status_.rejected_not_after_quiet;
   status_ = fresh;
 }
 
@@ -228,6 +236,25 @@ void PWaveStage::start_candidate() {
   sum_d2_ = sum_v2_ = sum_a2_ = peak_a_ = peak_v_ = peak_d_ = peak_h_ = Real(0);
 }
 
+// A candidate out of quiet begins an excitation; a retry starts within max_retry_s of its
+// first candidate, or the excitation is refused (p_wave.h: the shaking under way).
+void PWaveStage::start_or_refuse_candidate() {
+  if (!excited_) {
+    excited_ = true;
+    excitation_refused_ = false;
+    excitation_since_ = sample_;
+    status_.excitation_onset_s = static_cast<Time>(sample_ - 1) * settings_.sample_period_s;
+  } else if (sample_ - excitation_since_ > max_retry_samples_) {
+    if (!excitation_refused_) {
+      excitation_refused_ = true;
+      ++status_.rejected_not_after_quiet;
+      status_.last_rejection = PWaveRejection::kNotAfterQuiet;
+    }
+    return;
+  }
+  start_candidate();
+}
+
 void PWaveStage::judge_candidate() {
   const Real tau_c = window_tau_c();
   PWaveRejection rejection = PWaveRejection::kNone;
@@ -248,7 +275,9 @@ void PWaveStage::judge_candidate() {
     state_since_ = sample_;
     return;
   }
-  // A new event: its parameters and probability start afresh.
+  // A new event: its parameters and probability start afresh; its excitation is spent (after
+  // the hold a candidate starts a new one).
+  excited_ = false;
   ++status_.triggers;
   status_.state = PWaveState::kWindow;
   status_.onset_s = static_cast<Time>(state_since_ - 1) * settings_.sample_period_s;
@@ -314,9 +343,11 @@ const PWaveStatus& PWaveStage::update(const Vector3r& ground_m_s2) {
     state_since_ = sample_;
     status_.probability = Real(0);
   }
-  if (status_.state == PWaveState::kIdle && status_.sta_lta >= settings_.trigger_ratio &&
-      sta_ >= min_energy_) {
-    start_candidate();
+  if (status_.state == PWaveState::kIdle) {
+    if (status_.sta_lta < settings_.detrigger_ratio) excited_ = false;  // quiet again
+    if (status_.sta_lta >= settings_.trigger_ratio && sta_ >= min_energy_) {
+      start_or_refuse_candidate();
+    }
   }
   if (status_.state == PWaveState::kCandidate || status_.state == PWaveState::kWindow) {
     for (detail::PWaveChannelFilter& f : filters_) f.step_integration();

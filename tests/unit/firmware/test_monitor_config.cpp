@@ -72,11 +72,14 @@ TEST(MonitorConfigFile, ThePWaveTable) {
   EXPECT_EQ(pwave(empty).predictor[0].ln_pga_over_pa, monitor::kDefaultVerticalPredictor[0].ln_pga_over_pa);
   // A horizontal box takes the horizontal table.
   const MonitorFile h = load_monitor_text("[pwave]\nchannel = \"horizontal\"\nhold_s = 20\n"
+                                          "max_retry_s = 1.5\ndetrigger_ratio = 3\n"
                                           "[alarm_policy]\nwarning_pwave = { on = 0.7, off = 0.5 }\n",
                                           "/etc/plinth/box.toml", MonitorConfig{});
   EXPECT_EQ(pwave(h).channel, monitor::PWaveChannel::kHorizontal);
   EXPECT_EQ(pwave(h).predictor[3].sigma_ln, monitor::kDefaultHorizontalPredictor[3].sigma_ln);
   EXPECT_EQ(pwave(h).hold_s, 20.0);
+  EXPECT_EQ(pwave(h).max_retry_s, 1.5);
+  EXPECT_EQ(pwave(h).detrigger_ratio, 3.0);
   EXPECT_EQ(h.config.alarm.warning_pwave.on, 0.7);
   // The table plinth-eval pwave-fit prints.
   const MonitorFile fitted = load_monitor_text(
@@ -99,6 +102,9 @@ TEST(MonitorConfigFile, ThePWaveTable) {
   refused("[pwave]\nchannel = \"diagonal\"\n",
           "box.toml:2: pwave.channel: expected \"vertical\" or \"horizontal\", got \"diagonal\"");
   refused("[pwave]\nhold_s = \"long\"\n", "box.toml:2: pwave.hold_s: expected a number");
+  refused("[pwave]\nmax_retry_s = 0\n", "box.toml:2: pwave.max_retry_s: must be greater than zero");
+  refused("[pwave]\ndetrigger_ratio = 8\n",
+          "box.toml:2: pwave.detrigger_ratio: must be below pwave.trigger_ratio (limit 8)");
   refused("[pwave]\nenabled = true\n", "box.toml:2: pwave.enabled: unknown key");
   refused("[pwave]\npredictor = 3\n", "pwave.predictor: expected an array of tables");
   refused("[pwave]\npredictor = []\n", "pwave.predictor: must have 1 to 8 points, has 0");

@@ -83,6 +83,18 @@ TEST(PWaveSettings, DefaultsAreValidAndEveryFieldIsChecked) {
   s.confirm_s = 5.0;
   expect_refused(s, "pwave.confirm_s", ErrorCode::kInconsistent, "max_window_s");
   s = {};
+  s.detrigger_ratio = 0.0;
+  expect_refused(s, "pwave.detrigger_ratio", ErrorCode::kOutOfRange);
+  s = {};
+  s.detrigger_ratio = 8.0;
+  expect_refused(s, "pwave.detrigger_ratio", ErrorCode::kInconsistent, "trigger_ratio");
+  s = {};
+  s.max_retry_s = 0.0;
+  expect_refused(s, "pwave.max_retry_s", ErrorCode::kOutOfRange);
+  s = {};
+  s.max_retry_s = nan;
+  expect_refused(s, "pwave.max_retry_s", ErrorCode::kNotFinite);
+  s = {};
   s.min_tau_p_s = 20.0;
   expect_refused(s, "pwave.min_tau_p_s", ErrorCode::kInconsistent, "max_tau_c_s");
   s = {};
@@ -239,6 +251,13 @@ Trace run(PWaveStage& stage, const std::vector<Vector3r>& samples) {
   Trace trace;
   for (const Vector3r& a : samples) trace.status.push_back(stage.update(a));
   return trace;
+}
+
+// The event's highest probability over a run.
+double highest_probability(const Trace& trace) {
+  double highest = 0.0;
+  for (const PWaveStatus& s : trace.status) highest = std::max(highest, double(s.probability));
+  return highest;
 }
 
 PWaveSettings with_fragility(double rate_hz, double median_g, double beta) {
@@ -435,9 +454,7 @@ TEST(PWaveStage, ProbabilityIsHeldThenTheStageRearms) {
   EXPECT_EQ(held.state, PWaveState::kHolding);
   EXPECT_GT(held.probability, 0.0);
   // The highest probability of the event is the one held.
-  double highest = 0.0;
-  for (const PWaveStatus& st : trace.status) highest = std::max(highest, double(st.probability));
-  EXPECT_EQ(held.probability, highest);
+  EXPECT_EQ(held.probability, highest_probability(trace));
   // After hold_s: idle, probability 0, and the S waves' coda (the LTA followed it while
   // holding) does not trigger again.
   const PWaveStatus& after = trace.at(closed_at + 10.5, quake.rate_hz);
@@ -465,10 +482,15 @@ TEST(PWaveStage, RejectsShortPeriodsAndHorizontalMotion) {
     quake.p_amplitude_m_s2 = 5.0;
     quake.s_after_p_s = -1.0;
     PWaveStage stage = make(at_rate(quake.rate_hz));
-    const PWaveStatus end = run(stage, quake.samples()).status.back();
+    const Trace trace = run(stage, quake.samples());
+    const PWaveStatus& end = trace.status.back();
     EXPECT_EQ(end.triggers, 0U);
     EXPECT_GT(end.rejected_short, 0U);
-    EXPECT_EQ(end.last_rejection, PWaveRejection::kPeriodShort);
+    EXPECT_EQ(trace.at(quake.p_at_s + 0.9, quake.rate_hz).last_rejection,
+              PWaveRejection::kPeriodShort);
+    // It goes on: after max_retry_s its excitation is refused, not retried for 40 s.
+    EXPECT_EQ(end.rejected_not_after_quiet, 1U);
+    EXPECT_EQ(end.last_rejection, PWaveRejection::kNotAfterQuiet);
   }
   {
     SyntheticQuake quake;  // S waves without a P wave: a record that begins in the S waves
@@ -485,6 +507,90 @@ TEST(PWaveStage, RejectsShortPeriodsAndHorizontalMotion) {
     const PWaveStatus end = run(stage, samples).status.back();
     EXPECT_EQ(end.triggers, 0U);
     EXPECT_GT(end.rejected_horizontal, 0U);
+  }
+}
+
+// A record that begins in the strong motion (docs/pwave.md: held-out records on which the stage
+// triggered seconds into their S waves): after 20 s of quiet, horizontal shaking of 1.5 m/s2
+// at once, its vertical part growing from a seventh of it to its equal over 8 s. Each 0.5 s
+// candidate is rejected as not vertical enough and retried at once (the STA stays 8 times the
+// pre-event LTA, frozen while a candidate runs) until, 3 s in, one passes every test of a P wave.
+std::vector<Vector3r> begins_in_the_s_waves(double rate_hz) {
+  SyntheticQuake quiet;
+  quiet.rate_hz = rate_hz;
+  quiet.p_amplitude_m_s2 = 0.0;
+  quiet.s_after_p_s = -1.0;
+  std::vector<Vector3r> samples = quiet.samples();
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const double t = static_cast<double>(i) / rate_hz - quiet.p_at_s;
+    if (t < 0.0) continue;
+    samples[i].x() += 1.5 * std::sin(2.0 * kPi * 1.2 * t);
+    samples[i].z() += (0.2 + 1.3 * std::min(1.0, t / 8.0)) * std::sin(2.0 * kPi * 0.9 * t);
+  }
+  return samples;
+}
+
+TEST(PWaveStage, ARecordThatBeginsInTheSWavesDoesNotTrigger) {
+  for (const double rate : {200.0, 1000.0}) {
+    SCOPED_TRACE(std::to_string(rate) + " Hz");
+    const std::vector<Vector3r> samples = begins_in_the_s_waves(rate);
+    PWaveStage stage = make(with_fragility(rate, 0.2, 0.3));
+    const Trace trace = run(stage, samples);
+    const PWaveStatus& end = trace.status.back();
+    EXPECT_EQ(end.triggers, 0U);
+    EXPECT_EQ(highest_probability(trace), 0.0);
+    // The first candidate and its retries within max_retry_s (2 s: at 0, 0.5, 1 and 1.5 s),
+    // then the excitation is refused, counted once.
+    EXPECT_EQ(end.candidates, 4U);
+    EXPECT_EQ(end.rejected_horizontal, 4U);
+    EXPECT_EQ(end.rejected_not_after_quiet, 1U);
+    EXPECT_EQ(trace.at(20.0 + 2.5, rate).last_rejection, PWaveRejection::kNotAfterQuiet);
+    EXPECT_EQ(trace.at(20.0 + 2.5, rate).state, PWaveState::kIdle);
+    // Without the guard (retries for a minute) a retry 3 s into the shaking triggers: the S
+    // waves read as a P wave, and the probability follows.
+    PWaveSettings unguarded = with_fragility(rate, 0.2, 0.3);
+    unguarded.max_retry_s = 60.0;
+    PWaveStage retrying = make(unguarded);
+    const Trace late = run(retrying, samples);
+    EXPECT_EQ(late.status.back().triggers, 1U);
+    EXPECT_GT(late.status.back().onset_s, 20.0 + 2.0);
+    EXPECT_GT(highest_probability(late), 0.9);
+  }
+}
+
+// The guard changes nothing on a P wave after quiet: the same status at every sample as a
+// stage that retries for a minute, also where the onset's first candidates are rejected (a P
+// wave whose first 0.5 or 1.2 s carry a horizontal part of 1 m/s2, three times its vertical
+// one) and a retry triggers within max_retry_s.
+TEST(PWaveStage, APWaveAfterQuietTriggersAsWithoutTheGuard) {
+  for (const double horizontal_s : {0.0, 0.5, 1.2}) {
+    SCOPED_TRACE("horizontal onset " + std::to_string(horizontal_s) + " s");
+    SyntheticQuake quake;
+    quake.s_after_p_s = -1.0;
+    std::vector<Vector3r> samples = quake.samples();
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      const double t = static_cast<double>(i) / quake.rate_hz - quake.p_at_s;
+      if (t >= 0.0 && t < horizontal_s) samples[i].x() += std::sin(2.0 * kPi * 0.7 * t);
+    }
+    PWaveStage guarded = make(with_fragility(quake.rate_hz, 0.5, 0.4));
+    PWaveSettings unguarded = with_fragility(quake.rate_hz, 0.5, 0.4);
+    unguarded.max_retry_s = 60.0;
+    PWaveStage retrying = make(unguarded);
+    const Trace a = run(guarded, samples);
+    const Trace b = run(retrying, samples);
+    const PWaveStatus& end = a.status.back();
+    ASSERT_EQ(end.triggers, 1U);
+    const std::uint64_t rejected = horizontal_s == 0.0 ? 0U : horizontal_s < 1.0 ? 1U : 2U;
+    EXPECT_EQ(end.candidates, rejected + 1U);
+    EXPECT_EQ(end.rejected_horizontal, rejected);
+    EXPECT_EQ(end.rejected_not_after_quiet, 0U);
+    EXPECT_GE(end.onset_s, quake.p_at_s + 0.5 * static_cast<double>(rejected));
+    EXPECT_LE(end.onset_s, quake.p_at_s + 0.5 * static_cast<double>(rejected) + 0.3);
+    for (std::size_t i = 0; i < a.status.size(); ++i) {
+      ASSERT_EQ(a.status[i].state, b.status[i].state) << i;
+      ASSERT_EQ(a.status[i].probability, b.status[i].probability) << i;
+      ASSERT_EQ(a.status[i].onset_s, b.status[i].onset_s) << i;
+    }
   }
 }
 

@@ -17,7 +17,15 @@
 // Trigger (a state machine):
 //   idle       STA and LTA of a^2 (exponential averages over sta_s and lta_s). A candidate
 //              starts at the sample where STA >= trigger_ratio * max(LTA, noise_floor^2) and
-//              STA >= min_amplitude^2.
+//              STA >= min_amplitude^2 (the start condition), provided it comes out of quiet:
+//              an excitation begins with a candidate, and lasts until the stage, idle, sees
+//              STA < detrigger_ratio * max(LTA, noise_floor^2) (quiet again: an STA/LTA
+//              trigger's off ratio); its later candidates (retries after a rejection) may start
+//              up to max_retry_s after its first. Past that the signal has been loud against
+//              the pre-event LTA for longer than a P onset lasts: the shaking under way, most
+//              likely the S waves (a record that begins in them, or a P wave too small to
+//              trigger); the excitation is refused (counted once), no candidate starts, and
+//              the LTA follows the shaking until quiet ends the excitation.
 //   candidate  the LTA is frozen; the window's sums start at the candidate's first sample.
 //              After confirm_s the candidate is judged: a trigger when
 //                tau_p = 2 pi sqrt(sum v^2 / sum a^2) >= min_tau_p_s (the window's predominant
@@ -133,9 +141,14 @@ struct PWaveSettings {
   Time sta_s = 0.25;            // s, short-term average of a^2
   Time lta_s = 10.0;            // s, long-term average of a^2
   Real trigger_ratio = 8.0;     // STA / LTA (of a^2) that starts a candidate, > 1
+  Real detrigger_ratio = 2.0;   // STA / LTA below which an excitation ends, < trigger_ratio
   Real noise_floor_m_s2 = Real(0.002);   // m/s2 rms: the LTA never counts below it
   Real min_amplitude_m_s2 = Real(0.05);  // m/s2 rms: the STA must reach it too
   Time confirm_s = 0.5;         // s after the candidate's start: judged
+  // s: the latest a retry may start after its excitation's first candidate; a later one is
+  // inside the shaking, the S waves. The bundled records' triggers before their strong motion
+  // came at most 1.7 s after it (docs/pwave.md): the next half second up.
+  Time max_retry_s = 2.0;
   Time min_tau_p_s = 0.3;       // s: shorter is a floor, a door or traffic (docs/pwave.md)
   Time max_tau_c_s = 10.0;      // s: longer is drift (a tilt, a step)
   Real min_vertical_ratio = Real(0.5);  // vertical channel: peak |a_z| / peak |a_h| at least
@@ -151,10 +164,11 @@ struct PWaveSettings {
 };
 
 // Checks the settings; the Error names the field at fault ("pwave.lowpass_hz", ...): periods,
-// durations and amplitudes positive and finite; highpass_hz < lowpass_hz < half the sample
-// rate; trigger_ratio > 1; confirm_s <= max_window_s; min_tau_p_s < max_tau_c_s; the ratios
-// positive; the table's windows increasing, its sigmas positive; the fragility's median
-// positive and its beta not negative when known.
+// durations (max_retry_s too) and amplitudes positive and finite; highpass_hz < lowpass_hz <
+// half the sample rate; trigger_ratio > 1; 0 < detrigger_ratio < trigger_ratio; confirm_s <=
+// max_window_s; min_tau_p_s < max_tau_c_s; the ratios positive; the table's windows
+// increasing, its sigmas positive; the fragility's median positive and its beta not negative
+// when known.
 [[nodiscard]] Error validate(const PWaveSettings& settings);
 
 enum class PWaveState : std::uint8_t { kIdle = 0, kCandidate, kWindow, kHolding };
@@ -164,6 +178,7 @@ enum class PWaveRejection : std::uint8_t {
   kPeriodShort,  // tau_p below min_tau_p_s
   kPeriodLong,   // tau_c above max_tau_c_s
   kHorizontal,   // peak |a_z| below min_vertical_ratio * peak |a_h|
+  kNotAfterQuiet,  // would start over max_retry_s after its excitation's first candidate
 };
 
 enum class PWaveWindowEnd : std::uint8_t { kNone = 0, kMaxWindow, kSWave };
@@ -175,11 +190,12 @@ inline constexpr NameTable<PWaveState, 4> kPWaveStateNames{{{
     {PWaveState::kHolding, "holding"},
 }}};
 
-inline constexpr NameTable<PWaveRejection, 4> kPWaveRejectionNames{{{
+inline constexpr NameTable<PWaveRejection, 5> kPWaveRejectionNames{{{
     {PWaveRejection::kNone, "none"},
     {PWaveRejection::kPeriodShort, "period too short"},
     {PWaveRejection::kPeriodLong, "period too long"},
     {PWaveRejection::kHorizontal, "not vertical enough"},
+    {PWaveRejection::kNotAfterQuiet, "not after quiet"},
 }}};
 
 inline constexpr NameTable<PWaveWindowEnd, 3> kPWaveWindowEndNames{{{
@@ -198,7 +214,11 @@ struct PWaveStatus {
   std::uint64_t rejected_short = 0;       // candidates rejected for a short tau_p
   std::uint64_t rejected_long = 0;        // ... a long tau_c
   std::uint64_t rejected_horizontal = 0;  // ... too little vertical motion
+  // Excitations refused: loud for over max_retry_s since their first candidate (each counted
+  // once; no candidate of theirs is counted in `candidates`).
+  std::uint64_t rejected_not_after_quiet = 0;
   PWaveRejection last_rejection = PWaveRejection::kNone;
+  Time excitation_onset_s = 0.0;  // the latest excitation's first candidate (once candidates > 0)
   // The latest candidate that became a trigger (valid once triggers > 0):
   Time onset_s = 0.0;          // its first sample
   Time window_s = 0.0;         // W: the window so far (held after it closed)
@@ -279,6 +299,7 @@ class PWaveStage {
   [[nodiscard]] Real collapse_probability(Real predicted_pga_g, Real sigma_ln) const;
 
  private:
+  void start_or_refuse_candidate();
   void start_candidate();
   void judge_candidate();
   void update_window();
@@ -292,6 +313,7 @@ class PWaveStage {
   Real floor_energy_ = 0.0;
   Real min_energy_ = 0.0;
   std::int64_t confirm_samples_ = 0;
+  std::int64_t max_retry_samples_ = 0;
   std::int64_t max_window_samples_ = 0;
   std::int64_t hold_samples_ = 0;
 
@@ -300,6 +322,11 @@ class PWaveStage {
   Real lta_ = 0.0;
   std::int64_t sample_ = 0;        // samples since start or restart
   std::int64_t state_since_ = 0;   // sample the current state began
+  // The excitation: from a candidate out of quiet to the next idle sample with STA below
+  // detrigger_ratio * LTA.
+  bool excited_ = false;
+  bool excitation_refused_ = false;   // counted in rejected_not_after_quiet
+  std::int64_t excitation_since_ = 0;  // its first candidate's sample
   // The window since the candidate's start.
   Real sum_d2_ = 0.0;
   Real sum_v2_ = 0.0;
