@@ -40,7 +40,7 @@ struct AlarmPolicySettings {
   // wave comes 3 s early, within 5 points more unneeded warnings than the box without it.
   // None in a build without the stage (kPWaveStageBuiltIn).
   [[no_unique_address]] OptionalPart<RiskThresholds, kPWaveStageBuiltIn> warning_pwave =
-      part_if<kPWaveStageBuiltIn>(RiskThresholds{Real(0.8), Real(0.6)});
+      part_if<kPWaveStageBuiltIn>(RiskThresholds{Real(0.75), Real(0.6)});
   // On the probability of collapse under the worst held regional alert (regional_alert.h;
   // warning only): a guess about the coming ground motion, not the statue's physics. Calibrated
   // with plinth-eval --regional on the bundled three-component records (docs/regional.md): the
