@@ -1,11 +1,10 @@
 #include "eval_pwave_report.h"
 
 #include <algorithm>
-#include <cmath>
-#include <cstdarg>
-#include <cstdio>
+#include <optional>
 #include <set>
 
+#include "eval_warning_report.h"
 #include "plinth/host/input_error.h"
 #include "plinth/monitor/alarm_level.h"
 
@@ -51,25 +50,12 @@ PWaveThresholdRow score(const std::vector<EvalRun>& runs, int p, double threshol
   return row;
 }
 
-// The longest median lead over P >= 3 s collapses within the unneeded allowance; ties: the
-// higher threshold (fewer warnings). Returns the grid index, -1 when none qualifies.
+// The longest median lead over P >= 3 s collapses within the unneeded allowance (ties: the
+// higher threshold). Returns the grid index, -1 when none qualifies.
 int choose(const PWaveReport& r) {
-  int best = -1;
-  for (std::size_t i = 0; i < r.with.size(); ++i) {
-    const PWaveThresholdRow& w = r.with[i];
-    if (w.all.unneeded_rate() > r.without.all.unneeded_rate() + kPWaveUnneededAllowance + 1e-12) {
-      continue;
-    }
-    const double lead = w.by_class[0].lead_quantile(0.5);
-    const double best_lead =
-        best < 0 ? 0.0 : r.with[static_cast<std::size_t>(best)].by_class[0].lead_quantile(0.5);
-    if (best < 0 || lead > best_lead + 1e-12 ||
-        (std::fabs(lead - best_lead) <= 1e-12 &&
-         w.threshold > r.with[static_cast<std::size_t>(best)].threshold)) {
-      best = static_cast<int>(i);
-    }
-  }
-  return best;
+  return choose_threshold(
+      r.with, r.without.all.unneeded_rate(), kPWaveUnneededAllowance,
+      [](const PWaveThresholdRow& w) { return w.by_class[0].lead_quantile(0.5); });
 }
 
 PWaveReport score_table(const EvalTable& table) {
@@ -77,14 +63,16 @@ PWaveReport score_table(const EvalTable& table) {
     throw host::InputError("the runs file has no P-wave columns (plinth-eval run --pwave on)");
   }
   if (!table.has_grid) {
-    throw host::InputError("the runs file has no PGA grid columns: the collapse margins are not "
-                           "known (run it again with this plinth-eval)");
+    throw host::InputError(
+        "the runs file has no PGA grid columns: the collapse margins are not "
+        "known (run it again with this plinth-eval)");
   }
   PWaveReport r;
   r.runs = table.runs.size();
   std::set<std::string> seen;
   for (const EvalRun& run : table.runs) {
-    if (seen.insert(run.record).second) ++r.records_by_class[static_cast<std::size_t>(class_of(run))];
+    if (seen.insert(run.record).second)
+      ++r.records_by_class[static_cast<std::size_t>(class_of(run))];
     if (run.pwave_trigger_s >= 0.0) {
       ++r.triggered_runs;
       if (run.pwave_trigger_s < run.strong_motion_s) ++r.triggered_before_strong;
@@ -97,81 +85,71 @@ PWaveReport score_table(const EvalTable& table) {
   return r;
 }
 
-__attribute__((format(printf, 1, 2))) std::string text(const char* format, ...) {
-  char buffer[512];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buffer, sizeof buffer, format, args);
-  va_end(args);
-  return buffer;
-}
-
 std::string outcome_text(const host::WarningOutcome& o) {
   const host::BandCount unneeded = o.unneeded();
-  return text("%4d collapses, %3d missed, lead median %5.2f s, p10 %5.2f s; unneeded %5.1f %% "
-              "(%d of %d)",
-              o.collapses, o.misses, std::max(0.0, o.lead_quantile(0.5)),
-              std::max(0.0, o.lead_quantile(0.1)), 100.0 * unneeded.rate(), unneeded.alarms,
-              unneeded.runs);
+  return report_text(
+      "%4d collapses, %3d missed, lead median %5.2f s, p10 %5.2f s; unneeded %5.1f %% "
+      "(%d of %d)",
+      o.collapses, o.misses, std::max(0.0, o.lead_quantile(0.5)),
+      std::max(0.0, o.lead_quantile(0.1)), 100.0 * unneeded.rate(), unneeded.alarms, unneeded.runs);
 }
-
-double median_lead(const host::WarningOutcome& o) { return std::max(0.0, o.lead_quantile(0.5)); }
 
 }  // namespace
 
 PWaveReport make_pwave_report(const EvalTable& table, const EvalTable* calibrate_on) {
   PWaveReport r = score_table(table);
+  std::optional<PWaveReport> calibration;
   if (calibrate_on != nullptr) {
     if (calibrate_on->grids.pwave != table.grids.pwave) {
       throw host::InputError("the calibration file's pwave_ge_ grid differs from this file's");
     }
-    const int i = choose(score_table(*calibrate_on));
-    if (i >= 0) r.chosen = r.with[static_cast<std::size_t>(i)];
-    r.chosen_elsewhere = true;
-  } else {
-    const int i = choose(r);
-    if (i >= 0) r.chosen = r.with[static_cast<std::size_t>(i)];
+    calibration = score_table(*calibrate_on);
   }
+  set_chosen_threshold(r, calibration ? &*calibration : nullptr, choose);
   return r;
 }
 
 std::string pwave_report_text(const PWaveReport& r) {
   std::string out = "P-wave stage (warning; docs/pwave.md)\n";
-  out += text("  records: %d with the P wave >= 3 s before the strong motion, %d < 3 s, %d "
-              "without a P wave before it\n",
-              r.records_by_class[0], r.records_by_class[1], r.records_by_class[2]);
-  out += text("  the stage triggered in %d of %zu runs, %d of them before the strong motion\n",
-              r.triggered_runs, r.runs, r.triggered_before_strong);
+  out += report_text(
+      "  records: %d with the P wave >= 3 s before the strong motion, %d < 3 s, %d "
+      "without a P wave before it\n",
+      r.records_by_class[0], r.records_by_class[1], r.records_by_class[2]);
+  out +=
+      report_text("  the stage triggered in %d of %zu runs, %d of them before the strong motion\n",
+                  r.triggered_runs, r.runs, r.triggered_before_strong);
   const auto block = [&](const char* title, const PWaveThresholdRow& row) {
     out += std::string("  ") + title + "\n";
     out += "    all records:  " + outcome_text(row.all) + "\n";
     for (std::size_t c = 0; c < kPWaveClasses; ++c) {
-      out += text("    %-46s ", kClassNames[c]) + outcome_text(row.by_class[c]) + "\n";
+      out += report_text("    %-46s ", kClassNames[c]) + outcome_text(row.by_class[c]) + "\n";
     }
   };
   block("without the stage (the box's warning):", r.without);
   if (r.chosen) {
-    const std::string title = text("with the stage at p >= %g (chosen %s: the longest median lead "
-                                   "on P >= 3 s records, unneeded at most %g points more):",
-                                   r.chosen->threshold,
-                                   r.chosen_elsewhere ? "on the calibration file" : "on this file",
-                                   100.0 * kPWaveUnneededAllowance);
+    const std::string title = report_text(
+        "with the stage at p >= %g (chosen %s: the longest median lead "
+        "on P >= 3 s records, unneeded at most %g points more):",
+        r.chosen->threshold, r.chosen_elsewhere ? "on the calibration file" : "on this file",
+        100.0 * kPWaveUnneededAllowance);
     block(title.c_str(), *r.chosen);
-    out += text("  gain of the median lead: %+.2f s on P >= 3 s records, %+.2f s on all; "
-                "unneeded %+.1f points\n",
-                median_lead(r.chosen->by_class[0]) - median_lead(r.without.by_class[0]),
-                median_lead(r.chosen->all) - median_lead(r.without.all),
-                100.0 * (r.chosen->all.unneeded_rate() - r.without.all.unneeded_rate()));
+    out += report_text(
+        "  gain of the median lead: %+.2f s on P >= 3 s records, %+.2f s on all; "
+        "unneeded %+.1f points\n",
+        median_lead(r.chosen->by_class[0]) - median_lead(r.without.by_class[0]),
+        median_lead(r.chosen->all) - median_lead(r.without.all),
+        100.0 * (r.chosen->all.unneeded_rate() - r.without.all.unneeded_rate()));
   } else {
     out += "  no threshold keeps the unneeded warnings within the allowance\n";
   }
   out += "  every threshold: p, median lead on P >= 3 s / all (s), unneeded (%), missed\n";
-  out += text("    without  %5.2f / %5.2f  %5.1f  %d\n", median_lead(r.without.by_class[0]),
-              median_lead(r.without.all), 100.0 * r.without.all.unneeded_rate(),
-              r.without.all.misses);
+  out += report_text("    without  %5.2f / %5.2f  %5.1f  %d\n", median_lead(r.without.by_class[0]),
+                     median_lead(r.without.all), 100.0 * r.without.all.unneeded_rate(),
+                     r.without.all.misses);
   for (const PWaveThresholdRow& w : r.with) {
-    out += text("    %-7g  %5.2f / %5.2f  %5.1f  %d\n", w.threshold, median_lead(w.by_class[0]),
-                median_lead(w.all), 100.0 * w.all.unneeded_rate(), w.all.misses);
+    out +=
+        report_text("    %-7g  %5.2f / %5.2f  %5.1f  %d\n", w.threshold, median_lead(w.by_class[0]),
+                    median_lead(w.all), 100.0 * w.all.unneeded_rate(), w.all.misses);
   }
   return out;
 }

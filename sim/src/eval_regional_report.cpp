@@ -1,12 +1,12 @@
 #include "eval_regional_report.h"
 
 #include <algorithm>
-#include <cmath>
-#include <cstdarg>
 #include <cstdio>
+#include <optional>
 #include <set>
 #include <string>
 
+#include "eval_warning_report.h"
 #include "plinth/host/input_error.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
@@ -18,8 +18,8 @@ namespace {
 using host::EvalRun;
 using host::EvalTable;
 
-constexpr std::array<const char*, kRegionalClasses> kClassNames{
-    "Rhyp < 25 km (near the source)", "Rhyp 25-50 km", "Rhyp >= 50 km"};
+constexpr std::array<const char*, kRegionalClasses> kClassNames{"Rhyp < 25 km (near the source)",
+                                                                "Rhyp 25-50 km", "Rhyp >= 50 km"};
 
 RegionalThresholdRow score(const std::vector<EvalRun>& runs, double p) {
   RegionalThresholdRow row;
@@ -34,27 +34,11 @@ RegionalThresholdRow score(const std::vector<EvalRun>& runs, double p) {
   return row;
 }
 
-double median_lead(const host::WarningOutcome& o) { return std::max(0.0, o.lead_quantile(0.5)); }
-
-// The longest median lead over all collapses within the unneeded allowance; ties: the higher
-// threshold (fewer warnings). The index into `with`, -1 when none qualifies.
+// The longest median lead over all collapses within the unneeded allowance (ties: the higher
+// threshold). The index into `with`, -1 when none qualifies.
 int choose(const RegionalReport& r) {
-  int best = -1;
-  for (std::size_t i = 0; i < r.with.size(); ++i) {
-    const RegionalThresholdRow& w = r.with[i];
-    if (w.all.unneeded_rate() >
-        r.without.all.unneeded_rate() + kRegionalUnneededAllowance + 1e-12) {
-      continue;
-    }
-    const double lead = median_lead(w.all);
-    const double best_lead = best < 0 ? 0.0 : median_lead(r.with[static_cast<std::size_t>(best)].all);
-    if (best < 0 || lead > best_lead + 1e-12 ||
-        (std::fabs(lead - best_lead) <= 1e-12 &&
-         w.threshold > r.with[static_cast<std::size_t>(best)].threshold)) {
-      best = static_cast<int>(i);
-    }
-  }
-  return best;
+  return choose_threshold(r.with, r.without.all.unneeded_rate(), kRegionalUnneededAllowance,
+                          [](const RegionalThresholdRow& w) { return median_lead(w.all); });
 }
 
 RegionalReport score_table(const EvalTable& table, const char* which) {
@@ -63,7 +47,8 @@ RegionalReport score_table(const EvalTable& table, const char* which) {
                            " has no regional columns (plinth-eval run --regional on)");
   }
   if (!table.has_grid) {
-    throw host::InputError(std::string(which) + " has no PGA grid columns: the collapse margins "
+    throw host::InputError(std::string(which) +
+                           " has no PGA grid columns: the collapse margins "
                            "are not known (run it again with this plinth-eval)");
   }
   RegionalReport r;
@@ -89,16 +74,6 @@ RegionalReport score_table(const EvalTable& table, const char* which) {
   return r;
 }
 
-std::string line(const char* format, ...) __attribute__((format(printf, 1, 2)));
-std::string line(const char* format, ...) {
-  char buffer[512];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buffer, sizeof buffer, format, args);
-  va_end(args);
-  return std::string(buffer) + "\n";
-}
-
 }  // namespace
 
 std::size_t regional_class(double rhyp_km) {
@@ -116,36 +91,35 @@ double regional_warning_time(const EvalRun& r, double p) {
 
 RegionalReport make_regional_report(const EvalTable& table, const EvalTable* calibrate_on) {
   RegionalReport r = score_table(table, "the runs file");
+  std::optional<RegionalReport> calibration;
   if (calibrate_on != nullptr) {
-    const int i = choose(score_table(*calibrate_on, "the calibration file (--regional-calibrate-on)"));
-    if (i >= 0) r.chosen = r.with[static_cast<std::size_t>(i)];
-    r.chosen_elsewhere = true;
-  } else {
-    const int i = choose(r);
-    if (i >= 0) r.chosen = r.with[static_cast<std::size_t>(i)];
+    calibration = score_table(*calibrate_on, "the calibration file (--regional-calibrate-on)");
   }
+  set_chosen_threshold(r, calibration ? &*calibration : nullptr, choose);
   return r;
 }
 
 std::string regional_report_text(const RegionalReport& r) {
   std::string out = "Regional alerts (warning; simulated, docs/regional.md)\n";
-  out += line("  %zu runs of %d records; alerts in the blind zone (at or after the S arrival): "
-              "%d (%.1f %%); before the record's first sample (counted at 0 s): %d",
-              r.runs, r.total.records, r.total.blind,
-              r.total.runs ? 100.0 * r.total.blind / r.total.runs : 0.0, r.total.before_record);
+  out += report_line(
+      "  %zu runs of %d records; alerts in the blind zone (at or after the S arrival): "
+      "%d (%.1f %%); before the record's first sample (counted at 0 s): %d",
+      r.runs, r.total.records, r.total.blind,
+      r.total.runs ? 100.0 * r.total.blind / r.total.runs : 0.0, r.total.before_record);
   const auto table = [&](const char* title, const RegionalThresholdRow& with) {
     out += std::string("  ") + title + "\n";
-    out += "    class                          records  collapses  median lead without / with "
-           "(gain)   p10 without / with   unneeded without / with   missed   blind zone\n";
+    out +=
+        "    class                          records  collapses  median lead without / with "
+        "(gain)   p10 without / with   unneeded without / with   missed   blind zone\n";
     const auto row = [&](const char* name, int records, const host::WarningOutcome& a,
                          const host::WarningOutcome& b, const RegionalClassCounts& k) {
-      out += line("    %-31s %7d  %9d  %5.2f / %5.2f s (%+5.2f)     %5.2f / %5.2f s      %5.1f / "
-                  "%5.1f %%        %d / %d    %5.1f %%",
-                  name, records, a.collapses, median_lead(a), median_lead(b),
-                  median_lead(b) - median_lead(a), std::max(0.0, a.lead_quantile(0.1)),
-                  std::max(0.0, b.lead_quantile(0.1)), 100.0 * a.unneeded_rate(),
-                  100.0 * b.unneeded_rate(), a.misses, b.misses,
-                  k.runs ? 100.0 * k.blind / k.runs : 0.0);
+      out += report_line(
+          "    %-31s %7d  %9d  %5.2f / %5.2f s (%+5.2f)     %5.2f / %5.2f s      %5.1f / "
+          "%5.1f %%        %d / %d    %5.1f %%",
+          name, records, a.collapses, median_lead(a), median_lead(b),
+          median_lead(b) - median_lead(a), std::max(0.0, a.lead_quantile(0.1)),
+          std::max(0.0, b.lead_quantile(0.1)), 100.0 * a.unneeded_rate(), 100.0 * b.unneeded_rate(),
+          a.misses, b.misses, k.runs ? 100.0 * k.blind / k.runs : 0.0);
     };
     for (std::size_t c = 0; c < kRegionalClasses; ++c) {
       row(kClassNames[c], r.counts[c].records, r.without.by_class[c], with.by_class[c],
@@ -154,21 +128,22 @@ std::string regional_report_text(const RegionalReport& r) {
     row("all", r.total.records, r.without.all, with.all, r.total);
   };
   if (r.chosen) {
-    const std::string title =
-        line("with the alert at p >= %g (chosen %s: the longest median lead, unneeded at most %g "
-             "points more):",
-             r.chosen->threshold, r.chosen_elsewhere ? "on the calibration file" : "on this file",
-             100.0 * kRegionalUnneededAllowance);
+    const std::string title = report_line(
+        "with the alert at p >= %g (chosen %s: the longest median lead, unneeded at most %g "
+        "points more):",
+        r.chosen->threshold, r.chosen_elsewhere ? "on the calibration file" : "on this file",
+        100.0 * kRegionalUnneededAllowance);
     table(title.substr(0, title.size() - 1).c_str(), *r.chosen);
   } else {
-    out += line("  no threshold keeps the unneeded warnings within %g points of the box's (%s)",
-                100.0 * kRegionalUnneededAllowance,
-                r.chosen_elsewhere ? "on the calibration file" : "on this file");
+    out +=
+        report_line("  no threshold keeps the unneeded warnings within %g points of the box's (%s)",
+                    100.0 * kRegionalUnneededAllowance,
+                    r.chosen_elsewhere ? "on the calibration file" : "on this file");
   }
   if (r.box_default) {
-    const std::string title =
-        line("with the alert at the box's default, p >= %g (alarm_policy.warning_regional.on):",
-             r.box_default->threshold);
+    const std::string title = report_line(
+        "with the alert at the box's default, p >= %g (alarm_policy.warning_regional.on):",
+        r.box_default->threshold);
     table(title.substr(0, title.size() - 1).c_str(), *r.box_default);
   }
   out += "  every threshold: p, median lead (s) all";
