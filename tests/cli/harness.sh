@@ -28,6 +28,13 @@ fail() {
   echo "not ok - $1: $2"
   FAILED=$((FAILED + 1))
 }
+# ok_if NAME COMMAND...: passes NAME when COMMAND succeeds; else fails it with the start of
+# the last run's stderr.
+ok_if() {
+  local name=$1
+  shift
+  if "$@"; then pass "$name"; else fail "$name" "$(head -c 300 "$TMP/stderr")"; fi
+}
 
 TIMEOUT=()
 if command -v timeout >/dev/null 2>&1; then TIMEOUT=(timeout 120); fi

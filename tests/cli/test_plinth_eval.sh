@@ -21,13 +21,6 @@ CASES=(--scene "$EVAL_SCENES/isolated.toml" --scene "$EVAL_SCENES/ground-slender
   "${RECORDS[@]}" --pga-steps 4 --jobs 2)
 SMALL=("${CASES[@]}" --statues 2 --pga-from 0.3g --pga-to 1.5g)
 
-# ok_if NAME CONDITION...: passes when the command CONDITION succeeds.
-ok_if() {
-  local name=$1
-  shift
-  if "$@"; then pass "$name"; else fail "$name" "$(head -c 300 "$TMP/stderr")"; fi
-}
-
 expect_success "a small run" run "${SMALL[@]}" --out all.csv
 mv "$TMP/stdout" run.txt
 # Each case (2 records x 2 scenes x 2 statues) has rows up to its first collapse only.

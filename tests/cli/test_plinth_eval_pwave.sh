@@ -13,25 +13,9 @@ set -u
 PLINTH_SIM=${PLINTH_EVAL:-}
 # shellcheck source=tests/cli/harness.sh
 source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
-PW=$SRC/sim/data/records/pwave
-# Two stations: the P wave 5 s before the strong motion (LA - City Terrace), and near the source
-# (Rinaldi, no P wave before it).
-STATIONS=(--record "$PW/RSN990_NORTHR_LAC090.AT2" --vertical "$PW/RSN990_NORTHR_LAC-UP.AT2"
-  --record "$PW/RSN1063_NORTHR_RRS228.AT2" --vertical "$PW/RSN1063_NORTHR_RRS-UP.AT2")
-# The isolated block without its fragility, and with one (the numbers are this test's).
-sed -e '/^\[fragility\]/,/^\[/{/^\[fragility\]/d;/^median_g/d;/^beta/d}' \
-  "$SRC/sim/scenes/eval/isolated.toml" > no-fragility.toml
-grep -q "median_g" no-fragility.toml && { echo "no-fragility.toml kept its fragility" >&2; exit 1; }
-cp no-fragility.toml isolated.toml
-printf '\n[fragility]\nmedian_g = 0.8\nbeta = 0.3\n' >> isolated.toml
-CASES=(--scene isolated.toml "${STATIONS[@]}" --statues 2 --pga-from 0.4g --pga-to 1.6g
-  --pga-steps 4 --jobs 2)
-
-ok_if() {
-  local name=$1
-  shift
-  if "$@"; then pass "$name"; else fail "$name" "$(head -c 300 "$TMP/stderr")"; fi
-}
+# shellcheck source=tests/cli/eval_two_stations.sh
+source "$(dirname "${BASH_SOURCE[0]}")/eval_two_stations.sh"
+CASES=("${GRID[@]}" --jobs 2)
 
 expect_success "pwave-fit on two stations" pwave-fit "${STATIONS[@]}"
 ok_if "pwave-fit prints a line per record and scale, and its table" python3 - "$TMP/stdout" <<'PY'

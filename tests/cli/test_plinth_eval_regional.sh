@@ -14,26 +14,10 @@ set -u
 PLINTH_SIM=${PLINTH_EVAL:-}
 # shellcheck source=tests/cli/harness.sh
 source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
-PW=$SRC/sim/data/records/pwave
+# shellcheck source=tests/cli/eval_two_stations.sh
+source "$(dirname "${BASH_SOURCE[0]}")/eval_two_stations.sh"
 INFO=$PW/stations.csv
-# Two stations: LA - City Terrace (Rhyp 42.9 km: the alert comes before the S waves) and Rinaldi
-# (20.6 km: in the blind zone).
-STATIONS=(--record "$PW/RSN990_NORTHR_LAC090.AT2" --vertical "$PW/RSN990_NORTHR_LAC-UP.AT2"
-  --record "$PW/RSN1063_NORTHR_RRS228.AT2" --vertical "$PW/RSN1063_NORTHR_RRS-UP.AT2")
-sed -e '/^\[fragility\]/,/^\[/{/^\[fragility\]/d;/^median_g/d;/^beta/d}' \
-  "$SRC/sim/scenes/eval/isolated.toml" > no-fragility.toml
-grep -q "median_g" no-fragility.toml && { echo "no-fragility.toml kept its fragility" >&2; exit 1; }
-cp no-fragility.toml isolated.toml
-printf '\n[fragility]\nmedian_g = 0.8\nbeta = 0.3\n' >> isolated.toml
-GRID=(--scene isolated.toml "${STATIONS[@]}" --statues 2 --pga-from 0.4g --pga-to 1.6g
-  --pga-steps 4)
 CASES=("${GRID[@]}" --jobs 2)
-
-ok_if() {
-  local name=$1
-  shift
-  if "$@"; then pass "$name"; else fail "$name" "$(head -c 300 "$TMP/stderr")"; fi
-}
 
 # With the P-wave stage too: its strong_motion_s column is the S arrival the alert is built on.
 expect_success "a run with regional alerts" run "${CASES[@]}" --pwave on --regional on \
