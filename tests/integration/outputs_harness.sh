@@ -1,4 +1,4 @@
-# Shared by the tests of plinth-monitor's outputs (test_modbus.sh, test_mqtt.sh): the CLI
+# Shared by the tests of plinth-monitor's outputs (test_modbus.sh, test_mqtt*.sh): the CLI
 # harness (tests/cli/harness.sh), then BIN (PLINTH_MONITOR) and helpers for servers on loopback.
 # shellcheck source=tests/cli/harness.sh
 source "$(dirname "${BASH_SOURCE[0]}")/../cli/harness.sh"
@@ -36,4 +36,19 @@ wait_for() {
     sleep 0.1
   done
   return 1
+}
+
+# broker_cleanup_at_exit: at exit, kill the box (BOX, a pid) and the broker (BROKER_PID), which
+# the caller sets once it has started them, and every background job, then remove $TMP (the MQTT
+# tests).
+broker_cleanup() {
+  [[ -n "$BOX" ]] && kill -9 "$BOX" 2>/dev/null
+  [[ -n "$BROKER_PID" ]] && kill "$BROKER_PID" 2>/dev/null
+  jobs -p | xargs -r kill 2>/dev/null
+  rm -rf "$TMP"
+}
+broker_cleanup_at_exit() {
+  BROKER_PID=
+  BOX=
+  trap broker_cleanup EXIT
 }

@@ -21,15 +21,7 @@ MOSQUITTO=$(command -v mosquitto || echo /usr/sbin/mosquitto)
 ISOLATED=$SCENES/paper-isolated.toml
 ECCENTRIC=$SCENES/paper-eccentric.toml
 sha() { sha256sum "$1" | cut -d' ' -f1; }
-BROKER_PID=
-BOX=
-cleanup() {
-  [[ -n "$BOX" ]] && kill -9 "$BOX" 2>/dev/null
-  [[ -n "$BROKER_PID" ]] && kill "$BROKER_PID" 2>/dev/null
-  jobs -p | xargs -r kill 2>/dev/null
-  rm -rf "$TMP"
-}
-trap cleanup EXIT
+broker_cleanup_at_exit
 
 # The broker: users "box" and "watcher", a plain listener and a TLS one.
 PLAIN=$(free_port)

@@ -16,15 +16,7 @@ set -u
 source "$(dirname "${BASH_SOURCE[0]}")/outputs_harness.sh"
 require_tools mosquitto mosquitto_sub mosquitto_pub
 MOSQUITTO=$(command -v mosquitto || echo /usr/sbin/mosquitto)
-BROKER_PID=
-BOX=
-cleanup() {
-  [[ -n "$BOX" ]] && kill -9 "$BOX" 2>/dev/null
-  [[ -n "$BROKER_PID" ]] && kill "$BROKER_PID" 2>/dev/null
-  jobs -p | xargs -r kill 2>/dev/null
-  rm -rf "$TMP"
-}
-trap cleanup EXIT
+broker_cleanup_at_exit
 
 PORT=$(free_port)
 printf 'listener %s 127.0.0.1\nallow_anonymous true\n' "$PORT" >"$TMP/broker.conf"
