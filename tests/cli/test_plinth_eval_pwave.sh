@@ -14,7 +14,7 @@ PLINTH_SIM=${PLINTH_EVAL:-}
 # shellcheck source=tests/cli/harness.sh
 source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 # shellcheck source=tests/cli/eval_two_stations.sh
-source "$(dirname "${BASH_SOURCE[0]}")/eval_two_stations.sh"
+source "$SRC/tests/cli/eval_two_stations.sh"
 CASES=("${GRID[@]}" --jobs 2)
 
 expect_success "pwave-fit on two stations" pwave-fit "${STATIONS[@]}"
@@ -89,36 +89,21 @@ PY
 
 expect_success "the report of a run with the stage" report pw.csv
 cp "$TMP/stdout" report.txt
-ok_if "the report's P-wave section, recounted from the rows" python3 - pw.csv report.txt <<'PY'
-import csv, re, sys, statistics
+ok_if "the report's P-wave section, recounted from the rows" \
+  env PYTHONPATH="$SRC/tests/cli" python3 - pw.csv report.txt <<'PY'
+import csv, re, sys
+from warning_recount import score as recount
 rows = list(csv.DictReader(open(sys.argv[1])))
 text = open(sys.argv[2]).read()
 assert "P-wave stage (warning" in text, text[-500:]
-# Collapse margins from the case's rows (the grid's top for a case that never collapsed).
-cases = {}
-for r in rows:
-    cases.setdefault((r["record"], r["scene"], r["statue"]), []).append(r)
-def margin(r):
-    rs = cases[(r["record"], r["scene"], r["statue"])]
-    col = [float(x["scale_g"]) for x in rs if x["collapsed"] == "1"]
-    top = float(r["pga_to_g"])
-    return (min(col) if col else top) / float(r["scale_g"])
+def warning_time(r, p):
+    box = float(r["first_warning_s"])
+    if p is None:
+        return box
+    s = float(r["pwave_ge_" + p])
+    return box if s < 0 else s if box < 0 else min(box, s)
 def score(p):
-    leads, unneeded, warned = [], 0, 0
-    for r in rows:
-        box = float(r["first_warning_s"])
-        t = box
-        if p is not None:
-            s = float(r["pwave_ge_" + p])
-            if s >= 0:
-                t = s if box < 0 else min(box, s)
-        if r["collapsed"] == "1":
-            c = float(r["collapse_time_s"])
-            leads.append(c - t if 0 <= t < c else 0.0)
-        elif margin(r) >= 2.0 - 1e-9:
-            unneeded += 1
-            warned += t >= 0
-    return statistics.median(leads), 100.0 * warned / unneeded if unneeded else 0.0
+    return recount(rows, lambda r: warning_time(r, p))
 lines = {l.split()[0]: l for l in text.splitlines() if re.match(r"^    (without|\d)", l)}
 for key, line in lines.items():
     p = None if key == "without" else key

@@ -15,7 +15,7 @@ PLINTH_SIM=${PLINTH_EVAL:-}
 # shellcheck source=tests/cli/harness.sh
 source "$(dirname "${BASH_SOURCE[0]}")/harness.sh"
 # shellcheck source=tests/cli/eval_two_stations.sh
-source "$(dirname "${BASH_SOURCE[0]}")/eval_two_stations.sh"
+source "$SRC/tests/cli/eval_two_stations.sh"
 INFO=$PW/stations.csv
 CASES=("${GRID[@]}" --jobs 2)
 
@@ -66,37 +66,22 @@ ok_if "the alerts are drawn the same in another run (seeded per run)" cmp -s reg
 
 expect_success "the report of a run with regional alerts" report reg.csv
 cp "$TMP/stdout" report.txt
-ok_if "the report's regional section, recounted from the rows" python3 - reg.csv report.txt <<'PY'
-import csv, re, sys, statistics
+ok_if "the report's regional section, recounted from the rows" \
+  env PYTHONPATH="$SRC/tests/cli" python3 - reg.csv report.txt <<'PY'
+import csv, re, sys
+from warning_recount import score as recount
 rows = list(csv.DictReader(open(sys.argv[1])))
 text = open(sys.argv[2]).read()
 section = text[text.index("Regional alerts (warning"):]
-cases = {}
-for r in rows:
-    cases.setdefault((r["record"], r["scene"], r["statue"]), []).append(r)
-def margin(r):
-    rs = cases[(r["record"], r["scene"], r["statue"])]
-    col = [float(x["scale_g"]) for x in rs if x["collapsed"] == "1"]
-    return (min(col) if col else float(r["pga_to_g"])) / float(r["scale_g"])
+def warning_time(r, p):
+    t = float(r["first_warning_s"])
+    if p is not None and float(r["regional_probability"]) >= p:
+        a = max(0.0, float(r["regional_alert_s"]))
+        t = a if t < 0 else min(t, a)
+    return t
 def score(p, rhyp=None):
-    leads, unneeded, warned = [], 0, 0
-    for r in rows:
-        if float(r["model_valid_until_s"]) >= 0:
-            continue
-        if rhyp and not rhyp[0] <= float(r["regional_rhyp_km"]) < rhyp[1]:
-            continue
-        t = float(r["first_warning_s"])
-        if p is not None and float(r["regional_probability"]) >= p:
-            a = max(0.0, float(r["regional_alert_s"]))
-            t = a if t < 0 else min(t, a)
-        if r["collapsed"] == "1":
-            c = float(r["collapse_time_s"])
-            leads.append(c - t if 0 <= t < c else 0.0)
-        elif margin(r) >= 2.0 - 1e-9:
-            unneeded += 1
-            warned += t >= 0
-    med = statistics.median(leads) if leads else 0.0
-    return med, 100.0 * warned / unneeded if unneeded else 0.0
+    keep = lambda r: not rhyp or rhyp[0] <= float(r["regional_rhyp_km"]) < rhyp[1]
+    return recount(rows, lambda r: warning_time(r, p), keep)
 lines = [l for l in section.splitlines() if re.match(r"^    (without|0\.\d)\s", l)]
 assert len(lines) == 10, lines
 for line in lines:
