@@ -227,10 +227,12 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
     }
     const fw::MonitorUpdate update = monitor->on_sample(s);
     if (stage) {
-      // What the box's conditioning gives an ideal sensor: the ground's acceleration less the
-      // offset its start-up window estimated, the lead-in's (the record's first sample).
-      const Vector3r conditioned(gamma * (h[k] - h[0]), 0.0,
-                                 v.empty() ? 0.0 : gamma * (v[k] - v[0]));
+      // What the box's conditioning gives it: the replay's lead-in is at rest (0 g horizontal,
+      // 1 g vertical: record_replay_sample), its offset taken away, then the record as it is
+      // (a record that starts away from 0 steps there, for the box as for the truth).
+      const Vector3r conditioned = n < lead_in ? Vector3r::Zero()
+                                               : Vector3r(gamma * h[k], 0.0,
+                                                          v.empty() ? 0.0 : gamma * v[k]);
       const monitor::PWaveStatus& p = stage->update(conditioned);
       if (p.triggers > 0 && run.pwave_trigger_s < 0.0 && n >= lead_in) {
         run.pwave_trigger_s = std::max(0.0, p.onset_s - lead_in_s);

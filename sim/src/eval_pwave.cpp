@@ -100,12 +100,10 @@ StageTrace trace_stage(const host::Record& record, double gamma, const FitOption
   double candidate_s = 0.0;
   for (std::size_t n = 0; n < lead + count; ++n) {
     const std::size_t k = n < lead ? count : n - lead;  // count: the quiet lead-in
-    // --trace: less the record's first sample, as plinth-eval run gives the stage (the box's
-    // conditioning takes the lead-in's offset away); the fit has always read the record as is.
-    const double h0 = opt.trace ? h[0] : 0.0;
-    const double v0 = opt.trace ? v[0] : 0.0;
-    const Vector3r ground = k < count ? Vector3r(gamma * (h[k] - h0), 0.0, gamma * (v[k] - v0))
-                                      : Vector3r::Zero();
+    // The record as it is after a lead-in at rest: what the box's replay gives the stage
+    // (record_replay_sample; plinth-eval run's copy of the stage takes the same).
+    const Vector3r ground =
+        k < count ? Vector3r(gamma * h[k], 0.0, gamma * v[k]) : Vector3r::Zero();
     const monitor::PWaveStatus before = stage.status();
     const monitor::PWaveStatus& s = stage.update(ground);
     if (opt.trace) {
