@@ -24,10 +24,10 @@ import io
 import math
 import pathlib
 import re
-import subprocess
 import sys
 
-COMMIT = "4575a07afb90e2a254291c19a0518df52a87846d"
+from pwave_clone import COMMIT, fail, git  # tools/pwave_clone.py
+
 WORKBOOKS = ("Mainshock_DB.xlsx", "Aftershock_DB.xlsx")
 COLUMNS = {
     "earthquake": "earthquake_name",
@@ -38,20 +38,6 @@ COLUMNS = {
     "rhyp_km": "hypd_km",
     "vs30_m_s": "vs30_m_s_selectedforanalysis",
 }
-
-
-def fail(message):
-    print("pwave-stations.py: " + message, file=sys.stderr)
-    sys.exit(1)
-
-
-def git(clone, *args):
-    base = ["git", "-C", clone] if (pathlib.Path(clone) / ".git").exists() else [
-        "git", "--git-dir", clone]
-    done = subprocess.run(base + list(args), capture_output=True)
-    if done.returncode != 0:
-        fail(f"git {' '.join(args)}: {done.stderr.decode(errors='replace').strip()}")
-    return done.stdout
 
 
 def flatfile(clone):

@@ -45,6 +45,7 @@ struct FitOptions {
   bool fit_tau_c = false;
   double lead_in_s = 2.0;
   bool trace = false;       // print every candidate's judgement and every refusal
+  bool cross_validate = false;  // leave one earthquake out
   double max_retry_s = 0.0;  // the stage's S-wave guard, s (0: its default)
 };
 
@@ -133,6 +134,17 @@ StageTrace trace_stage(const host::Record& record, double gamma, const FitOption
   return trace;
 }
 
+// The earthquake of a PEER file name, RSN<number>_<earthquake>_<station and component>.AT2.
+std::string earthquake_of(const std::string& name) {
+  const std::size_t first = name.find('_');
+  const std::size_t second = first == std::string::npos ? first : name.find('_', first + 1);
+  if (name.rfind("RSN", 0) != 0 || second == std::string::npos || second == first + 1) {
+    throw InputError("--cross-validate: " + name +
+                     ": not named RSN<number>_<earthquake>_..., the earthquake is unknown");
+  }
+  return name.substr(first + 1, second - first - 1);
+}
+
 int run_fit(const FitOptions& opt) {
   monitor::PWaveSettings settings;
   settings.sample_period_s = 1.0 / opt.rate_hz;
@@ -147,6 +159,7 @@ int run_fit(const FitOptions& opt) {
   }
   const std::vector<host::Record> records = read_records(opt.record_paths, opt.vertical_paths);
   std::vector<host::PWaveWindowSample> samples;
+  std::vector<std::string> earthquakes;  // of each sample, for --cross-validate
   std::printf("# record, PGA (g), P pick (s), strong motion (s), trigger (s), window end, W (s), "
               "Pa (m/s2), tau_c (s), tau_p (s), predicted PGA at the close (g, the box's default "
               "table)\n");
@@ -157,6 +170,7 @@ int run_fit(const FitOptions& opt) {
     }
     const host::RecordPhases phases = host::record_phases(record);
     const std::string name = std::filesystem::path(opt.record_paths[r]).filename().string();
+    const std::string earthquake = opt.cross_validate ? earthquake_of(name) : std::string();
     for (const std::string& pga_text : opt.pgas) {
       const double pga =
           host::parse_acceleration(pga_text, kStandardGravity, "--pga") / kStandardGravity;
@@ -164,6 +178,7 @@ int run_fit(const FitOptions& opt) {
       const double gamma = pga * kStandardGravity / record.peak_horizontal();
       const StageTrace t = trace_stage(record, gamma, opt, settings, windows);
       samples.insert(samples.end(), t.samples.begin(), t.samples.end());
+      earthquakes.insert(earthquakes.end(), t.samples.size(), earthquake);
       const monitor::PWaveStatus& c = t.at_close;
       std::printf("%s, %.3g, %.2f, %.2f, %s, %s, %.2f, %.4g, %.3g, %.3g, %.3g\n", name.c_str(),
                   pga, phases.p_pick_s, phases.strong_motion_s,
@@ -182,6 +197,25 @@ int run_fit(const FitOptions& opt) {
   for (const host::PWaveFitPoint& p : table) {
     std::printf("%.1f, %zu, %.3f, %.3f, %.3f%s\n", p.window_s, p.samples, p.c0, p.c1, p.sigma,
                 p.borrowed ? ", borrowed" : "");
+  }
+  if (opt.cross_validate) {
+    const host::PWaveCrossValidation cv =
+        host::cross_validate_pwave_predictor(samples, earthquakes, windows);
+    std::printf("\n# leave one earthquake out (the earthquake from the file name, "
+                "RSN<number>_<earthquake>_), %zu earthquakes: window_s, samples, sigma_ln of "
+                "the residuals on the earthquake left out\n",
+                cv.groups.size());
+    for (const host::PWaveFitPoint& p : cv.pooled) {
+      std::printf("%.1f, %zu, %.3f\n", p.window_s, p.samples, p.sigma);
+    }
+    std::printf("\n# per earthquake left out: earthquake, then per window samples:rms\n");
+    for (std::size_t g = 0; g < cv.groups.size(); ++g) {
+      std::printf("%s", cv.groups[g].c_str());
+      for (std::size_t w = 0; w < windows.size(); ++w) {
+        std::printf(", %zu:%.3f", cv.count[g][w], cv.rms[g][w]);
+      }
+      std::printf("\n");
+    }
   }
   std::printf("\n# as C++ (p_wave.h) and as the box's file ([pwave] predictor)\n");
   for (const host::PWaveFitPoint& p : table) {
@@ -218,6 +252,9 @@ Subcommand add_pwave_fit(CLI::App& app) {
                 "instead of the fit: each candidate's judgement and each excitation refused, up "
                 "to the second trigger ('#' lines), on the samples plinth-eval run gives the "
                 "stage (less the record's first sample)");
+  fit->add_flag("--cross-validate", opt->cross_validate,
+                "also the residuals' sigma on each earthquake under the fit without it (leave "
+                "one earthquake out; the earthquake from the file name, RSN<number>_<name>_)");
   fit->add_option("--max-retry-s", opt->max_retry_s,
                   "the stage's S-wave guard: retries up to this long after an excitation's "
                   "first candidate, s (default: the stage's, 2)")

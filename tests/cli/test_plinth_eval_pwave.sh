@@ -29,6 +29,39 @@ assert windows == [0.5 * i for i in range(1, 9)], windows
 assert any("predictor = [" == l for l in lines)
 PY
 
+# --cross-validate: two stations of Northridge and two of Coalinga; each earthquake's residuals
+# under the fit on the other, pooled per window as the per-earthquake lines give them.
+CV=("${STATIONS[@]:0:4}" --record "$PW/RSN963_NORTHR_ORR090.AT2" --vertical "$PW/RSN963_NORTHR_ORR-UP.AT2"
+  --record "$PW/RSN410_COALINGA_D-PLM270.AT2" --vertical "$PW/RSN410_COALINGA_D-PLM-UP.AT2"
+  --record "$PW/RSN412_COALINGA_D-PVY045.AT2" --vertical "$PW/RSN412_COALINGA_D-PVY-UP.AT2"
+  --pga 0.3g --pga 0.6g --pga 1.2g --pga 2g --fit-tau-c)
+expect_success "pwave-fit --cross-validate" pwave-fit "${CV[@]}" --cross-validate
+ok_if "leave one earthquake out: pooled from the two earthquakes' residuals" python3 - "$TMP/stdout" <<'PY'
+import math, sys
+lines = open(sys.argv[1]).read().splitlines()
+def block(prefix, n):
+    at = lines.index(next(l for l in lines if l.startswith(prefix)))
+    return [l.split(", ") for l in lines[at + 1:at + 1 + n]]
+fit = block("# window_s", 8)
+assert lines[lines.index(next(l for l in lines if l.startswith("# leave one")))].count(
+    ", 2 earthquakes:") == 1
+pooled = block("# leave one", 8)
+per = {p[0]: [c.split(":") for c in p[1:]] for p in block("# per earthquake", 2)}
+assert sorted(per) == ["COALINGA", "NORTHR"], per
+for w in range(8):
+    n = sum(int(per[q][w][0]) for q in per)
+    assert int(pooled[w][1]) == n == int(fit[w][1]), (w, pooled[w], fit[w], n)
+    ss = sum(int(per[q][w][0]) * float(per[q][w][1]) ** 2 for q in per)
+    assert abs(float(pooled[w][2]) - math.sqrt(ss / n)) < 2e-3, (w, pooled[w], ss, n)
+# A line of all four stations fits them better than the other earthquake's line does.
+assert all(float(pooled[w][2]) > float(fit[w][4]) for w in range(3)), (pooled, fit)
+PY
+expect_failure "--cross-validate needs two earthquakes" "two earthquakes or more" \
+  -- pwave-fit "${STATIONS[@]}" --cross-validate
+cp "$PW/RSN990_NORTHR_LAC090.AT2" lac.AT2
+expect_failure "--cross-validate needs the earthquake in the file name" "lac.AT2: not named" \
+  -- pwave-fit --record lac.AT2 --vertical "$PW/RSN990_NORTHR_LAC-UP.AT2" --cross-validate
+
 # --trace on Kagel Canyon at 0.2 g: its first candidates are rejected again and again in its
 # strong motion; the S-wave guard refuses the excitation 2 s after its first candidate, and
 # without it (--max-retry-s 60) a candidate 10 s in, long after the strong motion, triggers.

@@ -145,4 +145,59 @@ std::vector<PWaveFitPoint> fit_pwave_predictor(const std::vector<PWaveWindowSamp
   return table;
 }
 
+PWaveCrossValidation cross_validate_pwave_predictor(
+    const std::vector<PWaveWindowSample>& samples, const std::vector<std::string>& group,
+    const std::vector<double>& windows_s) {
+  if (group.size() != samples.size()) {
+    throw InputError("pwave-fit: " + std::to_string(group.size()) + " groups for " +
+                     std::to_string(samples.size()) + " samples");
+  }
+  PWaveCrossValidation cv;
+  cv.groups = group;
+  std::sort(cv.groups.begin(), cv.groups.end());
+  cv.groups.erase(std::unique(cv.groups.begin(), cv.groups.end()), cv.groups.end());
+  if (cv.groups.size() < 2) {
+    throw InputError("pwave-fit: leaving one earthquake out needs two earthquakes or more, got " +
+                     std::to_string(cv.groups.size()));
+  }
+  cv.pooled = fit_pwave_predictor(samples, windows_s);
+  const std::size_t windows = windows_s.size();
+  std::vector<double> pooled_sq(windows, 0.0);
+  std::vector<std::size_t> pooled_count(windows, 0);
+  for (const std::string& left_out : cv.groups) {
+    std::vector<PWaveWindowSample> others;
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      if (group[i] != left_out) others.push_back(samples[i]);
+    }
+    const std::vector<PWaveFitPoint> table = fit_pwave_predictor(others, windows_s);
+    std::vector<double> sq(windows, 0.0);
+    std::vector<std::size_t> count(windows, 0);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      if (group[i] != left_out) continue;
+      for (std::size_t w = 0; w < windows; ++w) {
+        if (std::fabs(samples[i].window_s - windows_s[w]) >= 1e-9) continue;
+        const double r =
+            samples[i].ln_pga_over_pa - table[w].c0 - table[w].c1 * samples[i].ln_tau_c;
+        sq[w] += r * r;
+        ++count[w];
+      }
+    }
+    std::vector<double> rms(windows, 0.0);
+    for (std::size_t w = 0; w < windows; ++w) {
+      if (count[w] > 0) rms[w] = std::sqrt(sq[w] / static_cast<double>(count[w]));
+      pooled_sq[w] += sq[w];
+      pooled_count[w] += count[w];
+    }
+    cv.rms.push_back(rms);
+    cv.count.push_back(count);
+  }
+  for (std::size_t w = 0; w < windows; ++w) {
+    cv.pooled[w].samples = pooled_count[w];
+    cv.pooled[w].sigma =
+        pooled_count[w] > 0 ? std::sqrt(pooled_sq[w] / static_cast<double>(pooled_count[w]))
+                            : 0.0;
+  }
+  return cv;
+}
+
 }  // namespace plinth::host

@@ -125,5 +125,39 @@ TEST(PWaveFit, RecoversAKnownLinePerWindowAndBorrowsWhereDataAreShort) {
   EXPECT_THROW((void)fit_pwave_predictor({{1.0, 1.0, 0.0}}, {1.0}), InputError);
 }
 
+// Leave one earthquake out: with c0 alone, each group's residuals are its level less the
+// other groups' mean (A 1, B 3, C 2: -1.5, +1.5, 0); a line every group follows is predicted
+// exactly whichever group is left out.
+TEST(PWaveCrossValidation, ResidualsOnEachGroupUnderTheFitWithoutIt) {
+  std::vector<PWaveWindowSample> samples;
+  std::vector<std::string> group;
+  for (const auto& [name, level] : {std::pair{"A", 1.0}, {"B", 3.0}, {"C", 2.0}}) {
+    for (int i = 0; i < 5; ++i) {
+      samples.push_back({1.0, level, 0.0});
+      group.emplace_back(name);
+      const double x = 0.1 * i - 0.3 * level;  // the line y = 2 + 0.5 x at 2 s
+      samples.push_back({2.0, 2.0 + 0.5 * x, x});
+      group.emplace_back(name);
+    }
+  }
+  const PWaveCrossValidation cv = cross_validate_pwave_predictor(samples, group, {1.0, 2.0});
+  ASSERT_EQ(cv.groups, (std::vector<std::string>{"A", "B", "C"}));
+  ASSERT_EQ(cv.pooled.size(), 2U);
+  EXPECT_EQ(cv.pooled[0].samples, 15U);
+  EXPECT_NEAR(cv.pooled[0].c0, 2.0, 1e-12);  // the fit on all samples
+  EXPECT_NEAR(cv.pooled[0].sigma, std::sqrt(1.5), 1e-12);  // (5 x 1.5² x 2) / 15
+  EXPECT_NEAR(cv.rms[0][0], 1.5, 1e-12);
+  EXPECT_NEAR(cv.rms[1][0], 1.5, 1e-12);
+  EXPECT_NEAR(cv.rms[2][0], 0.0, 1e-12);
+  EXPECT_EQ(cv.count[2][0], 5U);
+  EXPECT_NEAR(cv.pooled[1].c1, 0.5, 1e-12);
+  EXPECT_NEAR(cv.pooled[1].sigma, 0.0, 1e-12);
+  EXPECT_THROW((void)cross_validate_pwave_predictor(samples, std::vector<std::string>(
+                                                                 samples.size(), "A"),
+                                                    {1.0, 2.0}),
+               InputError);  // one earthquake
+  EXPECT_THROW((void)cross_validate_pwave_predictor(samples, {"A"}, {1.0, 2.0}), InputError);
+}
+
 }  // namespace
 }  // namespace plinth::host

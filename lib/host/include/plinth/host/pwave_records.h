@@ -70,4 +70,21 @@ struct PWaveFitPoint {
 [[nodiscard]] std::vector<PWaveFitPoint> fit_pwave_predictor(
     const std::vector<PWaveWindowSample>& samples, const std::vector<double>& windows_s);
 
+// Whether the table's terms generalise to other earthquakes: per window, the residuals of each
+// group's samples (group[i] names the earthquake of samples[i]) under the table fitted on the
+// other groups' samples alone (leave one group out). Throws InputError for fewer than two
+// groups, a group per sample missing, or a fit without enough samples.
+struct PWaveCrossValidation {
+  // Per window, pooled over the groups: samples, sigma the residuals' root mean square (c0 and
+  // c1 are the fit on all samples).
+  std::vector<PWaveFitPoint> pooled;
+  std::vector<std::string> groups;  // sorted
+  // groups x windows: the group's residuals' root mean square and how many (0: none, rms 0).
+  std::vector<std::vector<double>> rms;
+  std::vector<std::vector<std::size_t>> count;
+};
+[[nodiscard]] PWaveCrossValidation cross_validate_pwave_predictor(
+    const std::vector<PWaveWindowSample>& samples, const std::vector<std::string>& group,
+    const std::vector<double>& windows_s);
+
 }  // namespace plinth::host
