@@ -123,7 +123,7 @@ PY
 expect_success "the report of a run with the stage" report pw.csv
 cp "$TMP/stdout" report.txt
 ok_if "the report's P-wave section, recounted from the rows" \
-  env PYTHONPATH="$SRC/tests/cli" python3 - pw.csv report.txt <<'PY'
+  env PYTHONPATH="$SRC/tools" python3 - pw.csv report.txt <<'PY'
 import csv, re, sys
 from warning_recount import score as recount
 rows = list(csv.DictReader(open(sys.argv[1])))

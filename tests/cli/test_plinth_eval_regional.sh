@@ -67,7 +67,7 @@ ok_if "the alerts are drawn the same in another run (seeded per run)" cmp -s reg
 expect_success "the report of a run with regional alerts" report reg.csv
 cp "$TMP/stdout" report.txt
 ok_if "the report's regional section, recounted from the rows" \
-  env PYTHONPATH="$SRC/tests/cli" python3 - reg.csv report.txt <<'PY'
+  env PYTHONPATH="$SRC/tools" python3 - reg.csv report.txt <<'PY'
 import csv, re, sys
 from warning_recount import score as recount
 rows = list(csv.DictReader(open(sys.argv[1])))
@@ -103,6 +103,35 @@ PY
 expect_success "a report calibrated on another file" report reg.csv --regional-calibrate-on reg.csv
 ok_if "it says where the threshold was chosen" grep -Eq "(chosen |\()on the calibration file" \
   "$TMP/stdout"
+
+# tools/warning-inputs.py: the box with both early inputs warns at the earliest of its own
+# warning, the stage's crossing and the alert (at 0 s when before the record).
+python3 "$SRC/tools/warning-inputs.py" reg.csv --pwave 0.5 --regional 0.5 > inputs.txt 2> inputs.err
+ok_if "warning-inputs.py: each input alone and both, recounted from the rows" \
+  env PYTHONPATH="$SRC/tools" python3 - reg.csv inputs.txt <<'PY'
+import csv, re, sys
+from warning_recount import score
+rows = list(csv.DictReader(open(sys.argv[1])))
+text = open(sys.argv[2]).read()
+def when(r, stage, alert):
+    t = [float(r["first_warning_s"])]
+    if stage:
+        t.append(float(r["pwave_ge_0.5"]))
+    if alert and float(r["regional_probability"]) >= 0.5:
+        t.append(max(0.0, float(r["regional_alert_s"])))
+    t = [x for x in t if x >= 0.0]
+    return min(t) if t else -1.0
+line = next(l for l in text.splitlines() if l.startswith("all records"))
+cells = [tuple(map(float, c)) for c in re.findall(r"([\d.]+) /\s+([\d.]+) %", line)]
+assert len(cells) == 4, line
+for cell, (stage, alert) in zip(cells, [(0, 0), (1, 0), (0, 1), (1, 1)]):
+    lead, unneeded = score(rows, lambda r: when(r, stage, alert))
+    assert abs(cell[0] - lead) < 0.006 and abs(cell[1] - unneeded) < 0.06, (cell, lead, unneeded)
+assert cells[3][0] >= max(cells[1][0], cells[2][0]) and cells[3][1] >= max(cells[1][1], cells[2][1])
+assert cells[1] != cells[0] and cells[2] != cells[0], cells   # each input changes something here
+PY
+ok_if "warning-inputs.py refuses a file without the alerts' columns, naming one" \
+  bash -c '! python3 "$0/tools/warning-inputs.py" off.csv 2> err.txt && grep -q "off.csv: no column regional_alert_s" err.txt' "$SRC"
 
 printf 'rsn,earthquake,station,magnitude,rrup_km,rjb_km,rhyp_km,vs30_m_s\n990,N,LAC,6.69,36.62,35.03,42.88,365\n' \
   > one.csv

@@ -1,8 +1,8 @@
 """The warning reports' figures recounted from a runs file's rows, apart from plinth-eval's own
-code (test_plinth_eval_pwave.sh, test_plinth_eval_regional.sh): each run's collapse margin from
-its case's rows, and for a rule giving each run's warning time, the median lead over the
-collapses and the share of runs at margin >= 2 that warned. Runs that left the model count in
-no outcome, as in plinth-eval report."""
+code (used by tests/cli/test_plinth_eval_pwave.sh and test_plinth_eval_regional.sh, and by
+tools/warning-inputs.py): each run's collapse margin from its case's rows, and for a rule giving
+each run's warning time, the median lead over the collapses and the share of runs at margin >= 2
+that warned. Runs that left the model count in no outcome, as in plinth-eval report."""
 import statistics
 
 
