@@ -218,46 +218,64 @@ void StatueFilter::stop_sliding() {
   slide_above_ = 0;
   slide_below_ = 0;
   sliding_ = false;
-  slide_scale_ = 0;
+  slide_relative_.fill(0);
+  slide_scale_.fill(0);
   estimate_.acceleration_used = false;
   estimate_.relative_acceleration = 0;
   estimate_.slide_threshold = 0;
 }
 
 // The gyroscope's phase (measure()) with sliding added from the accelerometer (see the header):
-// `theta_ddot` the differenced rate.
+// `theta_ddot` the differenced rate. Each member's base is a sticking block's own: sliding once
+// none of them explains the reading.
 void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration ground,
                                    const StatueMeasurement& measured, Real theta_ddot) {
-  const Scene& scene = members.nominal().scene();
   const Mode gyroscope = estimate_.mode;
-  if (!scene.params.has_friction || !measured.has_acceleration ||
+  if (!members.nominal().scene().params.has_friction || !measured.has_acceleration ||
       !std::isfinite(measured.specific_force_m_s2) || gyroscope.terminal()) {
     stop_sliding();
     return;
   }
   estimate_.acceleration_used = true;
   const bool rocking = gyroscope.rocking();
-  // Sticking: the pivot (the corner it rocks about; at rest either) moves with the base.
-  const Real base = members.base_acceleration();
-  const Vector2r from_pivot(scene.corner(gyroscope.corner).offset + mount_.offset_m,
-                            mount_.height_m);
-  const Real predicted =
-      block_specific_force(Vector2r(base, ground.vertical), from_pivot, estimate_.tilt,
-                           rocking ? estimate_.rotation_rate : Real(0),
-                           rocking ? theta_ddot : Real(0), scene.g)
-          .x();
-  Real& relative = estimate_.relative_acceleration;
-  relative += slide_alpha_ * (measured.specific_force_m_s2 - predicted - relative);
-  slide_scale_ += slide_alpha_ * (std::fabs(predicted) - slide_scale_);
-  // The filtered noise: the accelerometers', and rocking the differenced rate's at the lever arm.
-  const Real rate_noise =
-      rocking ? settings_.rate_noise_rad_s * from_pivot.norm() * slide_rate_noise_gain_ : Real(0);
   const Real acceleration_noise = settings_.acceleration_noise_m_s2 * slide_noise_gain_;
-  estimate_.slide_threshold =
-      kSlideSigmas * std::sqrt(acceleration_noise * acceleration_noise + rate_noise * rate_noise) +
-      settings_.acceleration_bias_m_s2 + settings_.slide_tolerance * slide_scale_;
+  bool explained = false;  // some member's base, sticking, explains the reading
+  Real closest = -1;       // the smallest |a_rel| / threshold, and its member's
+  Real closest_block = 0;  // the block's acceleration by that member's base
+  for (int m = 0; m < members_; ++m) {
+    const auto k = static_cast<std::size_t>(m);
+    const Scene& scene = members.member(m).scene();
+    // Sticking: the pivot (the corner it rocks about; at rest either) moves with the base as the
+    // member's own simulation moves it (its block's reaction on it included).
+    const Real base = members.base_acceleration(m);
+    const Vector2r from_pivot(scene.corner(gyroscope.corner).offset + mount_.offset_m,
+                              mount_.height_m);
+    const Real predicted =
+        block_specific_force(Vector2r(base, ground.vertical), from_pivot, estimate_.tilt,
+                             rocking ? estimate_.rotation_rate : Real(0),
+                             rocking ? theta_ddot : Real(0), scene.g)
+            .x();
+    Real& relative = slide_relative_[k];
+    relative += slide_alpha_ * (measured.specific_force_m_s2 - predicted - relative);
+    slide_scale_[k] += slide_alpha_ * (std::fabs(predicted) - slide_scale_[k]);
+    // The filtered noise: the accelerometers', and rocking the differenced rate's at the lever.
+    const Real rate_noise = rocking ? settings_.rate_noise_rad_s * from_pivot.norm() *
+                                          slide_rate_noise_gain_
+                                    : Real(0);
+    const Real threshold =
+        kSlideSigmas * std::sqrt(acceleration_noise * acceleration_noise + rate_noise * rate_noise) +
+        settings_.acceleration_bias_m_s2 + settings_.slide_tolerance * slide_scale_[k];
+    const Real ratio = std::fabs(relative) / threshold;
+    if (closest < 0 || ratio < closest) {
+      closest = ratio;
+      closest_block = base + relative;
+      estimate_.relative_acceleration = relative;
+      estimate_.slide_threshold = threshold;
+    }
+    explained = explained || ratio <= 1;
+  }
   // Debounced both ways.
-  if (std::fabs(relative) > estimate_.slide_threshold) {
+  if (!explained) {
     ++slide_above_;
     slide_below_ = 0;
   } else {
@@ -268,10 +286,8 @@ void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration g
   if (sliding_ && slide_below_ >= slide_end_samples_) sliding_ = false;
   if (!sliding_) return;
   estimate_.mode.phase = rocking ? Phase::kSlideRocking : Phase::kSliding;
-  // Kinetic friction opposes the slip: the block's acceleration (the base's and the relative
-  // one) has the sign of -x'.
-  estimate_.mode.slide_direction =
-      base + estimate_.relative_acceleration > 0 ? std::int8_t{-1} : std::int8_t{1};
+  // Kinetic friction opposes the slip: the block's acceleration has the sign of -x'.
+  estimate_.mode.slide_direction = closest_block > 0 ? std::int8_t{-1} : std::int8_t{1};
 }
 
 // The measured state as member `member` would have it: its own base and sliding (not measured),

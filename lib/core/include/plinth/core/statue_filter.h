@@ -47,8 +47,8 @@
 // Sliding, from the accelerometer (its horizontal specific force f along the axis, statue
 // frame, offset removed). A block whose contact with its base sticks moves with the base: the
 // accelerometer reads what a point of a rigid body pivoting on the base reads, the base's
-// absolute acceleration a_b = u'' + u_G'' (the ground's on the ground; the nominal member's on an
-// isolated base, Ensemble::base_acceleration) plus the tilt's terms: the gravity's projection
+// absolute acceleration a_b = u'' + u_G'' (the ground's on the ground; on an isolated base each
+// member's own, Ensemble::base_acceleration) plus the tilt's terms: the gravity's projection
 // g sin(theta) and, while it rocks, the lever arm's theta'' and centripetal theta'^2 terms about
 // the pivot (block_specific_force; theta and theta' from the gyroscope, theta'' their difference
 // over a sample, the same low-pass as the rest). A sliding block's acceleration is its
@@ -57,9 +57,10 @@
 // stays away from 0. Low-passed over slide_filter_s, it is compared with
 //   4 sigma_f + acceleration_bias_m_s2 + slide_tolerance * |f_predicted|
 // (sigma_f the filtered noise of the accelerometers' and, rocking, of the differenced rate at
-// the lever arm; the tolerance the model's, the two sensors' timing and the isolated base's
-// nominal member): above for slide_onset_s the block slides (slide-rocking while the gyroscope
-// says it rocks), below for slide_end_s it sticks again. An impact's jump of the sensor's
+// the lever arm; the tolerance the model's and the two sensors' timing), for every member's base
+// (the members span the declared uncertainty of an isolated base; on the ground they share it):
+// above for every member for slide_onset_s the block slides (slide-rocking while the gyroscope
+// says it rocks), within it for some member for slide_end_s it sticks again. An impact's jump of the sensor's
 // velocity is in the differenced rate too (theta'' h at theta = 0 about either corner): the
 // prediction carries it. The sliding direction is the opposite of the block's acceleration's. Only for a scene that can slide
 // ([friction]); without a fresh accelerometer sample the phase is the gyroscope's alone.
@@ -170,8 +171,10 @@ struct StatueEstimate {
   std::array<Real, kMaxEnsembleMembers> weights{};  // weights[0 .. members)
   // The accelerometer: its sample fed this one's sliding test (a scene that can slide).
   bool acceleration_used = false;
-  Real relative_acceleration = 0.0;  // m/s2, filtered: f less the prediction sticking
-  Real slide_threshold = 0.0;        // m/s2: its threshold now
+  // m/s2, filtered: f less the prediction sticking, by the member whose base explains the
+  // reading best (the smallest ratio to its threshold), and that threshold.
+  Real relative_acceleration = 0.0;
+  Real slide_threshold = 0.0;
 };
 
 // The forecast's probability of a collapse with the members weighted: the weight of the members
@@ -244,7 +247,9 @@ class StatueFilter {
   int slide_above_ = 0;
   int slide_below_ = 0;
   bool sliding_ = false;
-  Real slide_scale_ = 0.0;  // m/s2, |f_predicted| filtered
+  // Per member (its base): a_rel and |f_predicted|, filtered, m/s2.
+  std::array<Real, kMaxEnsembleMembers> slide_relative_{};
+  std::array<Real, kMaxEnsembleMembers> slide_scale_{};
 };
 
 }  // namespace plinth
