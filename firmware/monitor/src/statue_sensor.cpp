@@ -173,7 +173,7 @@ void StatueSensor::on_acceleration(const monitor::SensorSample& sample, bool qui
     const monitor::FedSample& fed = update.fed[i];
     const Vector3r statue = sensor_to_statue_ * fed.acceleration_g * kStandardGravity;  // m/s2
     // At rest the horizontal specific force is 0: only x and y have an offset to remove.
-    acceleration_offset_.add(Vector3r(statue.x(), statue.y(), 0), quiet);
+    acceleration_offset_.add(Vector3r(statue.x(), statue.y(), Real(0)), quiet);
     const Vector3r& offset = acceleration_offset_.offset();
     specific_force_ = Vector3r(statue.x() - offset.x(), statue.y() - offset.y(), statue.z());
     acceleration_saturated_ = fed.saturated;

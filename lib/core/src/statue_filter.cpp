@@ -110,7 +110,7 @@ Vector2r block_specific_force(const Vector2r& reference, const Vector2r& from_re
   const Vector2r r(t.cos * from_reference.x() - t.sin * from_reference.y(),
                    t.sin * from_reference.x() + t.cos * from_reference.y());
   const Vector2r world = reference + theta_ddot * Vector2r(-r.y(), r.x()) -
-                         theta_dot * theta_dot * r + Vector2r(0, g);
+                         theta_dot * theta_dot * r + Vector2r(Real(0), g);
   return {t.cos * world.x() + t.sin * world.y(), -t.sin * world.x() + t.cos * world.y()};
 }
 

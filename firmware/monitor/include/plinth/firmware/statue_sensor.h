@@ -52,8 +52,9 @@ struct StatueSensorSettings {
   bool present = false;
   std::uint8_t node = 2;  // CAN node id, 1..15, not a ground sensor's
   // Its mounting: the rotation from the sensor frame to the statue frame (orthonormal, det +1),
-  // and where it sits: height above the block's base and horizontal offsets from its vertical
-  // axis, m (the accelerometer's lever arm; the gyroscope reads the same anywhere on the block).
+  // and where it sits: height above the block's base and horizontal offsets from the vertical
+  // through its centre of mass, m (the accelerometer's lever arm, StatueAccelerometerMount; the
+  // gyroscope reads the same anywhere on the block).
   Matrix3r sensor_to_statue = Matrix3r::Identity();
   Real height_m = 1.0;
   Real offset_x_m = 0.0;
