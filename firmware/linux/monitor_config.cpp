@@ -152,8 +152,8 @@ void sensor_bindings(std::vector<Binding>& b, const std::string& mounting,
 }
 
 // [statue_sensor] (its mounting, its streams' health) and [statue_filter] (the gyroscope's noise,
-// the weighing of the members, the accelerometer's sliding test): statue_sensor.h, statue_filter.h. The table's presence
-// configures the sensor (load_monitor_text).
+// the weighing of the members, the accelerometer's sliding test): statue_sensor.h,
+// statue_filter.h. The table's presence configures the sensor (load_monitor_text).
 void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int& node) {
   b.push_back({"statue_sensor.node", integer_into(node), "an integer"});
   b.push_back({"statue_sensor.sensor_to_statue", rotation_into(statue.sensor_to_statue),

@@ -153,7 +153,9 @@ std::uint64_t run_seed(const EvalCase& c) {
 class StatueImu {
  public:
   StatueImu(const EvalCase& c, double rate_hz, const StatueImuModel& model)
-      : model_(model), random_(run_seed(c)), acceleration_random_(run_seed(c) ^ kAccelerometerSalt) {
+      : model_(model),
+        random_(run_seed(c)),
+        acceleration_random_(run_seed(c) ^ kAccelerometerSalt) {
     const double to_rad = std::numbers::pi / 180.0;
     std::uniform_real_distribution<double> offset(-model.zero_rate_offset_deg_s,
                                                   model.zero_rate_offset_deg_s);
@@ -338,7 +340,8 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.grid = c.grid;
   run.scale_g = c.scale_g;
   const StatueAccelerometerMount mount = statue_accelerometer_mount(box);
-  const Truth truth = simulate_truth(c, gamma, truth_settings, box.statue_sensor ? &mount : nullptr);
+  const Truth truth =
+      simulate_truth(c, gamma, truth_settings, box.statue_sensor ? &mount : nullptr);
   run.collapsed = truth.collapsed;
   run.collapse_time_s = truth.collapse_time_s;
   run.peak_ratio = truth.peak_ratio;

@@ -175,7 +175,8 @@ Error StatueFilter::start(const StatueFilterSettings& settings, const EstimatorS
   rest_samples_ = static_cast<int>(std::ceil(settings.rest_time_s / period));
   mount_ = mount;
   // The first-order low-pass y += alpha (x - y): a white input's variance times
-  // alpha / (2 - alpha); a differenced one's ((x_n - x_{n-1}) / T) times 2 alpha^2 / (T^2 (2 - alpha)).
+  // alpha / (2 - alpha); a differenced one's ((x_n - x_{n-1}) / T) times
+  // 2 alpha^2 / (T^2 (2 - alpha)).
   const double alpha = 1.0 - std::exp(-period / settings.slide_filter_s);
   slide_alpha_ = static_cast<Real>(alpha);
   slide_noise_gain_ = static_cast<Real>(std::sqrt(alpha / (2.0 - alpha)));
@@ -262,9 +263,10 @@ void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration g
     const Real rate_noise = rocking ? settings_.rate_noise_rad_s * from_pivot.norm() *
                                           slide_rate_noise_gain_
                                     : Real(0);
-    const Real threshold =
-        kSlideSigmas * std::sqrt(acceleration_noise * acceleration_noise + rate_noise * rate_noise) +
-        settings_.acceleration_bias_m_s2 + settings_.slide_tolerance * slide_scale_[k];
+    const Real noise =
+        std::sqrt(acceleration_noise * acceleration_noise + rate_noise * rate_noise);
+    const Real threshold = kSlideSigmas * noise + settings_.acceleration_bias_m_s2 +
+                           settings_.slide_tolerance * slide_scale_[k];
     const Real ratio = std::fabs(relative) / threshold;
     if (closest < 0 || ratio < closest) {
       closest = ratio;

@@ -60,10 +60,11 @@
 // the lever arm; the tolerance the model's and the two sensors' timing), for every member's base
 // (the members span the declared uncertainty of an isolated base; on the ground they share it):
 // above for every member for slide_onset_s the block slides (slide-rocking while the gyroscope
-// says it rocks), within it for some member for slide_end_s it sticks again. An impact's jump of the sensor's
-// velocity is in the differenced rate too (theta'' h at theta = 0 about either corner): the
-// prediction carries it. The sliding direction is the opposite of the block's acceleration's. Only for a scene that can slide
-// ([friction]); without a fresh accelerometer sample the phase is the gyroscope's alone.
+// says it rocks), within it for some member for slide_end_s it sticks again. An impact's jump of
+// the sensor's velocity is in the differenced rate too (theta'' h at theta = 0 about either
+// corner): the prediction carries it. The sliding direction is the opposite of the block's
+// acceleration's. Only for a scene that can slide ([friction]); without a fresh accelerometer
+// sample the phase is the gyroscope's alone.
 // Freestanding: no heap.
 #pragma once
 
