@@ -227,18 +227,21 @@ void StatueFilter::stop_sliding() {
 }
 
 // The gyroscope's phase (measure()) with sliding added from the accelerometer (see the header):
-// `theta_ddot` the differenced rate. Each member's base is a sticking block's own: sliding once
-// none of them explains the reading.
+// `previous_rate` the rate before this sample's, if any. Each member's base is a sticking
+// block's own: sliding once none of them explains the reading.
 void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration ground,
-                                   const StatueMeasurement& measured, Real theta_ddot) {
+                                   const StatueMeasurement& measured,
+                                   const Real* previous_rate) {
   const Mode gyroscope = estimate_.mode;
   if (!members.nominal().scene().params.has_friction || !measured.has_acceleration ||
       !std::isfinite(measured.specific_force_m_s2) || gyroscope.terminal()) {
-    stop_sliding();
+    if (estimate_.acceleration_used) stop_sliding();  // else nothing to forget
     return;
   }
   estimate_.acceleration_used = true;
   const bool rocking = gyroscope.rocking();
+  const Real theta_ddot =
+      previous_rate != nullptr ? (estimate_.rotation_rate - *previous_rate) / period_ : Real(0);
   const Real acceleration_noise = settings_.acceleration_noise_m_s2 * slide_noise_gain_;
   bool explained = false;  // some member's base, sticking, explains the reading
   Real closest = -1;       // the smallest |a_rel| / threshold, and its member's
@@ -350,11 +353,11 @@ void StatueFilter::on_sample(const Ensemble& members, GroundAcceleration ground,
                              const StatueMeasurement& measured) {
   if (members_ == 0 || members.size() != members_) return;
   if (!std::isfinite(measured.rotation_rate)) return;  // the conditioning passes none
-  const Real theta_ddot =
-      have_previous_ ? (measured.rotation_rate - previous_rate_) / period_ : Real(0);
+  const Real previous_rate = previous_rate_;
+  const bool had_previous = have_previous_;
   measure(members, measured);
   gyroscope_mode_ = estimate_.mode;
-  measure_sliding(members, ground, measured, theta_ddot);
+  measure_sliding(members, ground, measured, had_previous ? &previous_rate : nullptr);
   if (!have_previous_ || interval_count_ == 0) {
     interval_start_rate_ = estimate_.rotation_rate;
     interval_start_tilt_ = estimate_.tilt;

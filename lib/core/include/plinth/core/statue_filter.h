@@ -209,7 +209,7 @@ class StatueFilter {
   void weigh(const Ensemble& members);
   [[nodiscard]] State measured_state(const PlanarEstimator& member) const;
   void measure_sliding(const Ensemble& members, GroundAcceleration ground,
-                       const StatueMeasurement& measured, Real rotational_acceleration);
+                       const StatueMeasurement& measured, const Real* previous_rate);
   void stop_sliding();
 
   StatueFilterSettings settings_;
