@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "build_options.h"
 #include "plinth/core/internal/flows.h"
 
 namespace plinth {
@@ -16,6 +17,10 @@ constexpr Real kSignal = 4;
 constexpr Real kAgreement = 3;
 // The sliding test's threshold: this many standard deviations of the filtered noise.
 constexpr Real kSlideSigmas = 4;
+// A build whose feature sets all leave sliding out (PLINTH_CORE_FEATURE_SETS: a microcontroller's,
+// which refuses every scene with [friction]) leaves the sliding test out: the sets with sliding
+// are the contacts 1-3 of each base, bits 1-3, 5-7 and 9-11 (feature_sets.cpp).
+constexpr bool kSlidingBuiltIn = (PLINTH_CORE_FEATURE_MASK & 0xEEE) != 0;
 
 bool positive_finite(double x) { return std::isfinite(x) && x > 0.0; }
 
@@ -177,10 +182,11 @@ Error StatueFilter::start(const StatueFilterSettings& settings, const EstimatorS
   // The first-order low-pass y += alpha (x - y): a white input's variance times
   // alpha / (2 - alpha); a differenced one's ((x_n - x_{n-1}) / T) times
   // 2 alpha^2 / (T^2 (2 - alpha)).
-  const double alpha = 1.0 - std::exp(-period / settings.slide_filter_s);
-  slide_alpha_ = static_cast<Real>(alpha);
-  slide_noise_gain_ = static_cast<Real>(std::sqrt(alpha / (2.0 - alpha)));
-  slide_rate_noise_gain_ = static_cast<Real>(alpha / period * std::sqrt(2.0 / (2.0 - alpha)));
+  // (In Real: a float build's sqrt is an instruction, libm's double one 0.5 KB of flash.)
+  const auto alpha = static_cast<Real>(1.0 - std::exp(-period / settings.slide_filter_s));
+  slide_alpha_ = alpha;
+  slide_noise_gain_ = std::sqrt(alpha / (Real(2) - alpha));
+  slide_rate_noise_gain_ = alpha / period_ * std::sqrt(Real(2) / (Real(2) - alpha));
   const auto samples = [period](double s) {
     return std::max(1, static_cast<int>(std::lround(s / period)));
   };
@@ -233,7 +239,8 @@ void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration g
                                    const StatueMeasurement& measured,
                                    const Real* previous_rate) {
   const Mode gyroscope = estimate_.mode;
-  if (!members.nominal().scene().params.has_friction || !measured.has_acceleration ||
+  if (!kSlidingBuiltIn || !members.nominal().scene().params.has_friction ||
+      !measured.has_acceleration ||
       !std::isfinite(measured.specific_force_m_s2) || gyroscope.terminal()) {
     if (estimate_.acceleration_used) stop_sliding();  // else nothing to forget
     return;
