@@ -541,6 +541,33 @@ TEST(StatueFilter, ASlidingBlockOnAnIsolatedBaseIsMeasuredSliding) {
   EXPECT_EQ(r.last_phase, Phase::kFullContact);
 }
 
+// Sliding is said only when no member's base explains the reading. Members: the block on the
+// paper's isolated base and on the ground; the accelerometer reads what the block reads sticking
+// to an isolated base (a simulation of it: its absolute acceleration). Never sliding with both
+// members; with the ground's member alone, the same readings are sliding.
+TEST(StatueFilter, SlidingOnlyWhenNoMembersBaseExplainsTheReading) {
+  const Scene isolated = make(with_friction(paper_isolated(), 0.15, 0.12));
+  const auto slid = [&](std::vector<Scene> members) {
+    FilterRun run(std::move(members), isolated);
+    bool sliding = false;
+    for (int n = 0; n < 4 * static_cast<int>(kRate); ++n) {
+      const GroundAcceleration g = shaking(n, 0.3);
+      run.ensemble->push(g);
+      run.truth->push(g);  // the block on the isolated base
+      StatueMeasurement m{0.0};
+      m.has_acceleration = true;
+      m.specific_force_m_s2 =
+          run.truth->simulator().accelerations().u + run.truth->ground().horizontal;
+      run.filter.on_sample(*run.ensemble, g, m);
+      EXPECT_TRUE(run.filter.estimate().acceleration_used);
+      sliding = sliding || run.filter.estimate().mode.sliding();
+    }
+    return sliding;
+  };
+  EXPECT_FALSE(slid({isolated, sliding_block()}));
+  EXPECT_TRUE(slid({sliding_block()}));
+}
+
 // A block that rocks (0.4 g, as TheRockingStatueIsTheSlenderMember) and grips (mu_s 0.8): its
 // impacts and lever arm's accelerations are never taken for sliding.
 TEST(StatueFilter, ARockingBlockIsNeverMeasuredSliding) {
