@@ -151,9 +151,9 @@ void sensor_bindings(std::vector<Binding>& b, const std::string& mounting,
   }
 }
 
-// [statue_sensor] (its mounting, its streams' health) and [statue_filter] (the gyroscope's noise
-// and the weighing of the members): statue_sensor.h, statue_filter.h. The table's presence
-// configures the sensor (load_monitor_text).
+// [statue_sensor] (its mounting, its streams' health) and [statue_filter] (the gyroscope's noise,
+// the weighing of the members, the accelerometer's sliding test): statue_sensor.h,
+// statue_filter.h. The table's presence configures the sensor (load_monitor_text).
 void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int& node) {
   b.push_back({"statue_sensor.node", integer_into(node), "an integer"});
   b.push_back({"statue_sensor.sensor_to_statue", rotation_into(statue.sensor_to_statue),
@@ -183,6 +183,12 @@ void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int&
       {"statue_filter.credible_weight", &f.credible_weight},
       {"statue_filter.unexplained_score", &f.unexplained_score},
       {"statue_filter.ruled_out_fraction", &f.ruled_out_fraction},
+      {"statue_filter.acceleration_noise_m_s2", &f.acceleration_noise_m_s2},
+      {"statue_filter.acceleration_bias_m_s2", &f.acceleration_bias_m_s2},
+      {"statue_filter.slide_tolerance", &f.slide_tolerance},
+      {"statue_filter.slide_filter_s", &f.slide_filter_s},
+      {"statue_filter.slide_onset_s", &f.slide_onset_s},
+      {"statue_filter.slide_end_s", &f.slide_end_s},
   };
   for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
   const std::pair<const char*, int*> integers[] = {

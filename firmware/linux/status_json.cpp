@@ -283,6 +283,7 @@ std::string statue_weights_json(const StatueAxisStatus& a) {
       .count("best_member", static_cast<std::uint64_t>(a.best_member))
       .general("best_score", a.best_score, 4)
       .count("ruled_out", static_cast<std::uint64_t>(a.ruled_out))
+      .flag("acceleration_used", a.acceleration_used)
       .close();
 }
 

@@ -11,6 +11,7 @@
 
 #include "plinth/core/excitation.h"
 #include "plinth/core/simulator.h"
+#include "plinth/core/statue_filter.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/firmware/record_replay.h"
 #include "plinth/host/input_error.h"
@@ -36,16 +37,26 @@ struct Truth {
   double first_motion_s = -1.0;  // s: first out of full contact; -1: never
   double step_s = 0.0;
   std::vector<double> rotation_rate;  // theta' at each step's end, rad/s ([0]: t = 0)
+  // With the statue sensor: the specific force its accelerometer reads at each step's end, in
+  // the statue's x-z plane (simulated_specific_force), m/s2 ([0]: at rest, (0, g)).
+  std::vector<double> specific_force_x;
+  std::vector<double> specific_force_z;
 
   // theta' at time t (s from the record's start), linear between steps; 0 before the start,
   // the last one after the end.
-  [[nodiscard]] double rate_at(double t) const {
-    if (t <= 0.0 || rotation_rate.empty()) return 0.0;
+  [[nodiscard]] double rate_at(double t) const { return at(rotation_rate, t, 0.0); }
+  [[nodiscard]] Eigen::Vector2d specific_force_at(double t) const {
+    return {at(specific_force_x, t, 0.0), at(specific_force_z, t, kStandardGravity)};
+  }
+
+ private:
+  [[nodiscard]] double at(const std::vector<double>& steps, double t, double before) const {
+    if (t <= 0.0 || steps.empty()) return before;
     const double x = t / step_s;
     const auto i = static_cast<std::size_t>(x);
-    if (i + 1 >= rotation_rate.size()) return rotation_rate.back();
+    if (i + 1 >= steps.size()) return steps.back();
     const double w = x - static_cast<double>(i);
-    return (1.0 - w) * rotation_rate[i] + w * rotation_rate[i + 1];
+    return (1.0 - w) * steps[i] + w * steps[i + 1];
   }
 };
 
@@ -55,7 +66,9 @@ Excitation scaled(const host::Record& record, double gamma) {
                             gamma);
 }
 
-Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& settings) {
+// `mount`: where the statue sensor's accelerometer sits (nullptr: none to simulate).
+Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& settings,
+                     const StatueAccelerometerMount* mount) {
   SolverSettings solver;
   solver.step = settings.step_s;
   Simulator sim;
@@ -70,9 +83,19 @@ Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& setti
   Truth truth;
   truth.step_s = solver.step;
   truth.rotation_rate.push_back(0.0);
+  if (mount != nullptr) {
+    truth.specific_force_x.push_back(0.0);
+    truth.specific_force_z.push_back(s.g);
+  }
   while (sim.time() < t_end - 0.5 * solver.step && !sim.mode().terminal()) {
     sim.step();
     truth.rotation_rate.push_back(sim.state()[kThetaDot]);
+    if (mount != nullptr) {
+      const Vector2r f = simulated_specific_force(s, sim.mode(), sim.state(), sim.accelerations(),
+                                                  sim.ground(sim.time()), *mount);
+      truth.specific_force_x.push_back(f.x());
+      truth.specific_force_z.push_back(f.y());
+    }
     if (truth.first_motion_s < 0.0 && sim.mode().phase != Phase::kFullContact) {
       truth.first_motion_s = sim.time();
     }
@@ -104,6 +127,14 @@ fw::MonitorConfig box_config(const BoxSettings& box) {
   return config;
 }
 
+// Where the box's configuration puts the statue sensor's accelerometer (axis 0's plane).
+StatueAccelerometerMount statue_accelerometer_mount(const BoxSettings& box) {
+  const fw::MonitorConfig config = box_config(box);
+  const auto* statue = monitor::built_part<fw::StatueSensorSettings>(config.statue_sensor);
+  if (statue == nullptr) return {};
+  return {statue->height_m, statue->offset_x_m};
+}
+
 // A run's own seed: the case's key (record, scene, statue, scale) hashed, so that a run draws the
 // same in every shard.
 std::uint64_t run_seed(const EvalCase& c) {
@@ -114,19 +145,26 @@ std::uint64_t run_seed(const EvalCase& c) {
   return h;
 }
 
-// The statue sensor's samples of one run: the truth's theta' through StatueImuModel's noise,
-// offset and delay, as a gyroscope whose y axis points along the statue's y (theta'_0 =
-// -omega_y, statue_sensor.h). Seeded by the case, so a run is the same in every shard.
+// The statue sensor's samples of one run: the truth's theta' and specific force through
+// StatueImuModel's noise, offsets and delay, as an IMU whose axes are the statue's (theta'_0 =
+// -omega_y, statue_sensor.h). Seeded by the case, so a run is the same in every shard; the
+// accelerometer draws from a stream of its own (the gyroscope's draws are those of a run
+// without it).
 class StatueImu {
  public:
   StatueImu(const EvalCase& c, double rate_hz, const StatueImuModel& model)
-      : model_(model), random_(run_seed(c)) {
+      : model_(model),
+        random_(run_seed(c)),
+        acceleration_random_(run_seed(c) ^ kAccelerometerSalt) {
     const double to_rad = std::numbers::pi / 180.0;
     std::uniform_real_distribution<double> offset(-model.zero_rate_offset_deg_s,
                                                   model.zero_rate_offset_deg_s);
     for (double& o : offset_rad_s_) o = offset(random_) * to_rad;
     // White noise of the density over the output's band (half the rate).
     noise_rad_s_ = model.noise_density_deg_s_rthz * std::sqrt(rate_hz / 2.0) * to_rad;
+    std::uniform_real_distribution<double> zero_g(-model.zero_g_offset_mg, model.zero_g_offset_mg);
+    for (double& o : offset_g_) o = zero_g(acceleration_random_) * 1e-3;
+    noise_g_ = model.acceleration_noise_density_ug_rthz * 1e-6 * std::sqrt(rate_hz / 2.0);
   }
   fw::StatueSample sample(const fw::MonitorConfig& config, std::int64_t n, double rate_rad_s) {
     fw::StatueSample s = fw::replay_statue_sample(config, n, static_cast<Real>(rate_rad_s), 0);
@@ -136,14 +174,32 @@ class StatueImu {
     }
     return s;
   }
+  // The accelerometer's sample n (g, sensor frame = statue frame) of the specific force
+  // `statue_m_s2` (the statue's x-z plane, m/s2).
+  monitor::SensorSample acceleration(const fw::MonitorConfig& config, std::int64_t n,
+                                     const Eigen::Vector2d& statue_m_s2) {
+    monitor::SensorSample s = fw::record_replay_sample(config, n, Eigen::Vector3d::Zero(), 0);
+    const Eigen::Vector3d g(statue_m_s2.x(), 0.0, statue_m_s2.y());
+    for (int i = 0; i < 3; ++i) {
+      s.acceleration_g[i] = static_cast<Real>(g[i] / kStandardGravity +
+                                              offset_g_[static_cast<std::size_t>(i)] +
+                                              noise_g_ * acceleration_gauss_(acceleration_random_));
+    }
+    return s;
+  }
   [[nodiscard]] double delay_s() const { return model_.delay_s; }
 
  private:
+  static constexpr std::uint64_t kAccelerometerSalt = 0xa5a5a5a55a5a5a5aULL;
   StatueImuModel model_;
   std::mt19937_64 random_;
+  std::mt19937_64 acceleration_random_;
   std::normal_distribution<double> gauss_;
+  std::normal_distribution<double> acceleration_gauss_;  // its own: a distribution keeps draws
   std::array<double, 3> offset_rad_s_{};
+  std::array<double, 3> offset_g_{};
   double noise_rad_s_ = 0.0;
+  double noise_g_ = 0.0;
 };
 
 // First time each threshold of `grid` was reached by `value`.
@@ -222,8 +278,11 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
         fw::record_replay_sample(config, static_cast<std::int64_t>(n), ground, kStandardGravity);
     const double t = static_cast<double>(k) / rate;
     if (imu) {
-      const double rate_now = n < lead_in ? 0.0 : truth.rate_at(t - imu->delay_s());
-      (void)monitor->on_statue_sample(imu->sample(config, static_cast<std::int64_t>(n), rate_now));
+      const double then = n < lead_in ? 0.0 : t - imu->delay_s();
+      const auto i = static_cast<std::int64_t>(n);
+      (void)monitor->on_statue_sample(imu->sample(config, i, truth.rate_at(then)));
+      (void)monitor->on_statue_acceleration(
+          imu->acceleration(config, i, truth.specific_force_at(then)));
     }
     const fw::MonitorUpdate update = monitor->on_sample(s);
     if (stage) {
@@ -282,7 +341,9 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.seed = c.seed;
   run.grid = c.grid;
   run.scale_g = c.scale_g;
-  const Truth truth = simulate_truth(c, gamma, truth_settings);
+  const StatueAccelerometerMount mount = statue_accelerometer_mount(box);
+  const Truth truth =
+      simulate_truth(c, gamma, truth_settings, box.statue_sensor ? &mount : nullptr);
   run.collapsed = truth.collapsed;
   run.collapse_time_s = truth.collapse_time_s;
   run.peak_ratio = truth.peak_ratio;

@@ -34,8 +34,8 @@ struct BoxSettings {
   // probability's first crossings of grids.pwave go to the runs file. The scene must give its
   // [fragility].
   bool pwave = false;
-  // A statue sensor (firmware statue_sensor.h) simulated from the truth: its gyroscope as
-  // StatueImuModel says, at the box's rate.
+  // A statue sensor (firmware statue_sensor.h) simulated from the truth: its gyroscope and
+  // accelerometer as StatueImuModel says, at the box's rate.
   bool statue_sensor = false;
   // Regional alerts simulated by this model (plinth-eval run --regional on; docs/regional.md,
   // "Evaluation"): one alert per run, its probability from the box's regional room with the
@@ -43,15 +43,22 @@ struct BoxSettings {
   std::optional<host::RegionalAlertModel> regional;
 };
 
-// A MEMS gyroscope a museum would mount on a statue: a Bosch BMI088's typical figures as Bosch
-// Sensortec's application engineer gives them (the data sheet's table not found; source in
+// A MEMS IMU a museum would mount on a statue. Its gyroscope: a Bosch BMI088's typical figures as
+// Bosch Sensortec's application engineer gives them (the data sheet's table not found; source in
 // docs/forecast.md): rate noise density 0.014 deg/s/sqrt(Hz), zero-rate offset +-1 deg/s (each
 // run draws one per axis, uniformly), and a delay of one 200 Hz sample (its output filter's
-// group delay at 200 Hz ODR and the CAN frame's transit).
+// group delay at 200 Hz ODR and the CAN frame's transit). Its accelerometer, at the same rate and
+// delay: a noise density of 175 ug/sqrt(Hz) (the BMI088 accelerometer's as commonly quoted: an
+// assumption, its data sheet's table not found) and a zero-g offset within +-50 mg per axis
+// (Bosch's BMA280 in the CISS manual, +-50 mg; the BMI160's and BMA255's +-60 mg: the order of a
+// consumer MEMS accelerometer's; docs/forecast.md), at the mount's default place, 1 m up on the
+// block's axis.
 struct StatueImuModel {
   double noise_density_deg_s_rthz = 0.014;  // deg/s/sqrt(Hz)
   double zero_rate_offset_deg_s = 1.0;      // deg/s, the offset's bound
   double delay_s = 0.005;                   // s, behind the ground sensor's sample
+  double acceleration_noise_density_ug_rthz = 175.0;  // ug/sqrt(Hz)
+  double zero_g_offset_mg = 50.0;                     // mg, the offset's bound
 };
 
 struct TruthSettings {

@@ -378,6 +378,25 @@ else
   expect_failure "a missing gnuplot is named" "gnuplot" -- report all.csv --plot roc.png
 fi
 
+# The statue sensor's accelerometer on a statue that slides (ground-slender with [friction]
+# 0.2 / 0.16: it slides, never rocks): the measured phase leaves full contact (advisory) in
+# runs whose truth moved, never before the truth's first motion, never in a run that stayed.
+{ cat "$EVAL_SCENES/ground-slender.toml"; printf '\n[friction]\nstatic = 0.2\nkinetic = 0.16\n'; } \
+  >ground-sliding.toml
+expect_success "a sliding statue with the statue sensor" run --scene ground-sliding.toml \
+  "${RECORDS[@]}" --statues 2 --pga-from 0.3g --pga-to 1.5g --pga-steps 4 --jobs 2 \
+  --statue-sensor --out sliding.csv --motion-out sliding-motion.csv
+ok_if "the accelerometer's sliding: advisories after the truth's first motion only" \
+  python3 - sliding-motion.csv <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+raised = [r for r in rows if float(r["first_advisory_s"]) >= 0]
+assert len(rows) == 16 and len(raised) >= 4, (len(rows), len(raised))
+for r in raised:
+    assert 0 <= float(r["first_motion_s"]) <= float(r["first_advisory_s"]), r
+assert all(float(r["first_alarm_s"]) < 0 for r in rows)
+PY
+
 expect_failure "no scene" "--scene" -- run --record "$AT2" --out x.csv
 expect_failure "a scene that is not there" "nothing.toml" -- run --scene nothing.toml \
   "${RECORDS[@]}" --out x.csv

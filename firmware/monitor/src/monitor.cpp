@@ -62,8 +62,11 @@ Error Monitor::start(const MonitorConfig& config,
   if (status_.has_statue_sensor) {
     PLINTH_TRY(room().sensor.start(*statue, config.estimator.sample_period()));
     for (int i = 0; i < config.axis_count; ++i) {
+      // The accelerometer's lever arm in axis i's plane: x-z for axis 0, y-z for axis 1.
+      const StatueAccelerometerMount mount{statue->height_m,
+                                           i == 0 ? statue->offset_x_m : statue->offset_y_m};
       PLINTH_TRY(room().filters[static_cast<std::size_t>(i)].start(
-          statue->filter, config.estimator, config.risk, ensemble(i).size()));
+          statue->filter, config.estimator, config.risk, ensemble(i).size(), mount));
     }
     note_statue_health();
   }
@@ -142,10 +145,11 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
 }
 
 // Each axis's members take the sample; with the statue sensor's newest rate fresh, the axis's
-// filter weighs them on it (a restart of the statue's stream loses the tilt: the filters start
-// again).
+// filter weighs them on it, and tests sliding on the newest specific force when that is fresh
+// too (a restart of the statue's stream loses the tilt: the filters start again).
 void Monitor::push_ensembles(const Vector3r& g, std::int64_t receive_time_ns) {
   const bool measuring = statue_present() && room().sensor.usable(receive_time_ns);
+  const bool accelerating = measuring && room().sensor.acceleration_usable(receive_time_ns);
   if (measuring && room().sensor.restarts() != room().restarts) {
     room().restarts = room().sensor.restarts();
     for (StatueFilter& f : room().filters) f.reset();
@@ -155,7 +159,10 @@ void Monitor::push_ensembles(const Vector3r& g, std::int64_t receive_time_ns) {
     ensembles_[k].push({g[i], g.z()});
     if (statue_present()) room().measured[k] = measuring;
     if (measuring) {
-      room().filters[k].on_sample(ensembles_[k], {g[i], g.z()}, {room().sensor.axis_rate(i)});
+      room().filters[k].on_sample(
+          ensembles_[k], {g[i], g.z()},
+          {room().sensor.axis_rate(i), accelerating,
+           accelerating ? room().sensor.axis_specific_force(i) : Real(0)});
     }
   }
   if (monitor::PWaveStage* stage = pwave_stage()) (void)stage->update(g);
@@ -222,8 +229,9 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   axis.risk = e.risk;
   axis.worst_member = e.risk_member;
   axis.forecast.probability = weighted_collapse_probability(axis.forecast, e);
-  *statue = {true,         e.informative, !e.explained, e.weighted, e.effective_members,
-             e.best_score, e.best_member, e.ruled_out};
+  *statue = {true,          e.informative,     !e.explained,        e.weighted,
+             e.effective_members, e.best_score, e.best_member, e.ruled_out,
+             e.acceleration_used};
 }
 
 // The axes' part of the status: mode, state, risk, the forecast.
@@ -364,7 +372,7 @@ MonitorUpdate Monitor::on_statue_acceleration(const monitor::SensorSample& sampl
     return update;
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
-  room().sensor.on_acceleration(sample);
+  room().sensor.on_acceleration(sample, !status_.estimating || quiet());
   note_statue_health();
   evaluate(update);
   return update;

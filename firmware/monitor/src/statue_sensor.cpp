@@ -10,6 +10,8 @@ namespace plinth::firmware {
 namespace {
 // rad/s: the spread of a quiet window's rates (a BMI088's noise at 200 Hz is ~0.004 rad/s rms).
 constexpr Real kQuietSpreadRadS = Real(0.05);
+// m/s2: the same of the accelerometer's (a BMI088's noise at 200 Hz is ~0.02 m/s2 rms).
+constexpr Real kQuietSpreadM_S2 = Real(0.3);
 
 // lib/monitor's SensorHealthTracker compares a stream's three values with two limits; its names
 // say g for the ground's accelerometers. The gyroscope's stream crosses into it here only: its
@@ -128,22 +130,56 @@ Error StatueSensor::start(const StatueSensorSettings& settings, double sample_pe
   sensor_to_statue_ = settings.sensor_to_statue;
   max_age_ns_ = settings.max_age_s * 1e9;
   const double samples = std::ceil(settings.offset_window_s / sample_period_s);
-  window_samples_ = samples < 2.0 ? 2 : static_cast<int>(samples);
-  summed_ = 0;
-  sum_.setZero();
-  offset_.setZero();
+  const int window = samples < 2.0 ? 2 : static_cast<int>(samples);
+  rate_offset_.start(window, kQuietSpreadRadS);
+  acceleration_offset_.start(window, kQuietSpreadM_S2);
   rate_.setZero();
-  ready_ = false;
+  specific_force_.setZero();
   have_sample_ = false;
+  have_acceleration_ = false;
+  acceleration_saturated_ = false;
   newest_ns_ = 0;
+  newest_acceleration_ns_ = 0;
   restarts_ = 0;
   rate_health_ = rate_tracker_.health();
   acceleration_health_ = acceleration_tracker_.health();
   return ok_error();
 }
 
-void StatueSensor::on_acceleration(const monitor::SensorSample& sample) {
-  acceleration_health_ = acceleration_tracker_.on_sample(sample).health;
+// The offset: the mean of the first quiet window (a start-up rate offset of a MEMS gyroscope is
+// up to +-1 deg/s, an accelerometer's tens of mg; their drift in a museum's temperature is far
+// smaller). A window whose values spread beyond `spread` on an axis is the statue moving: again.
+void QuietWindowOffset::add(const Vector3r& value, bool quiet) {
+  if (ready_) return;
+  if (summed_ == 0) low_ = high_ = value;
+  low_ = low_.cwiseMin(value);
+  high_ = high_.cwiseMax(value);
+  if (quiet && (high_ - low_).maxCoeff() <= spread_) {
+    sum_ += value;
+    if (++summed_ >= window_samples_) {
+      offset_ = sum_ / static_cast<Real>(summed_);
+      ready_ = true;
+    }
+  } else {
+    summed_ = 0;
+    sum_.setZero();
+  }
+}
+
+void StatueSensor::on_acceleration(const monitor::SensorSample& sample, bool quiet) {
+  const monitor::SensorUpdate update = acceleration_tracker_.on_sample(sample);
+  acceleration_health_ = update.health;
+  for (std::size_t i = 0; i < update.fed_count; ++i) {
+    const monitor::FedSample& fed = update.fed[i];
+    const Vector3r statue = sensor_to_statue_ * fed.acceleration_g * kStandardGravity;  // m/s2
+    // At rest the horizontal specific force is 0: only x and y have an offset to remove.
+    acceleration_offset_.add(Vector3r(statue.x(), statue.y(), Real(0)), quiet);
+    const Vector3r& offset = acceleration_offset_.offset();
+    specific_force_ = Vector3r(statue.x() - offset.x(), statue.y() - offset.y(), statue.z());
+    acceleration_saturated_ = fed.saturated;
+    newest_acceleration_ns_ = fed.time_ns;
+    have_acceleration_ = true;
+  }
 }
 
 void StatueSensor::on_sample(const StatueSample& sample, bool quiet) {
@@ -154,35 +190,28 @@ void StatueSensor::on_sample(const StatueSample& sample, bool quiet) {
     if (fed.restart) ++restarts_;
     // tracker_sample() put the rates where the tracker keeps its values.
     const Vector3r statue = sensor_to_statue_ * fed.acceleration_g;  // rad/s
-    // The offset: the mean of the first quiet window (a start-up rate offset of a MEMS
-    // gyroscope is up to +-1 deg/s; its drift in a museum's temperature is far smaller).
-    // A window whose rates spread beyond kQuietSpread on an axis is the statue moving: again.
-    if (!ready_) {
-      if (summed_ == 0) low_ = high_ = statue;
-      low_ = low_.cwiseMin(statue);
-      high_ = high_.cwiseMax(statue);
-      if (quiet && (high_ - low_).maxCoeff() <= kQuietSpreadRadS) {
-        sum_ += statue;
-        if (++summed_ >= window_samples_) {
-          offset_ = sum_ / static_cast<Real>(summed_);
-          ready_ = true;
-        }
-      } else {
-        summed_ = 0;
-        sum_.setZero();
-      }
-    }
-    rate_ = statue - offset_;
+    rate_offset_.add(statue, quiet);
+    rate_ = statue - rate_offset_.offset();
     newest_ns_ = fed.time_ns;
     have_sample_ = true;
   }
 }
 
 bool StatueSensor::usable(std::int64_t now_ns) const {
-  if (!ready_ || !have_sample_ || rate_health_.state == monitor::HealthState::kFault) {
+  if (!rate_offset_.ready() || !have_sample_ ||
+      rate_health_.state == monitor::HealthState::kFault) {
     return false;
   }
   const std::int64_t age = now_ns - newest_ns_;
+  return static_cast<double>(age) <= max_age_ns_;
+}
+
+bool StatueSensor::acceleration_usable(std::int64_t now_ns) const {
+  if (!acceleration_offset_.ready() || !have_acceleration_ || acceleration_saturated_ ||
+      acceleration_health_.state == monitor::HealthState::kFault) {
+    return false;
+  }
+  const std::int64_t age = now_ns - newest_acceleration_ns_;
   return static_cast<double>(age) <= max_age_ns_;
 }
 

@@ -63,8 +63,9 @@ void Ensemble::risk(EnsembleRisk& out) const {
   }
 }
 
-Real Ensemble::base_acceleration() const {
-  return members_[0].simulator().accelerations().u + members_[0].ground().horizontal;
+Real Ensemble::base_acceleration(int member) const {
+  const PlanarEstimator& m = members_[static_cast<std::size_t>(member)];
+  return m.simulator().accelerations().u + m.ground().horizontal;
 }
 
 }  // namespace plinth

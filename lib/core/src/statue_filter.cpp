@@ -1,7 +1,9 @@
 #include "plinth/core/statue_filter.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "build_options.h"
 #include "plinth/core/internal/flows.h"
 
 namespace plinth {
@@ -13,6 +15,12 @@ constexpr Real kSignal = 4;
 // A member's own theta' agrees with the measured one within this many standard deviations
 // (the innovation's: noise and model tolerance).
 constexpr Real kAgreement = 3;
+// The sliding test's threshold: this many standard deviations of the filtered noise.
+constexpr Real kSlideSigmas = 4;
+// A build whose feature sets all leave sliding out (PLINTH_CORE_FEATURE_SETS: a microcontroller's,
+// which refuses every scene with [friction]) leaves the sliding test out: the sets with sliding
+// are the contacts 1-3 of each base, bits 1-3, 5-7 and 9-11 (feature_sets.cpp).
+constexpr bool kSlidingBuiltIn = (PLINTH_CORE_FEATURE_MASK & 0xEEE) != 0;
 
 bool positive_finite(double x) { return std::isfinite(x) && x > 0.0; }
 
@@ -76,7 +84,54 @@ Error validate(const StatueFilterSettings& s) {
   if (!positive_finite(s.ruled_out_fraction) || s.ruled_out_fraction > 1) {
     return {ErrorCode::kOutOfRange, "statue_filter.ruled_out_fraction", "must lie in (0, 1]"};
   }
+  if (!positive_finite(s.acceleration_noise_m_s2)) {
+    return {ErrorCode::kOutOfRange, "statue_filter.acceleration_noise_m_s2",
+            "must be finite and > 0 m/s2"};
+  }
+  if (!std::isfinite(s.acceleration_bias_m_s2) || s.acceleration_bias_m_s2 < 0) {
+    return {ErrorCode::kOutOfRange, "statue_filter.acceleration_bias_m_s2",
+            "must be finite and >= 0 m/s2"};
+  }
+  if (!std::isfinite(s.slide_tolerance) || s.slide_tolerance < 0 || s.slide_tolerance >= 1) {
+    return {ErrorCode::kOutOfRange, "statue_filter.slide_tolerance", "must lie in [0, 1)"};
+  }
+  const struct {
+    double value;
+    const char* field;
+  } times[] = {{s.slide_filter_s, "statue_filter.slide_filter_s"},
+               {s.slide_onset_s, "statue_filter.slide_onset_s"},
+               {s.slide_end_s, "statue_filter.slide_end_s"}};
+  for (const auto& t : times) {
+    if (!positive_finite(t.value) || t.value > 1.0) {
+      return {ErrorCode::kOutOfRange, t.field, "must lie in (0, 1] s"};
+    }
+  }
   return ok_error();
+}
+
+Vector2r block_specific_force(const Vector2r& reference, const Vector2r& from_reference,
+                              Real theta, Real theta_dot, Real theta_ddot, Real g) {
+  const internal::SinCos t = internal::sin_cos(theta);
+  const Vector2r r(t.cos * from_reference.x() - t.sin * from_reference.y(),
+                   t.sin * from_reference.x() + t.cos * from_reference.y());
+  const Vector2r world = reference + theta_ddot * Vector2r(-r.y(), r.x()) -
+                         theta_dot * theta_dot * r + Vector2r(Real(0), g);
+  return {t.cos * world.x() + t.sin * world.y(), -t.sin * world.x() + t.cos * world.y()};
+}
+
+Vector2r simulated_specific_force(const Scene& scene, const Mode& mode, const State& y,
+                                  const Accelerations& acc, GroundAcceleration ground,
+                                  const StatueAccelerometerMount& mount) {
+  // C's acceleration (as base_stop_reaction takes it), the ground's added.
+  const internal::PivotDistance pivot =
+      internal::pivot_distance(scene, mode.corner, mode.overhang, y[kX]);
+  const internal::ContactKinematics k = internal::contact_kinematics(
+      scene, pivot.offset(), pivot.overhanging, y, internal::sin_cos(y[kTheta]));
+  const Vector3r qdd(acc.u, acc.x, acc.theta);
+  const Vector2r c(k.jx.dot(qdd) + k.bias.x() + ground.horizontal,
+                   k.jy.dot(qdd) + k.bias.y() + ground.vertical);
+  return block_specific_force(c, Vector2r(mount.offset_m, mount.height_m - scene.h), y[kTheta],
+                              y[kThetaDot], acc.theta, scene.g);
 }
 
 double weighted_collapse_probability(const ForecastOutcome& forecast,
@@ -100,7 +155,8 @@ double weighted_collapse_probability(const ForecastOutcome& forecast,
 }
 
 Error StatueFilter::start(const StatueFilterSettings& settings, const EstimatorSettings& rate,
-                          const RiskSettings& risk, int members) {
+                          const RiskSettings& risk, int members,
+                          const StatueAccelerometerMount& mount) {
   PLINTH_TRY(validate(settings));
   PLINTH_TRY(validate(risk));
   if (members < 1 || members > kMaxEnsembleMembers) {
@@ -122,6 +178,20 @@ Error StatueFilter::start(const StatueFilterSettings& settings, const EstimatorS
   evidence_decay_ = static_cast<Real>(std::exp(-interval / settings.memory_s));
   score_decay_ = static_cast<Real>(std::exp(-interval / settings.score_memory_s));
   rest_samples_ = static_cast<int>(std::ceil(settings.rest_time_s / period));
+  mount_ = mount;
+  // The first-order low-pass y += alpha (x - y): a white input's variance times
+  // alpha / (2 - alpha); a differenced one's ((x_n - x_{n-1}) / T) times
+  // 2 alpha^2 / (T^2 (2 - alpha)).
+  // (In Real: a float build's sqrt is an instruction, libm's double one 0.5 KB of flash.)
+  const auto alpha = static_cast<Real>(1.0 - std::exp(-period / settings.slide_filter_s));
+  slide_alpha_ = alpha;
+  slide_noise_gain_ = std::sqrt(alpha / (Real(2) - alpha));
+  slide_rate_noise_gain_ = alpha / period_ * std::sqrt(Real(2) / (Real(2) - alpha));
+  const auto samples = [period](double s) {
+    return std::max(1, static_cast<int>(std::lround(s / period)));
+  };
+  slide_onset_samples_ = samples(settings.slide_onset_s);
+  slide_end_samples_ = samples(settings.slide_end_s);
   reset();
   return ok_error();
 }
@@ -145,6 +215,91 @@ void StatueFilter::reset() {
   score_.fill(0);
   score_norm_.fill(0);
   have_previous_ = false;
+  gyroscope_mode_ = Mode{};
+  stop_sliding();
+}
+
+// The sliding test forgets (no fresh accelerometer sample, or a restart): stuck, as the
+// gyroscope alone would say.
+void StatueFilter::stop_sliding() {
+  slide_above_ = 0;
+  slide_below_ = 0;
+  sliding_ = false;
+  slide_relative_.fill(0);
+  slide_scale_.fill(0);
+  estimate_.acceleration_used = false;
+  estimate_.relative_acceleration = 0;
+  estimate_.slide_threshold = 0;
+}
+
+// The gyroscope's phase (measure()) with sliding added from the accelerometer (see the header):
+// `previous_rate` the rate before this sample's, if any. Each member's base is a sticking
+// block's own: sliding once none of them explains the reading.
+void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration ground,
+                                   const StatueMeasurement& measured,
+                                   const Real* previous_rate) {
+  const Mode gyroscope = estimate_.mode;
+  if (!kSlidingBuiltIn || !members.nominal().scene().params.has_friction ||
+      !measured.has_acceleration ||
+      !std::isfinite(measured.specific_force_m_s2) || gyroscope.terminal()) {
+    if (estimate_.acceleration_used) stop_sliding();  // else nothing to forget
+    return;
+  }
+  estimate_.acceleration_used = true;
+  const bool rocking = gyroscope.rocking();
+  const Real theta_ddot =
+      previous_rate != nullptr ? (estimate_.rotation_rate - *previous_rate) / period_ : Real(0);
+  const Real acceleration_noise = settings_.acceleration_noise_m_s2 * slide_noise_gain_;
+  bool explained = false;  // some member's base, sticking, explains the reading
+  Real closest = -1;       // the smallest |a_rel| / threshold, and its member's
+  Real closest_block = 0;  // the block's acceleration by that member's base
+  for (int m = 0; m < members_; ++m) {
+    const auto k = static_cast<std::size_t>(m);
+    const Scene& scene = members.member(m).scene();
+    // Sticking: the pivot (the corner it rocks about; at rest either) moves with the base as the
+    // member's own simulation moves it (its block's reaction on it included).
+    const Real base = members.base_acceleration(m);
+    const Vector2r from_pivot(scene.corner(gyroscope.corner).offset + mount_.offset_m,
+                              mount_.height_m);
+    const Real predicted =
+        block_specific_force(Vector2r(base, ground.vertical), from_pivot, estimate_.tilt,
+                             rocking ? estimate_.rotation_rate : Real(0),
+                             rocking ? theta_ddot : Real(0), scene.g)
+            .x();
+    Real& relative = slide_relative_[k];
+    relative += slide_alpha_ * (measured.specific_force_m_s2 - predicted - relative);
+    slide_scale_[k] += slide_alpha_ * (std::fabs(predicted) - slide_scale_[k]);
+    // The filtered noise: the accelerometers', and rocking the differenced rate's at the lever.
+    const Real rate_noise = rocking ? settings_.rate_noise_rad_s * from_pivot.norm() *
+                                          slide_rate_noise_gain_
+                                    : Real(0);
+    const Real noise =
+        std::sqrt(acceleration_noise * acceleration_noise + rate_noise * rate_noise);
+    const Real threshold = kSlideSigmas * noise + settings_.acceleration_bias_m_s2 +
+                           settings_.slide_tolerance * slide_scale_[k];
+    const Real ratio = std::fabs(relative) / threshold;
+    if (closest < 0 || ratio < closest) {
+      closest = ratio;
+      closest_block = base + relative;
+      estimate_.relative_acceleration = relative;
+      estimate_.slide_threshold = threshold;
+    }
+    explained = explained || ratio <= 1;
+  }
+  // Debounced both ways.
+  if (!explained) {
+    ++slide_above_;
+    slide_below_ = 0;
+  } else {
+    ++slide_below_;
+    slide_above_ = 0;
+  }
+  if (!sliding_ && slide_above_ >= slide_onset_samples_) sliding_ = true;
+  if (sliding_ && slide_below_ >= slide_end_samples_) sliding_ = false;
+  if (!sliding_) return;
+  estimate_.mode.phase = rocking ? Phase::kSlideRocking : Phase::kSliding;
+  // Kinetic friction opposes the slip: the block's acceleration has the sign of -x'.
+  estimate_.mode.slide_direction = closest_block > 0 ? std::int8_t{-1} : std::int8_t{1};
 }
 
 // The measured state as member `member` would have it: its own base and sliding (not measured),
@@ -190,11 +345,11 @@ void StatueFilter::measure(const Ensemble& members, const StatueMeasurement& mea
   }
   const Real side = std::fabs(tilt) > settings_.rest_tilt_rad ? tilt : rate;
   mode.corner = side >= 0 ? Corner::kLeft : Corner::kRight;
-  if (mode.rocking() && estimate_.mode.rocking() && mode.corner != estimate_.mode.corner) {
+  if (mode.rocking() && gyroscope_mode_.rocking() && mode.corner != gyroscope_mode_.corner) {
     interval_impact_ = true;
   }
   if (mode.terminal()) interval_terminal_ = true;
-  if (mode.phase != Phase::kFullContact) interval_moved_ = true;
+  if (mode.phase != Phase::kFullContact) interval_moved_ = true;  // rocked (the gyroscope's)
   estimate_.mode = mode;
   estimate_.tilt = tilt;
   estimate_.rotation_rate = rate;
@@ -205,7 +360,11 @@ void StatueFilter::on_sample(const Ensemble& members, GroundAcceleration ground,
                              const StatueMeasurement& measured) {
   if (members_ == 0 || members.size() != members_) return;
   if (!std::isfinite(measured.rotation_rate)) return;  // the conditioning passes none
+  const Real previous_rate = previous_rate_;
+  const bool had_previous = have_previous_;
   measure(members, measured);
+  gyroscope_mode_ = estimate_.mode;
+  measure_sliding(members, ground, measured, had_previous ? &previous_rate : nullptr);
   if (!have_previous_ || interval_count_ == 0) {
     interval_start_rate_ = estimate_.rotation_rate;
     interval_start_tilt_ = estimate_.tilt;
@@ -213,7 +372,7 @@ void StatueFilter::on_sample(const Ensemble& members, GroundAcceleration ground,
   for (int m = 0; m < members_; ++m) {
     const PlanarEstimator& e = members.member(m);
     const bool base_moves = e.scene().has_base() && e.mode().held_stop == 0;
-    const Real a = rotational_acceleration(e.scene(), estimate_.mode, measured_state(e),
+    const Real a = rotational_acceleration(e.scene(), gyroscope_mode_, measured_state(e),
                                            base_moves, ground);
     const auto k = static_cast<std::size_t>(m);
     if (have_previous_ && interval_count_ > 0) {
@@ -267,8 +426,8 @@ void StatueFilter::finish_interval(const Ensemble& members) {
   interval_start_rate_ = estimate_.rotation_rate;
   interval_start_tilt_ = estimate_.tilt;
   interval_impact_ = false;
-  interval_terminal_ = estimate_.mode.terminal();
-  interval_moved_ = estimate_.mode.phase != Phase::kFullContact;
+  interval_terminal_ = gyroscope_mode_.terminal();
+  interval_moved_ = gyroscope_mode_.phase != Phase::kFullContact;
 }
 
 void StatueFilter::weigh(const Ensemble& members) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <random>
@@ -18,9 +19,11 @@ namespace {
 
 using testing::make;
 using testing::paper_block;
+using testing::paper_isolated;
 using testing::wide_block;
 using testing::ensemble_estimator_settings;
 using testing::no_forecast;
+using testing::with_friction;
 
 constexpr double kRate = 200.0;  // ensemble_estimator_settings()'s
 
@@ -63,7 +66,42 @@ struct FilterRun {
     truth->push(g);
     const double rate =
         measured != nullptr ? *measured : truth->state()[kThetaDot] + noise * gauss(random);
-    filter.on_sample(*ensemble, g, {static_cast<Real>(rate)});
+    StatueMeasurement m{static_cast<Real>(rate)};
+    ground_velocity += 0.5 * (previous_ground + g.horizontal) / kRate;
+    previous_ground = g.horizontal;
+    const Vector2r velocity = sensor_velocity();
+    if (accelerometer) {
+      const double read = averaging ? sample_mean_specific_force(velocity) : true_specific_force();
+      m.has_acceleration = true;
+      m.specific_force_m_s2 = static_cast<Real>(read + acceleration_bias +
+                                                acceleration_noise * gauss(acceleration_random));
+    }
+    previous_velocity = velocity;
+    filter.on_sample(*ensemble, g, m);
+  }
+  // The sensor's velocity (world frame, the ground's added; default mount, 1 m up on the axis):
+  // the pivot's (the corner it rocks about; at rest any) u' + x' and theta' about it.
+  [[nodiscard]] Vector2r sensor_velocity() const {
+    const State& y = truth->state();
+    const Real offset = truth_scene_.corner(truth->mode().corner).offset;
+    const Real th = y[kTheta];
+    const Vector2r r(std::cos(th) * offset - std::sin(th), std::sin(th) * offset + std::cos(th));
+    return Vector2r(ground_velocity + y[kUDot] + y[kXDot] - y[kThetaDot] * r.y(),
+                    y[kThetaDot] * r.x());
+  }
+  // A sensor whose output is its acceleration's mean over the sample (an ideal anti-alias
+  // filter): the change of its velocity over the sample, an impact's jump included, plus
+  // gravity, in the block's frame.
+  [[nodiscard]] double sample_mean_specific_force(const Vector2r& velocity) const {
+    const Vector2r a = (velocity - previous_velocity) * kRate;
+    const double th = truth->state()[kTheta];
+    return std::cos(th) * a.x() + std::sin(th) * (a.y() + kStandardGravity);
+  }
+  // What the accelerometer at the default mount (1 m up, on the axis) reads on the true statue.
+  [[nodiscard]] double true_specific_force() const {
+    return simulated_specific_force(truth_scene_, truth->mode(), truth->state(),
+                                    truth->simulator().accelerations(), truth->ground(), {})
+        .x();
   }
   std::vector<Scene> scenes;
   Scene truth_scene_;
@@ -73,6 +111,16 @@ struct FilterRun {
   double noise;
   std::mt19937 random{24};
   std::normal_distribution<double> gauss;
+  // The accelerometer, fed when `accelerometer`: white noise of acceleration_noise m/s2 rms
+  // (the default acceleration_noise_m_s2) and a bias its offset window left.
+  bool accelerometer = false;
+  bool averaging = false;  // the reading is the sample's mean, not the value at its end
+  double acceleration_noise = 0.03;
+  double acceleration_bias = 0.0;
+  std::mt19937 acceleration_random{26};
+  double ground_velocity = 0.0;  // m/s, the ground's, by the trapezoid rule
+  double previous_ground = 0.0;
+  Vector2r previous_velocity = Vector2r::Zero();
 };
 
 TEST(StatueFilter, SettingsNameTheirField) {
@@ -95,6 +143,33 @@ TEST(StatueFilter, SettingsNameTheirField) {
   EXPECT_EQ(f.start(s, ensemble_estimator_settings(), {}, 2).field, std::string("statue_filter.interval_s"));
   EXPECT_EQ(f.start({}, ensemble_estimator_settings(), {}, kMaxEnsembleMembers + 1).field,
             std::string("uncertainty"));
+}
+
+// The sliding test's settings, each named.
+TEST(StatueFilter, SlideSettingsNameTheirField) {
+  const auto field = [](auto change) {
+    StatueFilterSettings s;
+    change(s);
+    return std::string(validate(s).field);
+  };
+  EXPECT_EQ(field([](StatueFilterSettings& s) { s.acceleration_noise_m_s2 = 0; }),
+            "statue_filter.acceleration_noise_m_s2");
+  EXPECT_EQ(field([](StatueFilterSettings& s) { s.acceleration_bias_m_s2 = -0.1; }),
+            "statue_filter.acceleration_bias_m_s2");
+  EXPECT_EQ(field([](StatueFilterSettings& s) { s.acceleration_bias_m_s2 = NAN; }),
+            "statue_filter.acceleration_bias_m_s2");
+  EXPECT_EQ(field([](StatueFilterSettings& s) { s.slide_tolerance = 1; }),
+            "statue_filter.slide_tolerance");
+  EXPECT_EQ(field([](StatueFilterSettings& s) { s.slide_filter_s = 0; }),
+            "statue_filter.slide_filter_s");
+  EXPECT_EQ(field([](StatueFilterSettings& s) { s.slide_onset_s = 2; }),
+            "statue_filter.slide_onset_s");
+  EXPECT_EQ(field([](StatueFilterSettings& s) { s.slide_end_s = -1; }),
+            "statue_filter.slide_end_s");
+  StatueFilterSettings s;
+  s.acceleration_bias_m_s2 = 0;  // no bias left: allowed
+  s.slide_tolerance = 0;
+  EXPECT_TRUE(validate(s).ok());
 }
 
 // At rest under weak shaking nothing tells the members apart: uniform weights, not informative,
@@ -304,6 +379,304 @@ TEST(StatueFilter, TheForecastIsWeightedOnceTheEstimateIs) {
   EXPECT_EQ(weighted_collapse_probability(f, e), 0.0);
   e.disagreeing_members = 0b101;  // none left: the forecast's own
   EXPECT_EQ(weighted_collapse_probability(f, e), f.probability);
+}
+
+
+// --- Sliding, from the accelerometer ---
+
+// The paper's block on the ground with Coulomb friction: mu_s 0.15, mu_k 0.12. Its uplift needs
+// 0.33 g, more than friction ever passes on: it slides and never rocks.
+Scene sliding_block() { return make(with_friction(paper_block(), 0.15, 0.12)); }
+
+// The same with mu_s 0.8, mu_k 0.7: it rocks before it could slide.
+Scene gripping_block() { return make(with_friction(paper_block(), 0.8, 0.7)); }
+
+// `amplitude_g` at 1 Hz as shaking(), for `shake_s`, then still.
+GroundAcceleration burst(int n, double amplitude_g, double shake_s) {
+  return n / kRate < shake_s ? shaking(n, amplitude_g) : GroundAcceleration{};
+}
+
+// The specific force the accelerometer reads against the simulator's motion (the sign
+// conventions): sliding, the block's acceleration is its kinetic friction's, -mu_k g sign(x')
+// (Eqs 4-5), and the vertical reads g; in full contact it moves with the ground; rocking freely
+// (Eq 34's impulse, the ground still after it), the reading turned back into the world frame
+// less gravity is the second difference of the sensor's position about the pivot.
+TEST(StatueFilter, TheAccelerometerReadsTheSimulatedMotion) {
+  const Scene slider = sliding_block();
+  const StatueAccelerometerMount mount{Real(1.2), Real(0.1)};
+  Simulator sim;
+  SolverSettings solver;
+  solver.step = 1e-4;
+  ASSERT_TRUE(
+      Simulator::create(slider, Excitation::sine_pulse(Real(0.5 * kStandardGravity), 1.0), solver,
+                        sim)
+          .ok());
+  sim.start_at_rest();
+  int sliding = 0;
+  int sticking = 0;
+  while (sim.time() < 1.0 && !sim.mode().terminal()) {
+    sim.step();
+    const GroundAcceleration g = sim.ground(sim.time());
+    const Vector2r f =
+        simulated_specific_force(slider, sim.mode(), sim.state(), sim.accelerations(), g, mount);
+    if (sim.mode().phase == Phase::kSliding) {
+      ++sliding;
+      ASSERT_NEAR(f.x(), -0.12 * kStandardGravity * sim.mode().slide_direction, 1e-9);
+      ASSERT_NEAR(f.y(), kStandardGravity, 1e-9);
+    } else if (sim.mode().phase == Phase::kFullContact) {
+      ++sticking;
+      ASSERT_NEAR(f.x(), g.horizontal, 1e-9);
+    }
+  }
+  EXPECT_GT(sliding, 1000);
+  EXPECT_GT(sticking, 100);
+
+  const Scene rocker = make(paper_block());
+  ASSERT_TRUE(Simulator::create(rocker, Excitation::none(), solver, sim).ok());
+  sim.start_with_impulse(Real(0.4));  // the ground's velocity jumps by -0.4 m/s
+  // The sensor's position from the pivot, world frame.
+  const auto position = [&](const Simulator& s) {
+    const Real offset = rocker.corner(s.mode().corner).offset + mount.offset_m;
+    const Real th = s.state()[kTheta];
+    return Vector2r(std::cos(th) * offset - std::sin(th) * mount.height_m,
+                    std::sin(th) * offset + std::cos(th) * mount.height_m);
+  };
+  std::vector<Vector2r> p;
+  std::vector<Vector2r> a;
+  std::vector<Corner> corner;
+  while (sim.time() < 1.5 && !sim.mode().terminal()) {
+    sim.step();
+    ASSERT_TRUE(sim.mode().rocking());
+    const Vector2r f = simulated_specific_force(rocker, sim.mode(), sim.state(),
+                                                sim.accelerations(), {}, mount);
+    const Real th = sim.state()[kTheta];
+    a.emplace_back(std::cos(th) * f.x() - std::sin(th) * f.y(),
+                   std::sin(th) * f.x() + std::cos(th) * f.y() - kStandardGravity);
+    p.push_back(position(sim));
+    corner.push_back(sim.mode().corner);
+  }
+  int compared = 0;
+  for (std::size_t k = 1; k + 1 < p.size(); ++k) {
+    if (corner[k - 1] != corner[k] || corner[k + 1] != corner[k]) continue;  // an impact
+    const Vector2r second = (p[k + 1] - 2 * p[k] + p[k - 1]) / (solver.step * solver.step);
+    ASSERT_NEAR(a[k].x(), second.x(), 1e-3) << k;
+    ASSERT_NEAR(a[k].y(), second.y(), 1e-3) << k;
+    ++compared;
+  }
+  EXPECT_GT(compared, 10000);
+}
+
+// What the filter made of a block that slides and never rocks (its own scene the box's one
+// member), under 1 Hz shaking of `amplitude_g` for `shake_s`, then still, `seconds` in all; the
+// accelerometer at the default noise and a bias of 0.1 m/s2 left. Times in s from the start.
+struct SlideTimeline {
+  double first_truth = -1.0;  // the truth first slides
+  double last_truth = -1.0;   // and last
+  double first_measured = -1.0;
+  int truth_sliding = 0;  // samples
+  int both = 0;           // samples both slide
+  int same_direction = 0;  // of those, in the truth's direction
+  int stale = 0;  // samples measured sliding while the truth had stuck for 0.4 s (or never slid)
+  Phase last_phase = Phase::kFullContact;  // measured at the end
+};
+
+SlideTimeline slide_timeline(const Scene& block, double amplitude_g, double shake_s,
+                             double seconds) {
+  FilterRun run({block}, block);
+  run.accelerometer = true;
+  run.acceleration_bias = 0.1;
+  SlideTimeline r;
+  for (int n = 0; n < static_cast<int>(seconds * kRate); ++n) {
+    run.push(burst(n, amplitude_g, shake_s));
+    const double t = n / kRate;
+    const Mode& truth = run.truth->mode();
+    const StatueEstimate& e = run.filter.estimate();
+    EXPECT_FALSE(truth.rocking()) << t;
+    EXPECT_FALSE(e.mode.rocking()) << t;
+    EXPECT_TRUE(e.acceleration_used) << t;
+    if (truth.sliding()) {
+      if (r.first_truth < 0.0) r.first_truth = t;
+      r.last_truth = t;
+      ++r.truth_sliding;
+    }
+    if (e.mode.sliding()) {
+      EXPECT_EQ(e.mode.phase, Phase::kSliding) << t;
+      if (r.first_measured < 0.0) r.first_measured = t;
+      if (r.last_truth < 0.0 || t - r.last_truth >= 0.4) ++r.stale;
+    }
+    if (truth.sliding() && e.mode.sliding()) {
+      ++r.both;
+      r.same_direction += truth.slide_direction == e.mode.slide_direction ? 1 : 0;
+    }
+  }
+  r.last_phase = run.filter.estimate().mode.phase;
+  return r;
+}
+
+// A block sliding on the ground under 0.25 g for 4 s: the filter says sliding within 0.25 s of
+// the truth's first slide, for most of the truth's sliding, in its direction, never while the
+// truth has stuck for 0.4 s, and full contact again after the last slide.
+TEST(StatueFilter, ASlidingBlockIsMeasuredSliding) {
+  const SlideTimeline r = slide_timeline(sliding_block(), 0.25, 4.0, 6.0);
+  ASSERT_GT(r.first_truth, 0.0);
+  EXPECT_GT(r.truth_sliding, 200);
+  EXPECT_GE(r.first_measured, r.first_truth);
+  EXPECT_LT(r.first_measured - r.first_truth, 0.25) << r.first_truth;
+  EXPECT_GT(r.both, 0.6 * r.truth_sliding) << r.both << " of " << r.truth_sliding;
+  EXPECT_GT(r.same_direction, 0.9 * r.both) << r.same_direction << " of " << r.both;
+  EXPECT_EQ(r.stale, 0);
+  EXPECT_EQ(r.last_phase, Phase::kFullContact);
+}
+
+// The same on the paper's isolated base (T = 2 s, xi = 0.2) under 0.3 g for 5 s: the base's
+// acceleration is the member's, its block's reaction included (the member the true statue).
+TEST(StatueFilter, ASlidingBlockOnAnIsolatedBaseIsMeasuredSliding) {
+  const SlideTimeline r =
+      slide_timeline(make(with_friction(paper_isolated(), 0.15, 0.12)), 0.3, 5.0, 8.0);
+  ASSERT_GT(r.first_truth, 0.0);
+  EXPECT_GT(r.truth_sliding, 100);
+  EXPECT_LT(r.first_measured - r.first_truth, 0.25) << r.first_truth;
+  EXPECT_GT(r.both, r.truth_sliding / 2) << r.both << " of " << r.truth_sliding;
+  EXPECT_EQ(r.stale, 0);
+  EXPECT_EQ(r.last_phase, Phase::kFullContact);
+}
+
+// Sliding is said only when no member's base explains the reading. Members: the block on the
+// paper's isolated base and on the ground; the accelerometer reads what the block reads sticking
+// to an isolated base (a simulation of it: its absolute acceleration). Never sliding with both
+// members; with the ground's member alone, the same readings are sliding.
+TEST(StatueFilter, SlidingOnlyWhenNoMembersBaseExplainsTheReading) {
+  const Scene isolated = make(with_friction(paper_isolated(), 0.15, 0.12));
+  const auto slid = [&](std::vector<Scene> members) {
+    FilterRun run(std::move(members), isolated);
+    bool sliding = false;
+    for (int n = 0; n < 4 * static_cast<int>(kRate); ++n) {
+      const GroundAcceleration g = shaking(n, 0.3);
+      run.ensemble->push(g);
+      run.truth->push(g);  // the block on the isolated base
+      StatueMeasurement m{0.0};
+      m.has_acceleration = true;
+      m.specific_force_m_s2 =
+          run.truth->simulator().accelerations().u + run.truth->ground().horizontal;
+      run.filter.on_sample(*run.ensemble, g, m);
+      EXPECT_TRUE(run.filter.estimate().acceleration_used);
+      sliding = sliding || run.filter.estimate().mode.sliding();
+    }
+    return sliding;
+  };
+  EXPECT_FALSE(slid({isolated, sliding_block()}));
+  EXPECT_TRUE(slid({sliding_block()}));
+}
+
+// A block that rocks (0.4 g, as TheRockingStatueIsTheSlenderMember) and grips (mu_s 0.8): its
+// impacts and lever arm's accelerations are never taken for sliding.
+TEST(StatueFilter, ARockingBlockIsNeverMeasuredSliding) {
+  FilterRun run({gripping_block()}, gripping_block());
+  run.accelerometer = true;
+  run.averaging = true;  // the impacts' jumps in the reading
+  run.acceleration_bias = 0.1;
+  int rocked = 0;
+  for (int n = 0; n < 2000 && !run.truth->mode().terminal(); ++n) {
+    run.push(shaking(n, 0.4));
+    ASSERT_FALSE(run.truth->mode().sliding()) << n;
+    rocked += run.truth->mode().rocking() ? 1 : 0;
+    const StatueEstimate& e = run.filter.estimate();
+    ASSERT_FALSE(e.mode.sliding()) << n << " relative " << e.relative_acceleration
+                                   << " threshold " << e.slide_threshold;
+  }
+  EXPECT_GT(rocked, 200);
+}
+
+// The accelerometer's noise at the stated level (and a bias left of 0.15 m/s2) under shaking
+// too weak to slide the block, for 60 s: never sliding.
+TEST(StatueFilter, NoiseAloneIsNeverSliding) {
+  FilterRun run({sliding_block()}, sliding_block());
+  run.accelerometer = true;
+  run.acceleration_bias = 0.15;
+  for (int n = 0; n < 60 * static_cast<int>(kRate); ++n) {
+    run.push(shaking(n, 0.1));
+    ASSERT_FALSE(run.truth->mode().sliding()) << n;
+    ASSERT_FALSE(run.filter.estimate().mode.sliding()) << n;
+  }
+  EXPECT_TRUE(run.filter.estimate().acceleration_used);
+}
+
+// While sliding is measured, a missing or faulty accelerometer sample (none fresh, or not
+// finite) gives the gyroscope's phase at once; its return starts the test afresh.
+TEST(StatueFilter, AMissingAccelerometerFallsBackToTheGyroscope) {
+  FilterRun run({sliding_block()}, sliding_block());
+  run.accelerometer = true;
+  int n = 0;
+  for (; n < 4 * static_cast<int>(kRate) && !run.filter.estimate().mode.sliding(); ++n) {
+    run.push(shaking(n, 0.25));
+  }
+  ASSERT_TRUE(run.filter.estimate().mode.sliding());
+  ASSERT_TRUE(run.truth->mode().sliding());
+  // No fresh sample.
+  run.accelerometer = false;
+  run.push(shaking(n++, 0.25));
+  EXPECT_EQ(run.filter.estimate().mode.phase, Phase::kFullContact);
+  EXPECT_FALSE(run.filter.estimate().acceleration_used);
+  // A sample that is not a number.
+  run.ensemble->push(shaking(n, 0.25));
+  run.truth->push(shaking(n, 0.25));
+  StatueMeasurement m{run.truth->state()[kThetaDot]};
+  m.has_acceleration = true;
+  m.specific_force_m_s2 = std::numeric_limits<Real>::quiet_NaN();
+  run.filter.on_sample(*run.ensemble, shaking(n++, 0.25), m);
+  EXPECT_EQ(run.filter.estimate().mode.phase, Phase::kFullContact);
+  EXPECT_FALSE(run.filter.estimate().acceleration_used);
+  // Back: not sliding before the onset's time has passed again.
+  run.accelerometer = true;
+  run.push(shaking(n++, 0.25));
+  EXPECT_TRUE(run.filter.estimate().acceleration_used);
+  EXPECT_FALSE(run.filter.estimate().mode.sliding());
+}
+
+// A scene without [friction] never slides: its measured phase is the gyroscope's whatever the
+// accelerometer reads (an accelerometer reading 3 m/s2 on a still statue and ground).
+TEST(StatueFilter, AStatueThatCannotSlideIsNotTested) {
+  FilterRun run({make(paper_block())}, make(paper_block()));
+  const double still = 0.0;
+  for (int n = 0; n < 400; ++n) {
+    run.ensemble->push({});
+    run.truth->push({});
+    StatueMeasurement m{static_cast<Real>(still)};
+    m.has_acceleration = true;
+    m.specific_force_m_s2 = 3.0;
+    run.filter.on_sample(*run.ensemble, {}, m);
+    ASSERT_EQ(run.filter.estimate().mode.phase, Phase::kFullContact);
+    ASSERT_FALSE(run.filter.estimate().acceleration_used);
+  }
+}
+
+// A slender block whose friction (mu_s 0.4, mu_k 0.32) barely grips, under 0.8 g: it rocks, and
+// slides while rocking before it overturns. The filter says slide-rocking while the truth does,
+// and never sliding while the truth has not slid for 0.4 s.
+TEST(StatueFilter, ARockingBlockThatSlidesIsMeasuredSlideRocking) {
+  const Scene block = make(with_friction(paper_block(), 0.4, 0.32));
+  FilterRun run({block}, block);
+  run.accelerometer = true;
+  run.averaging = true;
+  run.acceleration_bias = 0.1;
+  int truth_slide_rocking = 0;
+  int both = 0;
+  double last_truth = -1.0;
+  for (int n = 0; n < 1200 && !run.truth->mode().terminal(); ++n) {
+    run.push(shaking(n, 0.8));
+    const double t = n / kRate;
+    const Mode& truth = run.truth->mode();
+    const Mode& e = run.filter.estimate().mode;
+    if (truth.sliding()) last_truth = t;
+    truth_slide_rocking += truth.phase == Phase::kSlideRocking ? 1 : 0;
+    if (e.sliding()) {
+      ASSERT_GE(last_truth, 0.0) << t;
+      ASSERT_LT(t - last_truth, 0.4) << t;
+    }
+    both += truth.phase == Phase::kSlideRocking && e.phase == Phase::kSlideRocking ? 1 : 0;
+  }
+  ASSERT_GT(truth_slide_rocking, 20);
+  EXPECT_GT(both, truth_slide_rocking / 3);
 }
 
 }  // namespace

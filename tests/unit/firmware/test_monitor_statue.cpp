@@ -1,6 +1,7 @@
 // The statue sensor in the monitor (statue_sensor.h): its offset, its rate to each axis's
 // StatueFilter, the measured phase and the weighted risk in the status, the fallback to the
-// worst member when it is silent, and the statue_unexplained fault when no member explains it.
+// worst member when it is silent, and the statue_unexplained fault when no member explains it;
+// its accelerometer's specific force to the filters' sliding test, and its fallback.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,6 +20,7 @@ namespace {
 using testing::make;
 using testing::paper_block;
 using testing::wide_block;
+using testing::with_friction;
 
 constexpr double kRate = 200.0;
 constexpr long kQuiet = 400;  // 2 s of quiet: both sensors' start-up windows (1 s)
@@ -195,6 +197,134 @@ TEST(MonitorStatue, StatueUnexplainedIsTheLastFault) {
   EXPECT_EQ(alarm_input(s, config, true).fault_cause, monitor::AlarmCause::kBusError);
   s.axes[0].outside_model = true;
   EXPECT_EQ(alarm_input(s, config, false).fault_cause, monitor::AlarmCause::kOutsideModel);
+}
+
+
+// A block that slides (the paper's with mu_s 0.15, mu_k 0.12) under a 1 Hz sine of 0.25 g for
+// 4 s after the quiet, then still; the statue sensor turned 90 degrees about z on it (statue =
+// R sensor), its accelerometer's y axis (the statue's -x) 0.03 g off, its gyroscope's 0.01 rad/s,
+// both with noise. Its readings come from a true statue fed the same ground (lib/core
+// simulated_specific_force, 1 m up on the axis). `accelerometer(n)` says whether sample n has an
+// accelerometer frame.
+struct SlidingStatueRun {
+  SlidingStatueRun()
+      : scenes{make(with_friction(paper_block(), 0.15, 0.12))},
+        monitor(std::make_unique<Monitor>()),
+        truth(std::make_unique<PlanarEstimator>()) {
+    config = statue_config();
+    config.statue_sensor.sensor_to_statue << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+    EstimatorSettings e;
+    e.sample_rate_hz = kRate;
+    e.steps_per_sample = 4;
+    EXPECT_TRUE(truth->start(scenes[0], e, {}).ok());
+  }
+  Error start() { return monitor->start(config, {std::span<const Scene>(scenes), {}}); }
+  template <typename Accelerometer>
+  const BoxStatus& step(long n, Accelerometer accelerometer) {
+    const double t = static_cast<double>(n - kQuiet) / kRate;
+    const double a = n < kQuiet || t >= 4.0 ? 0.0 : 0.25 * std::sin(2.0 * std::numbers::pi * t);
+    if (n >= kQuiet) truth->push({static_cast<Real>(a * kStandardGravity), 0});
+    const Matrix3r to_sensor = config.statue_sensor.sensor_to_statue.transpose();
+    const std::int64_t time_ns = std::llround(static_cast<double>(n) / kRate * 1e9);
+    const auto sequence = static_cast<std::uint8_t>(n & 0xFF);
+    StatueSample gyro;
+    gyro.receive_time_ns = time_ns;
+    gyro.sequence = sequence;
+    const Real rate = n < kQuiet ? Real(0) : truth->state()[kThetaDot];
+    gyro.rotation_rate_rad_s =
+        to_sensor * Vector3r(static_cast<Real>(0.003 * gauss(random)),
+                             -rate + static_cast<Real>(0.003 * gauss(random)),
+                             static_cast<Real>(0.003 * gauss(random))) +
+        Vector3r(0, Real(0.01), 0);
+    (void)monitor->on_statue_sample(gyro);
+    if (accelerometer(n)) {
+      Vector2r f(0, kStandardGravity);
+      if (n >= kQuiet) {
+        f = simulated_specific_force(scenes[0], truth->mode(), truth->state(),
+                                     truth->simulator().accelerations(), truth->ground(), {});
+      }
+      monitor::SensorSample s;
+      s.receive_time_ns = time_ns;
+      s.sequence = sequence;
+      s.acceleration_g = to_sensor * Vector3r(f.x(), 0, f.y()) / kStandardGravity +
+                         Vector3r(0, Real(0.03), 0) +
+                         Vector3r(static_cast<Real>(0.003 * gauss(random)),
+                                  static_cast<Real>(0.003 * gauss(random)),
+                                  static_cast<Real>(0.003 * gauss(random)));
+      (void)monitor->on_statue_acceleration(s);
+    }
+    monitor::SensorSample ground;
+    ground.receive_time_ns = time_ns;
+    ground.sequence = sequence;
+    ground.acceleration_g = Vector3r(static_cast<Real>(a), 0, 1);
+    return *monitor->on_sample(ground).status;
+  }
+  std::vector<Scene> scenes;
+  MonitorConfig config;
+  std::unique_ptr<Monitor> monitor;
+  std::unique_ptr<PlanarEstimator> truth;
+  std::mt19937 random{31};
+  std::normal_distribution<double> gauss;
+};
+
+// The statue sensor's accelerometer tells sliding: the axis's phase is sliding while the true
+// statue slides (through the mounting's rotation, the offset removed over the quiet window),
+// never before it, and full contact once it has stuck.
+TEST(MonitorStatue, TheAccelerometerMeasuresSliding) {
+  SlidingStatueRun run;
+  ASSERT_TRUE(run.start().ok());
+  const auto always = [](long) { return true; };
+  int truth_sliding = 0;
+  int both = 0;
+  double last_truth = -1.0;
+  for (long n = 0; n < kQuiet + 6 * static_cast<long>(kRate); ++n) {
+    const BoxStatus& s = run.step(n, always);
+    const double t = static_cast<double>(n - kQuiet) / kRate;
+    const bool truth_slides = n >= kQuiet && run.truth->mode().sliding();
+    if (truth_slides) last_truth = t;
+    truth_sliding += truth_slides ? 1 : 0;
+    if (n < kQuiet + 10) continue;
+    const AxisStatus& axis = s.axes[0];
+    ASSERT_TRUE(axis.statue.measured) << n;
+    ASSERT_TRUE(axis.statue.acceleration_used) << n;
+    if (axis.mode.sliding()) {
+      ASSERT_EQ(axis.mode.phase, Phase::kSliding) << n;
+      ASSERT_GE(last_truth, 0.0) << "sliding before the truth, t = " << t;
+      ASSERT_LT(t - last_truth, 0.4) << t;
+    }
+    both += truth_slides && axis.mode.sliding() ? 1 : 0;
+  }
+  EXPECT_GT(truth_sliding, 200);
+  EXPECT_GT(both, truth_sliding / 2) << both << " of " << truth_sliding;
+  const BoxStatus& s = *run.monitor->poll().status;
+  EXPECT_EQ(s.axes[0].mode.phase, Phase::kFullContact);
+  EXPECT_EQ(s.statue_sensor.acceleration.state, monitor::HealthState::kOk);
+}
+
+// The accelerometer falls silent while the statue slides: within max_age_s the phase is the
+// gyroscope's (full contact) and the status says the accelerometer is not used; its stream then
+// times out (fault). Sliding is never said from its last, stale sample.
+TEST(MonitorStatue, ASilentAccelerometerFallsBackToTheGyroscope) {
+  SlidingStatueRun run;
+  ASSERT_TRUE(run.start().ok());
+  const auto always = [](long) { return true; };
+  long n = 0;
+  for (; n < kQuiet + 4 * static_cast<long>(kRate); ++n) {
+    if (run.step(n, always).axes[0].mode.sliding()) break;
+  }
+  ASSERT_TRUE(run.monitor->poll().status->axes[0].mode.sliding());
+  const long silent = n + 1;
+  const auto until_silent = [silent](long k) { return k < silent; };
+  for (++n; n < silent + 100; ++n) {
+    const BoxStatus& s = run.step(n, until_silent);
+    if (n >= silent + 2) {  // max_age_s 0.01 s: two samples
+      ASSERT_FALSE(s.axes[0].mode.sliding()) << n - silent;
+      ASSERT_FALSE(s.axes[0].statue.acceleration_used) << n - silent;
+      ASSERT_TRUE(s.axes[0].statue.measured) << n - silent;  // the gyroscope still is
+    }
+  }
+  EXPECT_EQ(run.monitor->poll().status->statue_sensor.acceleration.state,
+            monitor::HealthState::kFault);
 }
 
 }  // namespace

@@ -31,6 +31,9 @@ struct StatueAxisStatus {
   Real best_score = 0.0;     // the best member's mean normalised innovation
   int best_member = 0;
   int ruled_out = 0;         // members the measured motion ruled out (their risk not counted)
+  // The accelerometer's sample tested sliding (fresh, healthy, a scene that can slide); else the
+  // phase is the gyroscope's alone.
+  bool acceleration_used = false;
 };
 
 // The statue sensor's streams: its gyroscope's and accelerometer's health, its rate offset

@@ -96,7 +96,9 @@ class Monitor {
   // estimators' next samples take it to each axis's StatueFilter. Ignored (a status, if due)
   // without a statue sensor configured.
   [[nodiscard]] MonitorUpdate on_statue_sample(const StatueSample& sample);
-  // One accelerometer sample of the statue sensor (g, sensor frame): its stream's health.
+  // One accelerometer sample of the statue sensor (g, sensor frame): its stream's health, its
+  // horizontal offsets while quiet; the estimators' next samples take it to each axis's
+  // StatueFilter's sliding test.
   [[nodiscard]] MonitorUpdate on_statue_acceleration(const monitor::SensorSample& sample);
   // Call periodically with the receive clock's time: sensor timeouts, heartbeats.
   [[nodiscard]] MonitorUpdate on_tick(std::int64_t receive_time_ns);

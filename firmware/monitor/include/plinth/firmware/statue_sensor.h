@@ -1,10 +1,12 @@
 // The statue sensor's room: an IMU on the statue (a CAN node like the ground sensors) whose
 // gyroscope measures the block's rotation (StatueRotation frames) and whose accelerometer
 // (SensorAcceleration frames of the same node) the block's specific force. Each stream has its
-// own health (gaps, stuck, saturation), the gyroscope's offset is estimated over a quiet window
-// at start-up, its axes turned into the statue frame; each axis's rotation rate then goes to
-// that axis's StatueFilter (lib/core statue_filter.h) beside the ensemble. The accelerometer's
-// samples are checked and counted; no estimate uses them yet.
+// own health (gaps, stuck, saturation), each stream's offset is estimated over a quiet window
+// at start-up (the accelerometer's horizontal ones: at rest the statue's horizontal specific
+// force is 0, whatever its bias and the mounting's small tilt), its axes turned into the statue
+// frame; each axis's rotation rate and horizontal specific force (m/s2) then go to that axis's
+// StatueFilter (lib/core statue_filter.h) beside the ensemble: the rate weighs the members and
+// gives the rocking phases, the specific force tells sliding.
 //
 // Axes: the statue frame is x, y the first and second principal horizontal axes, z up. Axis 0's
 // plane is x-z, its theta (> 0 about corner 1, the -x side: counter-clockwise with x right, z
@@ -50,15 +52,16 @@ struct StatueSensorSettings {
   bool present = false;
   std::uint8_t node = 2;  // CAN node id, 1..15, not a ground sensor's
   // Its mounting: the rotation from the sensor frame to the statue frame (orthonormal, det +1),
-  // and where it sits: height above the block's base and horizontal offsets from its vertical
-  // axis, m (the accelerometer's lever arm; the gyroscope reads the same anywhere on the block).
+  // and where it sits: height above the block's base and horizontal offsets from the vertical
+  // through its centre of mass, m (the accelerometer's lever arm, StatueAccelerometerMount; the
+  // gyroscope reads the same anywhere on the block).
   Matrix3r sensor_to_statue = Matrix3r::Identity();
   Real height_m = 1.0;
   Real offset_x_m = 0.0;
   Real offset_y_m = 0.0;
   StatueSensorHealthSettings health;
   double offset_window_s = 2.0;  // s: the quiet start-up window that estimates the rate offset
-  double max_age_s = 0.01;       // s: a rate older than this is not the statue's now
+  double max_age_s = 0.01;       // s: a sample older than this is not the statue's now
   StatueFilterSettings filter;   // its rate_noise_rad_s is the gyroscope's noise
 };
 
@@ -76,6 +79,34 @@ using StatueSensorConfig =
 [[nodiscard]] Error validate(const StatueSensorSettings& settings);
 [[nodiscard]] Error validate(const StatueSensorSettings& settings, double sample_period_s);
 
+// The mean of a stream's first quiet window (statue frame) whose values spread by at most
+// `spread` on every axis: its offset.
+class QuietWindowOffset {
+ public:
+  void start(int window_samples, Real spread) {
+    window_samples_ = window_samples;
+    spread_ = spread;
+    summed_ = 0;
+    sum_.setZero();
+    offset_.setZero();
+    ready_ = false;
+  }
+  // `value` statue frame; `quiet` as StatueSensor::on_sample's.
+  void add(const Vector3r& value, bool quiet);
+  [[nodiscard]] bool ready() const { return ready_; }
+  [[nodiscard]] const Vector3r& offset() const { return offset_; }
+
+ private:
+  int window_samples_ = 2;
+  Real spread_ = 0;
+  int summed_ = 0;
+  Vector3r sum_ = Vector3r::Zero();
+  Vector3r low_ = Vector3r::Zero();  // the window's smallest and largest values
+  Vector3r high_ = Vector3r::Zero();
+  Vector3r offset_ = Vector3r::Zero();
+  bool ready_ = false;
+};
+
 class StatueSensor {
  public:
   [[nodiscard]] Error start(const StatueSensorSettings& settings, double sample_period_s);
@@ -83,8 +114,9 @@ class StatueSensor {
   // true before the estimators run): the offset is estimated only then, over a window whose
   // rates spread by at most 0.05 rad/s.
   void on_sample(const StatueSample& sample, bool quiet);
-  // One accelerometer sample (g, sensor frame): its stream's health and counters.
-  void on_acceleration(const monitor::SensorSample& sample);
+  // One accelerometer sample (g, sensor frame): its stream's health and counters, its horizontal
+  // offsets (estimated as the rate's, while `quiet`), the newest specific force.
+  void on_acceleration(const monitor::SensorSample& sample, bool quiet);
   void tick(std::int64_t now_ns) {
     rate_health_ = rate_tracker_.tick(now_ns);
     acceleration_health_ = acceleration_tracker_.tick(now_ns);
@@ -97,13 +129,25 @@ class StatueSensor {
   [[nodiscard]] Real axis_rate(int axis) const {
     return axis == 0 ? -rate_.y() : rate_.x();
   }
+  // The accelerometer's horizontal offsets known, its stream not in fault, its newest sample
+  // not saturated and within max_age_s of `now_ns`.
+  [[nodiscard]] bool acceleration_usable(std::int64_t now_ns) const;
+  // The horizontal specific force along axis `axis` (0: x, 1: y), m/s2: the newest, offset
+  // removed, statue frame.
+  [[nodiscard]] Real axis_specific_force(int axis) const {
+    return axis == 0 ? specific_force_.x() : specific_force_.y();
+  }
   // The gyroscope's stream (its counters count rate samples) and the accelerometer's.
   [[nodiscard]] const monitor::SensorHealth& rate_health() const { return rate_health_; }
   [[nodiscard]] const monitor::SensorHealth& acceleration_health() const {
     return acceleration_health_;
   }
-  [[nodiscard]] bool ready() const { return ready_; }
-  [[nodiscard]] const Vector3r& offset_rad_s() const { return offset_; }
+  [[nodiscard]] bool ready() const { return rate_offset_.ready(); }
+  [[nodiscard]] const Vector3r& offset_rad_s() const { return rate_offset_.offset(); }
+  // The accelerometer's (x, y; z 0), m/s2.
+  [[nodiscard]] const Vector3r& acceleration_offset_m_s2() const {
+    return acceleration_offset_.offset();
+  }
   // Samples fed since the stream last restarted (a restart loses the tilt: the filter resets).
   [[nodiscard]] std::uint64_t restarts() const { return restarts_; }
 
@@ -114,16 +158,15 @@ class StatueSensor {
   monitor::SensorHealthTracker acceleration_tracker_;
   monitor::SensorHealth rate_health_;
   monitor::SensorHealth acceleration_health_;
-  int window_samples_ = 1;
-  int summed_ = 0;
-  Vector3r sum_ = Vector3r::Zero();
-  Vector3r low_ = Vector3r::Zero();  // the window's smallest and largest rates
-  Vector3r high_ = Vector3r::Zero();
-  Vector3r offset_ = Vector3r::Zero();
+  QuietWindowOffset rate_offset_;
+  QuietWindowOffset acceleration_offset_;
   Vector3r rate_ = Vector3r::Zero();  // statue frame, rad/s
-  bool ready_ = false;
+  Vector3r specific_force_ = Vector3r::Zero();  // statue frame, m/s2, horizontal offsets removed
   bool have_sample_ = false;
+  bool have_acceleration_ = false;
+  bool acceleration_saturated_ = false;  // the newest
   std::int64_t newest_ns_ = 0;
+  std::int64_t newest_acceleration_ns_ = 0;
   std::uint64_t restarts_ = 0;
 };
 

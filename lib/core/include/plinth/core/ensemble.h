@@ -56,9 +56,9 @@ class Ensemble {
   [[nodiscard]] bool in_full_contact() const;
   // The members' risks (the status keeps them in place: AxisStatus is an EnsembleRisk).
   void risk(EnsembleRisk& out) const;
-  // The nominal statue's absolute base acceleration u'' + u_G'' (Simulator::accelerations() of
-  // its mode, plus the ground's), m/s2.
-  [[nodiscard]] Real base_acceleration() const;
+  // Member `member`'s absolute base acceleration u'' + u_G'' (Simulator::accelerations() of its
+  // mode, plus the ground's), m/s2; by default the nominal statue's.
+  [[nodiscard]] Real base_acceleration(int member = 0) const;
 
   [[nodiscard]] int size() const { return static_cast<int>(scenes_.size()); }
   [[nodiscard]] const PlanarEstimator& member(int m) const {

@@ -42,7 +42,30 @@
 // score_memory_s, over the intervals whose measured or predicted change is beyond 4 times the
 // rate's noise; near 1 for the right member) stays below unexplained_score. Above it (an
 // anchored, cracked or toppled statue, a loose sensor) no member explains the measurement: the
-// filter says so and its risk is the worst member's, never less. Freestanding: no heap.
+// filter says so and its risk is the worst member's, never less.
+//
+// Sliding, from the accelerometer (its horizontal specific force f along the axis, statue
+// frame, offset removed). A block whose contact with its base sticks moves with the base: the
+// accelerometer reads what a point of a rigid body pivoting on the base reads, the base's
+// absolute acceleration a_b = u'' + u_G'' (the ground's on the ground; on an isolated base each
+// member's own, Ensemble::base_acceleration) plus the tilt's terms: the gravity's projection
+// g sin(theta) and, while it rocks, the lever arm's theta'' and centripetal theta'^2 terms about
+// the pivot (block_specific_force; theta and theta' from the gyroscope, theta'' their difference
+// over a sample, the same low-pass as the rest). A sliding block's acceleration is its
+// friction's, -mu_k sign(x') (g + v_G'') (Eqs 4-5), not the base's: the relative acceleration
+//   a_rel = f - f_predicted   (= x'' while it slides, 0 while it sticks)
+// stays away from 0. Low-passed over slide_filter_s, it is compared with
+//   4 sigma_f + acceleration_bias_m_s2 + slide_tolerance * |f_predicted|
+// (sigma_f the filtered noise of the accelerometers' and, rocking, of the differenced rate at
+// the lever arm; the tolerance the model's and the two sensors' timing), for every member's base
+// (the members span the declared uncertainty of an isolated base; on the ground they share it):
+// above for every member for slide_onset_s the block slides (slide-rocking while the gyroscope
+// says it rocks), within it for some member for slide_end_s it sticks again. An impact's jump of
+// the sensor's velocity is in the differenced rate too (theta'' h at theta = 0 about either
+// corner): the prediction carries it. The sliding direction is the opposite of the block's
+// acceleration's. Only for a scene that can slide ([friction]); without a fresh accelerometer
+// sample the phase is the gyroscope's alone.
+// Freestanding: no heap.
 #pragma once
 
 #include <array>
@@ -79,7 +102,41 @@ struct StatueFilterSettings {
   Real credible_weight = Real(0.2);       // the risk: reached by members holding this weight
   Real unexplained_score = Real(6);       // mean nu^2 / s^2 of the best member above: unexplained
   Real ruled_out_fraction = Real(0.1);    // weight below this x 1 / members: ruled out, (0, 1]
+  // Sliding from the accelerometer (above).
+  Real acceleration_noise_m_s2 = Real(0.03);  // m/s2 rms: a sample of f less the ground's, noise
+  Real acceleration_bias_m_s2 = Real(0.15);   // m/s2: their biases left after the offsets, >= 0
+  Real slide_tolerance = Real(0.15);  // the prediction holds to this fraction of itself, [0, 1)
+  double slide_filter_s = 0.05;       // s: the relative acceleration's low-pass, (0, 1]
+  double slide_onset_s = 0.05;        // s: above the threshold this long: sliding, (0, 1]
+  double slide_end_s = 0.15;          // s: below it this long: stuck again, (0, 1]
 };
+
+// Where the statue sensor's accelerometer sits on the block (StatueSensorSettings' mounting):
+// its height above the block's base and its horizontal offset along the axis from the vertical
+// through the block's centre of mass C, m.
+struct StatueAccelerometerMount {
+  Real height_m = 1.0;
+  Real offset_m = 0.0;
+};
+
+// The specific force f = a - g_vec an accelerometer fixed on the block reads, in the block's
+// frame (x along the axis, z up the block), m/s2: a point of the block at `reference`'s
+// acceleration (horizontal, vertical; world frame, without gravity), the accelerometer at
+// `from_reference` from it in the block's frame, the block turned by theta (> 0 about corner 1,
+// counter-clockwise) at theta' and theta'':
+//   r = R(theta) p,  a = a_ref + theta'' (-r_z, r_x) - theta'^2 r,  f = R(-theta) (a + (0, g)).
+[[nodiscard]] Vector2r block_specific_force(const Vector2r& reference,
+                                            const Vector2r& from_reference, Real theta,
+                                            Real theta_dot, Real theta_ddot, Real g);
+
+// What the accelerometer at `mount` reads on the simulated block (a Simulator's scene, mode,
+// state and accelerations at the ground `ground`): C's acceleration from the contact's
+// kinematics (Eqs 9-14), the rest by block_specific_force. Tests and plinth-eval simulate the
+// statue sensor with it.
+[[nodiscard]] Vector2r simulated_specific_force(const Scene& scene, const Mode& mode,
+                                                const State& y, const Accelerations& acc,
+                                                GroundAcceleration ground,
+                                                const StatueAccelerometerMount& mount);
 
 // Checks the settings; the Error names the field ("statue_filter.memory_s", ...).
 [[nodiscard]] Error validate(const StatueFilterSettings& settings);
@@ -87,11 +144,15 @@ struct StatueFilterSettings {
 // One measured sample of an axis, in the statue frame.
 struct StatueMeasurement {
   Real rotation_rate = 0.0;  // theta', rad/s (> 0 turns about corner 1)
+  // The accelerometer's sample, fresh and healthy: its horizontal specific force along the
+  // axis, m/s2 (statue frame, offset removed). Without one the phase is the gyroscope's alone.
+  bool has_acceleration = false;
+  Real specific_force_m_s2 = 0.0;
 };
 
 struct StatueEstimate {
   bool measuring = false;     // started and fed a sample since
-  Mode mode;                  // the measured phase and corner
+  Mode mode;                  // the measured phase and corner (sliding: the accelerometer's)
   Real tilt = 0.0;            // theta, rad
   Real rotation_rate = 0.0;   // theta', rad/s
   Real effective_members = 0.0;  // 1 / sum w^2
@@ -109,6 +170,12 @@ struct StatueEstimate {
   // own simulation's risk and forecast do not count.
   std::uint32_t disagreeing_members = 0;
   std::array<Real, kMaxEnsembleMembers> weights{};  // weights[0 .. members)
+  // The accelerometer: its sample fed this one's sliding test (a scene that can slide).
+  bool acceleration_used = false;
+  // m/s2, filtered: f less the prediction sticking, by the member whose base explains the
+  // reading best (the smallest ratio to its threshold), and that threshold.
+  Real relative_acceleration = 0.0;
+  Real slide_threshold = 0.0;
 };
 
 // The forecast's probability of a collapse with the members weighted: the weight of the members
@@ -122,7 +189,8 @@ class StatueFilter {
  public:
   // Refuses invalid settings and an interval shorter than one sample.
   [[nodiscard]] Error start(const StatueFilterSettings& settings, const EstimatorSettings& rate,
-                            const RiskSettings& risk, int members);
+                            const RiskSettings& risk, int members,
+                            const StatueAccelerometerMount& mount = {});
   // Forgets everything (the ensemble restarted): uniform weights, at rest.
   void reset();
   // The sample the ensemble's members just took (Ensemble::push(ground)) and the statue's
@@ -140,6 +208,9 @@ class StatueFilter {
   void finish_interval(const Ensemble& members);
   void weigh(const Ensemble& members);
   [[nodiscard]] State measured_state(const PlanarEstimator& member) const;
+  void measure_sliding(const Ensemble& members, GroundAcceleration ground,
+                       const StatueMeasurement& measured, const Real* previous_rate);
+  void stop_sliding();
 
   StatueFilterSettings settings_;
   RiskSettings risk_;
@@ -166,6 +237,20 @@ class StatueFilter {
   std::array<Real, kMaxEnsembleMembers> score_{};
   std::array<Real, kMaxEnsembleMembers> score_norm_{};
   bool have_previous_ = false;
+  // The sliding test.
+  Mode gyroscope_mode_;  // the phase the gyroscope alone measured last
+  StatueAccelerometerMount mount_;
+  Real slide_alpha_ = 1.0;            // the low-pass's weight of a new sample
+  Real slide_noise_gain_ = 1.0;       // its output's noise over a white input's
+  Real slide_rate_noise_gain_ = 0.0;  // 1/s2: a differenced rate's filtered noise over its own
+  int slide_onset_samples_ = 1;
+  int slide_end_samples_ = 1;
+  int slide_above_ = 0;
+  int slide_below_ = 0;
+  bool sliding_ = false;
+  // Per member (its base): a_rel and |f_predicted|, filtered, m/s2.
+  std::array<Real, kMaxEnsembleMembers> slide_relative_{};
+  std::array<Real, kMaxEnsembleMembers> slide_scale_{};
 };
 
 }  // namespace plinth
