@@ -191,6 +191,8 @@ void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int&
       {"statue_filter.slide_end_s", &f.slide_end_s},
   };
   for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
+  b.push_back({"statue_filter.slide_on_isolated_base", flag_into(f.slide_on_isolated_base),
+               "true or false"});
   const std::pair<const char*, int*> integers[] = {
       {"statue_sensor.health.max_bridge_samples", &h.max_bridge_samples},
       {"statue_sensor.health.recovery_samples", &h.recovery_samples},

@@ -239,8 +239,9 @@ void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration g
                                    const StatueMeasurement& measured,
                                    const Real* previous_rate) {
   const Mode gyroscope = estimate_.mode;
-  if (!kSlidingBuiltIn || !members.nominal().scene().params.has_friction ||
-      !measured.has_acceleration ||
+  const SceneParams& nominal = members.nominal().scene().params;
+  if (!kSlidingBuiltIn || !nominal.has_friction ||
+      (nominal.has_base && !settings_.slide_on_isolated_base) || !measured.has_acceleration ||
       !std::isfinite(measured.specific_force_m_s2) || gyroscope.terminal()) {
     if (estimate_.acceleration_used) stop_sliding();  // else nothing to forget
     return;

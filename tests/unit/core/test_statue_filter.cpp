@@ -481,8 +481,8 @@ struct SlideTimeline {
 };
 
 SlideTimeline slide_timeline(const Scene& block, double amplitude_g, double shake_s,
-                             double seconds) {
-  FilterRun run({block}, block);
+                             double seconds, const StatueFilterSettings& settings = {}) {
+  FilterRun run({block}, block, 0.002, settings);
   run.accelerometer = true;
   run.acceleration_bias = 0.1;
   SlideTimeline r;
@@ -530,15 +530,37 @@ TEST(StatueFilter, ASlidingBlockIsMeasuredSliding) {
 
 // The same on the paper's isolated base (T = 2 s, xi = 0.2) under 0.3 g for 5 s: the base's
 // acceleration is the member's, its block's reaction included (the member the true statue).
+StatueFilterSettings sliding_on_isolated_base() {
+  StatueFilterSettings s;
+  s.slide_on_isolated_base = true;
+  return s;
+}
+
 TEST(StatueFilter, ASlidingBlockOnAnIsolatedBaseIsMeasuredSliding) {
-  const SlideTimeline r =
-      slide_timeline(make(with_friction(paper_isolated(), 0.15, 0.12)), 0.3, 5.0, 8.0);
+  const SlideTimeline r = slide_timeline(make(with_friction(paper_isolated(), 0.15, 0.12)), 0.3,
+                                         5.0, 8.0, sliding_on_isolated_base());
   ASSERT_GT(r.first_truth, 0.0);
   EXPECT_GT(r.truth_sliding, 100);
   EXPECT_LT(r.first_measured - r.first_truth, 0.25) << r.first_truth;
   EXPECT_GT(r.both, r.truth_sliding / 2) << r.both << " of " << r.truth_sliding;
   EXPECT_EQ(r.stale, 0);
   EXPECT_EQ(r.last_phase, Phase::kFullContact);
+}
+
+// By default an isolated base is not tested (the members' simulated bases are not the statue's):
+// the same slide is not measured, and the accelerometer is said unused.
+TEST(StatueFilter, AnIsolatedBaseIsNotTestedByDefault) {
+  const Scene block = make(with_friction(paper_isolated(), 0.15, 0.12));
+  FilterRun run({block}, block);
+  run.accelerometer = true;
+  int truth_sliding = 0;
+  for (int n = 0; n < static_cast<int>(8.0 * kRate); ++n) {
+    run.push(burst(n, 0.3, 5.0));
+    truth_sliding += run.truth->mode().sliding() ? 1 : 0;
+    ASSERT_FALSE(run.filter.estimate().mode.sliding()) << n / kRate;
+    ASSERT_FALSE(run.filter.estimate().acceleration_used) << n / kRate;
+  }
+  EXPECT_GT(truth_sliding, 100);
 }
 
 // Sliding is said only when no member's base explains the reading. Members: the block on the
@@ -548,7 +570,7 @@ TEST(StatueFilter, ASlidingBlockOnAnIsolatedBaseIsMeasuredSliding) {
 TEST(StatueFilter, SlidingOnlyWhenNoMembersBaseExplainsTheReading) {
   const Scene isolated = make(with_friction(paper_isolated(), 0.15, 0.12));
   const auto slid = [&](std::vector<Scene> members) {
-    FilterRun run(std::move(members), isolated);
+    FilterRun run(std::move(members), isolated, 0.002, sliding_on_isolated_base());
     bool sliding = false;
     for (int n = 0; n < 4 * static_cast<int>(kRate); ++n) {
       const GroundAcceleration g = shaking(n, 0.3);

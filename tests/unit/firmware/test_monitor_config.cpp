@@ -190,7 +190,8 @@ TEST(MonitorConfigFile, TheStatueSensorsTables) {
       "rate_max_valid_rad_s = 8.5, acceleration_max_valid_g = 8.1 }\n"
       "[statue_filter]\nrate_noise_rad_s = 0.004\nmemory_s = 5\n"
       "acceleration_noise_m_s2 = 0.05\nacceleration_bias_m_s2 = 0.2\nslide_tolerance = 0.1\n"
-      "slide_filter_s = 0.04\nslide_onset_s = 0.06\nslide_end_s = 0.2\n",
+      "slide_filter_s = 0.04\nslide_onset_s = 0.06\nslide_end_s = 0.2\n"
+      "slide_on_isolated_base = true\n",
       "/etc/plinth/box.toml", MonitorConfig{});
   const StatueSensorSettings& s = f.config.statue_sensor;
   EXPECT_TRUE(s.present);
@@ -211,6 +212,7 @@ TEST(MonitorConfigFile, TheStatueSensorsTables) {
   EXPECT_EQ(s.filter.slide_filter_s, 0.04);
   EXPECT_EQ(s.filter.slide_onset_s, 0.06);
   EXPECT_EQ(s.filter.slide_end_s, 0.2);
+  EXPECT_TRUE(s.filter.slide_on_isolated_base);
   EXPECT_FALSE(load_monitor_text("[monitor]\nground_node = 2\n", "/etc/plinth/box.toml",
                                  MonitorConfig{})
                    .config.statue_sensor.present);
@@ -249,6 +251,9 @@ TEST(MonitorConfigFile, TheStatueSensorsTables) {
             0U);
   EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\nslide_tolerance = 1\n"),
             "/etc/plinth/box.toml:4: statue_filter.slide_tolerance: must lie in [0, 1)");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\n"
+                           "slide_on_isolated_base = 1\n"),
+            "/etc/plinth/box.toml:4: statue_filter.slide_on_isolated_base: expected true or false");
   EXPECT_EQ(box_file_error("[statue_filter]\nmemory_s = 3\n"),
             "/etc/plinth/box.toml:1: statue_filter: no [statue_sensor] table (the filter weighs "
             "its measurements)");
