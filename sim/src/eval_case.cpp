@@ -128,8 +128,7 @@ fw::MonitorConfig box_config(const BoxSettings& box) {
 }
 
 // Where the box's configuration puts the statue sensor's accelerometer (axis 0's plane).
-StatueAccelerometerMount statue_accelerometer_mount(const BoxSettings& box) {
-  const fw::MonitorConfig config = box_config(box);
+StatueAccelerometerMount statue_accelerometer_mount(const fw::MonitorConfig& config) {
   const auto* statue = monitor::built_part<fw::StatueSensorSettings>(config.statue_sensor);
   if (statue == nullptr) return {};
   return {statue->height_m, statue->offset_x_m};
@@ -238,10 +237,11 @@ monitor::PWaveStage pwave_stage(const EvalCase& c, double rate_hz) {
 // The box on the case's motion; stops at the true collapse (what comes after cannot make a hit)
 // or the true statue's lift-off (nothing after it is known), else at the end of the record and
 // its tail.
+// `config`: box_config(box).
 void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
-             const host::CrossingGrids& grids, const Truth& truth, EvalRun& run) {
+             const fw::MonitorConfig& config, const host::CrossingGrids& grids,
+             const Truth& truth, EvalRun& run) {
   const double stop_s = truth.collapsed ? truth.collapse_time_s : truth.lift_off_s;
-  const fw::MonitorConfig config = box_config(box);
   auto monitor = std::make_unique<fw::Monitor>();  // an ensemble is too big for the stack
   const std::span<const Scene> members = box.knows_true_statue
                                              ? std::span<const Scene>(c.true_statue, 1)
@@ -341,7 +341,8 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.seed = c.seed;
   run.grid = c.grid;
   run.scale_g = c.scale_g;
-  const StatueAccelerometerMount mount = statue_accelerometer_mount(box);
+  const fw::MonitorConfig config = box_config(box);
+  const StatueAccelerometerMount mount = statue_accelerometer_mount(config);
   const Truth truth =
       simulate_truth(c, gamma, truth_settings, box.statue_sensor ? &mount : nullptr);
   run.collapsed = truth.collapsed;
@@ -349,7 +350,7 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.peak_ratio = truth.peak_ratio;
   run.model_valid_until_s = truth.lift_off_s;
   run.first_motion_s = truth.first_motion_s;
-  run_box(c, gamma, box, grids, truth, run);
+  run_box(c, gamma, box, config, grids, truth, run);
   if (box.regional) run.regional = regional_alert(c, *box.regional);
   return run;
 }

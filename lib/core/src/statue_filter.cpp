@@ -238,7 +238,7 @@ void StatueFilter::stop_sliding() {
 void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration ground,
                                    const StatueMeasurement& measured,
                                    const Real* previous_rate) {
-  const Mode gyroscope = estimate_.mode;
+  const Mode& gyroscope = gyroscope_mode_;  // on_sample() set it to measure()'s phase
   const SceneParams& nominal = members.nominal().scene().params;
   if (!kSlidingBuiltIn || !nominal.has_friction ||
       (nominal.has_base && !settings_.slide_on_isolated_base) || !measured.has_acceleration ||
