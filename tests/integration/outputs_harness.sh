@@ -28,7 +28,15 @@ free_port() {
   python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'
 }
 
+# fresh FILE...: each FILE emptied now, by this shell. A job started with `>FILE &` opens FILE
+# only once it runs; until then a wait_for on FILE would match the lines of the run before it.
+fresh() {
+  local f
+  for f in "$@"; do : >"$f"; done
+}
+
 # wait_for FILE PATTERN SECONDS: until a line of FILE matches PATTERN (grep -E); 1 on timeout.
+# FILE written by a job started just before: `fresh FILE` first.
 wait_for() {
   local i
   for ((i = 0; i < $3 * 10; i++)); do

@@ -185,6 +185,7 @@ cat >"$TMP/box.toml" <<EOF
 listen = "127.0.0.1:$PORT"
 writes = true
 EOF
+fresh "$TMP/box.out"  # the run before overturned too
 "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
   --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
 BOX=$!

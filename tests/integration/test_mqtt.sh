@@ -103,6 +103,7 @@ restart_replay() {
   printf '%s\n' 'password_file = "box.pw"' 'tls_ca_file = "ca.crt"' 'reconnect_min_s = 0.1' \
     'reconnect_max_s = 0.5' 'state_interval_s = 0.2' "$@" >>"$TMP/box.toml"
   for attempt in 1 2 3; do
+    fresh "$TMP/events.out" "$TMP/box.out"
     mosquitto_sub "${WATCH[@]}" -c -i "watcher-$box-$attempt" -q 1 -v -t "plinth/$box/events" \
       >"$TMP/events.out" 2>"$TMP/events.err" &
     local watcher=$!
@@ -228,6 +229,8 @@ OPERATOR=(-h 127.0.0.1 -p "$PLAIN" -u operator -P operator-secret)
 printf '[mqtt]\nbroker = "127.0.0.1:%s"\nbox_id = "b6"\nusername = "box"\n' "$PLAIN" >"$TMP/box.toml"
 printf '%s\n' 'password_file = "box.pw"' 'state_interval_s = 0.2' 'commands = true' >>"$TMP/box.toml"
 DIGESTS=("$(sha "$ISOLATED")" "$(sha "$TMP/box.toml")")
+# The section before left an overturn in box.out: a wait on it must see this run's lines only.
+fresh "$TMP/replies.out" "$TMP/box.out"
 mosquitto_sub "${OPERATOR[@]}" -q 1 -t plinth/b6/command/reply >"$TMP/replies.out" 2>&1 &
 REPLIES=$!
 sleep 0.5
