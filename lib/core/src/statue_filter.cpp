@@ -150,7 +150,10 @@ double weighted_collapse_probability(const ForecastOutcome& forecast,
       p += collapses ? Real(1) : Real(0);
     }
   }
-  if (estimate.weighted) return static_cast<double>(p);
+  // Weights that sum to 1 can sum past it by a rounding when every member collapses, and the
+  // alarm policy takes a probability above 1 for an internal fault: the box showed `fault` in
+  // place of `alarm` until the forecast changed (docs/forecast.md, "The alarm a rounding held").
+  if (estimate.weighted) return static_cast<double>(std::min(p, Real(1)));
   return counted > 0 ? static_cast<double>(p) / counted : forecast.probability;
 }
 
