@@ -41,6 +41,8 @@ class JsonObject {
 [[nodiscard]] std::string status_json(const BoxStatus& status, double t_origin);
 // What the statue sensor's weights say of one axis (the status line's and the MQTT state's).
 [[nodiscard]] std::string statue_weights_json(const StatueAxisStatus& axis);
+// A held collapse (BoxStatus::collapse): its axis, phase, corner, whether it was restored.
+[[nodiscard]] std::string collapse_json(const CollapseRecord& collapse);
 
 // {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
 [[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);

@@ -152,6 +152,11 @@ bool SensorSet::update_primary() {
   return true;
 }
 
+void SensorSet::verify_primary() {
+  if (status_->primary < 0) return;
+  sensors_[static_cast<std::size_t>(status_->primary)].conditioner.begin_verification();
+}
+
 bool SensorSet::next_input(EstimatorInput& input) {
   if (status_->primary < 0) return false;
   Sensor& primary = sensors_[static_cast<std::size_t>(status_->primary)];

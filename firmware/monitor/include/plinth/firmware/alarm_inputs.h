@@ -19,8 +19,10 @@ namespace plinth::firmware {
 //    sensor_fault), a ground sensor that disagrees with the primary or, with
 //    config.plate.raises_fault, a plate mismatch (sensor_disagreement), `bus_fault` (bus_error),
 //    an estimate outside the model (outside_model: a member of an axis's ensemble lifted off,
-//    while the estimators run: the box cannot vouch for what it no longer models), no member
-//    explaining the statue sensor's motion (statue_unexplained);
+//    while the estimators run: the box cannot vouch for what it no longer models);
+//  - input fault (trouble beside the level, the risk being the box's without that input):
+//    status.input_fault, which the monitor sets while the statue sensor is unusable or would
+//    lower the level uncorroborated (statue_sensor_fault, statue_unexplained; docs/safety.md);
 //  - not calibrated: the estimators do not run, or run on an untrusted start (the start-up rule).
 [[nodiscard]] monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& config,
                                               bool bus_fault);

@@ -71,6 +71,9 @@ class SensorSet {
   // again at rest on its newest sample. True when the primary changed (the estimators have
   // inputs from the new one).
   bool update_primary();
+  // The estimators were started again by the monitor (not on a seam): the primary's conditioner
+  // verifies a new quiet window before they are trusted (condition() says when).
+  void verify_primary();
   // The estimators' next input from the primary's history; false when they have taken all.
   [[nodiscard]] bool next_input(EstimatorInput& input);
   // The model's absolute base acceleration u'' + u_G'' (m/s2, per modelled axis in x, y) at
