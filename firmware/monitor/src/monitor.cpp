@@ -62,6 +62,14 @@ Error Monitor::start(const MonitorConfig& config,
     }
     PLINTH_TRY(ensembles_[static_cast<std::size_t>(i)].start(members, config.estimator,
                                                              config.forecast, config.risk));
+    for (OtherReading& other : others_) {
+      PLINTH_TRY(other.ensembles[static_cast<std::size_t>(i)].start(
+          members, config.estimator, config.forecast, config.risk));
+    }
+  }
+  for (OtherReading& other : others_) {
+    other.running = false;
+    other.seen = 0;
   }
   config_ = config;
   config_.conditioning.sample_period_s = config.estimator.sample_period();
@@ -171,11 +179,74 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
   for (std::size_t i = 0; i < fed.fed_count; ++i) {
     if (sensors_.condition(sensor, fed.fed[i], quiet())) status_.calibrated = true;
     feed_estimators();
+    feed_other_reading(sensor);
   }
   // The estimators took every input the primary had; a new primary may have more.
   if (sensors_.update_primary()) feed_estimators();
   sensors_.cross_check();
   evaluate(update);
+}
+
+// Another ground sensor's newest conditioned sample to its own ensembles: they start at rest on
+// its first sample (its offset known) and again after a seam, a fault, or a turn as the primary.
+void Monitor::feed_other_reading(int sensor) {
+  if constexpr (kOtherReadings == 0) return;
+  if (sensor < 0 || sensor >= kOtherReadings) return;
+  OtherReading& other = others_[static_cast<std::size_t>(sensor)];
+  if (sensor == status_.primary || sensors_.config(sensor).role != SensorRole::kGround ||
+      !sensors_.healthy_ground(sensor)) {
+    other.running = false;
+    return;
+  }
+  ConditionedReading c;
+  if (!sensors_.newest_reading(sensor, other.seen, c)) return;
+  const bool start = !other.running || c.restart;
+  for (int i = 0; i < status_.axis_count; ++i) {
+    Ensemble& e = other.ensembles[static_cast<std::size_t>(i)];
+    const GroundAcceleration g{c.ground_m_s2[i], c.ground_m_s2.z()};
+    if (start) {
+      e.restart(g);
+    } else {
+      e.push(g);
+    }
+  }
+  if (start) other.start_ns = c.time_ns - epoch_ns_;
+  other.running = true;
+}
+
+// While the ground sensors disagree, each axis's risk, forecast and phase follow the most
+// dangerous healthy reading: the higher risk, the higher probability, the further phase
+// (docs/safety.md). One sensor turned or mis-scaled cannot then lower the alarm.
+void Monitor::follow_worst_reading() {
+  status_.risk_sensor = -1;
+  if (!status_.disagreement) return;
+  for (int sensor = 0; sensor < kOtherReadings; ++sensor) {
+    const OtherReading& other = others_[static_cast<std::size_t>(sensor)];
+    if (!other.running || sensor == status_.primary || !sensors_.healthy_ground(sensor)) continue;
+    for (int i = 0; i < status_.axis_count; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      AxisStatus& axis = status_.axes[k];
+      const Ensemble& e = other.ensembles[k];
+      EnsembleRisk r;
+      e.risk(r);
+      if (r.risk.total > axis.risk.total) {
+        static_cast<EnsembleRisk&>(axis) = r;
+        status_.risk_sensor = sensor;
+      }
+      const ForecastOutcome& f = e.forecaster().latest();
+      if (kForecastBuiltIn && f.valid && f.probability > axis.forecast.probability) {
+        axis.forecast = f;  // its times from the primary's estimators' start, as theirs are
+        axis.forecast.start_time_s +=
+            static_cast<double>(other.start_ns - status_.estimator_start_ns) * 1e-9;
+        status_.risk_sensor = sensor;
+      }
+      if (phase_severity(e.nominal().mode()) > phase_severity(axis.mode)) {
+        axis.mode = e.nominal().mode();
+        axis.state = e.nominal().state();
+        status_.risk_sensor = sensor;
+      }
+    }
+  }
 }
 
 // Each axis's members take the sample; with the statue sensor's newest rate fresh, the axis's
@@ -331,9 +402,12 @@ void Monitor::update_axes_status() {
   status_.collapse_forecast_s = -1.0;
   status_.input_fault = monitor::AlarmCause::kNone;
   for (int i = 0; i < status_.axis_count; ++i) {
+    if (status_.estimating) update_axis(i, status_.axes[static_cast<std::size_t>(i)]);
+  }
+  if (status_.estimating) follow_worst_reading();
+  for (int i = 0; i < status_.axis_count; ++i) {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
-    if (status_.estimating) update_axis(i, axis);
     if (const StatueAxisStatus* statue = monitor::built_part<StatueAxisStatus>(axis.statue);
         statue != nullptr && statue_present()) {
       status_.statue_unexplained = status_.statue_unexplained || statue->unexplained;

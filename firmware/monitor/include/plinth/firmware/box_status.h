@@ -140,6 +140,9 @@ struct BoxStatus : SensorSetStatus {
   monitor::AlarmCause trouble = monitor::AlarmCause::kNone;
   monitor::AlarmCause input_fault = monitor::AlarmCause::kNone;
   CollapseRecord collapse;
+  // While ground sensors disagree: the sensor whose reading the risk follows (the most
+  // dangerous healthy one; -1: the primary's, as without a disagreement).
+  int risk_sensor = -1;
   // Frames the update could not carry (the codec refused one, or the update was full) since
   // start(); never silently: MonitorUpdate::frames_lost says which update lost them.
   std::uint64_t frames_not_encoded = 0;

@@ -193,6 +193,8 @@ class Monitor {
   void update_axis(int axis_index, AxisStatus& axis) const;
   void update_axes_status();
   void note_statue_trouble();
+  void feed_other_reading(int sensor);
+  void follow_worst_reading();
   void note_collapse(const monitor::AlarmInput& input);
   void restart_estimators();
   void evaluate(MonitorUpdate& update);
@@ -206,6 +208,18 @@ class Monitor {
   SensorSet sensors_;
   Vector3r last_ground_ = Vector3r::Zero();  // the estimators' newest input, m/s2
   std::array<Ensemble, kMaxAxes> ensembles_{};
+  // Every other ground sensor's reading, estimated as the primary's is (its own ensembles, fed
+  // its own conditioned samples): while the sensors disagree the alarm follows the most
+  // dangerous healthy one (docs/safety.md). Slot i is sensor i's (the primary's idle); none in
+  // a build with one sensor.
+  struct OtherReading {
+    std::array<Ensemble, kMaxAxes> ensembles{};
+    bool running = false;   // started on one of its samples since its last seam or fault
+    std::uint64_t seen = 0;  // its conditioned samples taken
+    std::int64_t start_ns = 0;  // monitor time of its ensembles' latest start
+  };
+  static constexpr int kOtherReadings = kMaxSensors > 1 ? kMaxSensors : 0;
+  std::array<OtherReading, kOtherReadings> others_{};
   // The statue sensor and each axis's filter: none in a build without it, so that neither its
   // code nor its data take a microcontroller's room (statue_present() guards every use).
   struct StatueRoom {
