@@ -152,7 +152,7 @@ void sensor_bindings(std::vector<Binding>& b, const std::string& mounting,
 }
 
 // [statue_sensor] (its mounting, its streams' health) and [statue_filter] (the gyroscope's noise,
-// the weighing of the members, the accelerometer's sliding test): statue_sensor.h,
+// the weighing of the members, the accelerometer's sliding test, the corroboration): statue_sensor.h,
 // statue_filter.h. The table's presence configures the sensor (load_monitor_text).
 void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int& node) {
   b.push_back({"statue_sensor.node", integer_into(node), "an integer"});
@@ -189,6 +189,11 @@ void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int&
       {"statue_filter.slide_filter_s", &f.slide_filter_s},
       {"statue_filter.slide_onset_s", &f.slide_onset_s},
       {"statue_filter.slide_end_s", &f.slide_end_s},
+      {"statue_filter.follow_tolerance", &f.follow_tolerance},
+      {"statue_filter.follow_onset_s", &f.follow_onset_s},
+      {"statue_filter.contradiction_rate_rad_s", &f.contradiction_rate_rad_s},
+      {"statue_filter.contradiction_s", &f.contradiction_s},
+      {"statue_filter.trust_again_s", &f.trust_again_s},
   };
   for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
   b.push_back({"statue_filter.slide_on_isolated_base", flag_into(f.slide_on_isolated_base),
