@@ -333,6 +333,33 @@ TEST(MonitorConfigFile, EveryKeyOfTheWrongTypeIsSaidToBeOne) {
   EXPECT_GT(tables.size(), 12U);
 }
 
+// Issue 33: the keys read apart, arrays of tables, given a value or a table: their type is
+// named, never "unknown key" (sensor = 3 was one).
+TEST(MonitorConfigFile, AnArrayOfTablesOfTheWrongTypeIsSaidToBeOne) {
+  const struct {
+    const char* text;
+    const char* message;
+  } cases[] = {
+      {"sensor = 3\n",
+       "box.toml:1: sensor: expected [[sensor]] tables (an array of tables), got an integer"},
+      {"sensor = \"a\"\n", "sensor: expected [[sensor]] tables (an array of tables), got a string"},
+      {"sensor = []\n", "sensor: expected [[sensor]] tables (an array of tables), got an empty"},
+      {"sensor = [1, 2]\n", "sensor: expected [[sensor]] tables (an array of tables), got an array"},
+      {"[sensor]\nnode = 1\n",
+       "sensor: expected [[sensor]] tables (an array of tables), got a table"},
+      {"[pwave]\npredictor = 3\n", "pwave.predictor: expected an array of tables { window_s"},
+      {"[pwave.predictor]\nwindow_s = 1.0\n",
+       "pwave.predictor: expected an array of tables { window_s, ln_pga_over_pa, tau_c_exponent, "
+       "sigma_ln } (plinth-eval pwave-fit prints one), got a table"},
+  };
+  for (const auto& c : cases) {
+    const std::string message = box_file_error(c.text);
+    SCOPED_TRACE(c.text);
+    EXPECT_EQ(message.find("unknown key"), std::string::npos) << message;
+    EXPECT_NE(message.find(c.message), std::string::npos) << message;
+  }
+}
+
 // A directory was read as an empty file (the defaults, silently); /dev/zero grew memory.
 TEST(MonitorConfigFile, DirectoriesAndDevicesAreRefusedUnread) {
   const std::string message_for_dir = [] {
