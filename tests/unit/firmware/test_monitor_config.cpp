@@ -333,6 +333,27 @@ TEST(MonitorConfigFile, EveryKeyOfTheWrongTypeIsSaidToBeOne) {
   EXPECT_GT(tables.size(), 12U);
 }
 
+// Issue 33: the recorder's buffers hold every configured sensor's frames (the statue sensor's
+// two a sample beside the ground sensor's) and recorder.bus_frames_hz of other traffic.
+TEST(MonitorConfigFile, TheRecordersFrameRateCountsEverySensor) {
+  MonitorFile file = load_monitor_text("[estimator]\nsample_rate_hz = 200.0\n", "box.toml",
+                                       MonitorConfig{});
+  EXPECT_DOUBLE_EQ(recorder_frame_rate_hz(file), 1.25 * 200 + 1 + 2000);
+  file = load_monitor_text(
+      "[estimator]\nsample_rate_hz = 200.0\n[statue_sensor]\nnode = 2\n[recorder]\n"
+      "bus_frames_hz = 0\n",
+      "box.toml", MonitorConfig{});
+  EXPECT_DOUBLE_EQ(recorder_frame_rate_hz(file), 1.25 * 3 * 200 + 2) << "three frames a sample";
+  file = load_monitor_text(
+      "[estimator]\nsample_rate_hz = 1000.0\n[[sensor]]\nnode = 1\n[[sensor]]\nnode = 3\n"
+      "role = \"plate\"\n[recorder]\nbus_frames_hz = 500\n",
+      "box.toml", MonitorConfig{});
+  EXPECT_DOUBLE_EQ(recorder_frame_rate_hz(file), 1.25 * 2 * 1000 + 2 + 500);
+  EXPECT_EQ(box_file_error("[recorder]\nbus_frames_hz = -1\n"),
+            "/etc/plinth/box.toml:2: recorder.bus_frames_hz: must be a number of frames/s in [0, "
+            "25000] (a CAN bus at 1 Mbit/s carries at most about 21,000 frames/s)");
+}
+
 // Issue 33: the keys read apart, arrays of tables, given a value or a table: their type is
 // named, never "unknown key" (sensor = 3 was one).
 TEST(MonitorConfigFile, AnArrayOfTablesOfTheWrongTypeIsSaidToBeOne) {
