@@ -317,27 +317,40 @@ std::vector<CaptureOnDisk> CaptureFolder::scan() const {
   return out;
 }
 
-int CaptureFolder::remove_partial_files() {
+int CaptureFolder::remove_partial_files(int* completed) {
   const int fd = dir_fd_ < 0 ? -1 : ::openat(dir_fd_, ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   DIR* dir = fd < 0 ? nullptr : ::fdopendir(fd);
   if (dir == nullptr) {
     if (fd >= 0) ::close(fd);
     return 0;
   }
-  std::vector<std::string> partial;
+  std::vector<std::string> partial;  // the final names
   while (const dirent* entry = ::readdir(dir)) {
     // ".event-NNN.log.partial": a capture's name between the dot and the suffix.
     const std::string_view name = entry->d_name;
     if (name.size() > 1 + kPartialSuffix.size() && name[0] == '.' &&
         name.substr(name.size() - kPartialSuffix.size()) == kPartialSuffix &&
         capture_index(name.substr(1, name.size() - 1 - kPartialSuffix.size())) != 0) {
-      partial.emplace_back(name);
+      partial.emplace_back(name.substr(1, name.size() - 1 - kPartialSuffix.size()));
     }
   }
   ::closedir(dir);
   int removed = 0;
   for (const std::string& name : partial) {
-    if (::unlinkat(dir_fd_, name.c_str(), 0) == 0) ++removed;
+    std::string extension;
+    const std::string stem = capture_stem(capture_index(name, &extension));
+    struct stat log {};
+    const bool log_published = ::fstatat(dir_fd_, (stem + ".log").c_str(), &log,
+                                         AT_SYMLINK_NOFOLLOW) == 0 &&
+                               S_ISREG(log.st_mode);
+    std::string error;
+    if (extension == "json" && log_published && !taken(name) &&
+        publish(name, error) == WriteOutcome::kWritten) {
+      if (completed != nullptr) ++*completed;
+      continue;
+    }
+    discard_partial(name);
+    ++removed;
   }
   return removed;
 }
@@ -348,11 +361,20 @@ bool CaptureFolder::taken(std::string_view name) const {
   return ::fstatat(dir_fd_, n.c_str(), &st, AT_SYMLINK_NOFOLLOW) == 0 || errno != ENOENT;
 }
 
-WriteOutcome CaptureFolder::write_whole(std::string_view name, std::string_view text,
-                                        std::string& error, const std::function<void()>& halfway) {
-  const std::string final_name(name);
-  std::string partial_name(".");  // appended: GCC 12 warns falsely on "." + std::string
-  partial_name.append(name).append(kPartialSuffix);
+namespace {
+
+std::string partial_name_of(std::string_view name) {
+  std::string partial(".");  // appended: GCC 12 warns falsely on "." + std::string
+  partial.append(name).append(kPartialSuffix);
+  return partial;
+}
+
+}  // namespace
+
+WriteOutcome CaptureFolder::write_partial(std::string_view name, std::string_view text,
+                                          std::string& error,
+                                          const std::function<void()>& halfway) {
+  const std::string partial_name = partial_name_of(name);
   const std::string partial_path = joined(path_, partial_name);
   if (dir_fd_ < 0) {
     error = "the folder " + path_ + " is not open";
@@ -391,26 +413,44 @@ WriteOutcome CaptureFolder::write_whole(std::string_view name, std::string_view 
   }
   if (outcome == WriteOutcome::kWritten && ::fsync(fd) != 0) failed("cannot flush", errno);
   if (::close(fd) != 0 && outcome == WriteOutcome::kWritten) failed("cannot close", errno);
-  bool partial_left = true;  // removed on failure; after a link (no rename) the second name
-  if (outcome == WriteOutcome::kWritten) {
-    int e = ::renameat2(dir_fd_, partial_name.c_str(), dir_fd_, final_name.c_str(),
-                        RENAME_NOREPLACE) == 0
-                ? 0
-                : errno;
-    partial_left = e != 0;
-    if (e == EINVAL || e == ENOSYS) {  // a file system without RENAME_NOREPLACE: link, unlink
-      e = ::linkat(dir_fd_, partial_name.c_str(), dir_fd_, final_name.c_str(), 0) == 0 ? 0 : errno;
-    }
-    if (e == EEXIST) {
-      error = joined(path_, final_name) + " exists: not written over";
-      outcome = WriteOutcome::kNameTaken;
-    } else if (e != 0) {
-      error = errno_text("cannot rename to", joined(path_, final_name), e);
-      outcome = outcome_of(e);
-    }
-  }
-  if (partial_left) (void)::unlinkat(dir_fd_, partial_name.c_str(), 0);
+  if (outcome != WriteOutcome::kWritten) (void)::unlinkat(dir_fd_, partial_name.c_str(), 0);
   return outcome;
+}
+
+WriteOutcome CaptureFolder::publish(std::string_view name, std::string& error) {
+  const std::string final_name(name);
+  const std::string partial_name = partial_name_of(name);
+  if (dir_fd_ < 0) {
+    error = "the folder " + path_ + " is not open";
+    return WriteOutcome::kFailed;
+  }
+  int e = ::renameat2(dir_fd_, partial_name.c_str(), dir_fd_, final_name.c_str(),
+                      RENAME_NOREPLACE) == 0
+              ? 0
+              : errno;
+  const bool renamed = e == 0;
+  if (e == EINVAL || e == ENOSYS) {  // a file system without RENAME_NOREPLACE: link, unlink
+    e = ::linkat(dir_fd_, partial_name.c_str(), dir_fd_, final_name.c_str(), 0) == 0 ? 0 : errno;
+  }
+  // Gone on failure; after a link (not a rename), the second name.
+  if (!renamed) (void)::unlinkat(dir_fd_, partial_name.c_str(), 0);
+  if (e == EEXIST) {
+    error = joined(path_, final_name) + " exists: not written over";
+    return WriteOutcome::kNameTaken;
+  }
+  if (e != 0) {
+    error = errno_text("cannot rename to", joined(path_, final_name), e);
+    return outcome_of(e);
+  }
+  return WriteOutcome::kWritten;
+}
+
+void CaptureFolder::discard_partial(std::string_view name) { remove(partial_name_of(name)); }
+
+WriteOutcome CaptureFolder::write_whole(std::string_view name, std::string_view text,
+                                        std::string& error, const std::function<void()>& halfway) {
+  const WriteOutcome written = write_partial(name, text, error, halfway);
+  return written == WriteOutcome::kWritten ? publish(name, error) : written;
 }
 
 void CaptureFolder::remove_capture(std::uint64_t index) {

@@ -99,16 +99,27 @@ class CaptureFolder {
   // without its .log, or the reverse, is one capture all the same; a summary that cannot be
   // read counts as below alarm). Symlinks, folders, devices and other names are left alone.
   [[nodiscard]] std::vector<CaptureOnDisk> scan() const;
-  // Removes partial files (".event-*.partial") left by a process killed while writing; returns
-  // how many.
-  int remove_partial_files();
+  // The partial files (".event-*.partial") a process killed while writing left: a capture's
+  // summary whose log is already under its final name is renamed into place too (both files
+  // are flushed before either is renamed: it is whole; `completed` counts them); every other
+  // partial file is removed. Returns how many were removed.
+  int remove_partial_files(int* completed = nullptr);
   // Whether anything (a file, a symlink, a folder) has this name.
   [[nodiscard]] bool taken(std::string_view name) const;
-  // Writes `text` to `name` whole or not at all: into ".name.partial" first (created, never
-  // opened through a symlink), flushed to disk (fsync), then renamed to `name` unless a file has
-  // that name (kNameTaken: nothing is written over it). The partial file is removed on any
-  // failure; `error` says what failed. `halfway`, when set, runs with half the text written (a
-  // test's pause: the recorder's test_pause_mid_write_s).
+  // Writes `text` into ".name.partial", created afresh (whatever had that name, a symlink
+  // included, is removed first, never opened), and flushes it to disk (fsync): nothing is under
+  // `name` yet. On failure the partial file is removed and `error` says what failed. `halfway`,
+  // when set, runs with half the text written (a test's pause: the recorder's
+  // test_pause_mid_write_s).
+  [[nodiscard]] WriteOutcome write_partial(std::string_view name, std::string_view text,
+                                           std::string& error,
+                                           const std::function<void()>& halfway = {});
+  // Renames ".name.partial" to `name` unless a file has that name (kNameTaken: nothing is
+  // written over it); the partial file is removed on any failure.
+  [[nodiscard]] WriteOutcome publish(std::string_view name, std::string& error);
+  // Removes ".name.partial".
+  void discard_partial(std::string_view name);
+  // write_partial(), then publish(): `name` whole or not at all.
   [[nodiscard]] WriteOutcome write_whole(std::string_view name, std::string_view text,
                                          std::string& error,
                                          const std::function<void()>& halfway = {});

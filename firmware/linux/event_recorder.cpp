@@ -297,7 +297,12 @@ void EventRecorder::writer_loop() {
 }
 
 void EventRecorder::folder_opened() {
-  partial_files_removed_.fetch_add(folder_.remove_partial_files());
+  int completed = 0;
+  partial_files_removed_.fetch_add(folder_.remove_partial_files(&completed));
+  if (completed > 0) {
+    say("%d capture(s) killed between their log's and their summary's final names: completed",
+        completed);
+  }
   next_index_ = std::max(next_index_, next_capture_index(folder_.scan()));
   if (!wrote_any_) first_index_.store(next_index_ <= kMaxCaptureIndex ? next_index_ : 0);
   if (next_index_ > kMaxCaptureIndex) {
@@ -388,24 +393,34 @@ WriteOutcome EventRecorder::write_files(const std::string& stem, const std::stri
   const auto pause = [this] {
     std::this_thread::sleep_for(std::chrono::duration<double>(settings_.test_pause_mid_write_s));
   };
-  const auto write_one = [&](const std::string& name, const std::string& text, bool paused) {
+  const auto write_partial = [&](const std::string& name, const std::string& text, bool paused) {
     WriteOutcome outcome =
-        folder_.write_whole(name, text, error, paused ? pause : std::function<void()>());
+        folder_.write_partial(name, text, error, paused ? pause : std::function<void()>());
     // A full disk (statvfs is an estimate): room made, then once more.
     if (outcome == WriteOutcome::kNoSpace &&
         make_room(room_needed_ - std::min(room_needed_, folder_.free_bytes()) + block, alarm)) {
-      outcome = folder_.write_whole(name, text, error);
+      outcome = folder_.write_partial(name, text, error);
     }
     return outcome;
   };
-  // The log, then its summary, each whole under its final name or not at all.
-  WriteOutcome outcome = write_one(stem + ".log", log, settings_.test_pause_mid_write_s > 0.0);
+  // Both files whole on disk first, the log then its summary; then their final names, the log's
+  // first: a process killed between the two renames leaves a summary the next start completes.
+  const std::string log_name = stem + ".log";
+  const std::string json_name = stem + ".json";
+  WriteOutcome outcome = write_partial(log_name, log, settings_.test_pause_mid_write_s > 0.0);
   if (outcome != WriteOutcome::kWritten) return outcome;
-  outcome = write_one(stem + ".json", json, false);
+  outcome = write_partial(json_name, json, false);
+  if (outcome == WriteOutcome::kWritten) outcome = folder_.publish(log_name, error);
+  if (outcome != WriteOutcome::kWritten) {
+    folder_.discard_partial(log_name);
+    folder_.discard_partial(json_name);
+    return outcome;  // kNameTaken: the capture takes another number
+  }
+  outcome = folder_.publish(json_name, error);
   if (outcome == WriteOutcome::kNameTaken) {
-    folder_.remove(stem + ".log");  // ours, written just now: the capture takes another number
+    folder_.remove(log_name);  // ours, renamed just now: the capture takes another number
   } else if (outcome != WriteOutcome::kWritten) {
-    error += " (" + stem + ".log is kept without its summary)";
+    error += " (" + log_name + " is kept without its summary)";
   }
   return outcome;
 }

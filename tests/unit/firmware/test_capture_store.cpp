@@ -151,6 +151,31 @@ TEST_F(Folder, ScanFindsCapturesAndTheirLevels) {
   EXPECT_TRUE(fs::exists(fs::path(dir_) / "event-0018.json"));
 }
 
+// A process killed between a capture's two renames: its log under its final name, its summary
+// still partial (whole: both are flushed before either rename). The next start completes it;
+// other partial files go.
+TEST_F(Folder, ACaptureKilledBetweenItsRenamesIsCompleted) {
+  put("event-020.log", "x\n");
+  put(".event-020.json.partial", R"({"event":20,"highest_level":"alarm"})");
+  put(".event-021.json.partial", R"({"event":21})");  // its log never renamed
+  put(".event-022.log.partial", "half");
+  put("event-023.log", "y\n");
+  put("event-023.json", R"({"event":23})");
+  put(".event-023.json.partial", R"({"planted":true})");  // never over the summary there
+  CaptureFolder folder(dir_);
+  open(folder);
+  int completed = 0;
+  EXPECT_EQ(folder.remove_partial_files(&completed), 3);
+  EXPECT_EQ(completed, 1);
+  EXPECT_EQ(text_of(dir_ + "/event-020.json"), R"({"event":20,"highest_level":"alarm"})");
+  EXPECT_EQ(text_of(dir_ + "/event-023.json"), R"({"event":23})");
+  EXPECT_FALSE(fs::exists(fs::path(dir_) / "event-021.json"));
+  for (const char* partial : {".event-020.json.partial", ".event-021.json.partial",
+                              ".event-022.log.partial", ".event-023.json.partial"}) {
+    EXPECT_FALSE(fs::exists(fs::path(dir_) / partial)) << partial;
+  }
+}
+
 // What an attacker plants under a capture's name is no capture: a symlink (to a file that says
 // alarm), a folder, a FIFO (opening it would hang), a huge summary (read 64 KiB at most).
 TEST_F(Folder, ScanFollowsNoSymlinkAndReadsSummariesBounded) {
