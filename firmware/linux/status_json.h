@@ -42,6 +42,8 @@ class JsonObject {
 [[nodiscard]] std::string status_json(const BoxStatus& status, double t_origin);
 // What the statue sensor's weights say of one axis (the status line's and the MQTT state's).
 [[nodiscard]] std::string statue_weights_json(const StatueAxisStatus& axis);
+// A held collapse (BoxStatus::collapse): its axis, phase, corner, whether it was restored.
+[[nodiscard]] std::string collapse_json(const CollapseRecord& collapse);
 
 // The event recorder's health: {"health": "ok", "problem": "none", "captures_written": ..,
 // "captures_lost": .., "captures_truncated": .., "captures_deleted": ..} (the status line's

@@ -90,8 +90,10 @@ struct AlarmNotice {
 };
 
 enum class OperatorCommand : std::uint8_t {
-  kAcknowledge,  // the latched level, quoting the latest event's sequence
-  kReset,        // the monitor starts again as at power-up
+  kAcknowledge,   // the latched level, quoting the latest event's sequence
+  kReset,         // the monitor starts again, its latch and any collapse kept (refused while an
+                  // alarm is latched and unacknowledged)
+  kStatueStands,  // a person on site states that the statue stands again, quoting the sequence
 };
 
 // A regional alert an output received (MQTT), for the loop: the alert, or malformed (`field`,
@@ -109,10 +111,13 @@ struct CommandRequest {
   std::uint32_t id = 0;             // the output's own, quoted by the result
 };
 
-// What the loop did with a command: the acknowledgement's outcome (kNone for a reset).
+// What the loop did with a command: the acknowledgement's outcome, the statement's, or for a
+// reset whether it was refused (an alarm latched and unacknowledged).
 struct CommandResult {
   std::uint32_t id = 0;
   monitor::AckOutcome outcome = monitor::AckOutcome::kNone;
+  monitor::StandsOutcome stands = monitor::StandsOutcome::kNone;
+  bool reset_refused = false;
 };
 
 // The newest of a stream of values, one writer and one reader, without locks (a triple buffer):
