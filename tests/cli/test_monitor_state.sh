@@ -35,9 +35,10 @@ import json, sys
 text = open(sys.argv[1]).read()
 try:
     d = json.loads(text)
+    lines = []
 except ValueError:
     d = None
-lines = [json.loads(l) for l in text.splitlines() if l.startswith("{")]
+    lines = [json.loads(l) for l in text.splitlines() if l.startswith("{")]
 alarms = [l for l in lines if l.get("type") == "alarm"]
 status = [l for l in lines if l.get("type") == "status"]
 summary = next((l for l in lines if l.get("type") == "summary"), {})
@@ -52,7 +53,7 @@ check "the overturning replay runs" $? "$(head -c 300 "$tmp/err")"
 got=$(json "$state/alarm-state.json" '(d["latched_level"], d["collapse"]["held"], d["collapse"]["phase"])')
 [ "$got" = "('alarm', True, 'overturned')" ]
 check "the state holds the latched alarm and the collapse" $? "$got"
-got=$(json "$tmp/first.jsonl" '(status[-1]["collapse"]["phase"], status[-1]["phase"][0], status[-1]["alarm"])')
+got=$(json "$tmp/first.jsonl" '(status[-1]["collapse"]["phase"], status[-1]["phase"], status[-1]["alarm"])')
 [ "$got" = "('overturned', 'overturned', 'alarm')" ]
 check "the status shows the collapse held" $? "$got"
 
@@ -69,7 +70,7 @@ check "a line says what was restored" $? "$got"
 got=$(json "$tmp/second.jsonl" 'sorted({a["level"] for a in alarms} | {s["alarm"] for s in status})')
 [ "$got" = "['alarm']" ]
 check "never anything but alarm after the restart" $? "$got"
-got=$(json "$tmp/second.jsonl" 'sorted({p for s in status for p in s["phase"]})')
+got=$(json "$tmp/second.jsonl" 'sorted({s["phase"] for s in status})')
 [ "$got" = "['overturned']" ]
 check "the phase shows the collapse, never full contact" $? "$got"
 
@@ -101,8 +102,10 @@ wait "$pid" 2>/dev/null
 got=$(json "$state/alarm-state.json" 'd["latched_level"]')
 [ "$got" = "alarm" ]
 check "a killed box's state is whole and holds its alarm" $? "$got $(ls -a "$state")"
-[ ! -e "$state/.alarm-state.json.tmp" ]
-check "no temporary file left under its final name" $? "$(ls -a "$state")"
+# A kill during a write may leave the temporary file; the next start removes it with its write.
+run "$tmp/after-kill.jsonl" --scale 0.01
+[ ! -e "$state/.alarm-state.json.tmp" ] && [ "$(json "$state/alarm-state.json" 'd["latched_level"]')" = alarm ]
+check "the next start leaves no temporary file and keeps the alarm" $? "$(ls -a "$state")"
 
 # 5. An unreadable state: kept aside, the worst it may have said restored, said on stderr.
 printf '{"format": "plinth-alarm-state 1", "latched_level": "alarm", "latched_level": "normal"}' \

@@ -28,7 +28,8 @@ TEST(ModbusMap, TheShippedCsvIsTheCodesMap) {
 TEST(ModbusMap, EveryCauseHasItsCodeInTheCsv) {
   const std::string csv = map_csv();
   EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model;13=p_wave;"
-                     "14=statue_unexplained;15=regional_alert\""),
+                     "14=statue_unexplained;15=regional_alert;16=statue_sensor_fault;"
+                     "17=restored;18=statue_stands\""),
             std::string::npos);
   EXPECT_NE(csv.find("4=overturned;5=fell;6=lifted_off\""), std::string::npos);
   EXPECT_NE(csv.find("\"0=normal;1=advisory;2=warning;3=alarm;4=fault\""), std::string::npos);

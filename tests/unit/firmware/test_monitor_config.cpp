@@ -246,11 +246,18 @@ TEST(MonitorConfigFile, TheStatueSensorsTables) {
             "/etc/plinth/box.toml:3: statue_sensor.health.max_bridge_samples: expected an "
             "integer");
   EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\nmemory_s = 0\n")
-                .rfind("/etc/plinth/box.toml:4: statue_filter.memory_s: must be finite and > 0",
+                .rfind("/etc/plinth/box.toml:4: statue_filter.memory_s: must lie in [1, 600] s",
                        0),
             0U);
   EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\nslide_tolerance = 1\n"),
-            "/etc/plinth/box.toml:4: statue_filter.slide_tolerance: must lie in [0, 1)");
+            "/etc/plinth/box.toml:4: statue_filter.slide_tolerance: must lie in [0, 0.5]");
+  // The keys that decide how far the sensor may lower the risk: bounded, the key named
+  // (docs/statue-filter.md, "Bounds").
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\n"
+                           "unexplained_score = 1e300\n"),
+            "/etc/plinth/box.toml:4: statue_filter.unexplained_score: must lie in [2, 50]");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\nrest_rate_rad_s = 100\n"),
+            "/etc/plinth/box.toml:4: statue_filter.rest_rate_rad_s: must lie in (0, 0.05] rad/s");
   EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\n"
                            "slide_on_isolated_base = 1\n"),
             "/etc/plinth/box.toml:4: statue_filter.slide_on_isolated_base: expected true or false");
