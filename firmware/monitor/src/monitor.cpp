@@ -37,6 +37,10 @@ double first_counted_collapse(const ForecastOutcome& f, std::uint32_t counted, i
   return first;
 }
 
+// s beyond the statue sensor's offset window that its offset may take before its absence is
+// trouble (a window restarts whenever the statue or the sensor moves).
+constexpr double kStatueOffsetGraceS = 10.0;
+
 // The smallest probability a CollapseForecast frame carries above 0 (its resolution, 1e-4):
 // below half of it the frame says 0, and so does the status.
 constexpr double kSmallestShownProbability = 0.5e-4;
@@ -377,7 +381,18 @@ void Monitor::note_statue_trouble() {
   for (int i = 0; i < status_.axis_count; ++i) {
     measured_any = measured_any || room().measured[static_cast<std::size_t>(i)];
   }
-  if (!measured_any) {
+  // Usable since the last ground sample: measured from the next one on.
+  if (!measured_any && !room().sensor.usable(status_.time_ns + epoch_ns_)) {
+    // Its offset still being estimated: a state of knowledge for a while (as not_calibrated
+    // is for the ground's), then trouble.
+    const StatueSensorSettings* statue =
+        monitor::built_part<StatueSensorSettings>(config_.statue_sensor);
+    const double waited_s =
+        static_cast<double>(status_.time_ns - status_.estimator_start_ns) * 1e-9;
+    if (!room().sensor.ready() && statue != nullptr &&
+        waited_s < statue->offset_window_s + kStatueOffsetGraceS) {
+      return;
+    }
     status_.statue_sensor_unusable = true;
     status_.input_fault = monitor::AlarmCause::kStatueSensorFault;
     return;
@@ -581,7 +596,7 @@ MonitorUpdate Monitor::on_statue_acceleration(const monitor::SensorSample& sampl
     return update;
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
-  room().sensor.on_acceleration(sample, !status_.estimating || quiet());
+  room().sensor.on_acceleration(sample, !status_.estimating || quiet(), last_ground_);
   note_statue_health();
   evaluate(update);
   return update;
