@@ -195,10 +195,16 @@ else fail "mqtt: retained state" "$problem"; fi
 
 # 1b. A queue of 1: of the events held while the broker is away (two: the warning may be skipped
 #     on the way to the alarm), the oldest is dropped and counted; the others arrive in order.
+#     The start-up's two faults (sensor_timeout, not_calibrated) may come before the first
+#     connection: the first of them is then dropped too.
 restart_replay b4 'event_queue = 1'
 problem=$(check_events '
-assert received == alarms[:2] + alarms[3:], "received %s of %s" % (seq(received), seq(alarms))
-assert mqtt["events_dropped"] == 1 and mqtt["events_published"] == len(alarms) - 1, mqtt
+s = seq(alarms)
+normal = next(i for i, l in enumerate(alarms) if "\"level\": \"normal\"" in l)
+startup = s[:normal + 1] if seq(received)[0] == s[0] else s[1:normal + 1]
+assert seq(received) == startup + s[normal + 2:], "received %s of %s" % (seq(received), s)
+dropped = len(alarms) - len(received)
+assert mqtt["events_dropped"] == dropped and mqtt["events_published"] == len(received), mqtt
 assert mqtt["most_queued"] == 1, mqtt
 ')
 if ! grep -q 'alarm event queue full (mqtt.event_queue = 1, .*): the oldest waiting event dropped, 1 so far' \

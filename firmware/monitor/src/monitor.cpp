@@ -383,13 +383,14 @@ void Monitor::note_statue_trouble() {
   }
   // Usable since the last ground sample: measured from the next one on.
   if (!measured_any && !room().sensor.usable(status_.time_ns + epoch_ns_)) {
-    // Its offset still being estimated: a state of knowledge for a while (as not_calibrated
-    // is for the ground's), then trouble.
+    // Sending, its offset still being estimated: a state of knowledge for a while (as
+    // not_calibrated is for the ground's), then trouble. Silent or at fault: trouble at once.
     const StatueSensorSettings* statue =
         monitor::built_part<StatueSensorSettings>(config_.statue_sensor);
     const double waited_s =
         static_cast<double>(status_.time_ns - status_.estimator_start_ns) * 1e-9;
-    if (!room().sensor.ready() && statue != nullptr &&
+    const bool sending = room().sensor.rate_health().state != monitor::HealthState::kFault;
+    if (sending && !room().sensor.ready() && statue != nullptr &&
         waited_s < statue->offset_window_s + kStatueOffsetGraceS) {
       return;
     }
