@@ -1,6 +1,8 @@
 #include "event_recorder.h"
 
+#include <algorithm>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -72,8 +74,9 @@ void EventRecorder::close() {
   if (writer_.joinable()) writer_.join();
 }
 
-void EventRecorder::on_frame(const hal::TimedFrame& frame) {
-  ring_[ring_next_] = frame;
+void EventRecorder::on_frame(const hal::TimedFrame& frame, std::uint64_t lost_before) {
+  const RecordedFrame recorded{frame, lost_before};
+  ring_[ring_next_] = recorded;
   ring_next_ = (ring_next_ + 1) % ring_.size();
   if (ring_count_ < ring_.size()) ++ring_count_;
   if (active_ == nullptr) return;
@@ -81,7 +84,7 @@ void EventRecorder::on_frame(const hal::TimedFrame& frame) {
     hand_over();
     return;
   }
-  if (active_->frames.size() < active_->frames.capacity()) active_->frames.push_back(frame);
+  if (active_->frames.size() < active_->frames.capacity()) active_->frames.push_back(recorded);
 }
 
 void EventRecorder::trigger(const TriggerInfo& info, std::int64_t time_ns) {
@@ -101,8 +104,9 @@ void EventRecorder::trigger(const TriggerInfo& info, std::int64_t time_ns) {
   active_->frames.clear();  // keeps the capacity: no allocation
   const std::size_t first = (ring_next_ + ring_.size() - ring_count_) % ring_.size();
   for (std::size_t i = 0; i < ring_count_; ++i) {
-    const hal::TimedFrame& f = ring_[(first + i) % ring_.size()];
-    if (f.timestamp_ns >= time_ns - pre_ns_ && active_->frames.size() < active_->frames.capacity()) {
+    const RecordedFrame& f = ring_[(first + i) % ring_.size()];
+    if (f.timed.timestamp_ns >= time_ns - pre_ns_ &&
+        active_->frames.size() < active_->frames.capacity()) {
       active_->frames.push_back(f);
     }
   }
@@ -153,18 +157,37 @@ void EventRecorder::write(const Capture& c) {
   const std::string log_path = (std::filesystem::path(settings_.directory) / (stem + ".log")).string();
   std::string log;
   log.reserve(c.frames.size() * 48);
-  for (const hal::TimedFrame& f : c.frames) {
-    log += hal::format_candump_line(f.timestamp_ns, settings_.interface_name, f.frame);
+  // Frames lost within the capture: DROPCOUNT lines as candump writes them, before the frame
+  // that came next, their total counted from the capture's start (candump's counters are 32-bit:
+  // a larger loss takes several lines).
+  std::uint64_t lost = 0;
+  std::uint64_t loss_lines = 0;
+  std::uint32_t lost_total = 0;
+  for (const RecordedFrame& f : c.frames) {
+    for (std::uint64_t left = f.lost_before; left > 0;) {
+      const auto count = static_cast<std::uint32_t>(std::min<std::uint64_t>(left, UINT32_MAX));
+      lost_total += count;  // wraps as candump's does
+      log += hal::format_candump_drop_line(count, settings_.interface_name, lost_total);
+      log += '\n';
+      left -= count;
+      ++loss_lines;
+    }
+    lost += f.lost_before;
+    log += hal::format_candump_line(f.timed.timestamp_ns, settings_.interface_name, f.timed.frame);
     log += '\n';
   }
-  const double first = c.frames.empty() ? 0.0 : static_cast<double>(c.frames.front().timestamp_ns) * 1e-9;
-  const double last = c.frames.empty() ? 0.0 : static_cast<double>(c.frames.back().timestamp_ns) * 1e-9;
-  char numbers[256];
+  const double first =
+      c.frames.empty() ? 0.0 : static_cast<double>(c.frames.front().timed.timestamp_ns) * 1e-9;
+  const double last =
+      c.frames.empty() ? 0.0 : static_cast<double>(c.frames.back().timed.timestamp_ns) * 1e-9;
+  char numbers[320];
   std::snprintf(numbers, sizeof numbers,
                 "\"t\":%.6f,\"frames\":%zu,\"first_frame_time\":%.6f,\"last_frame_time\":%.6f,"
-                "\"pre_trigger_s\":%g,\"post_trigger_s\":%g",
+                "\"pre_trigger_s\":%g,\"post_trigger_s\":%g,\"frames_lost\":%llu,"
+                "\"loss_reports\":%llu",
                 c.info.t, c.frames.size(), first, last, settings_.pre_trigger_s,
-                settings_.post_trigger_s);
+                settings_.post_trigger_s, static_cast<unsigned long long>(lost),
+                static_cast<unsigned long long>(loss_lines));
   std::string json = "{\"event\":" + std::to_string(c.index) + ",\"level\":\"" + c.info.level +
                      "\",\"highest_level\":\"" + (c.reached_alarm ? "alarm" : c.info.level) +
                      "\",\"cause\":\"" + c.info.cause + "\"," + numbers + ",\"log\":\"" + log_path +

@@ -5,6 +5,8 @@
 // start-up, and captures are handed over through a mutex held only for a pointer swap. When the
 // writer is still busy with an earlier capture, a new trigger extends the capture in progress;
 // a trigger while both buffers are full is counted (captures_dropped), never silently lost.
+// Frames the input lost (a live socket's overflow, a log's DROPCOUNT lines) go into the capture
+// as candump writes them: a DROPCOUNT line before the next frame, and a count in its JSON.
 // The folder (capture_store.h): numbers continue after the highest capture present, each file
 // appears under its final name only when complete, and the retention limit is kept after each
 // capture.
@@ -57,8 +59,8 @@ class EventRecorder {
   EventRecorder(const EventRecorder&) = delete;
   EventRecorder& operator=(const EventRecorder&) = delete;
 
-  // Real-time side.
-  void on_frame(const hal::TimedFrame& frame);
+  // Real-time side. `lost_before`: frames the input lost just before this one.
+  void on_frame(const hal::TimedFrame& frame, std::uint64_t lost_before = 0);
   void trigger(const TriggerInfo& info, std::int64_t time_ns);
   // The input ended: the capture in progress is written with what it has.
   void flush();
@@ -76,8 +78,12 @@ class EventRecorder {
   [[nodiscard]] std::vector<std::string> written_paths();
 
  private:
+  struct RecordedFrame {
+    hal::TimedFrame timed;
+    std::uint64_t lost_before = 0;  // frames lost just before it
+  };
   struct Capture {
-    std::vector<hal::TimedFrame> frames;  // capacity reserved once
+    std::vector<RecordedFrame> frames;  // capacity reserved once
     TriggerInfo info;
     std::int64_t trigger_ns = 0;
     std::int64_t end_ns = 0;  // frames up to this receive time belong to the capture
@@ -93,7 +99,7 @@ class EventRecorder {
   EventRecorderSettings settings_;
   std::int64_t pre_ns_ = 0;
   std::int64_t post_ns_ = 0;
-  std::vector<hal::TimedFrame> ring_;
+  std::vector<RecordedFrame> ring_;
   std::size_t ring_next_ = 0;
   std::size_t ring_count_ = 0;
   Capture buffers_[2];
