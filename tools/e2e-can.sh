@@ -125,6 +125,31 @@ if [ "${1:-}" = "--guest" ]; then
     wait_line "$bus_dir/$1.bus.log" '* 330#40*' "$STOP_WAIT_POLLS" ||
       echo "no_normal_level=1" >>"$1.extra"
   }
+  # The monitor has worked through its queue once its second sensor_timeout fault is on the bus
+  # (AlarmEvent: level fault from any level, cause 4; the first is its start-up's "no data yet"):
+  # the input ended 50 ms before, in its own time. A monitor stopped earlier, behind in a starved
+  # guest, leaves frames unread.
+  wait_timeout_fault() {  # NAME
+    wait_line "$bus_dir/$1.bus.log" '* 330#?404*' 1000 2 || echo "no_timeout_fault=1" >>"$1.extra"
+  }
+  # The guest's CPU over a stretch of a run: cpu_mark, then cpu_note NAME adds to NAME.extra the
+  # share of it the CPU was idle (/proc/stat's ticks, which follow the wall clock in user-mode
+  # Linux whether the host runs the guest or not). Below MIN_IDLE_PERCENT the guest could not
+  # carry the monitor, candump and plinth-replay: the rig's, not the box's (rig_losses.awk).
+  cpu_ticks() {
+    local u n s i w q sq st
+    read -r _ u n s i w q sq st _ </proc/stat
+    ticks=$((u + n + s + i + w + q + sq + st))
+    idle=$i
+  }
+  cpu_mark() { cpu_ticks; mark_ticks=$ticks; mark_idle=$idle; }
+  cpu_note() {  # NAME
+    cpu_ticks
+    local all=$((ticks - mark_ticks)) percent
+    percent=$(((idle - mark_idle) * 100 / (all > 0 ? all : 1)))
+    echo "guest_idle_percent=$percent" >>"$1.extra"
+    echo "idle_percent_$1$n=$percent" >>guest.facts  # every run's, for docs/can-e2e.md
+  }
   lap() {  # NAME START_US
     us
     printf '%s=%d.%06d\n' "$1" $(((now - $2) / 1000000)) $(((now - $2) % 1000000)) >>guest.times
@@ -158,13 +183,17 @@ if [ "${1:-}" = "--guest" ]; then
       fi
       started=$now
       : >"$1.extra"
+      echo "$n: not finished: the guest's time (${GUEST_TIMEOUT_S} s, boot included) ran out" \
+        "during this run" >"$1.running"
       "scenario_$1"
+      : >"$1.running"
       lap "$1$n" "$started"
       us
       ((now - started <= longest_us)) || longest_us=$((now - started))
       echo "attempts=$n" >>"$1.extra"
       reasons=$(awk -f "$RIG_LOSSES_AWK" -v run="$1" -v report="$1.replay.json" \
-        -v timeout_us="$TIMEOUT_US" -v backlog_late_us="$BACKLOG_LATE_US" \
+        -v extra="$1.extra" -v timeout_us="$TIMEOUT_US" -v starved_late_us="$STARVED_LATE_US" \
+        -v backlog_late_us="$BACKLOG_LATE_US" -v min_idle_percent="$MIN_IDLE_PERCENT" \
         -v gaps_us="${REGIONAL_GAPS_US:-}" "$1.bus.log") || reasons="rig_losses.awk failed"
       [ -n "$reasons" ] || return 0
       reasons=${reasons//$'\n'/; }
@@ -181,7 +210,10 @@ if [ "${1:-}" = "--guest" ]; then
   scenario_main() {
     start_capture main
     start_monitor main
+    cpu_mark
     replay main
+    cpu_note main
+    wait_timeout_fault main
     nap 0.2
     stop_monitor main INT
     stop_capture main
@@ -198,9 +230,12 @@ if [ "${1:-}" = "--guest" ]; then
     start_capture stop
     start_monitor stop
     start_replay stop input.csv "$SPEED"
+    cpu_mark
     wait_normal stop
     nap "$KILL_AFTER_NORMAL"
     stop_replay stop KILL
+    cpu_note stop
+    wait_timeout_fault stop
     nap 0.3
     stop_monitor stop TERM
     stop_capture stop
@@ -281,17 +316,21 @@ if [ "${1:-}" = "--guest" ]; then
     start_capture regional
     start_monitor regional "$REGIONAL_SCENE" --config "$REGIONAL_CONFIG"
     start_replay regional quiet.csv 1
+    cpu_mark
     wait_normal regional
     nap 0.1
     canplayer -I regional.in.log || fail "canplayer could not send regional.in.log"
     nap "$REGIONAL_WAIT"
     stop_replay regional INT
+    cpu_note regional
+    wait_timeout_fault regional
     nap 0.2
     stop_monitor regional INT
     stop_capture regional
   }
   ! wanted regional || attempt regional
   lap guest "$run_started"
+  echo finished >guest.done
   exit 0
 fi
 
@@ -362,7 +401,8 @@ else
   mkdir -p "$work"
   work=$(cd "$work" && pwd)
   rm -f "$work"/*.log "$work"/*.jsonl "$work"/*.json "$work"/*.rc "$work"/*.err "$work"/*.extra \
-    "$work"/*.rig "$work"/*.csv "$work"/guest.times "$work"/guest.facts "$work"/config.env
+    "$work"/*.rig "$work"/*.running "$work"/*.csv "$work"/guest.times "$work"/guest.facts \
+    "$work"/guest.done "$work"/config.env
   keep=1
 fi
 case "$work" in
@@ -391,15 +431,18 @@ if [ "$status" -eq 77 ]; then
   [ "$keep" -eq 1 ] || rm -rf "$work"
   exit 77
 fi
-if [ "$status" -ne 0 ]; then
+# A guest whose time ran out (124): the checks name the run it was in, and those it never began,
+# as the rig's (NAME.running, no guest.done).
+if [ "$status" -ne 0 ] && [ "$status" -ne 124 ]; then
   echo "$me: the runs on the bus failed (status $status); files in $work" >&2
   exit 1
 fi
 echo "$me: bus runs took $(awk -v s="$started" -v e="$(date +%s%N)" \
   'BEGIN { printf "%.1f", (e - s) / 1e9 }') s (boot included)"
+[ "$status" -eq 0 ] || echo "$me: the guest's $guest_timeout s ran out; the checks follow" >&2
 status=0
 python3 "$root/tests/integration/e2e_can.py" check --work "$work" || status=$?
-if [ "$status" -ne 0 ]; then
+if [ "$status" -ne 0 ] || [ ! -e "$work/guest.done" ]; then
   echo "$me: FAILED; the run's files are in $work" >&2
   exit 1
 fi

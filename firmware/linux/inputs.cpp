@@ -90,7 +90,7 @@ class LogInput final : public MonitorInput {
            hal::LogPolicy drop_policy, const volatile std::sig_atomic_t& stop)
       : reader_(std::move(reader)),
         pacer_(speed),
-        policy_(time_policy),
+        time_policy_(time_policy),
         drop_policy_(drop_policy),
         stop_(stop) {}
 
@@ -156,7 +156,7 @@ class LogInput final : public MonitorInput {
     if (step.problem == hal::LogTimeProblem::kNone) return true;
     const std::string what = reader_.path() + ":" + std::to_string(reader_.line_number()) + ": " +
                              time_check_.describe(step, t);
-    if (policy_ == hal::LogPolicy::kRefuse) throw InputError(what + " (--log-time refuse)");
+    if (time_policy_ == hal::LogPolicy::kRefuse) throw InputError(what + " (--log-time refuse)");
     const std::int64_t max_gap_ns = std::llround(kMaxLogGapS * 1e9);
     switch (step.problem) {
       case hal::LogTimeProblem::kWentBack: ++time_.went_back; break;
@@ -196,7 +196,7 @@ class LogInput final : public MonitorInput {
 
   hal::CandumpLogReader reader_;
   hal::Pacer pacer_;
-  hal::LogPolicy policy_;
+  hal::LogPolicy time_policy_;
   hal::LogPolicy drop_policy_;
   const volatile std::sig_atomic_t& stop_;
   hal::TimedFrame frame_;

@@ -141,7 +141,9 @@ def prepare(args):
         # after each run: whether the rig carried it (rig_losses), and how often to try
         "RIG_LOSSES_AWK": str(RIG_LOSSES_AWK), "MAX_ATTEMPTS": str(MAX_ATTEMPTS),
         "TIMEOUT_US": str(round(config["timeout_s"] * 1e6)),
-        "BACKLOG_LATE_US": str(BACKLOG_LATE_US), "WITNESS_RCVBUF": str(WITNESS_RCVBUF),
+        "STARVED_LATE_US": str(STARVED_LATE_US), "BACKLOG_LATE_US": str(BACKLOG_LATE_US),
+        "MIN_IDLE_PERCENT": str(MIN_IDLE_PERCENT),
+        "WITNESS_RCVBUF": str(WITNESS_RCVBUF),
     }
     scenarios = args.scenarios.split(",")
     unknown = [name for name in scenarios if name not in SCENARIOS]
@@ -373,9 +375,17 @@ MAX_ATTEMPTS = 5
 # frames (measured in the guest: docs/can-e2e.md), 20 s of the main run's traffic, where the
 # kernel's default (rmem_default 212 992) holds 278.
 WITNESS_RCVBUF = 4 << 20
-# The garbage and burst runs: plinth-replay this late (its report's jitter_max_us) left a
-# backlog that could overflow the monitor's socket (278 frames with the kernel's default buffer).
+# plinth-replay this late (its report's jitter_max_us): the guest was starved. In main and
+# regional: its pacing jitter on a calm host is at most 27 ms (docs/can-e2e.md); in garbage and
+# burst, which load the guest on purpose, a backlog that could overflow the monitor's socket (278
+# frames with the kernel's default buffer).
+STARVED_LATE_US = 45_000
 BACKLOG_LATE_US = 300_000
+# The guest's CPU idle less than this share of the stream (main, stop, regional): it could not
+# carry the monitor, candump and plinth-replay (docs/can-e2e.md, "A run the rig spoiled"). Seen
+# at host load 13-19: 0-6 %; on a calm host about 85 % (the three cost ~150 us a frame together
+# in user-mode Linux, 550 frames a second, and plinth-replay's start).
+MIN_IDLE_PERCENT = 10
 
 
 RIG_LOSSES_AWK = Path(__file__).resolve().parent / "rig_losses.awk"
@@ -391,12 +401,39 @@ def rig_losses(work, name, config):
         ["awk", "-f", str(RIG_LOSSES_AWK), "-v", f"run={name}",
          "-v", f"report={work / f'{name}.replay.json'}",
          "-v", f"timeout_us={round(config['timeout_s'] * 1e6)}",
-         "-v", f"backlog_late_us={BACKLOG_LATE_US}",
+         "-v", f"starved_late_us={STARVED_LATE_US}", "-v", f"backlog_late_us={BACKLOG_LATE_US}",
+         "-v", f"extra={work / f'{name}.extra'}", "-v", f"min_idle_percent={MIN_IDLE_PERCENT}",
          "-v", f"gaps_us={config.get('regional_gaps_us', '')}", str(work / f"{name}.bus.log")],
         capture_output=True, text=True)
     if done.returncode != 0:
         raise ValueError(f"rig_losses.awk on {name}.bus.log: {done.stderr.strip()}")
     return [line for line in done.stdout.splitlines() if line]
+
+
+def read_notes(path):
+    """The non-empty lines of a note file of the guest's, [] when there is none."""
+    try:
+        return [line for line in Path(path).read_text().splitlines() if line.strip()]
+    except OSError:
+        return []
+
+
+def rig_cut_short(work, name, finished):
+    """Why the guest has no run of `name` to judge, "" when it has one: its time ran out during
+    the run (NAME.running), before the run began (no guest.done, no files), or it started none
+    because the runs before it, spoiled and run again, had spent the time (NAME.rig)."""
+    work = Path(work)
+    notes = read_notes(work / f"{name}.rig")
+    running = read_notes(work / f"{name}.running")
+    earlier = f" (each run before: {' | '.join(notes)})" if notes else ""
+    if running:
+        return f"run {running[0]}{earlier}"
+    if notes and notes[-1].split(": ", 1)[-1].startswith("not run") and \
+            not (work / f"{name}.bus.log").exists():
+        return notes[-1].split(": ", 1)[1]
+    if not finished and not (work / f"{name}.bus.log").exists():
+        return "not run: the guest's time ran out before it began"
+    return ""
 
 
 def rig_command(args):
@@ -915,13 +952,12 @@ def run_checks(args):
     figures = {}
     timing = read_keys(work / "guest.times")
     runs = {}
+    finished = (work / "guest.done").exists()
     for name in config["scenarios"]:
-        notes = (work / f"{name}.rig").read_text().splitlines() \
-            if (work / f"{name}.rig").exists() else []
-        if notes and notes[0].startswith("1: not run"):
+        cut_short = rig_cut_short(work, name, finished)
+        if cut_short:
             print(f"[{name}]")
-            checks(False, f"the rig could not carry the {name} run: {notes[0][3:]} (by the runs "
-                   f"before it, which the rig spoiled and the guest ran again). The rig's "
+            checks(False, f"the rig could not carry the {name} run: {cut_short}. The rig's "
                    f"losses, not the box's: run the test again on a less loaded host")
             continue
         try:

@@ -52,7 +52,7 @@ class Work:
                        "rate": 200.0, "lead_in_samples": 250, "short_record_s": 2.0}
         (self.dir / "config.json").write_text(json.dumps(self.config))
 
-    def run(self, name, bus_lines, sent, late_us=1_000, attempts=1, rig=""):
+    def run(self, name, bus_lines, sent, late_us=1_000, attempts=1, rig="", extra=""):
         (self.dir / f"{name}.bus.log").write_text("".join(bus_lines))
         (self.dir / f"{name}.replay.json").write_text(json.dumps(
             {"acceleration_frames": sent, "heartbeat_frames": 0, "jitter_max_us": late_us,
@@ -62,7 +62,8 @@ class Work:
         (self.dir / f"{name}.monitor.jsonl").write_text(json.dumps(summary) + "\n")
         (self.dir / f"{name}.monitor.rc").write_text("0\n")
         (self.dir / f"{name}.monitor.err").write_text("")
-        (self.dir / f"{name}.extra").write_text(f"attempts={attempts}\nstop_signal=SIGINT\n")
+        (self.dir / f"{name}.extra").write_text(f"attempts={attempts}\nstop_signal=SIGINT\n"
+                                                 + extra)
         (self.dir / f"{name}.rig").write_text(rig)
 
     def losses(self, name):
@@ -120,6 +121,30 @@ class RigLosses(unittest.TestCase):
         self.assertEqual(w.losses("garbage"), [], "garbage judges the box through silences")
         w.run("main", sensor_log(400, silence_after=200, silence_us=40_000), sent=400)
         self.assertEqual(w.losses("main"), [], "42.5 ms: within the timeout")
+
+    def test_plinth_replay_late_spoils_main_and_regional(self):
+        # Seen at host load 18: no silence over 30 ms, plinth-replay 236 ms late at worst, the
+        # monitor 9 s behind and 536 frames dropped from its socket.
+        w = Work(self, ("main",))
+        w.run("main", sensor_log(400), sent=400, late_us=235_838.9)
+        self.assertEqual(w.losses("main"), [
+            "the guest was starved: plinth-replay (the sensor) was up to 236 ms late, 45 ms "
+            "allowed (the monitor beside it falls behind)"])
+        w.run("main", sensor_log(400), sent=400, late_us=e2e_can.STARVED_LATE_US - 1)
+        self.assertEqual(w.losses("main"), [])
+
+    def test_a_guest_without_idle_cpu_spoils_main_stop_and_regional_not_burst(self):
+        # Seen at host load 13-19: 0-6 % idle.
+        w = Work(self, ("stop", "burst"))
+        w.run("stop", sensor_log(400), sent=400, extra="guest_idle_percent=6\n")
+        self.assertEqual(w.losses("stop"), [
+            "the guest was starved: its CPU was idle 6% of the stream, less than the 10% it "
+            "needs to carry the monitor, candump and plinth-replay"])
+        w.run("stop", sensor_log(400), sent=400,
+              extra=f"guest_idle_percent={e2e_can.MIN_IDLE_PERCENT}\n")
+        self.assertEqual(w.losses("stop"), [])
+        w.run("burst", sensor_log(400), sent=400, extra="guest_idle_percent=0\n")
+        self.assertEqual(w.losses("burst"), [], "the floods keep the guest busy on purpose")
 
     def test_plinth_replay_late_spoils_garbage_and_burst(self):
         w = Work(self, ("burst",))
@@ -229,6 +254,23 @@ class Verdict(unittest.TestCase):
         self.assertIn("FAIL  the rig could not carry the stop run: not run: the guest's time (420 "
                       "s, boot included) was spent", text)
         self.assertNotIn("left no usable output", text)
+
+    def test_a_guest_whose_time_ran_out_names_the_run_it_was_in_and_those_never_begun(self):
+        w = Work(self, ("main", "stop", "garbage"))
+        w.run("main", sensor_log(40), sent=40)
+        w.run("stop", sensor_log(40), sent=40, attempts=2,
+              rig="1: the guest was starved: the sensor (plinth-replay) fell silent ...\n")
+        (w.dir / "stop.running").write_text("2: not finished: the guest's time (420 s, boot "
+                                            "included) ran out during this run\n")
+        self.assertEqual(e2e_can.rig_cut_short(w.dir, "main", False), "")
+        self.assertEqual(e2e_can.rig_cut_short(w.dir, "stop", False),
+                         "run 2: not finished: the guest's time (420 s, boot included) ran out "
+                         "during this run (each run before: 1: the guest was starved: the sensor "
+                         "(plinth-replay) fell silent ...)")
+        self.assertEqual(e2e_can.rig_cut_short(w.dir, "garbage", False),
+                         "not run: the guest's time ran out before it began")
+        self.assertEqual(e2e_can.rig_cut_short(w.dir, "garbage", True), "",
+                         "a guest that finished: missing files are the checks' to report")
 
     def test_a_run_the_rig_carried_after_spoiled_ones_is_judged(self):
         w = Work(self)
