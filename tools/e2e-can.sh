@@ -74,7 +74,7 @@ if [ "${1:-}" = "--guest" ]; then
   }
   # The end marker (37F#E3) through candump's queue: once it is in the log, so is every frame
   # before it. Stopped at once, a witness behind with its writing lost what it had not written
-  # (seen: 1000 of 2451 sensor frames, host load 14).
+  # (seen: 1000 and 1500 of 2451 sensor frames, host load 14).
   stop_capture() {  # NAME
     cansend vcan0 37F#E3
     wait_line "$bus_dir/$1.bus.log" '* 37F#E3' 3000 || echo "witness_unfinished=1" >>"$1.extra"
@@ -124,13 +124,6 @@ if [ "${1:-}" = "--guest" ]; then
   wait_normal() {  # NAME
     wait_line "$bus_dir/$1.bus.log" '* 330#40*' "$STOP_WAIT_POLLS" ||
       echo "no_normal_level=1" >>"$1.extra"
-  }
-  # The monitor has worked through its queue once its second sensor_timeout fault is on the bus
-  # (AlarmEvent: level fault from any level, cause 4; the first is its start-up's "no data yet"):
-  # the input ended 50 ms before, in its own time. A monitor stopped earlier, behind in a starved
-  # guest, leaves frames unread.
-  wait_timeout_fault() {  # NAME
-    wait_line "$bus_dir/$1.bus.log" '* 330#?404*' 1000 2 || echo "no_timeout_fault=1" >>"$1.extra"
   }
   # The guest's CPU over a stretch of a run: cpu_mark, then cpu_note NAME adds to NAME.extra the
   # share of it the CPU was idle (/proc/stat's ticks, which follow the wall clock in user-mode
@@ -206,14 +199,14 @@ if [ "${1:-}" = "--guest" ]; then
   # 1. The record, clean bus: the monitor's timeline, every frame, latency, jitter. The sensor
   #    stops at the end of the input: the monitor times out (fault) before it is stopped. The
   #    timeline can only match plinth-sim's if no silence exceeded the monitor's 50 ms sensor
-  #    timeout (that restarts the estimator, as it must): a run with one is the rig's.
+  #    timeout (that restarts the estimator, as it must): a run with one is the rig's, as one
+  #    with plinth-replay 45 ms late or the guest's CPU not idle 10 % of the stream.
   scenario_main() {
     start_capture main
     start_monitor main
     cpu_mark
     replay main
     cpu_note main
-    wait_timeout_fault main
     nap 0.2
     stop_monitor main INT
     stop_capture main
@@ -224,8 +217,9 @@ if [ "${1:-}" = "--guest" ]; then
 
   # 2. The sensor node dies mid-record (SIGKILL: no goodbye), once the monitor's level is back
   #    to normal after its start-up (the fault of "no data yet" is held 2 s): the fault must
-  #    come within the sensor timeout. Run again if plinth-replay fell silent on the bus for
-  #    more than the timeout before it was killed (a starved guest).
+  #    come within the sensor timeout. Run again if the rig spoiled it (rig_losses.awk: the
+  #    sensor silent for more than the timeout before it was killed, the guest's CPU not idle
+  #    10 % of the stream, the witness's losses).
   scenario_stop() {
     start_capture stop
     start_monitor stop
@@ -235,7 +229,6 @@ if [ "${1:-}" = "--guest" ]; then
     nap "$KILL_AFTER_NORMAL"
     stop_replay stop KILL
     cpu_note stop
-    wait_timeout_fault stop
     nap 0.3
     stop_monitor stop TERM
     stop_capture stop
@@ -323,7 +316,6 @@ if [ "${1:-}" = "--guest" ]; then
     nap "$REGIONAL_WAIT"
     stop_replay regional INT
     cpu_note regional
-    wait_timeout_fault regional
     nap 0.2
     stop_monitor regional INT
     stop_capture regional

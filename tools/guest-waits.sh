@@ -11,10 +11,9 @@ mkfifo "$nap_fifo"
 exec {nap_fd}<>"$nap_fifo"
 nap() { read -r -t "$1" -u "$nap_fd" || true; }  # sleep S, without a process
 us() { now=${EPOCHREALTIME/./}; }                 # now: us since the epoch
-# Waits until a line of FILE matches the glob PATTERN (the NTH such line, default the first),
-# at most POLLS x 10 ms.
-wait_line() {  # FILE PATTERN POLLS [NTH]
-  local fd line rest="" i seen=0
+# Waits until a line of FILE matches the glob PATTERN, at most POLLS x 10 ms.
+wait_line() {  # FILE PATTERN POLLS
+  local fd line rest="" i
   for ((i = 0; i < $3; i++)); do
     [ -e "$1" ] && break  # a background job's redirection may not have run yet
     nap 0.01
@@ -25,7 +24,7 @@ wait_line() {  # FILE PATTERN POLLS [NTH]
       line=$rest$line
       rest=""
       # shellcheck disable=SC2053  # a glob on purpose
-      if [[ $line == $2 ]] && ((++seen >= ${4:-1})); then exec {fd}<&-; return 0; fi
+      if [[ $line == $2 ]]; then exec {fd}<&-; return 0; fi
     done
     rest=$rest$line
     nap 0.01
