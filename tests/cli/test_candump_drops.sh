@@ -261,7 +261,7 @@ capture_json=$(find events -name 'event-*.json' | head -n 1)
 capture_log=${capture_json%.json}.log
 expect_equal "recorder: the capture's JSON counts the loss" \
   "$(python3 -c 'import json, sys; d = json.load(open(sys.argv[1]))
-print(d["frames_lost"], d["loss_reports"])' "$capture_json")" \
+print(d["input_frames_lost"], d["input_loss_reports"])' "$capture_json")" \
   "5 1"
 # The frame before the loss (line cut), then in the capture (interface can0) the line after it.
 read -r stamp _ frame < <(sed -n "${cut}p" quake-drops.log)
