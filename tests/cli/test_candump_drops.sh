@@ -43,6 +43,7 @@ summary() {
 lines = [json.loads(l) for l in open(sys.argv[1]) if l.startswith("{")]
 s = next(l for l in lines if l.get("type") == "summary")
 alarms = [l for l in lines if l.get("type") == "alarm"]
+alarms_after = [a for a in alarms if a["t"] > 4.5]  # after the start-up (section 2)
 print(eval(sys.argv[2]))' "$TMP/stdout" "$1"
 }
 # expect_equal NAME GOT WANT
@@ -156,12 +157,15 @@ expect_stderr "monitor: the loss named with its line" \
   "^plinth-monitor: warning: $lost_five \\(its socket overflowed; 5 in all so far\\)\$"
 # As a live box sees its socket overflow: reported with the first frame after the loss, the
 # fault (cause bus_error) raised at the newest frame's time before it; cleared once 2 s of
-# frames have passed (kInputFaultHoldS), the level normal again after its 2 s fall.
-expect_equal "monitor: after the start-up, one fault (bus_error), then normal again" \
-  "$(summary '[(a["level"], a["cause"]) for a in alarms if a["t"] > 4.5]')" \
-  "[('fault', 'bus_error'), ('normal', 'none')]"
-raised=$(summary '[a["t"] for a in alarms if a["t"] > 4.5][0]')
-cleared=$(summary '[a["t"] for a in alarms if a["t"] > 4.5][-1]')
+# frames have passed (kInputFaultHoldS), the level normal again after its 2 s fall. Between,
+# the level stays fault while its cause changes (the samples missing, the estimator's restart:
+# an event each, docs/safety.md).
+expect_equal "monitor: after the start-up, the fault (bus_error) first, fault until normal again" \
+  "$(summary '(alarms_after[0]["cause"], {a["level"] for a in alarms_after[:-1]},
+               alarms_after[-1]["level"])')" \
+  "('bus_error', {'fault'}, 'normal')"
+raised=$(summary 'alarms_after[0]["t"]')
+cleared=$(summary 'alarms_after[-1]["t"]')
 if awk -v r="$raised" -v b="$before_t" -v a="$after_t" -v c="$cleared" \
   'BEGIN { exit !(r >= b && r < a && c >= a + 2 && c <= a + 4.1) }'; then
   pass "monitor: the fault at $raised s (the loss between $before_t and $after_t s), normal at \
