@@ -43,7 +43,7 @@ LEVELS = ["normal", "advisory", "warning", "alarm", "fault"]
 CAUSES = ["none", "risk_threshold", "phase_change", "overturn_detected", "sensor_timeout",
           "sensor_fault", "sensor_disagreement", "acknowledged", "bus_error", "internal_fault",
           "collapse_forecast", "not_calibrated", "outside_model", "p_wave", "statue_unexplained",
-          "regional_alert"]
+          "regional_alert", "statue_sensor_fault", "restored", "statue_stands"]
 SCENARIOS = ("main", "stop", "garbage", "burst", "regional")  # regional: e2e_can_regional.py
 # Sent by canplayer in the garbage case, each one refused by the DBC (or not for the monitor).
 GARBAGE = (
@@ -53,7 +53,7 @@ GARBAGE = (
     "320#00F0000000000000", "320#0700000000000000",  # MonitorStatus: bits 12-15; phase 7
     "320#0000112700000000", "320#0000000000000001",  # risk 10001 (> 1); bits 56-63
     "330#0000FE0000000000", "330#0500000000000000",  # AlarmEvent: bits 17-23; level 5
-    "330#0010000000000000",  # cause 16 (beyond the table)
+    "330#0013000000000000",  # cause 19 (beyond the table)
     "350#1127000100000000", "351#E803050364002800",  # CollapseForecast: probability 10001;
     "350#0000110100000000",  # worst member 5 of 3 members; worst member 17
     "340#F000000000000000", "340#00",  # Acknowledge: bits 4-7; short
