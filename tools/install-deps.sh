@@ -58,6 +58,7 @@ tests=(
   clang-14 libclang-rt-14-dev  # the sanitize preset: ASan + UBSan and libFuzzer (docs/fuzzing.md)
   dpkg-dev fakeroot  # the package preset (CPack DEB), its packages unpacked and checked
   python3-openpyxl  # tools/pwave-stations.py reads the NGA-West2 flatfile (xlsx; docs/regional.md)
+  stress-ng  # keeps the cores busy while the tests run, as on a user's laptop (README, can-e2e.md)
   # The package-arm64 preset (docs/install.md): Debian's cross compiler, the libraries for arm64
   # (multiarch), and qemu-user, which runs the arm64 plinth-monitor on this machine.
   g++-aarch64-linux-gnu qemu-user

@@ -61,7 +61,8 @@ struct Options {
   std::string pga;
   std::optional<double> scale;
   std::string speed = "max";
-  std::string log_time;  // --log-time: warn or refuse; empty: not given (warn)
+  std::string log_time;   // --log-time: warn or refuse; empty: not given (warn)
+  std::string log_drops;  // --log-drops: the same
   double duration = 0.0;
   std::string record_dir;
   std::string state_dir;
@@ -342,7 +343,7 @@ void take(const fw::InputItem& item, fw::Monitor& monitor, fw::FrameDecoder& dec
       ++outputs.totals.samples;
       break;
     case fw::InputItem::Kind::kFrame:
-      if (recorder != nullptr) recorder->on_frame(item.frame);
+      if (recorder != nullptr) recorder->on_frame(item.frame, item.lost_before);
       outputs.last_frame_ns = item.frame.timestamp_ns;
       outputs.handle(fw::on_frame(monitor, decoder, item.frame));
       break;
@@ -481,8 +482,12 @@ fw::InputOptions input_options(const Options& opt) {
   in.duration_s = opt.duration;
   in.recorder_frames = !opt.record_dir.empty();
   if (!opt.log_time.empty()) {
-    in.log_time = plinth::host::parse_name<plinth::hal::kLogTimePolicyNames>(
+    in.log_time = plinth::host::parse_name<plinth::hal::kLogPolicyNames>(
         opt.log_time, "--log-time", "policy");
+  }
+  if (!opt.log_drops.empty()) {
+    in.log_drops = plinth::host::parse_name<plinth::hal::kLogPolicyNames>(
+        opt.log_drops, "--log-drops", "policy");
   }
   return in;
 }
@@ -500,6 +505,9 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
   t.log_time_back = time.went_back;
   t.log_time_still = time.stood_still;
   t.log_time_gaps = time.gaps;
+  const fw::InputDropCounters drops = input.drop_counters();
+  t.log_drop_reports = drops.reports;
+  t.log_drop_frames = drops.frames;
   const fw::BusCounters bus = input.bus_counters();
   t.bus_errors = bus.bus_errors;
   t.bus_dropped_frames = bus.dropped_frames;
@@ -533,10 +541,12 @@ std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFi
 }
 
 // A file replay that ends without the box vouching for it: no estimator ever ran (an empty
-// log, no usable sensor frame), or the log's time could not be monitor time. Says why on
-// stderr; "" when the run is sound (a live bus is judged by its own fault levels).
+// log, no usable sensor frame), the log's time could not be monitor time, or the log lost
+// frames. Says why on stderr; "" when the run is sound (a live bus is judged by its own fault
+// levels).
 std::string input_fault(fw::MonitorInput& input, bool estimated) {
   const fw::InputTimeCounters time = input.time_counters();
+  const fw::InputDropCounters drops = input.drop_counters();
   if (time.total() > 0) {
     std::fprintf(stderr,
                  "plinth-monitor: fault: %s (%llu timestamps back, %llu standing still, %llu "
@@ -544,8 +554,15 @@ std::string input_fault(fw::MonitorInput& input, bool estimated) {
                  time.first.c_str(), static_cast<unsigned long long>(time.went_back),
                  static_cast<unsigned long long>(time.stood_still),
                  static_cast<unsigned long long>(time.gaps), fw::kMaxLogGapS);
-    return "log_time";
   }
+  if (drops.reports > 0) {
+    std::fprintf(stderr,
+                 "plinth-monitor: fault: %s (%llu frames lost in %llu DROPCOUNT lines in all)\n",
+                 drops.first.c_str(), static_cast<unsigned long long>(drops.frames),
+                 static_cast<unsigned long long>(drops.reports));
+  }
+  if (time.total() > 0) return "log_time";
+  if (drops.reports > 0) return "log_drops";
   if (!estimated && input.sink() == nullptr) {
     std::fprintf(stderr,
                  "plinth-monitor: fault: %s: no usable sensor data, the estimator never ran\n",
@@ -710,6 +727,9 @@ void refuse_without_effect(const CLI::App& app, const Options& opt) {
   refuse_without_effect(app, {"--log-time"}, log,
                         "applies to a candump log replay only (a record's samples are timed by "
                         "its sampling interval, a bus's frames by the receive clock)");
+  refuse_without_effect(app, {"--log-drops"}, log,
+                        "applies to a candump log replay only (a record has no DROPCOUNT lines; a "
+                        "bus's drops are the kernel's, counted in bus_dropped_frames)");
   refuse_without_effect(app, {"--pre-trigger", "--post-trigger"}, !opt.record_dir.empty(),
                         "sets the event recorder's captures, which is off (--record-dir)");
 }
@@ -730,6 +750,10 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--log-time", opt.log_time,
                  "a candump log's timestamps that go back, stand still or jump: warn (default: "
                  "named, counted, the box's input fault raised) or refuse (stop at the first)");
+  app.add_option("--log-drops", opt.log_drops,
+                 "a candump log's DROPCOUNT lines (frames its logger lost): warn (default: named, "
+                 "counted, the box's bus fault raised as for a live overflow) or refuse (stop at "
+                 "the first)");
   app.add_option("--rate", c.rate_hz, "sensor rate, Hz (100-1000; default: the record's, or 200)")
       ->check(plinth::host::kFinitePositive);
   app.add_option("--steps", c.steps, "solver steps per sample (default 4)")

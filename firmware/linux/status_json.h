@@ -85,8 +85,10 @@ struct RunTotals {
   std::uint64_t log_time_back = 0;       // log frames stamped before the previous (dropped)
   std::uint64_t log_time_still = 0;      // log frames stamped at the previous time (dropped)
   std::uint64_t log_time_gaps = 0;       // log jumps forward beyond kMaxLogGapS
-  // Why the run cannot be vouched for ("no_sensor_data", "log_time"), "" when it can: the
-  // summary then says "alarm": "fault" with this "input_fault".
+  std::uint64_t log_drop_reports = 0;    // a log's DROPCOUNT lines (its logger lost frames)
+  std::uint64_t log_drop_frames = 0;     // the frames they say were lost
+  // Why the run cannot be vouched for ("no_sensor_data", "log_time", "log_drops"), "" when it
+  // can: the summary then says "alarm": "fault" with this "input_fault".
   std::string input_fault;
   bool recorder = false;                 // the event recorder ran: its counters follow
   RecorderStatus recorder_status;        // its health at the end, written, lost, cut, deleted
