@@ -110,6 +110,7 @@ inline constexpr CodeTable<monitor::RegionalRefusal, monitor::kRegionalRefusalCo
         {monitor::RegionalRefusal::kDuplicate, 7},
         {monitor::RegionalRefusal::kOutOfOrder, 8},
         {monitor::RegionalRefusal::kNoRoom, 9},
+        {monitor::RegionalRefusal::kUnauthenticated, 10},
     }}};
 
 // Every value the domain names has exactly one code, and no two values share one.

@@ -177,8 +177,9 @@ class Outputs {
       // Regional alerts (MQTT): at the loop's time now, relative to their receipt.
       fw::RegionalRequest r;
       while (output->mailbox().take_regional(r)) {
-        handle(r.malformed ? monitor.regional_alert_malformed(r.field)
-                           : monitor.on_regional_alert(r.alert));
+        handle(r.refusal != mon::RegionalRefusal::kNone
+                   ? monitor.regional_alert_refused(r.refusal, r.field)
+                   : monitor.on_regional_alert(r.alert));
       }
       fw::CommandRequest c;
       while (output->mailbox().take_command(c)) {
@@ -457,7 +458,11 @@ std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFi
     outputs.push_back(std::make_unique<fw::ModbusServer>(file.modbus, identity));
   }
   if (!file.mqtt.broker.empty()) {
-    outputs.push_back(std::make_unique<fw::MqttPublisher>(file.mqtt, identity));
+    fw::MqttSettings mqtt = file.mqtt;
+    if (const auto* room = mon::built_part<mon::RegionalAlertSettings>(file.config.regional)) {
+      mqtt.regional = *room;  // its fragility ranks a burst, its key authenticates
+    }
+    outputs.push_back(std::make_unique<fw::MqttPublisher>(mqtt, identity));
   }
   return outputs;
 }
@@ -659,7 +664,11 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--modbus", c.modbus_listen,
                  "Modbus TCP server at HOST:PORT (modbus.listen; docs/integration.md)");
   app.add_flag("--modbus-writes", c.modbus_writes,
-               "the acknowledge and reset coils may be written (modbus.writes)");
+               "the acknowledge and reset coils may be written (modbus.writes) ...");
+  app.add_option("--modbus-write-from", c.modbus_write_from,
+                 "... by these addresses or prefixes only, comma-separated: 10.0.4.7,::1 "
+                 "(modbus.write_from)")
+      ->delimiter(',');
   app.add_flag_callback(
       "--modbus-map",
       [] {

@@ -42,6 +42,12 @@ class JsonObject {
 // What the statue sensor's weights say of one axis (the status line's and the MQTT state's).
 [[nodiscard]] std::string statue_weights_json(const StatueAxisStatus& axis);
 
+// The refusals of regional alerts more dangerous than the worst held (regional_alert.h): their
+// count and the latest, refused at JSON time `t` (null: none).
+[[nodiscard]] std::string refused_dangerous_json(std::uint64_t count,
+                                                 const monitor::RefusedRegionalAlert& latest,
+                                                 double t);
+
 // {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
 [[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);
 // The P-wave stage's part of a status line ("pwave", when it runs): state, probability,
