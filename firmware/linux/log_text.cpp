@@ -56,27 +56,39 @@ bool valid_utf8(std::string_view text) {
   return true;
 }
 
-LogLimiter::LogLimiter(std::string prefix, int burst, double period_s)
-    : prefix_(std::move(prefix)),
-      burst_(burst),
-      period_ns_(static_cast<std::int64_t>(period_s * 1e9)) {}
+BurstLimit::BurstLimit(int burst, double period_s)
+    : burst_(burst), period_ns_(static_cast<std::int64_t>(period_s * 1e9)) {}
 
-bool LogLimiter::say(const std::string& message, std::int64_t now_ns) {
+bool BurstLimit::allow(std::int64_t now_ns) {
   if (!started_ || now_ns - window_start_ns_ >= period_ns_) {
     started_ = true;
     window_start_ns_ = now_ns;
-    said_in_window_ = 0;
+    shown_in_window_ = 0;
   }
-  if (said_in_window_ >= burst_) {
+  if (shown_in_window_ >= burst_) {
     ++not_shown_;
     ++not_shown_total_;
     return false;
   }
-  ++said_in_window_;
-  if (not_shown_ > 0) {
+  ++shown_in_window_;
+  return true;
+}
+
+std::uint64_t BurstLimit::take_not_shown() {
+  const std::uint64_t n = not_shown_;
+  not_shown_ = 0;
+  return n;
+}
+
+LogLimiter::LogLimiter(std::string prefix, int burst, double period_s)
+    : prefix_(std::move(prefix)), limit_(burst, period_s) {}
+
+bool LogLimiter::say(const std::string& message, std::int64_t now_ns) {
+  if (!limit_.allow(now_ns)) return false;
+  const std::uint64_t not_shown = limit_.take_not_shown();
+  if (not_shown > 0) {
     std::fprintf(stderr, "plinth-monitor: %s: %s (%llu like it not shown before this one)\n",
-                 prefix_.c_str(), message.c_str(), static_cast<unsigned long long>(not_shown_));
-    not_shown_ = 0;
+                 prefix_.c_str(), message.c_str(), static_cast<unsigned long long>(not_shown));
   } else {
     std::fprintf(stderr, "plinth-monitor: %s: %s\n", prefix_.c_str(), message.c_str());
   }

@@ -18,27 +18,39 @@ namespace plinth::firmware {
 // Whether `text` is well-formed UTF-8 (RFC 3629: no overlong form, no surrogate, <= U+10FFFF).
 [[nodiscard]] bool valid_utf8(std::string_view text);
 
-// stderr lines about one kind of event from outside ("plinth-monitor: PREFIX: ..."), at most
-// `burst` of them each `period_s`; those beyond are counted, and the next line printed says how
-// many were not. Not thread-safe: one per thread.
-class LogLimiter {
+// At most `burst` lines each `period_s` about one kind of event from outside; those beyond are
+// counted, for the next line shown to say how many were not. Not thread-safe: one per thread.
+class BurstLimit {
  public:
-  LogLimiter(std::string prefix, int burst, double period_s);
-
-  // Prints "plinth-monitor: PREFIX: MESSAGE" unless the burst is spent; `now_ns` on one
-  // monotonic clock. True when printed.
-  bool say(const std::string& message, std::int64_t now_ns);
-  [[nodiscard]] std::uint64_t not_shown() const { return not_shown_total_; }
+  BurstLimit(int burst, double period_s);
+  // Whether a line at `now_ns` (one monotonic clock) may be shown; counted when not.
+  [[nodiscard]] bool allow(std::int64_t now_ns);
+  // Lines not shown since the last call (the next line shown says so).
+  [[nodiscard]] std::uint64_t take_not_shown();
+  [[nodiscard]] std::uint64_t not_shown_total() const { return not_shown_total_; }
 
  private:
-  std::string prefix_;
   int burst_;
   std::int64_t period_ns_;
   std::int64_t window_start_ns_ = 0;
-  int said_in_window_ = 0;
+  int shown_in_window_ = 0;
   bool started_ = false;
-  std::uint64_t not_shown_ = 0;        // since the last line printed
-  std::uint64_t not_shown_total_ = 0;  // in the run
+  std::uint64_t not_shown_ = 0;
+  std::uint64_t not_shown_total_ = 0;
+};
+
+// stderr lines "plinth-monitor: PREFIX: MESSAGE" under a BurstLimit; the first line after some
+// were not shown says how many. MESSAGE must be printable (printable() the outside's text).
+class LogLimiter {
+ public:
+  LogLimiter(std::string prefix, int burst, double period_s);
+  // True when printed.
+  bool say(const std::string& message, std::int64_t now_ns);
+  [[nodiscard]] std::uint64_t not_shown() const { return limit_.not_shown_total(); }
+
+ private:
+  std::string prefix_;
+  BurstLimit limit_;
 };
 
 }  // namespace plinth::firmware

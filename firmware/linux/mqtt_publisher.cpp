@@ -351,6 +351,16 @@ void MqttPublisher::on_connect(int rc) {
   const std::string problem = "connected to " + endpoint_text_;
   if (problem != last_problem_ && !last_problem_.empty()) say(problem);
   last_problem_ = problem;
+  // The box's own availability, its retained value first: after a session of this run that
+  // ended without the box's DISCONNECT, "offline" there is the box's Last Will, which the broker
+  // published while the box still ran (another client took its session, or the broker dropped
+  // it). Then "online".
+  checking_will_ = ended_uncleanly_;
+  ended_uncleanly_ = false;
+  if (mosquitto_subscribe_v5(client_, nullptr, availability_topic_.c_str(), kQos, 0, nullptr) !=
+      MOSQ_ERR_SUCCESS) {
+    checking_will_ = false;
+  }
   (void)publish(availability_topic_, "online", true, nullptr);
   // Also while commands are off: the reply says so. No retained command is sent (a retained
   // acknowledgement would be carried out at every connection), and one published retained
@@ -375,6 +385,7 @@ void MqttPublisher::on_connect(int rc) {
 
 void MqttPublisher::on_disconnect(int rc) {
   if (connected_ && rc != 0 && !stopping_.load()) ++connections_lost_;
+  if (connected_ && rc != 0) ended_uncleanly_ = true;
   if (rc == MQTT_RC_SESSION_TAKEN_OVER) {
     ++takeovers_;
     session_log_.say("the broker at " + endpoint_text_ + " closed the box's session: another "
@@ -521,6 +532,21 @@ void MqttPublisher::publish_head(std::int64_t now_ns) {
 // A well-formed acknowledgement goes to the loop; the reply waits for its outcome.
 void MqttPublisher::on_message(const std::string& topic, const std::string& payload,
                                bool retained, const std::string& hmac) {
+  if (topic == availability_topic_) {
+    // The first message after a connection is the retained value, if any; later ones are the
+    // box's own.
+    if (checking_will_ && retained && payload == "offline") {
+      ++wills_seen_;
+      session_log_.say("the broker published the box's Last Will (\"offline\" on " +
+                           availability_topic_ + ") while the box ran: another client " +
+                           "connected with its client id (" + client_id_ + "), or the broker " +
+                           "dropped the box's connection (" + std::to_string(wills_seen_) +
+                           " times so far)",
+                       monotonic_ns());
+    }
+    checking_will_ = false;
+    return;
+  }
   if (settings_.regional_alerts && topic == regional_topic_) {
     return on_regional_alert(payload, hmac);
   }
@@ -846,6 +872,7 @@ std::string MqttPublisher::state_json() const {
       .count("heartbeat", s.statuses)
       .count("events_dropped", events_dropped_ + mailbox_.events_dropped())
       .count("session_takeovers", takeovers_)
+      .count("wills_while_running", wills_seen_)
       .raw("version", JsonObject()
                           .text("project", version::kProjectVersion)
                           .text("git", version::kGitDescription)
@@ -923,6 +950,7 @@ std::string MqttPublisher::summary_json() const {
       .count("refusals", refusals_)
       .count("connections_lost", connections_lost_)
       .count("session_takeovers", takeovers_)
+      .count("wills_while_running", wills_seen_)
       .count("events_published", events_published_)
       .count("events_republished", events_republished_)
       .count("events_dropped", events_dropped_ + mailbox_.events_dropped())

@@ -14,8 +14,10 @@
 // back-off. Username/password and TLS (a CA, optionally a client certificate). MQTT 5: a
 // retained command is never taken (the subscription asks for none, and one published retained
 // is refused), the client id carries 64 random bits (no other client can take the session
-// without reading it off the box), and a takeover (reason 0x8E) is said and counted. Who may
-// publish a command is the broker's ACL: MQTT does not tell a subscriber who published; a
+// without reading it off the box or the broker's log), and a takeover is said and counted: the
+// DISCONNECT's reason 0x8E where the broker sends one, else the box's own Last Will found
+// retained when it connects again (mosquitto 2.0.11 sends no reason, but publishes the Will).
+// Who may publish a command is the broker's ACL: MQTT does not tell a subscriber who published; a
 // regional alert can carry its own HMAC (docs/regional.md). What comes in is read strictly
 // (json_payload.h) and said escaped (log_text.h), a burst of alerts keeps the most dangerous.
 // Topics and payloads: docs/integration.md. Host code: allocates and throws.
@@ -160,6 +162,8 @@ class MqttPublisher final : public StatusOutput {
   bool socket_open_ = false;  // a connection attempt or session is under way
   bool connected_ = false;    // the broker accepted the session
   bool answered_ = false;     // the broker answered this attempt (CONNACK, accepted or not)
+  bool ended_uncleanly_ = false;  // the last session ended without the box's DISCONNECT
+  bool checking_will_ = false;    // the availability topic's retained value is still to come
   std::int64_t next_attempt_ns_ = 0;
   double backoff_s_ = 0.0;
   std::string last_problem_;  // the latest message printed (printed again only when it changes)
@@ -199,6 +203,9 @@ class MqttPublisher final : public StatusOutput {
   std::uint64_t refusals_ = 0;          // the broker refused the session (CONNACK)
   std::uint64_t connections_lost_ = 0;
   std::uint64_t takeovers_ = 0;  // the broker closed the session: another client took the id
+  // At a reconnection, the box's Last Will retained on its availability topic: published while
+  // the box ran (a takeover by a broker that does not say so, as mosquitto 2.0.11, or a drop).
+  std::uint64_t wills_seen_ = 0;
   std::uint64_t events_published_ = 0;  // acknowledged by the broker
   std::uint64_t events_dropped_ = 0;    // the queue was full: the oldest went
   std::uint64_t next_drop_report_ = 1;     // say_dropped() speaks at this count

@@ -20,10 +20,12 @@
 #include "event_recorder.h"
 #include "inputs.h"
 #include "latency_log.h"
+#include "log_text.h"
 #include "modbus_map.h"
 #include "modbus_server.h"
 #include "monitor_config.h"
 #include "mqtt_publisher.h"
+#include "plinth/firmware/can_frames.h"
 #include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/hal/candump_log.h"
@@ -214,6 +216,41 @@ class Outputs {
     }
   }
 
+  // A line for an Acknowledge frame from the bus (unauthenticated: docs/monitor.md), as for a
+  // command from MQTT or Modbus; the refused and the ignored (the bus locked out after refusals)
+  // at most kBusRefusalLines a minute, the next line shown saying how many were not.
+  void bus_acknowledgement(const plinth::hal::can::CanFrame& frame, const fw::MonitorUpdate& u,
+                           const fw::FrameCounters& before, const fw::FrameCounters& after) {
+    plinth::hal::can::Acknowledge ack;
+    if (!plinth::hal::can::decode(frame, ack).ok()) return;
+    const bool released = u.acknowledgement == mon::AckOutcome::kReleased ||
+                          u.acknowledgement == mon::AckOutcome::kReleasedConditionHolds;
+    const std::int64_t now = fw::monotonic_ns();
+    if (!released && !bus_refusals_.allow(now)) return;
+    const mon::Acknowledgement a = fw::acknowledgement_of(ack);
+    fw::JsonObject line;
+    line.text("type", "command")
+        .text("command", "acknowledge")
+        .text("source", "can")
+        .count("source_id", ack.source_id)
+        .text("level", mon::alarm_level_name(a.level))
+        .count("sequence", a.event_sequence)
+        .text("outcome", after.acknowledgements_ignored != before.acknowledgements_ignored
+                             ? "ignored: bus acknowledgements locked out"
+                             : mon::ack_outcome_name(u.acknowledgement));
+    if (after.acknowledgement_lockouts != before.acknowledgement_lockouts) {
+      line.flag("locks_out_the_bus", true);
+      std::fprintf(stderr,
+                   "plinth-monitor: can: %d acknowledgements refused within %g s: the bus's are "
+                   "ignored while %s stays latched (acknowledge at the box, over MQTT or Modbus)\n",
+                   fw::kRefusedAcknowledgementsBeforeLockout,
+                   static_cast<double>(fw::kRefusedAcknowledgementWindowNs) * 1e-9,
+                   mon::alarm_level_name(monitor_.status().latched));
+    }
+    if (!released) line.count("not_shown", bus_refusals_.take_not_shown());
+    print_line(line.close());
+  }
+
   fw::RunTotals totals;
   fw::SampleTrace* trace = nullptr;  // --trace
   fw::Supervisor* supervisor = nullptr;  // STATUS= and the journal at each alarm change
@@ -259,6 +296,7 @@ class Outputs {
   std::vector<fw::StatusOutput*> outputs_;
   std::int64_t start_ns_;
   fw::StatusSnapshot snapshot_;
+  fw::BurstLimit bus_refusals_{5, 60.0};  // bus_acknowledgement's refused lines
 };
 
 // The monitor takes one input item.
@@ -271,11 +309,17 @@ void take(const fw::InputItem& item, fw::Monitor& monitor, fw::FrameDecoder& dec
       outputs.handle(monitor.on_sample(item.sample));
       ++outputs.totals.samples;
       break;
-    case fw::InputItem::Kind::kFrame:
+    case fw::InputItem::Kind::kFrame: {
       if (recorder != nullptr) recorder->on_frame(item.frame);
       outputs.last_frame_ns = item.frame.timestamp_ns;
-      outputs.handle(fw::on_frame(monitor, decoder, item.frame));
+      const fw::FrameCounters before = decoder.counters();
+      const fw::MonitorUpdate u = fw::on_frame(monitor, decoder, item.frame);
+      if (decoder.counters().acknowledgements != before.acknowledgements) {
+        outputs.bus_acknowledgement(item.frame.frame, u, before, decoder.counters());
+      }
+      outputs.handle(u);
       break;
+    }
     case fw::InputItem::Kind::kTick:
       outputs.handle(monitor.on_tick(item.time_ns));
       break;

@@ -1,6 +1,7 @@
 #include "plinth/firmware/frame_decoder.h"
 
 #include "plinth/firmware/can_frames.h"
+#include "plinth/monitor/hmac_sha256.h"
 
 namespace plinth::firmware {
 
@@ -18,6 +19,51 @@ void FrameDecoder::start(const MonitorConfig& config) {
   statue_node_ = statue != nullptr && statue->present ? statue->node : -1;
   counters_ = FrameCounters{};
   have_origin_ = false;
+  if (auto* tags = monitor::built_part<RegionalTagCheck>(tags_)) {
+    const auto* room = monitor::built_part<monitor::RegionalAlertSettings>(config.regional);
+    *tags = RegionalTagCheck{};
+    if (room != nullptr) tags->authentication = room->authentication;
+  }
+  ack_guard_ = BusAcknowledgementGuard{};
+}
+
+bool BusAcknowledgementGuard::admits(monitor::AlarmLevel latched) {
+  // The lockout holds while the level it began under stays latched.
+  if (locked_ && latched != locked_level_) locked_ = false;
+  return !locked_;
+}
+
+void BusAcknowledgementGuard::record(monitor::AckOutcome outcome, std::int64_t time_ns,
+                                     monitor::AlarmLevel latched, FrameCounters& counters) {
+  if (outcome != monitor::AckOutcome::kStale && outcome != monitor::AckOutcome::kWrongLevel) {
+    return;
+  }
+  ++counters.acknowledgements_refused;
+  refused_ns_[static_cast<std::size_t>(next_)] = time_ns;
+  next_ = (next_ + 1) % kRefusedAcknowledgementsBeforeLockout;
+  if (refused_count_ < kRefusedAcknowledgementsBeforeLockout) ++refused_count_;
+  // The oldest of the last kRefusedAcknowledgementsBeforeLockout refusals, within the window.
+  const std::int64_t oldest = refused_ns_[static_cast<std::size_t>(next_)];
+  if (refused_count_ == kRefusedAcknowledgementsBeforeLockout &&
+      time_ns - oldest <= kRefusedAcknowledgementWindowNs &&
+      latched != monitor::AlarmLevel::kNormal) {
+    locked_ = true;
+    locked_level_ = latched;
+    refused_count_ = 0;
+    ++counters.acknowledgement_lockouts;
+  }
+}
+
+MonitorUpdate FrameDecoder::acknowledge(Monitor& target,
+                                        const monitor::Acknowledgement& acknowledgement,
+                                        std::int64_t time_ns) {
+  if (!ack_guard_.admits(target.status().latched)) {
+    ++counters_.acknowledgements_ignored;
+    return target.poll();
+  }
+  MonitorUpdate update = target.acknowledge(acknowledgement);
+  ack_guard_.record(update.acknowledgement, time_ns, target.status().latched, counters_);
+  return update;
 }
 
 template <typename Message>
@@ -112,15 +158,19 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
         ++counters_.unknown_identifiers;
         break;
       }
+      drop_untagged(input);  // the alert before never got its tag
       can::RegionalAlertOrigin message;
       have_origin_ = decoded(frame, message);
       if (have_origin_) {
         origin_ = message;
+        origin_bytes_ = frame.data;
         origin_time_ns_ = timed.timestamp_ns;
       } else {
         ++counters_.regional_malformed;
-        input.kind = FrameInput::Kind::kRegionalMalformed;
-        input.malformed_field = refused_regional("RegionalAlertOrigin");
+        if (input.kind == FrameInput::Kind::kNone) {  // one input a frame: the untagged's first
+          input.kind = FrameInput::Kind::kRegionalMalformed;
+          input.malformed_field = refused_regional("RegionalAlertOrigin");
+        }
       }
       break;
     }
@@ -130,6 +180,13 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
         break;
       }
       decode_regional(timed, input);
+      break;
+    case can::MessageKind::kRegionalAlertTag:
+      if constexpr (!monitor::kRegionalAlertBuiltIn) {
+        ++counters_.unknown_identifiers;
+        break;
+      }
+      decode_tag(timed, input);
       break;
     case can::MessageKind::kUnknown:
       ++counters_.unknown_identifiers;
@@ -157,6 +214,56 @@ void FrameDecoder::decode_regional(const hal::TimedFrame& timed, FrameInput& inp
   ++counters_.regional_alerts;
   input.kind = FrameInput::Kind::kRegionalAlert;
   input.regional = regional_alert_of(origin_, message, static_cast<double>(gap_ns) * 1e-9);
+  RegionalTagCheck* tags = monitor::built_part<RegionalTagCheck>(tags_);
+  if (tags == nullptr || !tags->authentication.required) return;
+  // Held for its tag; an alert before it still waiting is refused now.
+  FrameInput held = input;
+  input = FrameInput{};
+  drop_untagged(input);
+  tags->pending = true;
+  tags->alert = held;
+  tags->origin_bytes = origin_bytes_;
+  tags->alert_bytes = timed.frame.data;
+  tags->alert_time_ns = timed.timestamp_ns;
+}
+
+void FrameDecoder::drop_untagged(FrameInput& input) {
+  RegionalTagCheck* tags = monitor::built_part<RegionalTagCheck>(tags_);
+  if (tags == nullptr || !tags->pending) return;
+  tags->pending = false;
+  ++counters_.regional_unauthenticated;
+  input.kind = FrameInput::Kind::kRegionalUnauthenticated;
+  input.malformed_field = "RegionalAlertTag";  // missing
+}
+
+void FrameDecoder::decode_tag(const hal::TimedFrame& timed, FrameInput& input) {
+  can::RegionalAlertTag message;
+  if (!decoded(timed.frame, message)) return;  // only its length can be wrong: counted
+  ++counters_.regional_tags;
+  RegionalTagCheck* tags = monitor::built_part<RegionalTagCheck>(tags_);
+  if (tags == nullptr || !tags->authentication.required || !tags->pending) return;  // ignored
+  const std::int64_t gap_ns = timed.timestamp_ns - tags->alert_time_ns;
+  if (gap_ns < 0 || gap_ns > kRegionalPairWindowNs) return drop_untagged(input);
+  tags->pending = false;
+  const monitor::ByteSpan parts[] = {{tags->origin_bytes.data(), tags->origin_bytes.size()},
+                                     {tags->alert_bytes.data(), tags->alert_bytes.size()},
+                                     {timed.frame.data.data(), 4}};
+  const monitor::Sha256Digest mac =
+      monitor::hmac_sha256(tags->authentication.key, parts, sizeof parts / sizeof parts[0]);
+  const bool replayed = tags->any_counter && message.counter <= tags->last_counter;
+  if (!monitor::same_bytes(mac.data(), timed.frame.data.data() + 4, 4) || replayed) {
+    ++counters_.regional_unauthenticated;
+    input.kind = FrameInput::Kind::kRegionalUnauthenticated;
+    input.malformed_field = replayed ? "Counter" : "Tag";
+    return;
+  }
+  tags->any_counter = true;
+  tags->last_counter = message.counter;
+  input = tags->alert;
+  // Its times were relative to the alert frame; the tag came `gap` later.
+  const double gap_s = static_cast<double>(gap_ns) * 1e-9;
+  input.regional.origin_age_s += gap_s;
+  input.regional.s_arrival_in_s -= gap_s;
 }
 
 MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::TimedFrame& frame) {
@@ -165,7 +272,7 @@ MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::Timed
     case FrameInput::Kind::kSensorSample:
       return monitor.on_sensor_sample(input.sensor, input.sample);
     case FrameInput::Kind::kAcknowledgement:
-      return monitor.acknowledge(input.acknowledgement);
+      return decoder.acknowledge(monitor, input.acknowledgement, frame.timestamp_ns);
     case FrameInput::Kind::kStatueRate:
       return monitor.on_statue_sample(input.statue);
     case FrameInput::Kind::kStatueAcceleration:
@@ -174,6 +281,9 @@ MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::Timed
       return monitor.on_regional_alert(input.regional, frame.timestamp_ns);
     case FrameInput::Kind::kRegionalMalformed:
       return monitor.regional_alert_malformed(input.malformed_field);
+    case FrameInput::Kind::kRegionalUnauthenticated:
+      return monitor.regional_alert_refused(plinth::monitor::RegionalRefusal::kUnauthenticated,
+                                            input.malformed_field);
     case FrameInput::Kind::kNone:
       break;
   }
