@@ -210,7 +210,8 @@ ModbusServer::Closed ModbusServer::read_from(Client& c, std::int64_t now_ns) {
   return Closed::kNo;
 }
 
-// Up to kFramesPerTurn of the client's whole frames answered; `more` when whole frames remain.
+// Up to kFramesPerTurn of the client's whole frames answered; `more` when whole frames (or a
+// fault) remain.
 ModbusServer::Closed ModbusServer::answer_frames(Client& c, std::int64_t now_ns, bool& more) {
   std::array<std::uint8_t, modbus::kMaxFrameBytes> out{};
   for (int turn = 0; turn < kFramesPerTurn; ++turn) {
@@ -253,7 +254,8 @@ ModbusServer::Closed ModbusServer::answer_frames(Client& c, std::int64_t now_ns,
     c.used -= frame.bytes;
     if (c.used > 0) c.frame_started_ns = now_ns;
   }
-  more = modbus::frame_at({c.received.data(), c.used}).bytes > 0;
+  const modbus::FrameSpan next = modbus::frame_at({c.received.data(), c.used});
+  more = next.bytes > 0 || next.fault != modbus::FrameFault::kNoFault;
   return Closed::kNo;
 }
 

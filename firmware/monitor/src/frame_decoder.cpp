@@ -182,11 +182,11 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
       decode_regional(timed, input);
       break;
     case can::MessageKind::kRegionalAlertTag:
-      if constexpr (!monitor::kRegionalAlertBuiltIn) {
-        ++counters_.unknown_identifiers;
-        break;
+      if constexpr (monitor::kRegionalAlertBuiltIn) {
+        decode_tag(timed, input);
+      } else {
+        ++counters_.unknown_identifiers;  // no room, no tag, no SHA-256 in the image
       }
-      decode_tag(timed, input);
       break;
     case can::MessageKind::kUnknown:
       ++counters_.unknown_identifiers;
@@ -261,7 +261,7 @@ void FrameDecoder::decode_tag(const hal::TimedFrame& timed, FrameInput& input) {
   tags->last_counter = message.counter;
   input = tags->alert;
   // Its times were relative to the alert frame; the tag came `gap` later.
-  const double gap_s = static_cast<double>(gap_ns) * 1e-9;
+  const auto gap_s = static_cast<Real>(static_cast<double>(gap_ns) * 1e-9);
   input.regional.origin_age_s += gap_s;
   input.regional.s_arrival_in_s -= gap_s;
 }
