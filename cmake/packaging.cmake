@@ -30,7 +30,7 @@ set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION TRUE)
 
 # The C++ runtime and the shared libraries the programs link (Debian 12's packages).
 set(plinth_cxx_runtime "libc6 (>= 2.34), libgcc-s1 (>= 3.0), libstdc++6 (>= 12)")
-set(PLINTH_MONITOR_DEPENDS "${plinth_cxx_runtime}, libgpiod2 (>= 1.6), libmodbus5 (>= 3.1.6), libmosquitto1 (>= 2.0), libsystemd0 (>= 252), libtomlplusplus3 (>= 3.3), systemd")
+set(PLINTH_MONITOR_DEPENDS "${plinth_cxx_runtime}, libgpiod2 (>= 1.6), libmosquitto1 (>= 2.0), libsystemd0 (>= 252), libtomlplusplus3 (>= 3.3), systemd")
 
 set(CPACK_DEBIAN_MONITOR_PACKAGE_NAME plinth-monitor)
 set(CPACK_DEBIAN_MONITOR_PACKAGE_DEPENDS "${PLINTH_MONITOR_DEPENDS}")

@@ -115,6 +115,7 @@ inline constexpr CodeTable<monitor::RegionalRefusal, monitor::kRegionalRefusalCo
         {monitor::RegionalRefusal::kDuplicate, 7},
         {monitor::RegionalRefusal::kOutOfOrder, 8},
         {monitor::RegionalRefusal::kNoRoom, 9},
+        {monitor::RegionalRefusal::kUnauthenticated, 10},
     }}};
 
 inline constexpr CodeTable<RecorderHealth, 3> kRecorderHealthCodes{{{

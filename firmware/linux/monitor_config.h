@@ -3,8 +3,10 @@
 // allocate and throw.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "capture_store.h"
 #include "plinth/firmware/monitor.h"
@@ -34,6 +36,11 @@ struct MonitorFile {
   RecorderFileSettings recorder;  // [recorder]
   ModbusSettings modbus;          // [modbus]
   MqttSettings mqtt;              // [mqtt]
+  // regional_alert.key_file, resolved (its key is in config.regional's authentication).
+  std::string regional_key_file;
+  // Each key the file set, and where: "box.toml:12" (the checks after the command line name
+  // the line of a key that has no effect).
+  std::map<std::string, std::string> key_where;
 };
 
 // Frames/s the event recorder's buffers are sized for (event_recorder.h): every configured
@@ -69,6 +76,7 @@ struct MonitorOverrides {
   bool no_relays = false;                   // --no-relays: the file's [relays] ignored
   std::string modbus_listen;                // --modbus HOST:PORT
   bool modbus_writes = false;               // --modbus-writes
+  std::vector<std::string> modbus_write_from;  // --modbus-write-from: replaces modbus.write_from
   std::string mqtt_broker;                  // --mqtt HOST:PORT
   std::string mqtt_box_id;                  // --mqtt-box-id
   std::string mqtt_username;                // --mqtt-username

@@ -21,10 +21,12 @@
 #include "event_recorder.h"
 #include "inputs.h"
 #include "latency_log.h"
+#include "log_text.h"
 #include "modbus_map.h"
 #include "modbus_server.h"
 #include "monitor_config.h"
 #include "mqtt_publisher.h"
+#include "plinth/firmware/can_frames.h"
 #include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/hal/candump_log.h"
@@ -163,11 +165,6 @@ class Outputs {
       }
       post_alarm(e);
     }
-    if (u.statue_stands != mon::StandsOutcome::kNone && u.stands_source >= 0) {
-      print_line(command_line("statue_stands", "can:" + std::to_string(u.stands_source))
-                     .text("outcome", mon::stands_outcome_name(u.statue_stands))
-                     .close());
-    }
     if (u.frames_lost > 0) note_frames_lost(s, u.frames_lost);
     if (state_ != nullptr) save_state();
     if (u.status_due) {
@@ -195,8 +192,9 @@ class Outputs {
       // Regional alerts (MQTT): at the loop's time now, relative to their receipt.
       fw::RegionalRequest r;
       while (output->mailbox().take_regional(r)) {
-        handle(r.malformed ? monitor.regional_alert_malformed(r.field)
-                           : monitor.on_regional_alert(r.alert));
+        handle(r.refusal != mon::RegionalRefusal::kNone
+                   ? monitor.regional_alert_refused(r.refusal, r.field)
+                   : monitor.on_regional_alert(r.alert));
       }
       fw::CommandRequest c;
       while (output->mailbox().take_command(c)) {
@@ -247,6 +245,67 @@ class Outputs {
 
   // The saved state (--state-dir): what the monitor must not forget, written when it changes.
   void keep_state_in(fw::BoxStateStore* state) { state_ = state; }
+
+  // A line for an Acknowledge frame from the bus (unauthenticated: docs/monitor.md), as for a
+  // command from MQTT or Modbus; the refused and the ignored (the bus locked out after refusals)
+  // at most kBusRefusalLines a minute, the next line shown saying how many were not.
+  void bus_acknowledgement(const plinth::hal::can::CanFrame& frame, const fw::MonitorUpdate& u,
+                           const fw::FrameCounters& before, const fw::FrameCounters& after) {
+    plinth::hal::can::Acknowledge ack;
+    if (!plinth::hal::can::decode(frame, ack).ok()) return;
+    const bool released = u.acknowledgement == mon::AckOutcome::kReleased ||
+                          u.acknowledgement == mon::AckOutcome::kReleasedConditionHolds;
+    const std::int64_t now = fw::monotonic_ns();
+    if (!released && !bus_refusals_.allow(now)) return;
+    const mon::Acknowledgement a = fw::acknowledgement_of(ack);
+    fw::JsonObject line;
+    line.text("type", "command")
+        .text("command", "acknowledge")
+        .text("source", "can")
+        .count("source_id", ack.source_id)
+        .text("level", mon::alarm_level_name(a.level))
+        .count("sequence", a.event_sequence)
+        .text("outcome", after.acknowledgements_ignored != before.acknowledgements_ignored
+                             ? "ignored: bus acknowledgements locked out"
+                             : mon::ack_outcome_name(u.acknowledgement));
+    if (after.acknowledgement_lockouts != before.acknowledgement_lockouts) {
+      line.flag("locks_out_the_bus", true);
+      std::fprintf(stderr,
+                   "plinth-monitor: can: %d acknowledgements refused within %g s: the bus's are "
+                   "ignored while %s stays latched (acknowledge at the box, over MQTT or Modbus)\n",
+                   fw::kRefusedStatementsBeforeLockout,
+                   static_cast<double>(fw::kRefusedStatementWindowNs) * 1e-9,
+                   mon::alarm_level_name(monitor_.status().latched));
+    }
+    if (!released) line.count("not_shown", bus_refusals_.take_not_shown());
+    print_line(line.close());
+  }
+
+  // A line for a StatueStands frame from the bus (unauthenticated, guarded as acknowledgements
+  // are: docs/monitor.md); the refused and the ignored share bus_acknowledgement's line budget.
+  void bus_statue_stands(const plinth::hal::can::CanFrame& frame, const fw::MonitorUpdate& u,
+                         const fw::FrameCounters& before, const fw::FrameCounters& after) {
+    plinth::hal::can::StatueStands stands;
+    if (!plinth::hal::can::decode(frame, stands).ok()) return;
+    const bool cleared = u.statue_stands == mon::StandsOutcome::kCleared;
+    if (!cleared && !bus_refusals_.allow(fw::monotonic_ns())) return;
+    fw::JsonObject line = command_line("statue_stands", "can:" + std::to_string(stands.source_id));
+    line.count("sequence", stands.event_sequence)
+        .text("outcome", after.statue_stands_ignored != before.statue_stands_ignored
+                             ? "ignored: bus statements locked out"
+                             : mon::stands_outcome_name(u.statue_stands));
+    if (after.statue_stands_lockouts != before.statue_stands_lockouts) {
+      line.flag("locks_out_the_bus", true);
+      std::fprintf(stderr,
+                   "plinth-monitor: can: %d statue-stands statements refused within %g s: the "
+                   "bus's are ignored while the collapse is held (state it at the box, over MQTT "
+                   "or Modbus)\n",
+                   fw::kRefusedStatementsBeforeLockout,
+                   static_cast<double>(fw::kRefusedStatementWindowNs) * 1e-9);
+    }
+    if (!cleared) line.count("not_shown", bus_refusals_.take_not_shown());
+    print_line(line.close());
+  }
 
   fw::RunTotals totals;
   fw::SampleTrace* trace = nullptr;  // --trace
@@ -330,6 +389,7 @@ class Outputs {
   fw::BoxStateStore* state_ = nullptr;
   bool state_failing_ = false;
   std::uint64_t frames_lost_ = 0;
+  fw::BurstLimit bus_refusals_{5, 60.0};  // bus_acknowledgement's refused lines
 };
 
 // The monitor takes one input item.
@@ -342,11 +402,20 @@ void take(const fw::InputItem& item, fw::Monitor& monitor, fw::FrameDecoder& dec
       outputs.handle(monitor.on_sample(item.sample));
       ++outputs.totals.samples;
       break;
-    case fw::InputItem::Kind::kFrame:
+    case fw::InputItem::Kind::kFrame: {
       if (recorder != nullptr) recorder->on_frame(item.frame, item.lost_before);
       outputs.last_frame_ns = item.frame.timestamp_ns;
-      outputs.handle(fw::on_frame(monitor, decoder, item.frame));
+      const fw::FrameCounters before = decoder.counters();
+      const fw::MonitorUpdate u = fw::on_frame(monitor, decoder, item.frame);
+      if (decoder.counters().acknowledgements != before.acknowledgements) {
+        outputs.bus_acknowledgement(item.frame.frame, u, before, decoder.counters());
+      }
+      if (decoder.counters().statue_stands != before.statue_stands) {
+        outputs.bus_statue_stands(item.frame.frame, u, before, decoder.counters());
+      }
+      outputs.handle(u);
       break;
+    }
     case fw::InputItem::Kind::kTick:
       outputs.handle(monitor.on_tick(item.time_ns));
       break;
@@ -535,7 +604,11 @@ std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFi
     outputs.push_back(std::make_unique<fw::ModbusServer>(file.modbus, identity));
   }
   if (!file.mqtt.broker.empty()) {
-    outputs.push_back(std::make_unique<fw::MqttPublisher>(file.mqtt, identity));
+    fw::MqttSettings mqtt = file.mqtt;
+    if (const auto* room = mon::built_part<mon::RegionalAlertSettings>(file.config.regional)) {
+      mqtt.regional = *room;  // its fragility ranks a burst, its key authenticates
+    }
+    outputs.push_back(std::make_unique<fw::MqttPublisher>(mqtt, identity));
   }
   return outputs;
 }
@@ -790,7 +863,11 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--modbus", c.modbus_listen,
                  "Modbus TCP server at HOST:PORT (modbus.listen; docs/integration.md)");
   app.add_flag("--modbus-writes", c.modbus_writes,
-               "the acknowledge and reset coils may be written (modbus.writes)");
+               "the acknowledge and reset coils may be written (modbus.writes) ...");
+  app.add_option("--modbus-write-from", c.modbus_write_from,
+                 "... by these addresses or prefixes only, comma-separated: 10.0.4.7,::1 "
+                 "(modbus.write_from)")
+      ->delimiter(',');
   app.add_flag_callback(
       "--modbus-map",
       [] {

@@ -50,6 +50,12 @@ class JsonObject {
 // "recorder", after the monitor's members; the MQTT state's).
 [[nodiscard]] std::string recorder_status_json(const RecorderStatus& recorder);
 
+// The refusals of regional alerts more dangerous than the worst held (regional_alert.h): their
+// count and the latest, refused at JSON time `t` (null: none).
+[[nodiscard]] std::string refused_dangerous_json(std::uint64_t count,
+                                                 const monitor::RefusedRegionalAlert& latest,
+                                                 double t);
+
 // {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
 [[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);
 // The P-wave stage's part of a status line ("pwave", when it runs): state, probability,

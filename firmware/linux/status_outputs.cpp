@@ -69,6 +69,10 @@ void copy_status(const BoxStatus& s, double t_origin, StatusSnapshot& snapshot) 
   out.time_to_s_arrival_s = static_cast<double>(r.time_to_s_arrival_s);
   out.s_arrival_t = static_cast<double>(r.worst.s_arrival_ns) * 1e-9 - t_origin;
   out.last_refusal = r.last_refusal;
+  out.refused_dangerous = r.refused_dangerous;
+  out.last_refused_dangerous = r.last_refused_dangerous;
+  out.last_refused_dangerous_t =
+      static_cast<double>(r.last_refused_dangerous.refused_ns) * 1e-9 - t_origin;
 }
 
 std::string Endpoint::text() const {

@@ -37,6 +37,10 @@ struct RegionalSnapshot {
   double time_to_s_arrival_s = 0.0;
   double s_arrival_t = 0.0;       // the JSON lines' time of its S arrival
   monitor::RegionalRefusal last_refusal = monitor::RegionalRefusal::kNone;
+  // Refusals of alerts more dangerous than the worst held (RegionalAlertStatus), the latest.
+  std::uint64_t refused_dangerous = 0;
+  monitor::RefusedRegionalAlert last_refused_dangerous;
+  double last_refused_dangerous_t = 0.0;  // the JSON lines' time of its refusal
 };
 
 // What the box shows after one update of the loop.
@@ -96,11 +100,11 @@ enum class OperatorCommand : std::uint8_t {
   kStatueStands,  // a person on site states that the statue stands again, quoting the sequence
 };
 
-// A regional alert an output received (MQTT), for the loop: the alert, or malformed (`field`,
-// a string literal, names what).
+// A regional alert an output received (MQTT), for the loop: the alert, or refused before it
+// was read (malformed, unauthenticated; `field`, a string literal, names what).
 struct RegionalRequest {
   monitor::RegionalAlert alert;
-  bool malformed = false;
+  monitor::RegionalRefusal refusal = monitor::RegionalRefusal::kNone;
   const char* field = "";
 };
 

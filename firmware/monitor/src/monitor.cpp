@@ -703,12 +703,17 @@ MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert) {
 }
 
 MonitorUpdate Monitor::regional_alert_malformed(const char* field) {
+  return regional_alert_refused(monitor::RegionalRefusal::kMalformed, field);
+}
+
+MonitorUpdate Monitor::regional_alert_refused(monitor::RegionalRefusal refusal,
+                                              const char* field) {
   MonitorUpdate update = new_update();
   if (auto* regional_state = monitor::built_part<monitor::RegionalAlertState>(regional_)) {
-    regional_state->refuse_malformed(field);
+    regional_state->refuse_unread(refusal, field);
   }
   update.regional_received = true;
-  update.regional = {monitor::RegionalRefusal::kMalformed, field};
+  update.regional = {refusal, field};
   evaluate(update);
   return update;
 }

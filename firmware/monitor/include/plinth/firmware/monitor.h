@@ -136,6 +136,9 @@ class Monitor {
   [[nodiscard]] MonitorUpdate on_regional_alert(const monitor::RegionalAlert& alert);
   // A regional alert the host could not read (counted as malformed; `field` names what).
   [[nodiscard]] MonitorUpdate regional_alert_malformed(const char* field);
+  // One the host refused before reading it: malformed or unauthenticated (regional_alert.h).
+  [[nodiscard]] MonitorUpdate regional_alert_refused(monitor::RegionalRefusal refusal,
+                                                     const char* field);
   // No input (a frame that is none of the monitor's): the status, if one is due; the alarm
   // policy's first evaluation if none happened since start() (so that no status says the
   // policy's initial `normal`).
