@@ -300,7 +300,7 @@ constexpr bool undefined_status_flags(std::uint8_t status) {
 }
 
 // The DBC message names, without node or axis suffix.
-constexpr NameTable<MessageKind, 10> kMessageKindNames{{{
+constexpr NameTable<MessageKind, 11> kMessageKindNames{{{
     {MessageKind::kSensorAcceleration, "SensorAcceleration"},
     {MessageKind::kSensorHeartbeat, "SensorHeartbeat"},
     {MessageKind::kMonitorStatus, "MonitorStatus"},
