@@ -56,7 +56,7 @@ HOSTILE = [
      frame(b"\x0f\x00\x00\x07\xd0\xfa" + b"\xff" * 250), "close"),
     ("function 03 quantity 0", frame(b"\x03\x00\x00\x00\x00"), 3),
     ("function 03 quantity 126", frame(b"\x03\x00\x00\x00\x7e"), 3),
-    ("function 04 past the map", frame(b"\x04\x00\x6c\x00\x02"), 2),
+    ("function 04 past the map", frame(b"\x04\x00\xff\x00\x02"), 2),
 ]
 
 
