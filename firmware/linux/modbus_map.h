@@ -57,7 +57,7 @@ inline constexpr CodeTable<monitor::AlarmLevel, 5> kAlarmLevelCodes{{{
     {monitor::AlarmLevel::kAlarm, 3},
     {monitor::AlarmLevel::kFault, 4},
 }}};
-inline constexpr CodeTable<monitor::AlarmCause, 16> kAlarmCauseCodes{{{
+inline constexpr CodeTable<monitor::AlarmCause, 17> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kNone, 0},
     {monitor::AlarmCause::kRiskThreshold, 1},
     {monitor::AlarmCause::kPhaseChange, 2},
@@ -74,6 +74,7 @@ inline constexpr CodeTable<monitor::AlarmCause, 16> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kPWave, 13},
     {monitor::AlarmCause::kStatueUnexplained, 14},
     {monitor::AlarmCause::kRegionalAlert, 15},
+    {monitor::AlarmCause::kCommissioningFailed, 19},
 }}};
 inline constexpr CodeTable<Phase, 7> kPhaseCodes{{{
     {Phase::kFullContact, 0},

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "capture_store.h"
+#include "commission_settings.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/firmware/record_replay.h"
 #include "modbus_server.h"
@@ -31,6 +32,7 @@ struct MonitorFile {
   RecorderFileSettings recorder;  // [recorder]
   ModbusSettings modbus;          // [modbus]
   MqttSettings mqtt;              // [mqtt]
+  CommissioningSettings commissioning;  // [commissioning] (docs/commissioning.md)
 };
 
 // Reads `path` over `defaults`. Throws host::InputError naming the file, the line and the key

@@ -49,7 +49,9 @@ static_assert(same_number(AlarmCause::kOutsideModel, can::AlarmCause::kOutsideMo
 static_assert(same_number(AlarmCause::kPWave, can::AlarmCause::kPWave));
 static_assert(same_number(AlarmCause::kStatueUnexplained, can::AlarmCause::kStatueUnexplained));
 static_assert(same_number(AlarmCause::kRegionalAlert, can::AlarmCause::kRegionalAlert));
-static_assert(monitor::kAlarmCauseNames.size() == 16);
+static_assert(same_number(AlarmCause::kCommissioningFailed,
+                          can::AlarmCause::kCommissioningFailed));
+static_assert(monitor::kAlarmCauseNames.size() == 17);
 
 // The sensors' status bits (SensorAcceleration.Status): passed through as they are.
 static_assert(monitor::sensor_flags::kSaturated == can::sensor_status::kSaturated);

@@ -78,6 +78,7 @@ Error Monitor::start(const MonitorConfig& config,
   frames_not_encoded_ = 0;
   have_epoch_ = false;
   bus_fault_ = false;
+  held_fault_ = monitor::AlarmCause::kNone;
   pending_ack_ = false;
   evaluated_ = false;
   status_interval_ns_ = std::llround(config.status_interval_s * 1e9);
@@ -284,6 +285,10 @@ void Monitor::evaluate(MonitorUpdate& update) {
     *shown = stage->status();
   }
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
+  if (held_fault_ != monitor::AlarmCause::kNone) {
+    input.fault_active = true;
+    input.fault_cause = held_fault_;
+  }
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
   pending_ack_ = false;

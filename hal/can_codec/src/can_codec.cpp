@@ -70,7 +70,7 @@ enum EventSignal : std::size_t { kLevel, kPreviousLevel, kCause, kLatched, kTime
 constexpr std::array<SignalLayout, 6> kEventSignals{{
     {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
-    {"Cause", 8, 8, false, 1.0, 0.0, 0, 15, "", true, kNoSpecialRaw},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 19, "", true, kNoSpecialRaw},
     {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true, kNoSpecialRaw},
     {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false, kNoSpecialRaw},
     {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},

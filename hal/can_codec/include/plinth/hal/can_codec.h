@@ -116,6 +116,7 @@ enum class AlarmCause : std::uint8_t {
   kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
   kStatueUnexplained = 14,  // no member of the ensemble explains the statue sensor's motion
   kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
+  kCommissioningFailed = 19,  // the box's commissioning report failed or is missing
 };
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.
