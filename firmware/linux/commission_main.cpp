@@ -402,9 +402,6 @@ int run(const Options& opt) {
   if (live == !opt.log_path.empty()) {
     throw InputError("give exactly one input: --can INTERFACE (live) or --log FILE (a recording)");
   }
-  if (live && !opt.windows.empty()) {
-    throw InputError("--window: a live session takes its windows from the prompts");
-  }
   fw::MonitorFile file = fw::load_monitor_file(opt.config_path, fw::box_defaults());
   fw::CommissioningSettings settings = file.commissioning;
   if (opt.wedge_deg) settings.wedge_deg = *opt.wedge_deg;
@@ -535,7 +532,17 @@ int main(int argc, char** argv) {
   app.add_option("--hold-s", opt.hold_s, "s of each raise held, live (commissioning.hold_s)")
       ->check(plinth::host::kFinitePositive);
   app.add_flag("--no-picture", opt.no_picture, "write no picture (no gnuplot on this machine)");
-  if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {
+  const auto checks = [&] {
+    const bool live = !opt.can_interface.empty();
+    plinth::host::refuse_without_effect(app, {"--rest-s", "--hold-s"}, live,
+                                        "times a live session's prompted windows; a log's windows "
+                                        "are found in its data or given by --window");
+    plinth::host::refuse_without_effect(app, {"--window"}, !live,
+                                        "gives a step's window in a log; a live session takes "
+                                        "its windows from the prompts");
+  };
+  if (const std::optional<int> exit_code =
+          plinth::host::parse_command_line(app, argc, argv, checks)) {
     return *exit_code;
   }
   std::signal(SIGINT, on_signal);
