@@ -7,7 +7,7 @@
 // gets its sensor's bias and noise, then the codec's frames (hal/can_codec).
 //
 //   plinth-commission-fixture --config BOX.toml --out SESSION.log [--windows W.txt]
-//       [--fault KIND]... [--half-width 0.3] [--lift-mm 6] [--wedge-deg 5] [--seed 1]
+//       [--fault KIND]... [--half-width 0.3] [--lift-mm 6] [--wedge-deg 5] [--seed 1] [--short]
 //
 // Faults (NODE a node id, AXIS x, y or z of the sensor's own frame):
 //   turned:NODE:DEG   mounted turned DEG about the statue's vertical from its declared mounting
@@ -19,14 +19,22 @@
 //   statue-on-plinth  the statue sensor is fixed to the plinth: the statue's raises leave it still
 //   gyro-gain:K       the statue sensor's gyroscope reads K times its turn (K = -1: reversed)
 // --windows writes each step's true hold as a plinth-commission --window option, one a line.
+// --can IF sends the session on a bus in real time instead (the live test,
+// tests/integration/commission_live.sh): at each step's wait point it prints "hold STEP" and
+// stays there until a line on stdin, as a site stands still while a custodian answers a prompt.
+#include <poll.h>
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "monitor_config.h"
@@ -34,6 +42,8 @@
 #include "plinth/firmware/record_replay.h"
 #include "plinth/hal/can_codec.h"
 #include "plinth/hal/candump_log.h"
+#include "plinth/hal/pacing.h"
+#include "plinth/hal/socketcan.h"
 #include "plinth/host/cli.h"
 #include "plinth/host/input_error.h"
 
@@ -97,6 +107,34 @@ void ramp(double u, double& s, double& ds, double& dds) {
   dds = 0.5 * kPi * kPi * std::cos(kPi * u);
 }
 
+// How long each part of the session lasts, s.
+struct Timeline {
+  double rest = 12.0;         // the first rest
+  double place = 2.0;         // a wedge put under a sensor (a hand on it)
+  double hold = 7.0;          // the sensor on the wedge
+  double remove = 2.0;        // the wedge taken away
+  double stand = 3.0;         // the sensor back on its marks
+  double statue_stand = 5.0;  // the statue standing before a raise
+  double raise = 2.5;         // the statue's side raised, or lowered
+  double statue_hold = 7.0;   // the statue's side held up
+  double final_rest = 17.0;   // everything back, at the end
+};
+// --short: a live test's session (tests/integration/commission_live.sh, windows of 3 s).
+constexpr Timeline kShortTimeline{6.0, 1.5, 4.5, 1.5, 2.0, 3.5, 2.0, 4.5, 8.0};
+
+struct Options {
+  std::string config;
+  std::string out;
+  std::string can_interface;  // live: send the session on this bus
+  std::string windows;
+  std::vector<std::string> faults;
+  double half_width = 0.3;  // m
+  double lift_mm = 6.0;
+  double wedge_deg = 5.0;
+  unsigned seed = 1;
+  bool short_session = false;
+};
+
 struct Segment {
   double t0 = 0.0;
   double t1 = 0.0;
@@ -105,41 +143,46 @@ struct Segment {
   int kind = 0;
   int device = -1;
   int axis = 0;
+  // Live (--can): the step a custodian is prompted for while the site stands in this segment;
+  // the session stays in its middle until told to go on ("" none).
+  std::string step;
 };
 
 class Session {
  public:
-  Session(std::vector<Device> devices, int axes, double wedge_rad, double lift_rad, double rate)
+  Session(std::vector<Device> devices, int axes, double wedge_rad, double lift_rad, double rate,
+          const Timeline& time)
       : devices_(std::move(devices)), wedge_rad_(wedge_rad), lift_rad_(lift_rad), rate_(rate) {
     double t = 0.0;
-    const auto add = [&](double length, int kind, int device, int axis) {
-      segments_.push_back({t, t + length, kind, device, axis});
+    const auto add = [&](double length, int kind, int device, int axis, std::string step = "") {
+      segments_.push_back({t, t + length, kind, device, axis, std::move(step)});
       t += length;
     };
-    add(12.0, 0, -1, 0);
-    rest_ = {1.0, 11.0};
+    add(time.rest, 0, -1, 0, "rest");
     for (std::size_t d = 0; d < devices_.size(); ++d) {
       if (!devices_[d].ground || devices_[d].index < 0) continue;
       for (int axis = 0; axis < 2; ++axis) {
-        add(2.0, 1, static_cast<int>(d), axis);
-        holds_.push_back({name_wedge(devices_[d].node, axis), t + 0.5, t + 6.5});
-        add(7.0, 2, static_cast<int>(d), axis);
-        add(2.0, 3, static_cast<int>(d), axis);
-        add(3.0, 0, -1, 0);
+        add(time.place, 1, static_cast<int>(d), axis);
+        const std::string name = name_wedge(devices_[d].node, axis);
+        holds_.push_back({name, t + 0.5, t + time.hold - 0.5});
+        add(time.hold, 2, static_cast<int>(d), axis, name);
+        add(time.remove, 3, static_cast<int>(d), axis);
+        add(time.stand, 0, -1, 0);
       }
     }
     for (std::size_t d = 0; d < devices_.size(); ++d) {
       if (!devices_[d].statue) continue;
       for (int axis = 0; axis < axes; ++axis) {
-        add(5.0, 0, -1, 0);
-        add(2.5, 4, static_cast<int>(d), axis);
-        holds_.push_back({axis == 0 ? "statue-x" : "statue-y", t + 0.5, t + 6.5});
-        add(7.0, 5, static_cast<int>(d), axis);
-        add(2.5, 6, static_cast<int>(d), axis);
+        const std::string name = axis == 0 ? "statue-x" : "statue-y";
+        add(time.statue_stand, 0, -1, 0, name + "-before");
+        add(time.raise, 4, static_cast<int>(d), axis);
+        holds_.push_back({name, t + 0.5, t + time.statue_hold - 0.5});
+        add(time.statue_hold, 5, static_cast<int>(d), axis, name);
+        add(time.raise, 6, static_cast<int>(d), axis);
+        add(time.statue_stand, 0, -1, 0, name + "-after");
       }
     }
-    add(5.0, 0, -1, 0);
-    add(12.0, 0, -1, 0);
+    add(time.final_rest, 0, -1, 0, "final-rest");
     end_ = t;
   }
 
@@ -194,6 +237,15 @@ class Session {
     return m;
   }
 
+  // Live: the next wait point from session time `t` on (its step and the middle of its segment),
+  // or none.
+  [[nodiscard]] const Segment* next_wait(double t) const {
+    for (const Segment& s : segments_) {
+      if (!s.step.empty() && 0.5 * (s.t0 + s.t1) >= t) return &s;
+    }
+    return nullptr;
+  }
+
   std::vector<Device>& devices() { return devices_; }
   [[nodiscard]] double end() const { return end_; }
   [[nodiscard]] const std::vector<Hold>& holds() const { return holds_; }
@@ -203,7 +255,6 @@ class Session {
   std::vector<Device> devices_;
   std::vector<Segment> segments_;
   std::vector<Hold> holds_;
-  std::pair<double, double> rest_;
   double wedge_rad_;
   double lift_rad_;
   double rate_;
@@ -270,13 +321,51 @@ void parse_fault(const std::string& fault, std::vector<Device>& devices, int& ex
   }
 }
 
-int run(const std::string& config_path, const std::string& out_path,
-        const std::string& windows_path, const std::vector<std::string>& faults, double half_width,
-        double lift_mm, double wedge_deg, unsigned seed) {
-  const fw::MonitorFile file = fw::load_monitor_file(config_path, fw::box_defaults());
+// Live (--can): the session sent on a bus in real time; at each step's wait point it stays
+// there ("hold STEP" on stdout) until a line on stdin, then goes on to the next; it ends after
+// the last one.
+template <typename Sample>
+int run_live(const Options& opt, const Session& session, Sample& sample) {
+  plinth::hal::SocketCanOpenResult opened = plinth::hal::SocketCanPort::open(opt.can_interface);
+  if (!opened.ok()) throw InputError(opened.message);
+  plinth::hal::SocketCanPort& port = *opened.port;
+  const double rate = session.rate();
+  const auto start = std::chrono::steady_clock::now();
+  double tau = 0.0;
+  const Segment* wait = session.next_wait(0.0);
+  bool said = false;
+  std::string line;
+  for (std::int64_t n = 0; wait != nullptr; ++n) {
+    std::this_thread::sleep_until(
+        start + std::chrono::nanoseconds(std::llround(1e9 * static_cast<double>(n) / rate)));
+    const double middle = 0.5 * (wait->t0 + wait->t1);
+    if (tau >= middle && !said) {
+      std::printf("hold %s\n", wait->step.c_str());
+      std::fflush(stdout);
+      said = true;
+    }
+    pollfd in{STDIN_FILENO, POLLIN, 0};
+    if (said && n % 10 == 0 && ::poll(&in, 1, 0) > 0) {  // a look every 10 samples is enough
+      char c = 0;
+      if (::read(STDIN_FILENO, &c, 1) <= 0) break;  // stdin closed: the session ends
+      if (c == '\n') {
+        wait = session.next_wait(middle + 1e-6);
+        said = false;
+      }
+    }
+    sample(n, tau, plinth::hal::realtime_now_ns(), [&port](std::int64_t, const can::CanFrame& f) {
+      if (port.send(f) != plinth::hal::IoStatus::kOk) throw InputError("cannot send on the bus");
+    });
+    if (!said) tau += 1.0 / rate;  // a wait point holds the site still
+  }
+  return 0;
+}
+
+int run(const Options& opt) {
+  const fw::MonitorFile file = fw::load_monitor_file(opt.config, fw::box_defaults());
   std::array<fw::SensorConfig, fw::kMaxSensors> sensors{};
   const int count = fw::resolved_sensors(file.config, sensors);
-  std::mt19937 random(seed);
+  std::mt19937 random(opt.seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   std::vector<Device> devices;
   for (int i = 0; i < count; ++i) {
@@ -306,7 +395,7 @@ int run(const std::string& config_path, const std::string& out_path,
   const double rate_hz = file.config.estimator.sample_rate_hz;
   int extra = -1;
   int duplicate = -1;
-  for (const std::string& f : faults) parse_fault(f, devices, extra, duplicate);
+  for (const std::string& f : opt.faults) parse_fault(f, devices, extra, duplicate);
   if (extra > 0) {
     Device d;
     d.node = extra;
@@ -322,17 +411,17 @@ int run(const std::string& config_path, const std::string& out_path,
   }
   const int axes = file.second_scene_path.empty() ? 1 : 2;
   const double rate = file.config.estimator.sample_rate_hz;
-  Session session(devices, axes, wedge_deg * kPi / 180.0, lift_mm * 1e-3 / (2.0 * half_width),
-                  rate);
+  Session session(devices, axes, opt.wedge_deg * kPi / 180.0,
+                  opt.lift_mm * 1e-3 / (2.0 * opt.half_width), rate,
+                  opt.short_session ? kShortTimeline : Timeline{});
 
-  std::ofstream out(out_path);
-  if (!out) throw InputError(out_path + ": cannot write");
-  const auto samples = static_cast<std::int64_t>(session.end() * rate);
-  for (std::int64_t n = 0; n < samples; ++n) {
+  // One sample of each device at session time `tau` (+ its phase), stamped `stamp_ns` (+ its
+  // phase): its frames to `emit`.
+  const auto sample = [&](std::int64_t n, double tau, std::int64_t stamp_ns, auto emit) {
     for (Device& d : session.devices()) {
       if (d.silent) continue;
-      const double t = static_cast<double>(n) / rate + d.phase_s;
-      const std::int64_t t_ns = kEpochNs + std::llround(t * 1e9);
+      const double t = tau + d.phase_s;
+      const std::int64_t t_ns = stamp_ns + std::llround(d.phase_s * 1e9);
       const Motion m = session.motion(t);
       Eigen::Vector3d f(0.0, 0.0, kG0);  // statue frame, the body's own specific force, m/s2
       Eigen::Vector3d omega = Eigen::Vector3d::Zero();  // statue frame, rad/s
@@ -341,7 +430,8 @@ int run(const std::string& config_path, const std::string& out_path,
       }
       if (d.statue && !d.on_plinth && m.theta != 0.0) {
         // The block turning about its -x (-y) base edge, the sensor at its place on the block.
-        const double from_edge = half_width + (m.statue_axis == 0 ? d.offset_x_m : d.offset_y_m);
+        const double from_edge =
+            opt.half_width + (m.statue_axis == 0 ? d.offset_x_m : d.offset_y_m);
         const plinth::Vector2r plane = plinth::block_specific_force(
             plinth::Vector2r::Zero(), plinth::Vector2r(from_edge, d.height_m), m.theta, m.theta_dot,
             m.theta_ddot, kG0);
@@ -371,7 +461,7 @@ int run(const std::string& config_path, const std::string& out_path,
       acc.sequence = static_cast<std::uint8_t>(d.sequence);
       can::CanFrame frame;
       if (!can::encode(acc, frame).ok()) throw InputError("a sample beyond the frame's range");
-      out << frame_line(t_ns, frame);
+      emit(t_ns, frame);
       if (d.statue) {
         const Eigen::Vector3d w = d.gyro_gain * (d.to_statue.transpose() * omega);
         can::StatueRotation rot;
@@ -381,20 +471,31 @@ int run(const std::string& config_path, const std::string& out_path,
         rot.wz_rad_s = w.z() + kRateNoise * normal(random);
         rot.sequence = acc.sequence;
         if (!can::encode(rot, frame).ok()) throw InputError("a rate beyond the frame's range");
-        out << frame_line(t_ns + 1000, frame);  // its own microsecond (the log's time check)
+        emit(t_ns + 1000, frame);  // its own microsecond (the log's time check)
       }
       d.sequence = (d.sequence + 1) % 256;
       if (n % static_cast<std::int64_t>(rate) == 0) {  // heartbeats, once a second
         can::SensorHeartbeat beat;
         beat.node = acc.node;
         beat.uptime_s = static_cast<std::uint32_t>(n / static_cast<std::int64_t>(rate));
-        if (can::encode(beat, frame).ok()) out << frame_line(t_ns + 2000, frame);
+        if (can::encode(beat, frame).ok()) emit(t_ns + 2000, frame);
       }
     }
+  };
+  if (!opt.can_interface.empty()) return run_live(opt, session, sample);
+
+  std::ofstream out(opt.out);
+  if (!out) throw InputError(opt.out + ": cannot write");
+  const auto samples = static_cast<std::int64_t>(session.end() * rate);
+  for (std::int64_t n = 0; n < samples; ++n) {
+    const double tau = static_cast<double>(n) / rate;
+    sample(
+        n, tau, kEpochNs + std::llround(tau * 1e9),
+        [&out](std::int64_t t_ns, const can::CanFrame& frame) { out << frame_line(t_ns, frame); });
   }
-  if (!out.flush()) throw InputError(out_path + ": write failed");
-  if (!windows_path.empty()) {
-    std::ofstream w(windows_path);
+  if (!out.flush()) throw InputError(opt.out + ": write failed");
+  if (!opt.windows.empty()) {
+    std::ofstream w(opt.windows);
     for (const Session::Hold& h : session.holds()) {
       char line[96];
       std::snprintf(line, sizeof line, "%s=%.3f:%.3f\n", h.name.c_str(), h.t0, h.t1);
@@ -408,24 +509,20 @@ int run(const std::string& config_path, const std::string& out_path,
 
 int main(int argc, char** argv) {
   CLI::App app{"plinth-commission-fixture: a commissioning session as a candump log (tests)"};
-  std::string config;
-  std::string out;
-  std::string windows;
-  std::vector<std::string> faults;
-  double half_width = 0.3;
-  double lift_mm = 6.0;
-  double wedge_deg = 5.0;
-  unsigned seed = 1;
-  app.add_option("--config", config, "the box file (the installation as declared)")->required();
-  app.add_option("--out", out, "the candump log to write")->required();
-  app.add_option("--windows", windows, "write each step's true hold as --window options here");
-  app.add_option("--fault", faults, "a fault of the installation (see the source's head)");
-  app.add_option("--half-width", half_width, "the statue's half base width, m");
-  app.add_option("--lift-mm", lift_mm, "how far the statue's side is raised, mm");
-  app.add_option("--wedge-deg", wedge_deg, "the wedge's angle, deg");
-  app.add_option("--seed", seed, "the noise's seed");
+  Options opt;
+  app.add_option("--config", opt.config, "the box file (the installation as declared)")->required();
+  app.add_option("--out", opt.out, "the candump log to write");
+  app.add_option("--can", opt.can_interface,
+                 "send the session on this bus in real time, waiting at each step (stdin)")
+      ->excludes("--out");
+  app.add_option("--windows", opt.windows, "write each step's true hold as --window options here");
+  app.add_option("--fault", opt.faults, "a fault of the installation (see the source's head)");
+  app.add_option("--half-width", opt.half_width, "the statue's half base width, m");
+  app.add_option("--lift-mm", opt.lift_mm, "how far the statue's side is raised, mm");
+  app.add_option("--wedge-deg", opt.wedge_deg, "the wedge's angle, deg");
+  app.add_option("--seed", opt.seed, "the noise's seed");
+  app.add_flag("--short", opt.short_session,
+               "a short session (rests of 6 s, holds of 4.5 s), for the live test");
   if (const auto code = plinth::host::parse_command_line(app, argc, argv)) return *code;
-  return plinth::host::run_tool("plinth-commission-fixture", [&] {
-    return run(config, out, windows, faults, half_width, lift_mm, wedge_deg, seed);
-  });
+  return plinth::host::run_tool("plinth-commission-fixture", [&] { return run(opt); });
 }
