@@ -120,7 +120,7 @@ struct Timeline {
   double final_rest = 17.0;   // everything back, at the end
 };
 // --short: a live test's session (tests/integration/commission_live.sh, windows of 3 s).
-constexpr Timeline kShortTimeline{6.0, 1.5, 4.5, 1.5, 2.0, 3.5, 2.0, 4.5, 8.0};
+constexpr Timeline kShortTimeline{6.0, 1.0, 4.5, 1.0, 1.0, 3.5, 2.0, 4.5, 8.0};
 
 struct Options {
   std::string config;

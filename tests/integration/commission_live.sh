@@ -18,14 +18,15 @@ if [ "${1:-}" = "--guest" ]; then
   work=${2:?}
   cd "$work" || exit 1
   trap '[ $? -ne 77 ] || exit 1' EXIT  # never 77 from here: vcan-bus's "cannot start"
-  printf '[[sensor]]\nnode = 1\n' >box.toml
+  # 100 Hz: a guest's system calls are slow, and the site and the check make several a frame.
+  printf '[estimator]\nsample_rate_hz = 100.0\n[[sensor]]\nnode = 1\n' >box.toml
   rm -rf reports answers site
   mkfifo answers site
   # wait_for FILE PATTERN COUNT: until FILE has COUNT lines matching PATTERN (at most 120 s).
   wait_for() {
-    for _ in $(seq 2400); do
+    for _ in $(seq 600); do
       [ "$(grep -c -- "$2" "$1" 2>/dev/null)" -ge "$3" ] && return 0
-      sleep 0.05
+      sleep 0.2
     done
     echo "timed out waiting for '$2' in $1: $(tail -c 600 "$1")" >&2
     return 1
@@ -52,13 +53,13 @@ if [ "${1:-}" = "--guest" ]; then
     fi
     echo >&3
     wait_for out.txt 'recorded\.' "$step" || { ok=1; break; }
-    for _ in $(seq 2400); do
+    for _ in $(seq 600); do
       grep -qE "^\[$((step + 1))/4\]|^commissioning (PASSED|FAILED)" out.txt && break
       if [ "$(grep -c '^This step failed' out.txt)" -gt "$failed" ]; then
         failed=$((failed + 1))
         echo >&3
       fi
-      sleep 0.05
+      sleep 0.2
     done
   done
   wait "$commission"
@@ -67,12 +68,18 @@ if [ "${1:-}" = "--guest" ]; then
   wait "$site"
   echo "plinth-commission exit $status; the site: $(tr '\n' ';' <site.txt)"
   cat out.txt err.txt
+  # Frames lost in a starved guest are the rig's failure, not plinth-commission's (which says
+  # so, as it must): exit 3, the host tries once more.
+  if [ $status -eq 4 ] && ! grep '^  FAIL ' out.txt | grep -qvE 'samples lost|dropped frames'; then
+    echo "the rig lost frames (the guest starved): $(grep '^  FAIL ' out.txt | head -1)"
+    exit 3
+  fi
   check() {
     if eval "$2"; then echo "ok - $1"; else echo "not ok - $1"; ok=1; fi
   }
   check "live on vcan0: exit 0, PASSED" "[ $status -eq 0 ] && grep -q '^commissioning PASSED' out.txt"
   check "the report: pass, the interface, 4 windows from the prompts" \
-    "grep -q '\"result\": \"pass\"' reports/commission-001.json &&
+    "grep -q '^  \"result\": \"pass\",\$' reports/commission-001.json &&
      grep -q '\"interface\": \"vcan0\"' reports/commission-001.json &&
      [ \$(grep -c '\"from\": \"prompt\"' reports/commission-001.json) -eq 4 ]"
   check "the session's frames kept as commission-001.log" \
@@ -98,5 +105,11 @@ for bin in "${PLINTH_COMMISSION:-}" "${PLINTH_COMMISSION_FIXTURE:-}"; do
 done
 rm -rf "$work"
 mkdir -p "$work"
-exec bash "$root/tools/vcan-bus.sh" "${bus[@]}" --timeout 200 -- \
-  bash "$root/tests/integration/commission_live.sh" --guest "$work"
+for attempt in 1 2; do
+  status=0
+  bash "$root/tools/vcan-bus.sh" "${bus[@]}" --timeout 240 -- \
+    bash "$root/tests/integration/commission_live.sh" --guest "$work" || status=$?
+  [ $status -eq 3 ] || exit $status
+  echo "attempt $attempt: the guest lost frames; $([ $attempt -eq 1 ] && echo once more)"
+done
+exit 1
