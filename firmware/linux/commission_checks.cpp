@@ -459,15 +459,25 @@ class Checker {
             continue;
           }
           const double end = w.after.found() ? w.after.t1 : w.hold.t1;
-          const std::vector<Eigen::Vector3d> turn =
-              gyro_turn(i, gyro_offset(i, w), w.before.t0, end);
+          const Eigen::Vector3d bias = gyro_offset(i, w);
+          const std::vector<Eigen::Vector3d> turn = gyro_turn(i, bias, w.before.t0, end);
+          // The statue stands before and after: the turn is 0 in both windows, the offset's
+          // error (a line) taken out, as the check's up-and-down mean does.
+          const Eigen::Vector3d at_before = mean_turn(i, bias, w.before.t0, w.before);
+          const Eigen::Vector3d at_after =
+              w.after.found() ? mean_turn(i, bias, w.before.t0, w.after) : at_before;
+          const double c_before = 0.5 * (w.before.t0 + w.before.t1);
+          const double c_after = w.after.found() ? 0.5 * (w.after.t0 + w.after.t1) : c_before;
           const Stream& rate = rate_[i];
+          const auto first = std::lower_bound(rate.t.begin(), rate.t.end(), w.before.t0);
           for (std::size_t k = 0; k < turn.size(); k += stride) {
-            const auto first = std::lower_bound(rate.t.begin(), rate.t.end(), w.before.t0);
-            trace.gyro_t.push_back(*(first + static_cast<std::ptrdiff_t>(k)));
+            const double t = *(first + static_cast<std::ptrdiff_t>(k));
+            const double along = c_after > c_before ? (t - c_before) / (c_after - c_before) : 0.0;
+            const Eigen::Vector3d r = turn[k] - at_before - along * (at_after - at_before);
+            trace.gyro_t.push_back(t);
             // Raising +x turns the block about -y; raising +y about +x.
-            trace.gyro_raise_x_deg.push_back(-turn[k].y() * kDeg);
-            trace.gyro_raise_y_deg.push_back(turn[k].x() * kDeg);
+            trace.gyro_raise_x_deg.push_back(-r.y() * kDeg);
+            trace.gyro_raise_y_deg.push_back(r.x() * kDeg);
           }
           trace.gyro_t.push_back(std::numeric_limits<double>::quiet_NaN());  // a break
           trace.gyro_raise_x_deg.push_back(std::numeric_limits<double>::quiet_NaN());

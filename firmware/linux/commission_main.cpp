@@ -146,7 +146,7 @@ std::vector<Prompt> prompts(const fw::Step& step,
                     side, kStandingS);
       out.push_back({fw::window_name(step, "before"), text, kStandingS});
       std::snprintf(text, sizeof text,
-                    "Raise the statue's %s side by 3 to 10 mm (it turns on its %s edge: a "
+                    "Raise the statue's %s side by 5 to 10 mm (it turns on its %s edge: a "
                     "conservator's jack or lever, as when shims are set) and hold it still. Press "
                     "Enter, then hold it for %.0f s.",
                     side, edge, s.hold_s);
@@ -480,13 +480,13 @@ int run(const Options& opt) {
 constexpr const char* kFooter = R"(PROCEDURE (docs/commissioning.md)
   Stop the box first (systemctl stop plinth-monitor@can0): a tilted sensor is shaking to it.
   1. rest         nobody touches anything, rest_s (10 s): each accelerometer's gravity (its unit
-                  and vertical gain), its level, its noise; the statue gyroscope's offset.
+                  and vertical gain), its level, its noise; the statue gyroscope's spread.
   2. tilt-x:N     for each ground and plate sensor N in the box file's order: a wedge of
      tilt-y:N     wedge_deg (5 deg) under its +x side, then under its +y side, hold_s (5 s):
                   the raise must read wedge_deg +- wedge_tolerance_deg toward +x, then +y:
                   heading (a sensor turned about the vertical), each horizontal axis's sign
                   and gain.
-  3. statue-x     the statue's +x side raised by 3 to 10 mm and held (statue-y too, with a
+  3. statue-x     the statue's +x side raised by 5 to 10 mm and held (statue-y too, with a
      statue-y     second axis), its sensor standing before and after: the statue sensor must
                   tilt by statue_min_tilt_deg at least, toward +x (+y), its gyroscope turn as its
                   accelerometer tilts (sign, gain, deg/s for rad/s), the statue back on its seat.

@@ -48,7 +48,7 @@ std::string plain(const std::string& text) {
   std::string out;
   for (const char c : text) {
     const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                      std::string_view(" .,:;_+-()/=").find(c) != std::string_view::npos;
+                      std::string_view(" .,:;_+-()[]/=").find(c) != std::string_view::npos;
     out.push_back(keep ? c : '_');
   }
   return out.substr(0, 160);
