@@ -1,6 +1,7 @@
 // The commissioning's parts (docs/commissioning.md): the box file's [commissioning] table, the
-// mounting's digest, plinth-monitor's reading of the reports (commission_gate.h), and the checks
-// on a session built here sample by sample (commission_checks.h). The programs on sessions made
+// mounting's digest, plinth-monitor's reading of the reports (commission_gate.h), the fault it
+// holds while refusing (Monitor::hold_fault), and the checks on a session built here sample by
+// sample (commission_checks.h). The programs on sessions made
 // from the solver, and plinth-monitor's refusal: tests/cli/test_commission.sh; live on a bus:
 // tests/integration/commission_live.sh.
 #include <gtest/gtest.h>
@@ -16,6 +17,9 @@
 #include "commission_gate.h"
 #include "commission_report.h"
 #include "monitor_config.h"
+#include "plinth/firmware/frame_decoder.h"
+#include "plinth/firmware/monitor.h"
+#include "test_support.h"
 
 namespace plinth::firmware {
 namespace {
@@ -189,6 +193,63 @@ TEST_F(Gate, PollLooksAgainOnlyAfterItsIntervalAndWhenTheFolderChanged) {
   EXPECT_TRUE(gate.poll(3'100'000'000));
   EXPECT_EQ(gate.verdict().state, GateState::kPassed);
   EXPECT_FALSE(gate.poll(5'200'000'000));  // nothing new
+}
+
+// The box's refusal (Monitor::hold_fault, as plinth-monitor holds it while the gate refuses):
+// fault with the cause commissioning_failed from the first evaluation, through a quiet start-up
+// that would otherwise earn normal; never hiding the alarm of a collapse (the non-isolated block
+// pushed over, as test_monitor's AcknowledgeFrameReleasesTheLatch); and normal again once
+// released.
+TEST(HeldFault, ShowsCommissioningFailedNeverHidesTheAlarmAndLifts) {
+  const Scene scene = testing::make(testing::paper_block(0.0));
+  MonitorConfig config;
+  config.estimator.sample_rate_hz = 200.0;
+  config.conditioning.startup_window_s = 0.5;
+  config.sensor_health.stuck_samples = 0;
+  const auto run = [&](Monitor& monitor, bool push, int samples, bool release_at_half) {
+    FrameDecoder decoder;
+    decoder.start(config);
+    std::vector<monitor::AlarmEventRecord> events;
+    for (int n = 0; n < samples && !monitor.status().axes[0].mode.terminal(); ++n) {
+      if (release_at_half && n == samples / 2) monitor.hold_fault(monitor::AlarmCause::kNone);
+      hal::can::SensorAcceleration m;
+      m.node = 1;
+      m.ax_g = push && n >= 400 && n < 600 ? 0.6 : 0.0;
+      m.az_g = 1.0;
+      m.sequence = static_cast<std::uint8_t>(n);
+      hal::TimedFrame frame;
+      frame.timestamp_ns = static_cast<std::int64_t>(n) * 5'000'000;
+      EXPECT_TRUE(hal::can::encode(m, frame.frame).ok());
+      const MonitorUpdate u = on_frame(monitor, decoder, frame);
+      events.insert(events.end(), u.events.begin(),
+                    u.events.begin() + static_cast<std::ptrdiff_t>(u.event_count));
+      if (n > 0 && n < 400 && !(release_at_half && n >= samples / 2)) {
+        EXPECT_EQ(u.status->alarm, monitor::AlarmLevel::kFault) << n;
+      }
+    }
+    return events;
+  };
+  Monitor pushed;
+  ASSERT_TRUE(pushed.start(config, {&scene, nullptr}).ok());
+  pushed.hold_fault(monitor::AlarmCause::kCommissioningFailed);
+  std::vector<monitor::AlarmEventRecord> events = run(pushed, true, 1400, false);
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.front().level, monitor::AlarmLevel::kFault);
+  EXPECT_EQ(events.front().cause, monitor::AlarmCause::kCommissioningFailed);
+  EXPECT_EQ(pushed.status().axes[0].mode.phase, Phase::kOverturned);
+  EXPECT_EQ(pushed.status().alarm, monitor::AlarmLevel::kAlarm);
+  Monitor released;
+  ASSERT_TRUE(released.start(config, {&scene, nullptr}).ok());
+  released.hold_fault(monitor::AlarmCause::kCommissioningFailed);
+  events = run(released, false, 2000, true);  // 10 s, released after 5 s
+  ASSERT_GE(events.size(), 2U);
+  EXPECT_EQ(events.front().cause, monitor::AlarmCause::kCommissioningFailed);
+  EXPECT_EQ(events.back().level, monitor::AlarmLevel::kNormal);
+  EXPECT_EQ(released.status().alarm, monitor::AlarmLevel::kNormal);
+  // A restart forgets it: plinth-monitor holds it again after each start.
+  ASSERT_TRUE(pushed.start(config, {&scene, nullptr}).ok());
+  EXPECT_NE(run(pushed, false, 600, false).front().cause,
+            monitor::AlarmCause::kCommissioningFailed);
 }
 
 // A session made here: one ground sensor at rest, on the wedge on its +x side, then its +y side,
