@@ -23,7 +23,6 @@
 #include <string>
 #include <vector>
 
-#include "capture_store.h"
 #include "commission_checks.h"
 #include "commission_report.h"
 #include "commission_session.h"
@@ -378,7 +377,7 @@ std::string write_report(const Options& opt, const Outcome& outcome, fw::ReportC
   std::string error;
   if (!outcome.log_text.empty()) {
     context.record_name = stem + ".log";
-    if (!fw::write_file_whole(directory, context.record_name, outcome.log_text, error)) {
+    if (!fw::write_report_file(directory, context.record_name, outcome.log_text, error)) {
       throw InputError(error);
     }
   }
@@ -389,7 +388,7 @@ std::string write_report(const Options& opt, const Outcome& outcome, fw::ReportC
     const std::string png = fw::draw_picture(outcome.result, title, context.picture_note);
     if (!png.empty()) {
       context.picture_name = stem + ".png";
-      if (!fw::write_file_whole(directory, context.picture_name, png, error)) {
+      if (!fw::write_report_file(directory, context.picture_name, png, error)) {
         throw InputError(error);
       }
     }
@@ -398,8 +397,7 @@ std::string write_report(const Options& opt, const Outcome& outcome, fw::ReportC
   }
   // The JSON last: plinth-monitor takes the newest JSON, which comes with its files.
   const std::string name = stem + ".json";
-  if (!fw::write_file_whole(directory, name, fw::report_json(outcome.result, context), error) ||
-      !fw::commit_folder(directory, error)) {
+  if (!fw::write_report_file(directory, name, fw::report_json(outcome.result, context), error)) {
     throw InputError(error);
   }
   if (!context.picture_note.empty() && context.picture_note != "--no-picture") {

@@ -1,11 +1,14 @@
 #include "commission_report.h"
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
@@ -275,6 +278,50 @@ int newest_report_index(const std::string& directory) {
     newest = std::max(newest, std::stoi(digits));
   }
   return newest;
+}
+
+bool write_report_file(const std::string& directory, const std::string& name,
+                       const std::string& text, std::string& error) {
+  const fs::path final_path = fs::path(directory) / name;
+  const fs::path partial = fs::path(directory) / ("." + name + ".partial");
+  const auto failed = [&](const char* what, const fs::path& path) {
+    error = std::string("cannot ") + what + " " + path.string() + ": " + std::strerror(errno);
+    ::unlink(partial.c_str());
+    return false;
+  };
+  std::error_code exists_error;
+  if (fs::exists(fs::symlink_status(final_path, exists_error))) {
+    error = final_path.string() + " exists already: a report is never written over";
+    return false;
+  }
+  ::unlink(partial.c_str());  // a partial file left by a killed run, or a symlink: never opened
+  const int fd =
+      ::open(partial.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd < 0) return failed("create", partial);
+  std::size_t done = 0;
+  while (done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      ::close(fd);
+      return failed("write", partial);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    ::close(fd);
+    return failed("flush", partial);
+  }
+  if (::close(fd) != 0) return failed("close", partial);
+  if (::rename(partial.c_str(), final_path.c_str()) != 0) return failed("rename", partial);
+  const int dir = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  const bool synced = dir >= 0 && ::fsync(dir) == 0;
+  if (dir >= 0) ::close(dir);
+  if (!synced) {
+    error = "cannot flush the folder " + directory + ": " + std::strerror(errno);
+    return false;
+  }
+  return true;
 }
 
 std::string utc_now() {

@@ -50,6 +50,13 @@ struct ReportContext {
 // or missing: 0 too).
 [[nodiscard]] int newest_report_index(const std::string& directory);
 
+// Writes `text` to `directory`/`name` whole or not at all, as the recorder writes its captures
+// (docs/monitor.md, "Event recorder"): into ".name.partial" (created afresh), flushed (fsync),
+// renamed, the folder flushed. Never over an existing file: false with `error` saying so, as for
+// any failed step (the partial file is then removed).
+[[nodiscard]] bool write_report_file(const std::string& directory, const std::string& name,
+                                     const std::string& text, std::string& error);
+
 // ISO 8601 UTC of the wall clock now: "2025-05-12T09:41:07Z".
 [[nodiscard]] std::string utc_now();
 
