@@ -59,7 +59,7 @@ inline constexpr CodeTable<monitor::AlarmLevel, 5> kAlarmLevelCodes{{{
     {monitor::AlarmLevel::kAlarm, 3},
     {monitor::AlarmLevel::kFault, 4},
 }}};
-inline constexpr CodeTable<monitor::AlarmCause, 19> kAlarmCauseCodes{{{
+inline constexpr CodeTable<monitor::AlarmCause, 20> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kNone, 0},
     {monitor::AlarmCause::kRiskThreshold, 1},
     {monitor::AlarmCause::kPhaseChange, 2},
@@ -79,6 +79,7 @@ inline constexpr CodeTable<monitor::AlarmCause, 19> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kStatueSensorFault, 16},
     {monitor::AlarmCause::kRestored, 17},
     {monitor::AlarmCause::kStatueStands, 18},
+    {monitor::AlarmCause::kCommissioningFailed, 19},
 }}};
 inline constexpr CodeTable<Phase, 7> kPhaseCodes{{{
     {Phase::kFullContact, 0},
