@@ -333,6 +333,54 @@ TEST(MonitorConfigFile, EveryKeyOfTheWrongTypeIsSaidToBeOne) {
   EXPECT_GT(tables.size(), 12U);
 }
 
+// Issue 33: the recorder's buffers hold every configured sensor's frames (the statue sensor's
+// two a sample beside the ground sensor's) and recorder.bus_frames_hz of other traffic.
+TEST(MonitorConfigFile, TheRecordersFrameRateCountsEverySensor) {
+  MonitorFile file = load_monitor_text("[estimator]\nsample_rate_hz = 200.0\n", "box.toml",
+                                       MonitorConfig{});
+  EXPECT_DOUBLE_EQ(recorder_frame_rate_hz(file), 1.25 * 200 + 1 + 2000);
+  file = load_monitor_text(
+      "[estimator]\nsample_rate_hz = 200.0\n[statue_sensor]\nnode = 2\n[recorder]\n"
+      "bus_frames_hz = 0\n",
+      "box.toml", MonitorConfig{});
+  EXPECT_DOUBLE_EQ(recorder_frame_rate_hz(file), 1.25 * 3 * 200 + 2) << "three frames a sample";
+  file = load_monitor_text(
+      "[estimator]\nsample_rate_hz = 1000.0\n[[sensor]]\nnode = 1\n[[sensor]]\nnode = 3\n"
+      "role = \"plate\"\n[recorder]\nbus_frames_hz = 500\n",
+      "box.toml", MonitorConfig{});
+  EXPECT_DOUBLE_EQ(recorder_frame_rate_hz(file), 1.25 * 2 * 1000 + 2 + 500);
+  EXPECT_EQ(box_file_error("[recorder]\nbus_frames_hz = -1\n"),
+            "/etc/plinth/box.toml:2: recorder.bus_frames_hz: must be a number of frames/s in [0, "
+            "25000] (a CAN bus at 1 Mbit/s carries at most about 21,000 frames/s)");
+}
+
+// Issue 33: the keys read apart, arrays of tables, given a value or a table: their type is
+// named, never "unknown key" (sensor = 3 was one).
+TEST(MonitorConfigFile, AnArrayOfTablesOfTheWrongTypeIsSaidToBeOne) {
+  const struct {
+    const char* text;
+    const char* message;
+  } cases[] = {
+      {"sensor = 3\n",
+       "box.toml:1: sensor: expected [[sensor]] tables (an array of tables), got an integer"},
+      {"sensor = \"a\"\n", "sensor: expected [[sensor]] tables (an array of tables), got a string"},
+      {"sensor = []\n", "sensor: expected [[sensor]] tables (an array of tables), got an empty"},
+      {"sensor = [1, 2]\n", "sensor: expected [[sensor]] tables (an array of tables), got an array"},
+      {"[sensor]\nnode = 1\n",
+       "sensor: expected [[sensor]] tables (an array of tables), got a table"},
+      {"[pwave]\npredictor = 3\n", "pwave.predictor: expected an array of tables { window_s"},
+      {"[pwave.predictor]\nwindow_s = 1.0\n",
+       "pwave.predictor: expected an array of tables { window_s, ln_pga_over_pa, tau_c_exponent, "
+       "sigma_ln } (plinth-eval pwave-fit prints one), got a table"},
+  };
+  for (const auto& c : cases) {
+    const std::string message = box_file_error(c.text);
+    SCOPED_TRACE(c.text);
+    EXPECT_EQ(message.find("unknown key"), std::string::npos) << message;
+    EXPECT_NE(message.find(c.message), std::string::npos) << message;
+  }
+}
+
 // A directory was read as an empty file (the defaults, silently); /dev/zero grew memory.
 TEST(MonitorConfigFile, DirectoriesAndDevicesAreRefusedUnread) {
   const std::string message_for_dir = [] {
