@@ -120,8 +120,9 @@ Fault parse_fault(const std::string& text) {
   const std::size_t colon = text.find(':');
   const std::string kind = text.substr(0, colon);
   if (!kFaultKindNames.parse(kind, f.kind)) {
-    throw InputError("--fault: unknown kind " + host::shown(kind) + " (" +
-                     joined_names<kFaultKindNames>("one of ").data() + ")");
+    throw InputError("--fault: unknown kind " + host::shown(kind) +
+                     " (plinth-eval run --help lists the kinds; docs/safety.md says what each "
+                     "does)");
   }
   const bool has_param = colon != std::string::npos;
   f.param = has_param ? text.substr(colon + 1) : "";
