@@ -613,25 +613,24 @@ TEST(EvalMetrics, RunsFileErrorsNameTheLineAndColumn) {
       "first_warning_s,first_alarm_s,fault,fault_param,fault_at,fault_began_s,"
       "first_fault_trouble_s,fault_trouble_at_end,first_statue_fault_s,"
       "first_statue_unexplained_s,level_at_end,trouble_at_end,runs_written\n";
-  const std::string run = "r,s,0,0.3,0,-1,0.1,-1,-1,-1,";
-  EXPECT_NE(error_reading(fault_header + run + "none,,,1,-1,0,-1,-1,normal,none,all\n")
-                .find(":2: fault none: its parameter, onset and began_s must be empty"),
-            std::string::npos);
-  EXPECT_NE(error_reading(fault_header + run + "reset,,3,3,-1,2,-1,-1,normal,none,all\n")
-                .find(":2: fault_trouble_at_end: expected 0 or 1, got \"2\""),
-            std::string::npos);
-  EXPECT_NE(error_reading(fault_header + run + "reset,,3,3,-1,0,-1,-1,asleep,none,all\n")
-                .find(":2: level_at_end: expected a level or down, got \"asleep\""),
-            std::string::npos);
-  EXPECT_NE(error_reading(fault_header + run + "reset,,3,3,-1,0,-1,-1,down,sleepy,all\n")
-                .find(":2: trouble_at_end: expected a cause, got \"sleepy\""),
-            std::string::npos);
-  EXPECT_NE(error_reading(fault_header + run + "reset,,3,3,-1,0,-1,-1,down,none,some\n")
-                .find(":2: runs_written: expected all or collapses, got \"some\""),
-            std::string::npos);
-  EXPECT_NE(error_reading(fault_header + run + "reset,,3,x,-1,0,-1,-1,down,none,all\n")
-                .find(":2: fault_began_s: expected a finite number, got \"x\""),
-            std::string::npos);
+  const auto refused = [&](const std::string& fields, const std::string& message) {
+    EXPECT_NE(error_reading(fault_header + "r,s,0,0.3,0,-1,0.1,-1,-1,-1," + fields + "\n")
+                  .find(":2: " + message),
+              std::string::npos)
+        << message;
+  };
+  refused("none,,,1,-1,0,-1,-1,normal,none,all",
+          "fault none: its parameter, onset and began_s must be empty");
+  refused("reset,,3,3,-1,2,-1,-1,normal,none,all",
+          "fault_trouble_at_end: expected 0 or 1, got \"2\"");
+  refused("reset,,3,3,-1,0,-1,-1,asleep,none,all",
+          "level_at_end: expected a level or down, got \"asleep\"");
+  refused("reset,,3,3,-1,0,-1,-1,down,sleepy,all",
+          "trouble_at_end: expected a cause, got \"sleepy\"");
+  refused("reset,,3,3,-1,0,-1,-1,down,none,some",
+          "runs_written: expected all or collapses, got \"some\"");
+  refused("reset,,3,x,-1,0,-1,-1,down,none,all",
+          "fault_began_s: expected a finite number, got \"x\"");
 }
 
 // A run whose true statue lifted off has no truth: it counts in no outcome. A runs file
