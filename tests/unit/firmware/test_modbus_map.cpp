@@ -96,7 +96,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 7);
+  EXPECT_EQ(at(reg::kMapVersion), 8);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";
