@@ -34,11 +34,15 @@ set(PLINTH_MONITOR_DEPENDS "${plinth_cxx_runtime}, libgpiod2 (>= 1.6), libmosqui
 
 set(CPACK_DEBIAN_MONITOR_PACKAGE_NAME plinth-monitor)
 set(CPACK_DEBIAN_MONITOR_PACKAGE_DEPENDS "${PLINTH_MONITOR_DEPENDS}")
+# plinth-commission draws its report's picture with gnuplot (docs/commissioning.md); without it
+# the report says so and has no picture.
+set(CPACK_DEBIAN_MONITOR_PACKAGE_RECOMMENDS "gnuplot-nox | gnuplot")
 set(CPACK_DEBIAN_MONITOR_PACKAGE_SUGGESTS "can-utils, mbpoll, mosquitto-clients")
 set(CPACK_COMPONENT_MONITOR_DESCRIPTION "plinth's monitor box: the statue's earthquake early warning
  plinth-monitor estimates the phase of motion and the overturning risk of a statue on its
  isolation base from accelerometers on a CAN bus, and raises alarms on CAN, relays, Modbus TCP
- and MQTT; plinth-replay sends recorded earthquakes on a bus. A systemd unit per CAN interface
+ and MQTT; plinth-commission checks the sensors on site against the box file before the box is
+ trusted; plinth-replay sends recorded earthquakes on a bus. A systemd unit per CAN interface
  (plinth-monitor@can0), its Modbus socket unit, the service's user, and the data: the CAN
  database, example scenes and box configuration.")
 set(plinth_debian ${CMAKE_CURRENT_LIST_DIR}/debian)

@@ -143,6 +143,7 @@ Answer write_coils(std::span<const std::uint8_t> request, bool may_write,
   a.function = function;
   a.acknowledge = written[coil::kAcknowledge];
   a.reset = written[coil::kReset];
+  a.statue_stands = written[coil::kStatueStands];
   // Function 05 echoes the request; 15 answers with the address and the quantity.
   Writer w(request, out);
   w.byte(function);

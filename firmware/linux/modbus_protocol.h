@@ -70,6 +70,7 @@ struct Answer {
   bool write_refused = false;  // a register write, or a coil write this client may not make
   bool acknowledge = false;    // coil 0 written 1
   bool reset = false;          // coil 1 written 1
+  bool statue_stands = false;  // coil 2 written 1
 };
 
 // Answers the complete frame `request` (frame_at()'s bytes) from `image` into `out`; coil

@@ -250,6 +250,7 @@ ModbusServer::Closed ModbusServer::answer_frames(Client& c, std::int64_t now_ns,
     }
     if (a.acknowledge) post_command(OperatorCommand::kAcknowledge);
     if (a.reset) post_command(OperatorCommand::kReset);
+    if (a.statue_stands) post_command(OperatorCommand::kStatueStands);
     std::memmove(c.received.data(), c.received.data() + frame.bytes, c.used - frame.bytes);
     c.used -= frame.bytes;
     if (c.used > 0) c.frame_started_ns = now_ns;

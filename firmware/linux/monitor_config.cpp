@@ -322,6 +322,26 @@ void pwave_bindings(std::vector<Binding>& b, monitor::PWaveSettings& p, std::str
   for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
 }
 
+// [commissioning] (commission_settings.h).
+void commissioning_bindings(std::vector<Binding>& b, CommissioningSettings& c) {
+  b.push_back({"commissioning.required", flag_into(c.required), "true or false"});
+  b.push_back({"commissioning.report", string_into(c.report), "a string (a report's path)"});
+  b.push_back({"commissioning.override", string_into(c.override_reason), "a string (the reason)"});
+  const std::pair<const char*, double*> numbers[] = {
+      {"commissioning.wedge_deg", &c.wedge_deg},
+      {"commissioning.wedge_tolerance_deg", &c.wedge_tolerance_deg},
+      {"commissioning.heading_tolerance_deg", &c.heading_tolerance_deg},
+      {"commissioning.gravity_tolerance", &c.gravity_tolerance},
+      {"commissioning.level_tolerance_deg", &c.level_tolerance_deg},
+      {"commissioning.statue_min_tilt_deg", &c.statue_min_tilt_deg},
+      {"commissioning.gyro_tolerance", &c.gyro_tolerance},
+      {"commissioning.seat_tolerance_deg", &c.seat_tolerance_deg},
+      {"commissioning.rest_s", &c.rest_s},
+      {"commissioning.hold_s", &c.hold_s},
+  };
+  for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
+}
+
 std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::string& unit,
                               std::array<bool, kRelayCount>& relay_active_low,
                               monitor::PWaveSettings& pwave, std::string& pwave_channel) {
@@ -382,6 +402,7 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::
   b.push_back({"recorder.test_pause_mid_write_s", number_into(f.recorder.test_pause_mid_write_s),
                "a number (s; test only)"});
   output_bindings(b, f.modbus, f.mqtt);
+  commissioning_bindings(b, f.commissioning);
   pwave_bindings(b, pwave, pwave_channel);
   using monitor::built_part;
   using monitor::RiskThresholds;
@@ -945,6 +966,15 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   if (const toml::node* table = doc.get("pwave")) read_pwave(*table, pwave, pwave_channel, file.config, lines);
   check(file.config, lines);
   check_outputs(file, lines, origin);
+  if (const std::optional<SettingError> e = validate(file.commissioning)) {
+    lines.fail(e->key, e->message);
+  }
+  if (lines.has("commissioning.override") && file.commissioning.override_reason.empty()) {
+    lines.fail("commissioning.override",
+               "commissioning.override: give the reason the box monitors without a passing "
+               "commissioning (it is logged at each start)");
+  }
+  resolve_path(file.commissioning.report, origin);
   read_regional_key(file, lines, origin);
   file.key_where = lines.all_where();
   return file;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "capture_store.h"
+#include "commission_settings.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/firmware/record_replay.h"
 #include "modbus_server.h"
@@ -41,6 +42,7 @@ struct MonitorFile {
   // Each key the file set, and where: "box.toml:12" (the checks after the command line name
   // the line of a key that has no effect).
   std::map<std::string, std::string> key_where;
+  CommissioningSettings commissioning;  // [commissioning] (docs/commissioning.md)
 };
 
 // Frames/s the event recorder's buffers are sized for (event_recorder.h): every configured

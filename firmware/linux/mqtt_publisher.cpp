@@ -530,8 +530,9 @@ void MqttPublisher::publish_head(std::int64_t now_ns) {
 }
 
 // An operator's command (docs/integration.md, "Commands"): {"command": "acknowledge",
-// "level": .., "sequence": .., "id": ..}; level and sequence default to what the box shows.
-// A well-formed acknowledgement goes to the loop; the reply waits for its outcome.
+// "level": .., "sequence": .., "id": ..}, or {"command": "statue_stands", "sequence": ..,
+// "id": ..} (docs/safety.md); level and sequence default to what the box shows. A well-formed
+// command goes to the loop; the reply waits for its outcome.
 void MqttPublisher::on_message(const std::string& topic, const std::string& payload,
                                bool retained, const std::string& hmac) {
   if (topic == availability_topic_) {
@@ -555,8 +556,9 @@ void MqttPublisher::on_message(const std::string& topic, const std::string& payl
   if (topic != command_topic_) return;
   ++commands_received_;
   std::string id_json = "null";
+  std::string name = "acknowledge";  // the reply's "command"
   const auto refuse = [&](const std::string& why) {
-    reply(id_json, "refused", why, "");
+    reply(id_json, name, "refused", why, "");
     incoming_log_.say("command refused: " + why + ": " + printable(payload), monotonic_ns());
   };
   // Published retained, a command would be carried out again at every connection of the box.
@@ -583,15 +585,19 @@ void MqttPublisher::on_message(const std::string& topic, const std::string& payl
     }
   }
   if (!command.contains("command") || !command["command"].is_string()) {
-    return refuse("command: expected \"acknowledge\"");
+    return refuse("command: expected \"acknowledge\" or \"statue_stands\"");
   }
-  if (command["command"].get<std::string>() != "acknowledge") {
+  CommandRequest request;
+  if (command["command"].get<std::string>() == "statue_stands") {
+    name = "statue_stands";
+    request.command = OperatorCommand::kStatueStands;
+    if (command.contains("level")) return refuse("level: statue_stands takes a sequence only");
+  } else if (command["command"].get<std::string>() != "acknowledge") {
     return refuse("command: unknown command " +
                   printable(command["command"].dump(-1, ' ', true), 64) +
-                  " (expected \"acknowledge\")");
+                  " (expected \"acknowledge\" or \"statue_stands\")");
   }
   if (!settings_.commands) return refuse("commands are off (mqtt.commands = false)");
-  CommandRequest request;
   request.level = state_.latched;
   request.event_sequence = state_.event_sequence;
   if (command.contains("level")) {
@@ -615,10 +621,12 @@ void MqttPublisher::on_message(const std::string& topic, const std::string& payl
   }
   request.id = next_command_id_++;
   if (!mailbox_.post_command(request)) return refuse("busy: the loop has not taken commands");
-  pending_[request.id] = {id_json, JsonObject()
-                                       .text("level", monitor::alarm_level_name(request.level))
-                                       .count("sequence", request.event_sequence)
-                                       .close()};
+  JsonObject details;
+  if (request.command == OperatorCommand::kAcknowledge) {
+    details.text("level", monitor::alarm_level_name(request.level));
+  }
+  pending_[request.id] = {id_json, request.command,
+                          details.count("sequence", request.event_sequence).close()};
 }
 
 // A regional alert (docs/regional.md, "MQTT"), its UTC times made relative to now, its HMAC
@@ -685,13 +693,15 @@ void MqttPublisher::pass_regional_alerts(std::int64_t now_ns) {
                           regional_waiting_.begin() + static_cast<std::ptrdiff_t>(passed));
 }
 
-// {"id": .., "command": "acknowledge", "result": "accepted" | "refused", "reason": ..,
-// "level": .., "sequence": .., "outcome": ..}: `details` are the members after "reason".
-void MqttPublisher::reply(const std::string& id_json, const std::string& result,
-                          const std::string& why, const std::string& details) {
+// {"id": .., "command": "acknowledge" | "statue_stands", "result": "accepted" | "refused",
+// "reason": .., "level": .., "sequence": .., "outcome": ..}: `details` are the members after
+// "reason".
+void MqttPublisher::reply(const std::string& id_json, const std::string& command,
+                          const std::string& result, const std::string& why,
+                          const std::string& details) {
   (result == "accepted" ? commands_accepted_ : commands_refused_) += 1;
   JsonObject line;
-  line.raw("id", id_json).text("command", "acknowledge").text("result", result);
+  line.raw("id", id_json).text("command", command).text("result", result);
   if (!why.empty()) line.text("reason", why);
   std::string text = line.close();
   if (!details.empty()) text.replace(text.size() - 1, 1, ", " + details.substr(1));
@@ -704,12 +714,17 @@ void MqttPublisher::take_results() {
   while (mailbox_.take_result(result)) {
     const auto it = pending_.find(result.id);
     if (it == pending_.end()) continue;
-    const bool released = result.outcome == monitor::AckOutcome::kReleased ||
-                          result.outcome == monitor::AckOutcome::kReleasedConditionHolds;
-    const std::string outcome = monitor::ack_outcome_name(result.outcome);
+    const bool stands = it->second.command == OperatorCommand::kStatueStands;
+    const bool accepted =
+        stands ? result.stands == monitor::StandsOutcome::kCleared
+               : result.outcome == monitor::AckOutcome::kReleased ||
+                     result.outcome == monitor::AckOutcome::kReleasedConditionHolds;
+    const std::string outcome = stands ? monitor::stands_outcome_name(result.stands)
+                                       : monitor::ack_outcome_name(result.outcome);
     std::string details = it->second.details;
     details.replace(details.size() - 1, 1, ", \"outcome\": " + host::json_quoted(outcome) + "}");
-    reply(it->second.id_json, released ? "accepted" : "refused", released ? "" : outcome, details);
+    reply(it->second.id_json, stands ? "statue_stands" : "acknowledge",
+          accepted ? "accepted" : "refused", accepted ? "" : outcome, details);
     pending_.erase(it);
   }
 }
@@ -861,6 +876,8 @@ std::string MqttPublisher::state_json() const {
       .text("level", monitor::alarm_level_name(s.level))
       .text("latched", monitor::alarm_level_name(s.latched))
       .text("cause", monitor::alarm_cause_name(s.cause))
+      .text("trouble", monitor::alarm_cause_name(s.trouble))
+      .flag("collapse_held", s.collapse_held)
       .fixed("risk", s.risk, 4)
       .raw("forecast", forecast_json.close())
       .raw("phase", phase.close())

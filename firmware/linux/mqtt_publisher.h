@@ -130,8 +130,8 @@ class MqttPublisher final : public StatusOutput {
   void back_off(std::int64_t now_ns);
   void say_offline();
   void publish_discovery();
-  void reply(const std::string& id_json, const std::string& result, const std::string& why,
-             const std::string& details);
+  void reply(const std::string& id_json, const std::string& command, const std::string& result,
+             const std::string& why, const std::string& details);
   void take_results();
   void on_regional_alert(const std::string& payload, const std::string& hmac);
   void pass_regional_alerts(std::int64_t now_ns);
@@ -181,6 +181,7 @@ class MqttPublisher final : public StatusOutput {
   // operator quoted.
   struct PendingCommand {
     std::string id_json;
+    OperatorCommand command = OperatorCommand::kAcknowledge;
     std::string details;  // "level" and "sequence" members of the reply
   };
   std::map<std::uint32_t, PendingCommand> pending_;

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "box_state_store.h"
+#include "commission_gate.h"
 #include "event_recorder.h"
 #include "inputs.h"
 #include "latency_log.h"
@@ -74,6 +75,7 @@ struct Options {
   double post_trigger = 60.0;
   bool quiet_events = false;
   bool latency = false;
+  std::string commissioning_override;  // --commissioning-override REASON
   fw::MonitorOverrides config;  // --config and the options that override it
 };
 
@@ -168,9 +170,14 @@ class Outputs {
     if (u.frames_lost > 0) note_frames_lost(s, u.frames_lost);
     if (state_ != nullptr) save_state();
     if (u.status_due) {
-      // The first status line says what runs: the version, the scene and box files' digests.
+      // The first status line says what runs: the version, the scene and box files' digests,
+      // the commissioning; every line the commissioning while it refuses or is overridden.
       std::string line = fw::status_json(s, t_origin_);
-      if (snapshot_.statuses == 0) line = fw::with_members(line, identity);
+      if (snapshot_.statuses == 0) {
+        line = fw::with_members(line, identity);
+      } else if (!status_extra.empty()) {
+        line = fw::with_members(line, status_extra);
+      }
       if (recorder_ != nullptr) {
         const std::string health = fw::recorder_status_json(recorder_->status());
         line = fw::with_members(line, std::string("\"recorder\": ").append(health));
@@ -311,6 +318,7 @@ class Outputs {
   fw::SampleTrace* trace = nullptr;  // --trace
   fw::Supervisor* supervisor = nullptr;  // STATUS= and the journal at each alarm change
   std::string identity;  // run_identity.h's members, in the first status line
+  std::string status_extra;  // members every later status line carries ("" none)
   std::int64_t last_frame_ns = 0;  // receive time of the newest frame (the recorder's clock)
 
  private:
@@ -509,10 +517,10 @@ std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings)
 // The loop: each input item taken, its latency noted (--latency), the network outputs' operator
 // commands carried out, the watchdog told of the progress. True when the estimators ran at some
 // point.
-template <typename Restart>
+template <typename Restart, typename Poll>
 bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, fw::FrameDecoder& decoder,
               Outputs& outputs, fw::EventRecorder* recorder, fw::Supervisor& supervisor,
-              fw::LatencyLog* latency, fw::LatencyLog* due_latency, Restart restart) {
+              fw::LatencyLog* latency, fw::LatencyLog* due_latency, Restart restart, Poll poll) {
   supervisor.ready("monitoring " + input.source());
   fw::InputItem item;
   bool estimated = false;
@@ -533,6 +541,7 @@ bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, fw::FrameDecoder& d
       continue;
     }
     supervisor.on_progress(now_ns);
+    poll(now_ns);
   }
   supervisor.stopping();
   return estimated;
@@ -708,11 +717,22 @@ int run(const Options& opt, const CLI::App& app) {
   fw::MonitorConfig& config = file.config;
   config.axis_count = scene_y ? 2 : 1;
   set_fragility(config, scene_x, scene_y);
+  // The commissioning of this mounting (docs/commissioning.md), before a record replay reduces
+  // the sensors to its one.
+  fw::CommissioningGate gate(file.commissioning, opt.record_dir, fw::mounting_sha256(config),
+                             opt.commissioning_override);
+  gate.check();
+  gate.announce();
   const std::unique_ptr<fw::MonitorInput> input = fw::open_input(input_settings, config, g_stop);
 
   fw::Monitor monitor;
   fw::FrameDecoder decoder;
   start_monitor(monitor, decoder, config, scene_x, scene_y, app, opt.config.config_path);
+  const auto hold_commissioning = [&] {
+    monitor.hold_fault(gate.refuses() ? mon::AlarmCause::kCommissioningFailed
+                                      : mon::AlarmCause::kNone);
+  };
+  hold_commissioning();
   std::optional<fw::BoxStateStore> state;
   if (!opt.state_dir.empty()) restore_state(monitor, state.emplace(opt.state_dir));
   std::vector<AxisEvents> sinks;
@@ -723,7 +743,8 @@ int run(const Options& opt, const CLI::App& app) {
   }
   const fw::RunIdentity run_identity =
       fw::run_identity(opt.scene_path, file.second_scene_path, opt.config.config_path);
-  const std::string identity = fw::identity_members(run_identity);
+  const std::string identity =
+      fw::identity_members(run_identity) + ", " + gate.status_member();
   const std::unique_ptr<fw::EventRecorder> recorder = make_recorder(opt, file, identity);
   // --frames-out: the frames a replay sends, stamped with the receive time of the input that
   // caused them (what candump on the bus would show).
@@ -760,12 +781,28 @@ int run(const Options& opt, const CLI::App& app) {
   fw::Supervisor supervisor(file.watchdog);
   outputs.supervisor = &supervisor;
   outputs.identity = identity;
+  const auto commissioning_extra = [&] {
+    outputs.status_extra = gate.verdict().state == fw::GateState::kRefused ||
+                                   gate.verdict().state == fw::GateState::kOverridden
+                               ? gate.status_member()
+                               : "";
+  };
+  commissioning_extra();
   const auto restart = [&] {
     start_monitor(monitor, decoder, config, scene_x, scene_y, app, opt.config.config_path);
+    hold_commissioning();
+  };
+  // A newer report (plinth-commission ran) changes what the box vouches for, within
+  // kGateRescanS.
+  const auto poll = [&](std::int64_t now_ns) {
+    if (!gate.poll(now_ns)) return;
+    gate.announce();
+    hold_commissioning();
+    commissioning_extra();
   };
   const bool estimated = run_loop(*input, monitor, decoder, outputs, recorder.get(), supervisor,
                                   latency ? &*latency : nullptr,
-                                  due_latency ? &*due_latency : nullptr, restart);
+                                  due_latency ? &*due_latency : nullptr, restart, poll);
   if (trace) trace->close();
   if (recorder) recorder->close();  // every capture is on disk before the summary
   if (frames_log && !frames_log->flush()) throw InputError("--frames-out: " + frames_log->error());
@@ -776,6 +813,7 @@ int run(const Options& opt, const CLI::App& app) {
     totals.outputs.emplace_back(o->name(), o->summary_json());
   }
   if (latency) totals.outputs.emplace_back("latency", latency->summary_json());
+  totals.outputs.emplace_back("commissioning", gate.json());
   if (due_latency && input_settings.speed > 0.0) {
     totals.outputs.emplace_back("latency_from_due", due_latency->summary_json());
   }
@@ -885,6 +923,9 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--mqtt-key", c.mqtt_key_file, "TLS: its private key");
   app.add_flag("--no-forecast", c.no_forecast,
                "the box without the forecast (forecast.enabled = false; docs/forecast.md)");
+  app.add_option("--commissioning-override", opt.commissioning_override,
+                 "monitor whatever the commissioning report says, for this reason (logged at "
+                 "each start; commissioning.override; docs/commissioning.md)");
   app.add_flag("--latency", opt.latency,
                "the summary gives each sample's latency, arrival to status ready (median, p99)");
   app.add_option("--stuck-samples", c.stuck_samples,

@@ -27,6 +27,8 @@ void copy_status(const BoxStatus& s, double t_origin, StatusSnapshot& snapshot) 
   snapshot.t = static_cast<double>(s.time_ns) * 1e-9 - t_origin;
   snapshot.level = s.alarm;
   snapshot.latched = s.latched;
+  snapshot.trouble = s.trouble;
+  snapshot.collapse_held = s.collapse.held;
   snapshot.risk = s.risk;
   snapshot.probability = s.probability;
   snapshot.forecast_axis = s.forecast_axis;

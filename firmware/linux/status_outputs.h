@@ -54,6 +54,8 @@ struct StatusSnapshot {
   monitor::AlarmLevel level = monitor::AlarmLevel::kNormal;    // shown
   monitor::AlarmLevel latched = monitor::AlarmLevel::kNormal;  // kNormal: nothing latched
   monitor::AlarmCause cause = monitor::AlarmCause::kNone;      // of the latest alarm event
+  monitor::AlarmCause trouble = monitor::AlarmCause::kNone;    // beside the level (safety.md)
+  bool collapse_held = false;  // a collapse held until a person states the statue stands
   std::uint8_t event_sequence = 0;  // of the latest alarm event (an acknowledgement quotes it)
   bool any_event = false;
   double risk = 0.0;

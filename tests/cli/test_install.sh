@@ -102,8 +102,8 @@ mount -t tmpfs plinth-hidden "$build" && mount -t tmpfs plinth-hidden "$src" || 
 export PATH=/usr/sbin:/usr/bin:/sbin:/bin
 unset PLINTH_MONITOR PLINTH_SOURCE_DIR
 cd "$tmp"
-for p in plinth-monitor plinth-replay plinth-sim plinth-sweep plinth-eval plinth-accuracy \
-  plinth-event-plot; do
+for p in plinth-monitor plinth-replay plinth-commission plinth-sim plinth-sweep plinth-eval \
+  plinth-accuracy plinth-event-plot; do
   echo "version $p $("$prefix/bin/$p" --version 2>&1)"
 done
 share=$prefix/share/plinth
@@ -132,8 +132,8 @@ rc=$?
 check "source and build trees hidden (tmpfs over both)" $? "exit $rc: $(tail -3 "$tmp/hidden.out")"
 result() { sed -n "s/^$1 //p" "$tmp/hidden.out"; }
 
-for p in plinth-monitor plinth-replay plinth-sim plinth-sweep plinth-eval plinth-accuracy \
-  plinth-event-plot; do
+for p in plinth-monitor plinth-replay plinth-commission plinth-sim plinth-sweep plinth-eval \
+  plinth-accuracy plinth-event-plot; do
   got=$(result "version $p")
   [ "$got" = "$p $expected" ]
   check "installed $p --version: $expected" $? "$got"

@@ -66,6 +66,7 @@ dpkg-deb -x "$(deb plinth-tools)" "$tmp/x-tools"
 dpkg-deb -x "$(deb libplinth-dev)" "$tmp/x-dev"
 missing=""
 for f in x-monitor/usr/bin/plinth-monitor x-monitor/usr/bin/plinth-replay \
+  x-monitor/usr/bin/plinth-commission \
   x-monitor/etc/plinth/box.toml x-monitor/usr/lib/systemd/system/plinth-monitor@.service \
   x-monitor/usr/lib/systemd/system/plinth-monitor@.socket \
   x-monitor/usr/lib/sysusers.d/plinth-monitor.conf x-monitor/usr/lib/udev/rules.d/60-plinth-gpio.rules \

@@ -123,6 +123,7 @@ Error Monitor::start(const MonitorConfig& config,
   frames_not_encoded_ = 0;
   have_epoch_ = false;
   bus_fault_ = false;
+  held_fault_ = monitor::AlarmCause::kNone;
   pending_ack_ = false;
   pending_stands_ = false;
   evaluated_ = false;
@@ -465,6 +466,10 @@ void Monitor::evaluate(MonitorUpdate& update) {
     *shown = stage->status();
   }
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
+  if (held_fault_ != monitor::AlarmCause::kNone) {
+    input.fault_active = true;
+    input.fault_cause = held_fault_;
+  }
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
   input.statue_stands = pending_stands_;

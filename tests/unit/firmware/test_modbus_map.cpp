@@ -29,7 +29,7 @@ TEST(ModbusMap, EveryCauseHasItsCodeInTheCsv) {
   const std::string csv = map_csv();
   EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model;13=p_wave;"
                      "14=statue_unexplained;15=regional_alert;16=statue_sensor_fault;"
-                     "17=restored;18=statue_stands\""),
+                     "17=restored;18=statue_stands;19=commissioning_failed\""),
             std::string::npos);
   EXPECT_NE(csv.find("4=overturned;5=fell;6=lifted_off\""), std::string::npos);
   EXPECT_NE(csv.find("\"0=normal;1=advisory;2=warning;3=alarm;4=fault\""), std::string::npos);
@@ -44,6 +44,7 @@ TEST(ModbusMap, CodesArePinned) {
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kPWave), 13);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kStatueUnexplained), 14);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kRegionalAlert), 15);
+  EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kCommissioningFailed), 19);
   EXPECT_EQ(kAlarmLevelCodes.code(monitor::AlarmLevel::kFault), 4);
   EXPECT_EQ(kPhaseCodes.code(Phase::kFell), 5);
   EXPECT_EQ(kPhaseCodes.code(Phase::kLiftedOff), 6);
@@ -95,7 +96,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 7);
+  EXPECT_EQ(at(reg::kMapVersion), 8);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";

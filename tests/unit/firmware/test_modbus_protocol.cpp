@@ -148,8 +148,9 @@ TEST(ModbusAnswer, WhatIsNotServedIsAnExceptionNotASilence) {
   EXPECT_EQ(ask(frame({0x05, 0x00, 0x00, 0x12, 0x34}), true).answer.exception,
             Exception::kIllegalDataValue)
       << "a coil value other than 0xFF00 or 0";
-  EXPECT_EQ(ask(frame({0x05, 0x00, 0x02, 0xFF, 0x00}), true).answer.exception,
-            Exception::kIllegalDataAddress);
+  EXPECT_EQ(ask(frame({0x05, 0x00, 0x03, 0xFF, 0x00}), true).answer.exception,
+            Exception::kIllegalDataAddress)
+      << "coils 0-2 only";
 }
 
 TEST(ModbusAnswer, WritesAreCommandsOnlyFromAWriter) {
@@ -167,6 +168,12 @@ TEST(ModbusAnswer, WritesAreCommandsOnlyFromAWriter) {
   const Reply both = ask(frame({0x0F, 0x00, 0x00, 0x00, 0x02, 0x01, 0x03}), true);
   EXPECT_TRUE(both.answer.acknowledge && both.answer.reset);
   EXPECT_EQ(both.bytes, (Bytes{0x12, 0x34, 0, 0, 0, 6, 0x11, 0x0F, 0, 0, 0, 2}));
+  EXPECT_FALSE(both.answer.statue_stands);
+  const Reply stands = ask(frame({0x05, 0x00, 0x02, 0xFF, 0x00}), true);
+  EXPECT_TRUE(stands.answer.statue_stands) << "coil 2: the statue stands";
+  EXPECT_FALSE(stands.answer.acknowledge || stands.answer.reset);
+  EXPECT_FALSE(ask(frame({0x05, 0x00, 0x02, 0xFF, 0x00}), false).answer.statue_stands)
+      << "not from a client that may not write";
   for (const int code : {0x06, 0x10, 0x16, 0x17}) {
     const auto function = static_cast<std::uint8_t>(code);
     const Reply r = ask(frame({function, 0x00, 0x00, 0x00, 0x01}), true);

@@ -979,7 +979,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
     EXPECT_STREQ(rk.signal, "Level");
   }
-  for (unsigned v = 19; v <= 255; ++v) {
+  for (unsigned v = 20; v <= 255; ++v) {
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -997,11 +997,12 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  e.cause = static_cast<AlarmCause>(19);
+  e.cause = static_cast<AlarmCause>(20);
   EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
   for (const AlarmCause cause :
        {AlarmCause::kPWave, AlarmCause::kStatueUnexplained, AlarmCause::kRegionalAlert,
-        AlarmCause::kStatueSensorFault, AlarmCause::kRestored, AlarmCause::kStatueStands}) {
+        AlarmCause::kStatueSensorFault, AlarmCause::kRestored, AlarmCause::kStatueStands,
+        AlarmCause::kCommissioningFailed}) {
     e.cause = cause;
     EXPECT_TRUE(encode(e, f).ok()) << static_cast<unsigned>(cause);
   }

@@ -123,6 +123,7 @@ enum class AlarmCause : std::uint8_t {
   kStatueSensorFault = 16,  // the statue sensor unhealthy or not corroborated: it may not lower
   kRestored = 17,           // a latched level or a collapse restored after a restart
   kStatueStands = 18,       // a person on site stated that the statue stands again
+  kCommissioningFailed = 19,  // the box's commissioning report failed or is missing
 };
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.
