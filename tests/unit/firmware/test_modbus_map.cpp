@@ -154,6 +154,23 @@ TEST(ModbusMap, TheStatueSensorsRegisters) {
   for (int r = 0; r < reg::kCount; ++r) EXPECT_EQ(owners[static_cast<std::size_t>(r)], 1) << r;
 }
 
+// The safety rule's registers (117-118, map 8): the trouble beside the level, coded as the
+// cause register, and the held collapse.
+TEST(ModbusMap, TheTroubleAndTheHeldCollapse) {
+  StatusSnapshot s;
+  Image image;
+  fill(s, 0, image);
+  const auto at = [&](int address) { return image.registers[static_cast<std::size_t>(address)]; };
+  EXPECT_EQ(reg::kCollapseHeld + 1, reg::kCount);
+  EXPECT_EQ(at(reg::kTrouble), 0);
+  EXPECT_EQ(at(reg::kCollapseHeld), 0);
+  s.trouble = monitor::AlarmCause::kStatueSensorFault;
+  s.collapse_held = true;
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kTrouble), 16);
+  EXPECT_EQ(at(reg::kCollapseHeld), 1);
+}
+
 // The event recorder's registers (109-116, map 7): kNone in health and problem without one
 // (--record-dir), else their pinned codes and the counts.
 TEST(ModbusMap, TheRecordersRegisters) {
@@ -162,7 +179,7 @@ TEST(ModbusMap, TheRecordersRegisters) {
   fill(s, 0, image);
   const auto at = [&](int address) { return image.registers[static_cast<std::size_t>(address)]; };
   EXPECT_EQ(reg::kRecorderHealth, reg::kStatueEffectiveMembersY + 1);
-  EXPECT_EQ(reg::kCount, 117);
+  EXPECT_EQ(reg::kTrouble, reg::kCapturesTruncated + 2);
   EXPECT_EQ(at(reg::kRecorderHealth), kNone);
   EXPECT_EQ(at(reg::kRecorderProblem), kNone);
   EXPECT_EQ(read32(image, reg::kCapturesWritten), 0U);
