@@ -126,6 +126,7 @@ expect_fault() {
     fail "$name" "the fixture failed: $(head -c 200 "$TMP/fixture.err")"
     return
   fi
+  rm -f "$TMP/fault.json"  # a report is never written over (commission_report.h)
   run --config "$box" --log "$TMP/fault.log" --report "$TMP/fault.json" --no-picture
   local failures
   failures=$(failures)
