@@ -23,8 +23,12 @@ struct Context {
   const State& y0;
 };
 
+// Which leading guards (guards.h, leading_guards) a kernel's modes have.
+enum class Leading { kRocking, kOnsets, kByMode };
+
 struct Base {
   static constexpr bool kExact = false;  // true: the kernel propagates itself (no stepper)
+  static constexpr Leading kLeading = Leading::kOnsets;
 
   const Scene* s;
   const Excitation* excitation;
@@ -47,6 +51,7 @@ struct Base {
 // the points where an event is located) from those of its start, theta0, computed once by
 // sin_cos (not carried over from the last step: no drift of roundings).
 struct Turning : Base {
+  static constexpr Leading kLeading = Leading::kRocking;
   Real theta0;
   SinCos trig0;
 
@@ -74,6 +79,7 @@ struct FullContact : Base {
 // A phase the scene's features do not have (a sliding phase without friction, set by
 // start_from): it stays still.
 struct Frozen : Base {
+  static constexpr Leading kLeading = Leading::kByMode;  // sliding or slide-rocking
   explicit Frozen(const Context& c) : Base(c) {}
 
   [[nodiscard]] State derivative(GroundAcceleration /*ag*/, const State& y) const {

@@ -40,17 +40,31 @@ struct StepInterval {
 
   // evaluate_guards at the interval's end, and whether any guard may have crossed since the start:
   // negative or zero there and not negative now (both zero: resting on the surface). The
-  // step-end methods need a strict start; earliest_crossing sorts that out.
+  // step-end methods need a strict start; earliest_crossing sorts that out. The kernel's leading
+  // guards (guards.h) are evaluated with their ids known here, the rest by their ids' switch.
   static bool evaluate_end_guards(const Scene& s, const Mode& mode, const ActiveGuards& guards,
                                   const State& y, const FlowPoint& p, const GuardValues& start,
                                   GuardValues& out) {
     bool any = false;
-    for (int i = 0; i < guards.count; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      const Real b = step_guard_value(guards.ids[k], s, mode, y, p);
+    const auto check = [&](std::size_t k, GuardId id) {
+      const Real b = step_guard_value(id, s, mode, y, p);
       const Real a = start[k];
       out[k] = b;
       any = any || (a <= Real(0) && b >= Real(0) && (a < Real(0) || b > Real(0)));
+    };
+    int i = 0;
+    if constexpr (Kernel::kLeading != kernels::Leading::kByMode) {
+      if (guards.count >= kLeadingGuards) {
+        constexpr auto kIds = leading_guards(Kernel::kLeading == kernels::Leading::kRocking);
+        check(0, kIds[0]);
+        check(1, kIds[1]);
+        check(2, kIds[2]);
+        i = kLeadingGuards;
+      }
+    }
+    for (; i < guards.count; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      check(k, guards.ids[k]);
     }
     return any;
   }
@@ -131,8 +145,15 @@ struct StepInterval {
     Crossing first;
     for (int i = 0; i < guards.count; ++i) {
       const auto j = static_cast<std::size_t>(i);
-      const Real a = g_start[j];
+      Real a = g_start[j];
       const Real b = g_end[j];
+      // The lift-off guard's start may be its bound (step_guard_value), negative as the guard
+      // is: where it crossed, its own value is what the location starts from. (The end's is its
+      // own: a bound is never at or above 0.)
+      if (guards.ids[j] == GuardId::kLiftOff && a < Real(0) && b >= Real(0)) {
+        a = guard_value(GuardId::kLiftOff, *sim.scene_, mode, y0, start.ground, start.acc,
+                        start.trig);
+      }
       if constexpr (Method::kLocated) {
         if (a > Real(0) || b < Real(0) || (a == Real(0) && b == Real(0))) continue;
         const Real tau = crossing_time(sim, k, mode, guards.ids[j], t0, y0, start, h, a, b);
