@@ -17,6 +17,7 @@
 #include <utility>
 #include <vector>
 
+#include "box_state_store.h"
 #include "event_recorder.h"
 #include "inputs.h"
 #include "latency_log.h"
@@ -63,6 +64,7 @@ struct Options {
   std::string log_time;  // --log-time: warn or refuse; empty: not given (warn)
   double duration = 0.0;
   std::string record_dir;
+  std::string state_dir;
   std::string frames_out;
   std::string trace_path;
   double pre_trigger = 30.0;
@@ -135,7 +137,8 @@ class Outputs {
     const fw::BoxStatus& s = *u.status;
     if (relays_ != nullptr) {  // first: the alarm panel's contacts
       relays_->update(s.alarm, s.latched,
-                      s.sensors_state == mon::HealthState::kFault || s.disagreement);
+                      s.sensors_state == mon::HealthState::kFault || s.disagreement ||
+                          s.trouble != mon::AlarmCause::kNone);
     }
     totals.max_risk = std::fmax(totals.max_risk, s.risk);
     for (std::size_t i = 0; i < u.frame_count; ++i) {
@@ -159,18 +162,32 @@ class Outputs {
       }
       post_alarm(e);
     }
+    if (u.statue_stands != mon::StandsOutcome::kNone && u.stands_source >= 0) {
+      print_line(command_line("statue_stands", "can:" + std::to_string(u.stands_source))
+                     .text("outcome", mon::stands_outcome_name(u.statue_stands))
+                     .close());
+    }
+    if (u.frames_lost > 0) note_frames_lost(s, u.frames_lost);
+    if (state_ != nullptr) save_state();
     if (u.status_due) {
       // The first status line says what runs: the version, the scene and box files' digests.
-      print_line(snapshot_.statuses == 0 ? fw::with_members(fw::status_json(s, t_origin_), identity)
-                                         : fw::status_json(s, t_origin_));
+      std::string line = fw::status_json(s, t_origin_);
+      if (snapshot_.statuses == 0) line = fw::with_members(line, identity);
+      if (recorder_ != nullptr) {
+        const std::string health = fw::recorder_status_json(recorder_->status());
+        line = fw::with_members(line, std::string("\"recorder\": ").append(health));
+      }
+      print_line(line);
       ++snapshot_.statuses;
     }
     if (trace != nullptr) trace->after_update(u, monitor_);
     post_snapshot(s);
   }
 
-  // The outputs' operator commands, carried out on the loop: an acknowledgement is the
-  // monitor's (as one from the bus); a reset starts the monitor again (`restart`).
+  // The outputs' operator commands, carried out on the loop: an acknowledgement and a statement
+  // that the statue stands are the monitor's (as those from the bus); a reset starts the monitor
+  // again (`restart`) with its memory (the latch, any collapse), refused while an alarm is
+  // latched and unacknowledged.
   template <typename Restart>
   void carry_out_commands(fw::Monitor& monitor, Restart restart) {
     for (fw::StatusOutput* output : outputs_) {
@@ -184,25 +201,39 @@ class Outputs {
       while (output->mailbox().take_command(c)) {
         ++snapshot_.commands;
         if (c.command == fw::OperatorCommand::kReset) {
-          restart();
-          ++snapshot_.resets;
-          snapshot_.any_event = false;
-          snapshot_.cause = mon::AlarmCause::kNone;
-          print_line(fw::JsonObject()
-                         .text("type", "command")
-                         .text("command", "reset")
-                         .text("source", output->name())
+          const bool refused = monitor.status().latched == mon::AlarmLevel::kAlarm;
+          if (!refused) {
+            const fw::BoxMemory memory = monitor.memory();
+            restart();
+            monitor.restore(memory);
+            ++snapshot_.resets;
+            snapshot_.any_event = false;
+            snapshot_.cause = mon::AlarmCause::kNone;
+          }
+          print_line(command_line("reset", output->name())
+                         .text("outcome", refused ? "refused: an alarm is latched, acknowledge "
+                                                    "it first"
+                                                  : "done")
                          .close());
           post_snapshot(monitor.status());
-          output->mailbox().post_result({c.id, mon::AckOutcome::kNone});
+          output->mailbox().post_result({c.id, mon::AckOutcome::kNone,
+                                         mon::StandsOutcome::kNone, refused});
+          if (!refused) handle(monitor.poll());  // the restored level, at once
+          continue;
+        }
+        if (c.command == fw::OperatorCommand::kStatueStands) {
+          const fw::MonitorUpdate u = monitor.statue_stands(c.event_sequence);
+          print_line(command_line("statue_stands", output->name())
+                         .count("sequence", c.event_sequence)
+                         .text("outcome", mon::stands_outcome_name(u.statue_stands))
+                         .close());
+          handle(u);
+          output->mailbox().post_result({c.id, mon::AckOutcome::kNone, u.statue_stands});
           continue;
         }
         const fw::MonitorUpdate u = monitor.acknowledge({c.level, c.event_sequence});
         snapshot_.last_ack = u.acknowledgement;
-        print_line(fw::JsonObject()
-                       .text("type", "command")
-                       .text("command", "acknowledge")
-                       .text("source", output->name())
+        print_line(command_line("acknowledge", output->name())
                        .text("level", mon::alarm_level_name(c.level))
                        .count("sequence", c.event_sequence)
                        .text("outcome", mon::ack_outcome_name(u.acknowledgement))
@@ -212,6 +243,9 @@ class Outputs {
       }
     }
   }
+
+  // The saved state (--state-dir): what the monitor must not forget, written when it changes.
+  void keep_state_in(fw::BoxStateStore* state) { state_ = state; }
 
   fw::RunTotals totals;
   fw::SampleTrace* trace = nullptr;  // --trace
@@ -234,6 +268,39 @@ class Outputs {
     recorder_->trigger(info, last_frame_ns);
   }
 
+  static fw::JsonObject command_line(const char* command, const std::string& source) {
+    fw::JsonObject line;
+    line.text("type", "command").text("command", command).text("source", source);
+    return line;
+  }
+
+  // A failed write is said once, and again after a write succeeded; the box goes on (its
+  // memory is the process's until the folder takes writes again).
+  void save_state() {
+    const bool saved = state_->save(monitor_.memory(), fw::wall_clock_ns());
+    if (!saved && !state_failing_) {
+      std::fprintf(stderr, "plinth-monitor: error: cannot save the box's state: %s\n",
+                   state_->error().c_str());
+    } else if (saved && state_failing_) {
+      std::fprintf(stderr, "plinth-monitor: the box's state is saved again (%s)\n",
+                   state_->path().c_str());
+    }
+    state_failing_ = !saved;
+  }
+
+  // Frames the update could not carry: said on stderr (the first, then at every power of two),
+  // counted in the status (frames_not_encoded) and the summary.
+  void note_frames_lost(const fw::BoxStatus& s, std::size_t lost) {
+    const std::uint64_t before = frames_lost_;
+    frames_lost_ += lost;
+    if ((before & frames_lost_) != 0 && before != 0) return;  // not across a power of two
+    std::fprintf(stderr,
+                 "plinth-monitor: error: %zu frame(s) not sent at t = %.3f s (the codec refused "
+                 "them; %llu in all, frames_not_encoded in the status)\n",
+                 lost, static_cast<double>(s.time_ns) * 1e-9 - t_origin_,
+                 static_cast<unsigned long long>(frames_lost_));
+  }
+
   void post_alarm(const mon::AlarmEventRecord& e) {
     snapshot_.cause = e.cause;
     snapshot_.event_sequence = e.sequence;
@@ -244,6 +311,7 @@ class Outputs {
   void post_snapshot(const fw::BoxStatus& status) {
     if (outputs_.empty()) return;
     fw::copy_status(status, t_origin_, snapshot_);
+    if (recorder_ != nullptr) snapshot_.recorder = recorder_->status();
     ++snapshot_.updates;
     snapshot_.wall_time_ns = fw::wall_clock_ns();
     snapshot_.uptime_ns = fw::monotonic_ns() - start_ns_;
@@ -258,6 +326,9 @@ class Outputs {
   std::vector<fw::StatusOutput*> outputs_;
   std::int64_t start_ns_;
   fw::StatusSnapshot snapshot_;
+  fw::BoxStateStore* state_ = nullptr;
+  bool state_failing_ = false;
+  std::uint64_t frames_lost_ = 0;
 };
 
 // The monitor takes one input item.
@@ -345,14 +416,13 @@ void start_monitor(fw::Monitor& monitor, fw::FrameDecoder& decoder,
 
 std::unique_ptr<fw::EventRecorder> make_recorder(const Options& opt, const fw::MonitorFile& file,
                                                  const std::string& identity) {
-  const fw::MonitorConfig& config = file.config;
   if (opt.record_dir.empty()) return nullptr;
   fw::EventRecorderSettings rs;
   rs.directory = opt.record_dir;
   rs.interface_name = opt.can_interface.empty() ? "can0" : opt.can_interface;
   rs.pre_trigger_s = opt.pre_trigger;
   rs.post_trigger_s = opt.post_trigger;
-  rs.frame_rate_hz = 2.0 * config.estimator.sample_rate_hz + 100.0;
+  rs.frame_rate_hz = fw::recorder_frame_rate_hz(file);
   rs.retention = file.recorder.retention;
   rs.test_pause_mid_write_s = file.recorder.test_pause_mid_write_s;
   rs.identity_json = identity;
@@ -436,11 +506,11 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
   if (input.sink() != nullptr) t.bus_send_errors += monitor.frames_not_encoded();
   if (recorder != nullptr) {
     t.recorder = true;
-    t.captures_written = recorder->captures_written();
+    t.recorder_status = recorder->status();
     t.captures_dropped = recorder->captures_dropped();
     t.recorder_write_errors = recorder->write_errors();
-    t.captures_deleted = recorder->captures_deleted();
-    t.recorder_first_index = static_cast<std::uint64_t>(recorder->first_index());
+    t.frames_lost = recorder->frames_lost();
+    t.recorder_first_index = recorder->first_index();
     t.partial_files_removed = static_cast<std::uint64_t>(recorder->partial_files_removed());
   }
   return t;
@@ -500,6 +570,37 @@ void set_fragility(fw::MonitorConfig& config, const plinth::host::UncertainScene
   give(mon::built_part<mon::PWaveSettings>(config.pwave));
 }
 
+// What the state directory held, into the monitor just started: a line saying what was restored
+// (nothing said on a first start), and an error for a file that could not be trusted (the worst
+// it may have said is restored: a latched alarm).
+void restore_state(fw::Monitor& monitor, const fw::BoxStateStore& state) {
+  if (!state.unreadable().empty()) {
+    std::fprintf(stderr,
+                 "plinth-monitor: error: the box's saved state cannot be read: %s; restored the "
+                 "worst it may have said, a latched alarm (acknowledge it once the statue is "
+                 "seen)\n",
+                 state.unreadable().c_str());
+  }
+  if (!state.loaded()) return;
+  const fw::SavedBoxState& saved = *state.loaded();
+  const fw::BoxMemory& m = saved.memory;
+  monitor.restore(m);
+  if (m.alarm.latched_level == mon::AlarmLevel::kNormal && !m.alarm.collapse_held) return;
+  fw::JsonObject line;
+  line.text("type", "restored")
+      .text("latched", mon::alarm_level_name(m.alarm.latched_level))
+      .text("cause", mon::alarm_cause_name(m.alarm.latched_cause))
+      .flag("collapse_held", m.alarm.collapse_held);
+  if (m.alarm.collapse_held) {
+    line.count("collapse_axis", static_cast<std::uint64_t>(m.collapse.axis))
+        .text("collapse_phase", plinth::phase_name(m.collapse.mode.phase))
+        .general("collapse_wall_s", static_cast<double>(saved.collapse_wall_ns) * 1e-9, 13);
+  }
+  line.general("saved_wall_s", static_cast<double>(saved.saved_wall_ns) * 1e-9, 13)
+      .text("from", state.path());
+  print_line(line.close());
+}
+
 int run(const Options& opt, const CLI::App& app) {
   const int sources = (opt.replay_path.empty() ? 0 : 1) + (opt.can_interface.empty() ? 0 : 1);
   if (sources != 1) throw InputError("give exactly one input: --replay FILE or --can INTERFACE");
@@ -522,6 +623,8 @@ int run(const Options& opt, const CLI::App& app) {
   fw::Monitor monitor;
   fw::FrameDecoder decoder;
   start_monitor(monitor, decoder, config, scene_x, scene_y, app, opt.config.config_path);
+  std::optional<fw::BoxStateStore> state;
+  if (!opt.state_dir.empty()) restore_state(monitor, state.emplace(opt.state_dir));
   std::vector<AxisEvents> sinks;
   sinks.reserve(static_cast<std::size_t>(config.axis_count));
   for (int i = 0; i < config.axis_count; ++i) {
@@ -552,6 +655,7 @@ int run(const Options& opt, const CLI::App& app) {
   std::vector<fw::StatusOutput*> output_list;
   for (const auto& o : network) output_list.push_back(o.get());
   Outputs outputs(monitor, input->t_origin(), recorder.get(), bus, relays.get(), output_list);
+  if (state) outputs.keep_state_in(&*state);
   frames_clock = &outputs;
   std::optional<fw::SampleTrace> trace;
   if (!opt.trace_path.empty()) {
@@ -641,6 +745,9 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--duration", opt.duration, "live: stop after this many seconds")
       ->check(plinth::host::kFinitePositive);
   app.add_option("--record-dir", opt.record_dir, "event recorder: write captures here");
+  app.add_option("--state-dir", opt.state_dir,
+                 "keep the latched alarm and any collapse here (alarm-state.json), restored at "
+                 "the next start (docs/safety.md)");
   app.add_option("--frames-out", opt.frames_out,
                  "replay: write the status and alarm frames sent to this candump log")
       ->excludes("--can");

@@ -251,7 +251,10 @@ std::string status_json(const BoxStatus& s, double t_origin) {
                                       : formatted(s.collapse_forecast_s - t_origin, 3, true))
       .text("alarm", monitor::alarm_level_name(s.alarm))
       .text("latched", monitor::alarm_level_name(s.latched))
-      .flag("estimating", s.estimating)
+      .text("trouble", monitor::alarm_cause_name(s.trouble));
+  if (s.collapse.held) line.raw("collapse", collapse_json(s.collapse));
+  if (s.frames_not_encoded > 0) line.count("frames_not_encoded", s.frames_not_encoded);
+  line.flag("estimating", s.estimating)
       .flag("calibrated", s.calibrated)
       .text("sensor", monitor::health_state_name(s.sensor.state))
       .text("sensor_cause", monitor::health_cause_name(s.sensor.cause))
@@ -284,6 +287,30 @@ std::string statue_weights_json(const StatueAxisStatus& a) {
       .general("best_score", a.best_score, 4)
       .count("ruled_out", static_cast<std::uint64_t>(a.ruled_out))
       .flag("acceleration_used", a.acceleration_used)
+      .flag("corroborated", a.corroborated)
+      .text("refutation", statue_refutation_name(a.refutation))
+      .flag("lowering_refused", a.lowering_refused)
+      .fixed("risk_without", static_cast<double>(a.risk_without), 4)
+      .close();
+}
+
+std::string collapse_json(const CollapseRecord& c) {
+  return JsonObject()
+      .count("axis", static_cast<std::uint64_t>(c.axis))
+      .text("phase", phase_name(c.mode.phase))
+      .text("corner", corner_name(c.mode.corner))
+      .flag("restored", c.restored)
+      .close();
+}
+
+std::string recorder_status_json(const RecorderStatus& r) {
+  return JsonObject()
+      .text("health", kRecorderHealthNames.name(r.health))
+      .text("problem", kRecorderProblemNames.name(r.problem))
+      .count("captures_written", r.captures_written)
+      .count("captures_lost", r.captures_lost)
+      .count("captures_truncated", r.captures_truncated)
+      .count("captures_deleted", r.captures_deleted)
       .close();
 }
 
@@ -370,6 +397,7 @@ std::string alarm_json(const monitor::AlarmEventRecord& e, double t_origin) {
       .text("previous", monitor::alarm_level_name(e.previous_level))
       .text("cause", monitor::alarm_cause_name(e.cause))
       .flag("latched", e.latched)
+      .text("trouble", monitor::alarm_cause_name(e.trouble))
       .count("sequence", e.sequence)
       .close();
 }
@@ -422,13 +450,19 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
                                   .close());
   }
   if (totals.recorder) {
+    const RecorderStatus& r = totals.recorder_status;
     line.raw("recorder", JsonObject()
-                             .count("captures_written", totals.captures_written)
+                             .count("captures_written", r.captures_written)
                              .count("captures_dropped", totals.captures_dropped)
                              .count("write_errors", totals.recorder_write_errors)
-                             .count("captures_deleted", totals.captures_deleted)
+                             .count("captures_deleted", r.captures_deleted)
                              .count("first_index", totals.recorder_first_index)
                              .count("partial_files_removed", totals.partial_files_removed)
+                             .text("health", kRecorderHealthNames.name(r.health))
+                             .text("problem", kRecorderProblemNames.name(r.problem))
+                             .count("captures_lost", r.captures_lost)
+                             .count("captures_truncated", r.captures_truncated)
+                             .count("frames_lost", totals.frames_lost)
                              .close());
   }
   for (const auto& [key, json] : totals.outputs) line.raw(key, json);

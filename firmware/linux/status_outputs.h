@@ -17,6 +17,7 @@
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/sensor_health.h"
+#include "recorder_status.h"
 
 namespace plinth::firmware {
 
@@ -79,6 +80,7 @@ struct StatusSnapshot {
   std::uint64_t commands = 0;  // operator commands the loop carried out
   std::uint64_t resets = 0;
   RegionalSnapshot regional;
+  RecorderStatus recorder;  // the event recorder's health (present: --record-dir)
 };
 
 // One alarm event as the JSON alarm line writes it.
@@ -88,8 +90,10 @@ struct AlarmNotice {
 };
 
 enum class OperatorCommand : std::uint8_t {
-  kAcknowledge,  // the latched level, quoting the latest event's sequence
-  kReset,        // the monitor starts again as at power-up
+  kAcknowledge,   // the latched level, quoting the latest event's sequence
+  kReset,         // the monitor starts again, its latch and any collapse kept (refused while an
+                  // alarm is latched and unacknowledged)
+  kStatueStands,  // a person on site states that the statue stands again, quoting the sequence
 };
 
 // A regional alert an output received (MQTT), for the loop: the alert, or malformed (`field`,
@@ -107,10 +111,13 @@ struct CommandRequest {
   std::uint32_t id = 0;             // the output's own, quoted by the result
 };
 
-// What the loop did with a command: the acknowledgement's outcome (kNone for a reset).
+// What the loop did with a command: the acknowledgement's outcome, the statement's, or for a
+// reset whether it was refused (an alarm latched and unacknowledged).
 struct CommandResult {
   std::uint32_t id = 0;
   monitor::AckOutcome outcome = monitor::AckOutcome::kNone;
+  monitor::StandsOutcome stands = monitor::StandsOutcome::kNone;
+  bool reset_refused = false;
 };
 
 // The newest of a stream of values, one writer and one reader, without locks (a triple buffer):

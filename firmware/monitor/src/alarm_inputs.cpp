@@ -25,14 +25,14 @@ monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& co
   const bool sensor_fault = status.sensor.state == monitor::HealthState::kFault;
   const bool disagreement = status.disagreement;
   const bool mismatch_fault = status.plate_mismatch && config.plate.raises_fault;
-  const bool unexplained = kStatueSensorBuiltIn && status.statue_unexplained;
-  input.fault_active =
-      sensor_fault || disagreement || mismatch_fault || bus_fault || outside_model || unexplained;
-  input.fault_cause = sensor_fault ? monitor::to_alarm_cause(status.sensor.cause)
-                      : (disagreement || mismatch_fault) ? monitor::AlarmCause::kSensorDisagreement
-                      : bus_fault                        ? monitor::AlarmCause::kBusError
-                      : outside_model                    ? monitor::AlarmCause::kOutsideModel
-                                                         : monitor::AlarmCause::kStatueUnexplained;
+  input.fault_active = sensor_fault || mismatch_fault || bus_fault || outside_model;
+  input.fault_cause = sensor_fault     ? monitor::to_alarm_cause(status.sensor.cause)
+                      : mismatch_fault ? monitor::AlarmCause::kSensorDisagreement
+                      : bus_fault      ? monitor::AlarmCause::kBusError
+                                       : monitor::AlarmCause::kOutsideModel;
+  // Ground sensors that disagree: the risk follows the most dangerous healthy reading, still
+  // valid, so the trouble shows beside the level; then the statue sensor's.
+  input.input_fault = disagreement ? monitor::AlarmCause::kSensorDisagreement : status.input_fault;
   input.not_calibrated = !status.estimating || !status.calibrated;
   return input;
 }

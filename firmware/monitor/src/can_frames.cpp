@@ -49,7 +49,10 @@ static_assert(same_number(AlarmCause::kOutsideModel, can::AlarmCause::kOutsideMo
 static_assert(same_number(AlarmCause::kPWave, can::AlarmCause::kPWave));
 static_assert(same_number(AlarmCause::kStatueUnexplained, can::AlarmCause::kStatueUnexplained));
 static_assert(same_number(AlarmCause::kRegionalAlert, can::AlarmCause::kRegionalAlert));
-static_assert(monitor::kAlarmCauseNames.size() == 16);
+static_assert(same_number(AlarmCause::kStatueSensorFault, can::AlarmCause::kStatueSensorFault));
+static_assert(same_number(AlarmCause::kRestored, can::AlarmCause::kRestored));
+static_assert(same_number(AlarmCause::kStatueStands, can::AlarmCause::kStatueStands));
+static_assert(monitor::kAlarmCauseNames.size() == 19);
 
 // The sensors' status bits (SensorAcceleration.Status): passed through as they are.
 static_assert(monitor::sensor_flags::kSaturated == can::sensor_status::kSaturated);
@@ -105,6 +108,8 @@ can::MonitorStatus status_message(const BoxStatus& status, int axis, std::uint8_
   m.phase = to_wire(a.mode.phase);
   m.corner = wire_corner(a.mode);
   m.alarm_level = to_wire(status.alarm);
+  m.trouble = status.trouble != monitor::AlarmCause::kNone;
+  m.collapse_held = status.collapse.held;
   m.risk = a.risk.total;
   m.sequence = sequence;
   // Not estimating yet: no sample was used, the age is the largest the frame can say.
@@ -126,7 +131,12 @@ can::CollapseForecast forecast_message(const BoxStatus& status, int axis, double
   m.members = static_cast<std::uint8_t>(f.members);
   m.horizon_s = horizon_s;
   m.sequence = sequence;
-  if (f.worst_member < 0 || a.collapse_forecast_s < 0.0) return m;  // none collapses
+  // None collapses, or too few to show above the frame's resolution: the frame says 0 and
+  // names no member (its signals must agree; the status names no collapse time either).
+  if (f.worst_member < 0 || a.collapse_forecast_s < 0.0 || std::round(f.probability * 1e4) < 1) {
+    m.probability = 0.0;
+    return m;
+  }
   m.worst_member = static_cast<std::uint8_t>(f.worst_member);
   // From the frame's time (the status's): a collapse forecast for a time now past is due now.
   const double in_ms =
@@ -142,6 +152,7 @@ can::AlarmEvent alarm_event_message(const monitor::AlarmEventRecord& record) {
   event.previous_level = to_wire(record.previous_level);
   event.cause = to_wire(record.cause);
   event.latched = record.latched;
+  event.trouble = record.trouble != monitor::AlarmCause::kNone;
   // Modulo 2^32 ms, as the frame's counter wraps.
   const std::int64_t ms = record.time_ns / kNanosecondsPerMillisecond;
   event.time_since_start_ms = static_cast<std::uint32_t>(static_cast<std::uint64_t>(ms));

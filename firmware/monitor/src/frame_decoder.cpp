@@ -80,6 +80,12 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
       input.acknowledgement = acknowledgement_of(message);
       break;
     }
+    case can::MessageKind::kStatueStands: {
+      if (!decoded(frame, input.stands)) break;
+      ++counters_.statue_stands;
+      input.kind = FrameInput::Kind::kStatueStands;
+      break;
+    }
     case can::MessageKind::kMonitorStatus: {
       can::MonitorStatus message;
       if (decoded(frame, message)) ++counters_.monitor_frames;
@@ -166,6 +172,11 @@ MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::Timed
       return monitor.on_sensor_sample(input.sensor, input.sample);
     case FrameInput::Kind::kAcknowledgement:
       return monitor.acknowledge(input.acknowledgement);
+    case FrameInput::Kind::kStatueStands: {
+      MonitorUpdate update = monitor.statue_stands(input.stands.event_sequence);
+      update.stands_source = input.stands.source_id;
+      return update;
+    }
     case FrameInput::Kind::kStatueRate:
       return monitor.on_statue_sample(input.statue);
     case FrameInput::Kind::kStatueAcceleration:

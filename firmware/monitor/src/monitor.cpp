@@ -10,6 +10,39 @@ namespace plinth::firmware {
 // The CAN protocol (hal/can_codec).
 namespace can = hal::can;
 
+namespace {
+
+// How far a phase is from standing: full contact, moving (sliding, rocking), lifted off,
+// collapsed. The statue sensor uncorroborated may show a phase only further than the box's own.
+int phase_severity(const Mode& mode) {
+  if (mode.collapsed()) return 3;
+  if (mode.phase == Phase::kLiftedOff) return 2;
+  return mode.phase == Phase::kFullContact ? 0 : 1;
+}
+
+// The first collapse forecast among the members in `counted` (bit m: member m), s from the
+// forecast's start; -1: none of them collapses.
+double first_counted_collapse(const ForecastOutcome& f, std::uint32_t counted, int& member) {
+  double first = -1.0;
+  member = -1;
+  for (int m = 0; m < f.members && m < kMaxEnsembleMembers; ++m) {
+    const std::uint32_t bit = std::uint32_t{1} << static_cast<unsigned>(m);
+    if ((f.collapsing_members & counted & bit) == 0U) continue;
+    const double at = f.member_collapse_in_s[static_cast<std::size_t>(m)];
+    if (member < 0 || at < first) {
+      first = at;
+      member = m;
+    }
+  }
+  return first;
+}
+
+// The smallest probability a CollapseForecast frame carries above 0 (its resolution, 1e-4):
+// below half of it the frame says 0, and so does the status.
+constexpr double kSmallestShownProbability = 0.5e-4;
+
+}  // namespace
+
 Error Monitor::start(const MonitorConfig& config,
                      const std::array<const Scene*, kMaxAxes>& scenes) {
   std::array<std::span<const Scene>, kMaxAxes> ensembles{};
@@ -29,6 +62,14 @@ Error Monitor::start(const MonitorConfig& config,
     }
     PLINTH_TRY(ensembles_[static_cast<std::size_t>(i)].start(members, config.estimator,
                                                              config.forecast, config.risk));
+    for (OtherReading& other : others_) {
+      PLINTH_TRY(other.ensembles[static_cast<std::size_t>(i)].start(
+          members, config.estimator, config.forecast, config.risk));
+    }
+  }
+  for (OtherReading& other : others_) {
+    other.running = false;
+    other.seen = 0;
   }
   config_ = config;
   config_.conditioning.sample_period_s = config.estimator.sample_period();
@@ -79,6 +120,7 @@ Error Monitor::start(const MonitorConfig& config,
   have_epoch_ = false;
   bus_fault_ = false;
   pending_ack_ = false;
+  pending_stands_ = false;
   evaluated_ = false;
   status_interval_ns_ = std::llround(config.status_interval_s * 1e9);
   next_status_ns_ = 0;
@@ -137,11 +179,74 @@ void Monitor::take_sample(int sensor, const monitor::SensorSample& sample, Monit
   for (std::size_t i = 0; i < fed.fed_count; ++i) {
     if (sensors_.condition(sensor, fed.fed[i], quiet())) status_.calibrated = true;
     feed_estimators();
+    feed_other_reading(sensor);
   }
   // The estimators took every input the primary had; a new primary may have more.
   if (sensors_.update_primary()) feed_estimators();
   sensors_.cross_check();
   evaluate(update);
+}
+
+// Another ground sensor's newest conditioned sample to its own ensembles: they start at rest on
+// its first sample (its offset known) and again after a seam, a fault, or a turn as the primary.
+void Monitor::feed_other_reading(int sensor) {
+  if constexpr (kOtherReadings == 0) return;
+  if (sensor < 0 || sensor >= kOtherReadings) return;
+  OtherReading& other = others_[static_cast<std::size_t>(sensor)];
+  if (sensor == status_.primary || sensors_.config(sensor).role != SensorRole::kGround ||
+      !sensors_.healthy_ground(sensor)) {
+    other.running = false;
+    return;
+  }
+  ConditionedReading c;
+  if (!sensors_.newest_reading(sensor, other.seen, c)) return;
+  const bool start = !other.running || c.restart;
+  for (int i = 0; i < status_.axis_count; ++i) {
+    Ensemble& e = other.ensembles[static_cast<std::size_t>(i)];
+    const GroundAcceleration g{c.ground_m_s2[i], c.ground_m_s2.z()};
+    if (start) {
+      e.restart(g);
+    } else {
+      e.push(g);
+    }
+  }
+  if (start) other.start_ns = c.time_ns - epoch_ns_;
+  other.running = true;
+}
+
+// While the ground sensors disagree, each axis's risk, forecast and phase follow the most
+// dangerous healthy reading: the higher risk, the higher probability, the further phase
+// (docs/safety.md). One sensor turned or mis-scaled cannot then lower the alarm.
+void Monitor::follow_worst_reading() {
+  status_.risk_sensor = -1;
+  if (!status_.disagreement) return;
+  for (int sensor = 0; sensor < kOtherReadings; ++sensor) {
+    const OtherReading& other = others_[static_cast<std::size_t>(sensor)];
+    if (!other.running || sensor == status_.primary || !sensors_.healthy_ground(sensor)) continue;
+    for (int i = 0; i < status_.axis_count; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      AxisStatus& axis = status_.axes[k];
+      const Ensemble& e = other.ensembles[k];
+      EnsembleRisk r;
+      e.risk(r);
+      if (r.risk.total > axis.risk.total) {
+        static_cast<EnsembleRisk&>(axis) = r;
+        status_.risk_sensor = sensor;
+      }
+      const ForecastOutcome& f = e.forecaster().latest();
+      if (kForecastBuiltIn && f.valid && f.probability > axis.forecast.probability) {
+        axis.forecast = f;  // its times from the primary's estimators' start, as theirs are
+        axis.forecast.start_time_s +=
+            static_cast<double>(other.start_ns - status_.estimator_start_ns) * 1e-9;
+        status_.risk_sensor = sensor;
+      }
+      if (phase_severity(e.nominal().mode()) > phase_severity(axis.mode)) {
+        axis.mode = e.nominal().mode();
+        axis.state = e.nominal().state();
+        status_.risk_sensor = sensor;
+      }
+    }
+  }
 }
 
 // Each axis's members take the sample; with the statue sensor's newest rate fresh, the axis's
@@ -208,9 +313,11 @@ void Monitor::feed_estimators() {
   }
 }
 
-// One axis: the nominal statue's mode and state, the worst member's risk, the forecast; with
-// the statue sensor measuring, the measured phase, tilt and rate, the filter's risk (weighted
-// once informative, else the worst member's) and the forecast's probability weighted alike.
+// One axis: the nominal statue's mode and state, the worst member's risk, the forecast (the box
+// without the statue sensor). With the statue sensor measuring and corroborated, the measured
+// phase, tilt and rate, the filter's risk (weighted once informative, else the worst member's)
+// and the forecast's probability weighted alike; uncorroborated, the sensor only raises: the
+// higher risk and probability, the further phase (docs/safety.md).
 void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   const auto k = static_cast<std::size_t>(axis_index);
   const Ensemble& statues = ensemble(axis_index);
@@ -221,17 +328,69 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   StatueAxisStatus* statue = monitor::built_part<StatueAxisStatus>(axis.statue);
   if (statue == nullptr || !statue_present()) return;
   *statue = StatueAxisStatus{};
+  statue->risk_without = axis.risk.total;
   if (!room().measured[k]) return;
   const StatueEstimate& e = room().filters[k].estimate();
-  axis.mode = e.mode;
-  axis.state[kTheta] = e.tilt;
-  axis.state[kThetaDot] = e.rotation_rate;
-  axis.risk = e.risk;
-  axis.worst_member = e.risk_member;
-  axis.forecast.probability = weighted_collapse_probability(axis.forecast, e);
+  const double probability = weighted_collapse_probability(axis.forecast, e);
   *statue = {true,          e.informative,     !e.explained,        e.weighted,
              e.effective_members, e.best_score, e.best_member, e.ruled_out,
-             e.acceleration_used};
+             e.acceleration_used, e.corroborated, e.refutation, false,
+             axis.risk.total};
+  if (e.corroborated) {
+    axis.mode = e.mode;
+    axis.state[kTheta] = e.tilt;
+    axis.state[kThetaDot] = e.rotation_rate;
+    axis.risk = e.risk;
+    axis.worst_member = e.risk_member;
+    // The collapse named is the first among the members the weighing keeps.
+    const std::uint32_t left_out =
+        e.weighted ? e.ruled_out_members : e.ruled_out_members | e.disagreeing_members;
+    axis.forecast.worst_member = -1;
+    axis.forecast.collapse_in_s = first_counted_collapse(axis.forecast, ~left_out,
+                                                         axis.forecast.worst_member);
+    axis.forecast.probability = probability;
+    return;
+  }
+  statue->lowering_refused = e.risk.total < axis.risk.total ||
+                             probability < axis.forecast.probability ||
+                             phase_severity(e.mode) < phase_severity(axis.mode);
+  if (e.risk.total > axis.risk.total) {
+    axis.risk = e.risk;
+    axis.worst_member = e.risk_member;
+  }
+  if (probability > axis.forecast.probability) axis.forecast.probability = probability;
+  if (phase_severity(e.mode) > phase_severity(axis.mode)) {
+    axis.mode = e.mode;
+    axis.state[kTheta] = e.tilt;
+    axis.state[kThetaDot] = e.rotation_rate;
+  }
+}
+
+// The statue sensor's trouble (an input fault: the level stays at least the box's without it):
+// unusable while the estimators run calibrated, or not corroborated on a measured axis (a
+// custodian hears of a sensor the box no longer trusts, whether or not it would lower the level
+// now: docs/safety.md).
+void Monitor::note_statue_trouble() {
+  status_.statue_sensor_unusable = false;
+  if (!statue_present() || !status_.estimating || !status_.calibrated) return;
+  bool measured_any = false;
+  for (int i = 0; i < status_.axis_count; ++i) {
+    measured_any = measured_any || room().measured[static_cast<std::size_t>(i)];
+  }
+  if (!measured_any) {
+    status_.statue_sensor_unusable = true;
+    status_.input_fault = monitor::AlarmCause::kStatueSensorFault;
+    return;
+  }
+  for (int i = 0; i < status_.axis_count; ++i) {
+    const auto* statue =
+        monitor::built_part<StatueAxisStatus>(status_.axes[static_cast<std::size_t>(i)].statue);
+    if (statue == nullptr || !statue->measured || statue->corroborated) continue;
+    status_.input_fault = statue->refutation == StatueRefutation::kUnexplained
+                              ? monitor::AlarmCause::kStatueUnexplained
+                              : monitor::AlarmCause::kStatueSensorFault;
+    return;
+  }
 }
 
 // The axes' part of the status: mode, state, risk, the forecast.
@@ -241,10 +400,14 @@ void Monitor::update_axes_status() {
   status_.probability = 0.0;
   status_.forecast_axis = -1;
   status_.collapse_forecast_s = -1.0;
+  status_.input_fault = monitor::AlarmCause::kNone;
+  for (int i = 0; i < status_.axis_count; ++i) {
+    if (status_.estimating) update_axis(i, status_.axes[static_cast<std::size_t>(i)]);
+  }
+  if (status_.estimating) follow_worst_reading();
   for (int i = 0; i < status_.axis_count; ++i) {
     const auto k = static_cast<std::size_t>(i);
     AxisStatus& axis = status_.axes[k];
-    if (status_.estimating) update_axis(i, axis);
     if (const StatueAxisStatus* statue = monitor::built_part<StatueAxisStatus>(axis.statue);
         statue != nullptr && statue_present()) {
       status_.statue_unexplained = status_.statue_unexplained || statue->unexplained;
@@ -257,7 +420,8 @@ void Monitor::update_axes_status() {
       status_.probability = f.probability;
       status_.forecast_axis = i;
     }
-    if (f.worst_member >= 0) {
+    // A collapse time is named only beside a probability the frames show above 0.
+    if (f.worst_member >= 0 && f.probability >= kSmallestShownProbability) {
       const double at_s = static_cast<double>(status_.estimator_start_ns) * 1e-9 +
                           f.start_time_s + f.collapse_in_s;
       axis.collapse_forecast_s = at_s;
@@ -267,6 +431,7 @@ void Monitor::update_axes_status() {
     }
   }
   status_.risk = static_cast<double>(risk);
+  note_statue_trouble();
 }
 
 void Monitor::evaluate(MonitorUpdate& update) {
@@ -286,7 +451,10 @@ void Monitor::evaluate(MonitorUpdate& update) {
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
+  input.statue_stands = pending_stands_;
+  input.statue_stands_sequence = stands_sequence_;
   pending_ack_ = false;
+  pending_stands_ = false;
   const monitor::AlarmOutput out = alarm_.update(input);
   for (std::size_t i = 0; i < out.event_count && update.event_count < update.events.size(); ++i) {
     update.events[update.event_count++] = out.events[i];
@@ -294,10 +462,47 @@ void Monitor::evaluate(MonitorUpdate& update) {
   if (out.acknowledgement != monitor::AckOutcome::kNone) {
     update.acknowledgement = out.acknowledgement;
   }
+  if (out.statue_stands != monitor::StandsOutcome::kNone) {
+    update.statue_stands = out.statue_stands;
+  }
   status_.alarm = out.level;
   status_.latched = out.latched_level;
+  status_.trouble = out.trouble;
+  note_collapse(input);
   evaluated_ = true;
   report(update);
+}
+
+// The held collapse: recorded when the policy begins to hold one, shown on every axis while it
+// holds (no later reading shows the statue standing: docs/safety.md), forgotten when a person
+// said the statue stands.
+void Monitor::note_collapse(const monitor::AlarmInput& input) {
+  CollapseRecord& c = status_.collapse;
+  if (!alarm_.collapse_held()) {
+    c = CollapseRecord{};
+    return;
+  }
+  if (!c.held && input.collapse_detected) {
+    c.held = true;
+    c.restored = false;
+    c.time_ns = status_.time_ns;
+    for (int i = 0; i < status_.axis_count; ++i) {
+      const Mode& mode = status_.axes[static_cast<std::size_t>(i)].mode;
+      if (!mode.collapsed()) continue;
+      c.axis = i;
+      c.mode = mode;
+      break;
+    }
+  }
+  for (int i = 0; i < status_.axis_count; ++i) {
+    Mode& shown = status_.axes[static_cast<std::size_t>(i)].mode;
+    if (shown.collapsed()) continue;
+    if (i == c.axis) {
+      shown = c.mode;
+    } else {
+      shown.phase = c.mode.phase;  // the other plane: the corner it shows is its own
+    }
+  }
 }
 
 // A status without new input: evaluated once first, so that no status says the alarm policy's
@@ -310,11 +515,15 @@ void Monitor::report_state(MonitorUpdate& update) {
   }
 }
 
+// A frame the update cannot carry is counted in the status and in the update, never dropped
+// silently (the update is sized for the most it has: a full one is a defect).
 template <typename Message>
 void Monitor::add_frame(MonitorUpdate& update, const Message& message) {
-  if (update.frame_count >= update.frames.size()) return;  // sized for the most an update has
-  if (!can::encode(message, update.frames[update.frame_count]).ok()) {
+  if (update.frame_count >= update.frames.size() ||
+      !can::encode(message, update.frames[update.frame_count]).ok()) {
     ++frames_not_encoded_;
+    ++update.frames_lost;
+    status_.frames_not_encoded = frames_not_encoded_;
     return;
   }
   ++update.frame_count;
@@ -400,6 +609,62 @@ MonitorUpdate Monitor::acknowledge(const monitor::Acknowledgement& acknowledgeme
   ack_ = acknowledgement;
   evaluate(update);
   return update;
+}
+
+MonitorUpdate Monitor::statue_stands(std::uint8_t event_sequence) {
+  MonitorUpdate update = new_update();
+  bool measured_collapse = false;
+  for (int i = 0; statue_present() && i < status_.axis_count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    const StatueEstimate& e = room().filters[k].estimate();
+    measured_collapse = measured_collapse ||
+                        (room().measured[k] && e.corroborated && e.mode.collapsed());
+  }
+  // The estimators' own collapse is their simulation's, and an uncorroborated statue sensor's
+  // proves nothing: a person's word outranks them, and they start again (the filters too). A
+  // corroborated sensor's measured collapse is not overruled (kStillCollapsed).
+  if (alarm_.collapse_held() && !measured_collapse &&
+      alarm_.sequence_is_latest(event_sequence)) {
+    restart_estimators();
+  }
+  pending_stands_ = true;
+  stands_sequence_ = event_sequence;
+  evaluate(update);
+  return update;
+}
+
+// The estimators again at rest on the newest input, untrusted until the primary's conditioner
+// passes a quiet window (the start-up rule).
+void Monitor::restart_estimators() {
+  for (int i = 0; i < status_.axis_count; ++i) {
+    const auto k = static_cast<std::size_t>(i);
+    ensembles_[k].restart({last_ground_[i], last_ground_.z()});
+    if (statue_present()) {
+      room().filters[k].reset();
+      room().measured[k] = false;
+    }
+  }
+  for (OtherReading& other : others_) other.running = false;  // again on their next samples
+  if (monitor::PWaveStage* stage = pwave_stage()) stage->restart();
+  ++status_.estimator_restarts;
+  status_.estimator_start_ns = status_.time_ns;
+  status_.calibrated = false;
+  sensors_.verify_primary();
+}
+
+BoxMemory Monitor::memory() const { return {alarm_.memory(), status_.collapse}; }
+
+void Monitor::restore(const BoxMemory& memory) {
+  alarm_.restore(memory.alarm);
+  status_.collapse = memory.alarm.collapse_held ? memory.collapse : CollapseRecord{};
+  status_.collapse.held = memory.alarm.collapse_held;
+  status_.collapse.restored = memory.alarm.collapse_held;
+  if (memory.collapse.axis < 0 || memory.collapse.axis >= status_.axis_count) {
+    status_.collapse.axis = 0;
+  }
+  if (status_.collapse.held && !status_.collapse.mode.collapsed()) {
+    status_.collapse.mode.phase = Phase::kOverturned;  // a record without its phase
+  }
 }
 
 MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert,

@@ -152,6 +152,20 @@ bool SensorSet::update_primary() {
   return true;
 }
 
+bool SensorSet::newest_reading(int sensor, std::uint64_t& seen, ConditionedReading& out) const {
+  const History& h = sensors_[static_cast<std::size_t>(sensor)].history;
+  if (h.pushed <= seen || h.empty()) return false;
+  seen = h.pushed;
+  const HistoryEntry& e = h.newest();
+  out = {e.time_ns, e.value, e.restart};
+  return true;
+}
+
+void SensorSet::verify_primary() {
+  if (status_->primary < 0) return;
+  sensors_[static_cast<std::size_t>(status_->primary)].conditioner.begin_verification();
+}
+
 bool SensorSet::next_input(EstimatorInput& input) {
   if (status_->primary < 0) return false;
   Sensor& primary = sensors_[static_cast<std::size_t>(status_->primary)];

@@ -103,11 +103,15 @@ Error validate(const StatueSensorSettings& s) {
   if (!std::isfinite(s.offset_x_m) || !std::isfinite(s.offset_y_m)) {
     return {ErrorCode::kNotFinite, "statue_sensor.offset_x_m", "the offsets must be finite"};
   }
-  if (!std::isfinite(s.offset_window_s) || s.offset_window_s <= 0.0) {
-    return {ErrorCode::kOutOfRange, "statue_sensor.offset_window_s", "must be finite and > 0"};
+  if (!std::isfinite(s.offset_window_s) || s.offset_window_s <= 0.0 || s.offset_window_s > 60.0) {
+    return {ErrorCode::kOutOfRange, "statue_sensor.offset_window_s", "must lie in (0, 60] s",
+            s.offset_window_s > 60.0 ? 60.0 : 0.0};
   }
-  if (!std::isfinite(s.max_age_s) || s.max_age_s <= 0.0) {
-    return {ErrorCode::kOutOfRange, "statue_sensor.max_age_s", "must be finite and > 0"};
+  // A sample older than this is taken for the statue's now: beyond 0.1 s a stale reading could
+  // say the statue stands while it rocks.
+  if (!std::isfinite(s.max_age_s) || s.max_age_s <= 0.0 || s.max_age_s > 0.1) {
+    return {ErrorCode::kOutOfRange, "statue_sensor.max_age_s", "must lie in (0, 0.1] s",
+            s.max_age_s > 0.1 ? 0.1 : 0.0};
   }
   return validate(s.filter);
 }

@@ -55,23 +55,43 @@ constexpr std::array<SignalLayout, 6> kHeartbeatSignals{{
 }};
 
 // MonitorStatus (0x320 + axis)
-enum StatusSignal : std::size_t { kPhase, kCorner, kAlarmLevel, kRisk, kStSequence, kSampleAge };
-constexpr std::array<SignalLayout, 6> kStatusSignals{{
+enum StatusSignal : std::size_t {
+  kPhase,
+  kCorner,
+  kAlarmLevel,
+  kStTrouble,
+  kCollapseHeld,
+  kRisk,
+  kStSequence,
+  kSampleAge
+};
+constexpr std::array<SignalLayout, 8> kStatusSignals{{
     {"Phase", 0, 4, false, 1.0, 0.0, 0, 6, "", true, kNoSpecialRaw},
     {"Corner", 4, 4, false, 1.0, 0.0, 0, 2, "", true, kNoSpecialRaw},
     {"AlarmLevel", 8, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
+    {"Trouble", 12, 1, false, 1.0, 0.0, 0, 1, "", false, kNoSpecialRaw},
+    {"CollapseHeld", 13, 1, false, 1.0, 0.0, 0, 1, "", false, kNoSpecialRaw},
     {"Risk", 16, 16, false, 0.0001, 0.0, 0, 10000, "", false, kNoSpecialRaw},
     {"Sequence", 32, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
     {"SampleAge", 40, 16, false, 1.0, 0.0, 0, kU16Max, "ms", false, kNoSpecialRaw},
 }};
 
 // AlarmEvent (0x330)
-enum EventSignal : std::size_t { kLevel, kPreviousLevel, kCause, kLatched, kTime, kEvSequence };
-constexpr std::array<SignalLayout, 6> kEventSignals{{
+enum EventSignal : std::size_t {
+  kLevel,
+  kPreviousLevel,
+  kCause,
+  kLatched,
+  kEvTrouble,
+  kTime,
+  kEvSequence
+};
+constexpr std::array<SignalLayout, 7> kEventSignals{{
     {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
-    {"Cause", 8, 8, false, 1.0, 0.0, 0, 15, "", true, kNoSpecialRaw},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 18, "", true, kNoSpecialRaw},
     {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true, kNoSpecialRaw},
+    {"Trouble", 17, 1, false, 1.0, 0.0, 0, 1, "", false, kNoSpecialRaw},
     {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false, kNoSpecialRaw},
     {"Sequence", 56, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
 }};
@@ -82,6 +102,13 @@ constexpr std::array<SignalLayout, 3> kAcknowledgeSignals{{
     {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"SourceId", 8, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
     {"EventSequence", 16, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+}};
+
+// StatueStands (0x341)
+enum StandsSignal : std::size_t { kStandsSourceId, kStandsEventSequence };
+constexpr std::array<SignalLayout, 2> kStandsSignals{{
+    {"SourceId", 0, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
+    {"EventSequence", 8, 8, false, 1.0, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
 }};
 
 // CollapseForecast (0x350 + axis)
@@ -266,12 +293,13 @@ constexpr bool undefined_status_flags(std::uint8_t status) {
 }
 
 // The DBC message names, without node or axis suffix.
-constexpr NameTable<MessageKind, 9> kMessageKindNames{{{
+constexpr NameTable<MessageKind, 10> kMessageKindNames{{{
     {MessageKind::kSensorAcceleration, "SensorAcceleration"},
     {MessageKind::kSensorHeartbeat, "SensorHeartbeat"},
     {MessageKind::kMonitorStatus, "MonitorStatus"},
     {MessageKind::kAlarmEvent, "AlarmEvent"},
     {MessageKind::kAcknowledge, "Acknowledge"},
+    {MessageKind::kStatueStands, "StatueStands"},
     {MessageKind::kCollapseForecast, "CollapseForecast"},
     {MessageKind::kStatueRotation, "StatueRotation"},
     {MessageKind::kRegionalAlert, "RegionalAlert"},
@@ -308,7 +336,9 @@ MessageKind classify(std::uint32_t id) {
     case kAlarmEventId:
       return index == 0 ? MessageKind::kAlarmEvent : MessageKind::kUnknown;
     case kAcknowledgeId:
-      return index == 0 ? MessageKind::kAcknowledge : MessageKind::kUnknown;
+      return index == 0   ? MessageKind::kAcknowledge
+             : index == 1 ? MessageKind::kStatueStands
+                          : MessageKind::kUnknown;
     case kCollapseForecastBaseId:
       return index < kMonitorAxisCount ? MessageKind::kCollapseForecast : MessageKind::kUnknown;
     case kStatueRotationBaseId:
@@ -335,6 +365,7 @@ std::span<const SignalLayout> signal_layouts(MessageKind kind) {
     case MessageKind::kMonitorStatus: return kStatusSignals;
     case MessageKind::kAlarmEvent: return kEventSignals;
     case MessageKind::kAcknowledge: return kAcknowledgeSignals;
+    case MessageKind::kStatueStands: return kStandsSignals;
     case MessageKind::kCollapseForecast: return kForecastSignals;
     case MessageKind::kStatueRotation: return kRotationSignals;
     case MessageKind::kRegionalAlert: return kRegionalSignals;
@@ -500,6 +531,8 @@ EncodeResult encode(const MonitorStatus& message, CanFrame& frame) {
   packer.enumeration(message.phase, s[kPhase]);
   packer.enumeration(message.corner, s[kCorner]);
   packer.enumeration(message.alarm_level, s[kAlarmLevel]);
+  packer.integer(message.trouble ? 1U : 0U, s[kStTrouble]);
+  packer.integer(message.collapse_held ? 1U : 0U, s[kCollapseHeld]);
   packer.physical(message.risk, s[kRisk]);
   packer.integer(message.sequence, s[kStSequence]);
   packer.integer(message.sample_age_ms, s[kSampleAge]);
@@ -514,6 +547,8 @@ DecodeResult decode(const CanFrame& frame, MonitorStatus& message) {
   m.phase = unpacker.enumeration<Phase>(s[kPhase]);
   m.corner = unpacker.enumeration<Corner>(s[kCorner]);
   m.alarm_level = unpacker.enumeration<AlarmLevel>(s[kAlarmLevel]);
+  m.trouble = unpacker.integer<std::uint8_t>(s[kStTrouble]) != 0;
+  m.collapse_held = unpacker.integer<std::uint8_t>(s[kCollapseHeld]) != 0;
   m.risk = unpacker.physical(s[kRisk]);
   m.sequence = unpacker.integer<std::uint8_t>(s[kStSequence]);
   m.sample_age_ms = unpacker.integer<std::uint16_t>(s[kSampleAge]);
@@ -528,6 +563,7 @@ EncodeResult encode(const AlarmEvent& message, CanFrame& frame) {
   packer.enumeration(message.previous_level, s[kPreviousLevel]);
   packer.enumeration(message.cause, s[kCause]);
   packer.integer(message.latched ? 1U : 0U, s[kLatched]);
+  packer.integer(message.trouble ? 1U : 0U, s[kEvTrouble]);
   packer.integer(message.time_since_start_ms, s[kTime]);
   packer.integer(message.sequence, s[kEvSequence]);
   return packer.finish(kAlarmEventId, frame);
@@ -541,6 +577,7 @@ DecodeResult decode(const CanFrame& frame, AlarmEvent& message) {
   m.previous_level = unpacker.enumeration<AlarmLevel>(s[kPreviousLevel]);
   m.cause = unpacker.enumeration<AlarmCause>(s[kCause]);
   m.latched = unpacker.integer<std::uint8_t>(s[kLatched]) != 0;
+  m.trouble = unpacker.integer<std::uint8_t>(s[kEvTrouble]) != 0;
   m.time_since_start_ms = unpacker.integer<std::uint32_t>(s[kTime]);
   m.sequence = unpacker.integer<std::uint8_t>(s[kEvSequence]);
   if (unpacker.result().ok()) message = m;
@@ -563,6 +600,24 @@ DecodeResult decode(const CanFrame& frame, Acknowledge& message) {
   m.level = unpacker.enumeration<AlarmLevel>(s[kAckLevel]);
   m.source_id = unpacker.integer<std::uint8_t>(s[kSourceId]);
   m.event_sequence = unpacker.integer<std::uint8_t>(s[kEventSequence]);
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+EncodeResult encode(const StatueStands& message, CanFrame& frame) {
+  const auto& s = kStandsSignals;
+  Packer packer;
+  packer.integer(message.source_id, s[kStandsSourceId]);
+  packer.integer(message.event_sequence, s[kStandsEventSequence]);
+  return packer.finish(kStatueStandsId, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, StatueStands& message) {
+  const auto& s = kStandsSignals;
+  Unpacker unpacker(frame, MessageKind::kStatueStands, s);
+  StatueStands m;
+  m.source_id = unpacker.integer<std::uint8_t>(s[kStandsSourceId]);
+  m.event_sequence = unpacker.integer<std::uint8_t>(s[kStandsEventSequence]);
   if (unpacker.result().ok()) message = m;
   return unpacker.result();
 }

@@ -217,6 +217,8 @@ void Forecaster::finish_member(bool collapsed, double time_s) {
   if (collapsed) {
     ++building_.collapsing;
     building_.collapsing_members |= std::uint32_t{1} << static_cast<unsigned>(member_);
+    building_.member_collapse_in_s[static_cast<std::size_t>(member_)] =
+        static_cast<float>(time_s);
     if (building_.worst_member < 0 || time_s < building_.collapse_in_s) {
       building_.worst_member = member_;
       building_.collapse_in_s = time_s;

@@ -22,8 +22,6 @@ constexpr Real kSlideSigmas = 4;
 // are the contacts 1-3 of each base, bits 1-3, 5-7 and 9-11 (feature_sets.cpp).
 constexpr bool kSlidingBuiltIn = (PLINTH_CORE_FEATURE_MASK & 0xEEE) != 0;
 
-bool positive_finite(double x) { return std::isfinite(x) && x > 0.0; }
-
 // theta'' of `scene` at the measured mode and state (Eq 8); at rest the rotation that Eq 16's
 // onset starts about either corner (the flow at theta = theta' = 0 turning away from the
 // ground), else none.
@@ -47,64 +45,72 @@ Real rotational_acceleration(const Scene& scene, const Mode& measured, const Sta
 
 }  // namespace
 
+// A tunable within [low, high] (low excluded when `open_low`), its reason naming the range.
+static Error check_range(double value, double low, double high, bool open_low, const char* field,
+                  const char* reason) {
+  if (!std::isfinite(value)) return {ErrorCode::kNotFinite, field, "must be finite"};
+  if (value < low || (open_low && value <= low)) {
+    return {ErrorCode::kOutOfRange, field, reason, low};
+  }
+  if (value > high) return {ErrorCode::kOutOfRange, field, reason, high};
+  return ok_error();
+}
+
+// The bounds are physical where the quantity is (a gyroscope's noise, a rest rate, a tilt), and
+// elsewhere where a value stops meaning what its name says and starts switching a check off
+// (docs/statue-filter.md, "Bounds").
 Error validate(const StatueFilterSettings& s) {
-  if (!positive_finite(s.rate_noise_rad_s)) {
-    return {ErrorCode::kOutOfRange, "statue_filter.rate_noise_rad_s", "must be finite and > 0"};
-  }
-  if (!positive_finite(s.model_tolerance) || s.model_tolerance > 2) {
-    return {ErrorCode::kOutOfRange, "statue_filter.model_tolerance", "must lie in (0, 2]"};
-  }
-  if (!positive_finite(s.rest_rate_rad_s)) {
-    return {ErrorCode::kOutOfRange, "statue_filter.rest_rate_rad_s", "must be finite and > 0"};
-  }
-  if (!positive_finite(s.rest_tilt_rad) || s.rest_tilt_rad > Real(0.1)) {
-    return {ErrorCode::kOutOfRange, "statue_filter.rest_tilt_rad", "must lie in (0, 0.1] rad"};
-  }
-  if (!positive_finite(s.rest_time_s)) {
-    return {ErrorCode::kOutOfRange, "statue_filter.rest_time_s", "must be finite and > 0"};
-  }
-  if (!positive_finite(s.interval_s) || s.interval_s > 1.0) {
-    return {ErrorCode::kOutOfRange, "statue_filter.interval_s", "must lie in (0, 1] s"};
-  }
-  if (!positive_finite(s.memory_s)) {
-    return {ErrorCode::kOutOfRange, "statue_filter.memory_s", "must be finite and > 0"};
-  }
-  if (!positive_finite(s.score_memory_s)) {
-    return {ErrorCode::kOutOfRange, "statue_filter.score_memory_s", "must be finite and > 0"};
-  }
-  if (!positive_finite(s.informative_fraction) || s.informative_fraction > 1) {
-    return {ErrorCode::kOutOfRange, "statue_filter.informative_fraction", "must lie in (0, 1]"};
-  }
-  if (!positive_finite(s.credible_weight) || s.credible_weight > 1) {
-    return {ErrorCode::kOutOfRange, "statue_filter.credible_weight", "must lie in (0, 1]"};
-  }
-  if (!positive_finite(s.unexplained_score)) {
-    return {ErrorCode::kOutOfRange, "statue_filter.unexplained_score", "must be finite and > 0"};
-  }
-  if (!positive_finite(s.ruled_out_fraction) || s.ruled_out_fraction > 1) {
-    return {ErrorCode::kOutOfRange, "statue_filter.ruled_out_fraction", "must lie in (0, 1]"};
-  }
-  if (!positive_finite(s.acceleration_noise_m_s2)) {
-    return {ErrorCode::kOutOfRange, "statue_filter.acceleration_noise_m_s2",
-            "must be finite and > 0 m/s2"};
-  }
-  if (!std::isfinite(s.acceleration_bias_m_s2) || s.acceleration_bias_m_s2 < 0) {
-    return {ErrorCode::kOutOfRange, "statue_filter.acceleration_bias_m_s2",
-            "must be finite and >= 0 m/s2"};
-  }
-  if (!std::isfinite(s.slide_tolerance) || s.slide_tolerance < 0 || s.slide_tolerance >= 1) {
-    return {ErrorCode::kOutOfRange, "statue_filter.slide_tolerance", "must lie in [0, 1)"};
-  }
   const struct {
     double value;
+    double low;
+    double high;
+    bool open_low;
     const char* field;
-  } times[] = {{s.slide_filter_s, "statue_filter.slide_filter_s"},
-               {s.slide_onset_s, "statue_filter.slide_onset_s"},
-               {s.slide_end_s, "statue_filter.slide_end_s"}};
-  for (const auto& t : times) {
-    if (!positive_finite(t.value) || t.value > 1.0) {
-      return {ErrorCode::kOutOfRange, t.field, "must lie in (0, 1] s"};
-    }
+    const char* reason;
+  } kRanges[] = {
+      {s.rate_noise_rad_s, 1e-4, 0.05, false, "statue_filter.rate_noise_rad_s",
+       "must lie in [1e-4, 0.05] rad/s"},
+      {s.model_tolerance, 0.05, 1.0, false, "statue_filter.model_tolerance",
+       "must lie in [0.05, 1]"},
+      {s.rest_rate_rad_s, 0.0, 0.05, true, "statue_filter.rest_rate_rad_s",
+       "must lie in (0, 0.05] rad/s"},
+      {s.rest_tilt_rad, 0.0, 0.01, true, "statue_filter.rest_tilt_rad",
+       "must lie in (0, 0.01] rad"},
+      {s.rest_time_s, 0.0, 10.0, true, "statue_filter.rest_time_s", "must lie in (0, 10] s"},
+      {s.interval_s, 0.0, 1.0, true, "statue_filter.interval_s", "must lie in (0, 1] s"},
+      {s.memory_s, 1.0, 600.0, false, "statue_filter.memory_s", "must lie in [1, 600] s"},
+      {s.score_memory_s, 0.1, 60.0, false, "statue_filter.score_memory_s",
+       "must lie in [0.1, 60] s"},
+      {s.informative_fraction, 0.0, 1.0, true, "statue_filter.informative_fraction",
+       "must lie in (0, 1]"},
+      {s.credible_weight, 0.0, 0.5, true, "statue_filter.credible_weight",
+       "must lie in (0, 0.5]"},
+      {s.unexplained_score, 2.0, 50.0, false, "statue_filter.unexplained_score",
+       "must lie in [2, 50]"},
+      {s.ruled_out_fraction, 0.0, 0.5, true, "statue_filter.ruled_out_fraction",
+       "must lie in (0, 0.5]"},
+      {s.acceleration_noise_m_s2, 0.0, 1.0, true, "statue_filter.acceleration_noise_m_s2",
+       "must lie in (0, 1] m/s2"},
+      {s.acceleration_bias_m_s2, 0.0, 1.0, false, "statue_filter.acceleration_bias_m_s2",
+       "must lie in [0, 1] m/s2"},
+      {s.slide_tolerance, 0.0, 0.5, false, "statue_filter.slide_tolerance",
+       "must lie in [0, 0.5]"},
+      {s.slide_filter_s, 0.0, 1.0, true, "statue_filter.slide_filter_s", "must lie in (0, 1] s"},
+      {s.slide_onset_s, 0.0, 1.0, true, "statue_filter.slide_onset_s", "must lie in (0, 1] s"},
+      {s.slide_end_s, 0.0, 1.0, true, "statue_filter.slide_end_s", "must lie in (0, 1] s"},
+      {s.follow_tolerance, 0.05, 0.7, false, "statue_filter.follow_tolerance",
+       "must lie in [0.05, 0.7]"},
+      {s.follow_onset_s, 0.0, 1.0, true, "statue_filter.follow_onset_s",
+       "must lie in (0, 1] s"},
+      {s.contradiction_rate_rad_s, 0.02, 0.5, false, "statue_filter.contradiction_rate_rad_s",
+       "must lie in [0.02, 0.5] rad/s"},
+      {s.contradiction_s, 0.0, 1.0, true, "statue_filter.contradiction_s",
+       "must lie in (0, 1] s"},
+      {s.trust_again_s, 1.0, 600.0, false, "statue_filter.trust_again_s",
+       "must lie in [1, 600] s"},
+  };
+  for (const auto& r : kRanges) {
+    PLINTH_TRY(check_range(r.value, r.low, r.high, r.open_low, r.field, r.reason));
   }
   return ok_error();
 }
@@ -195,6 +201,9 @@ Error StatueFilter::start(const StatueFilterSettings& settings, const EstimatorS
   };
   slide_onset_samples_ = samples(settings.slide_onset_s);
   slide_end_samples_ = samples(settings.slide_end_s);
+  follow_onset_samples_ = samples(settings.follow_onset_s);
+  contradiction_samples_ = samples(settings.contradiction_s);
+  trust_again_samples_ = samples(settings.trust_again_s);
   reset();
   return ok_error();
 }
@@ -220,6 +229,15 @@ void StatueFilter::reset() {
   have_previous_ = false;
   gyroscope_mode_ = Mode{};
   stop_sliding();
+  slide_relative_.fill(0);
+  slide_scale_.fill(0);
+  slide_noise_.fill(0);
+  measured_force_ = 0;
+  compared_once_ = false;
+  beyond_samples_ = 0;
+  without_acceleration_ = 0;
+  contradicting_samples_ = 0;
+  rest_agreeing_samples_ = 0;
 }
 
 // The sliding test forgets (no fresh accelerometer sample, or a restart): stuck, as the
@@ -228,40 +246,41 @@ void StatueFilter::stop_sliding() {
   slide_above_ = 0;
   slide_below_ = 0;
   sliding_ = false;
-  slide_relative_.fill(0);
-  slide_scale_.fill(0);
   estimate_.acceleration_used = false;
   estimate_.relative_acceleration = 0;
   estimate_.slide_threshold = 0;
 }
 
-// The gyroscope's phase (measure()) with sliding added from the accelerometer (see the header):
-// `previous_rate` the rate before this sample's, if any. Each member's base is a sticking
-// block's own: sliding once none of them explains the reading.
-void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration ground,
-                                   const StatueMeasurement& measured,
-                                   const Real* previous_rate) {
+// The accelerometer's specific force against what it reads on a block sticking to each
+// member's base (the pivot moving as the member's own simulation moves its base; the block's
+// rotation from the gyroscope): the relative acceleration a_rel = f - f_predicted, |f_predicted|
+// and the noise, low-passed over slide_filter_s from 0. `previous_rate` the rate before this
+// sample's, if any. False (nothing compared, the filters forgotten) without a usable sample or
+// once the gyroscope says collapse.
+bool StatueFilter::compare_with_bases(const Ensemble& members, GroundAcceleration ground,
+                                      const StatueMeasurement& measured,
+                                      const Real* previous_rate) {
   const Mode& gyroscope = gyroscope_mode_;  // on_sample() set it to measure()'s phase
-  const SceneParams& nominal = members.nominal().scene().params;
-  if (!kSlidingBuiltIn || !nominal.has_friction ||
-      (nominal.has_base && !settings_.slide_on_isolated_base) || !measured.has_acceleration ||
-      !std::isfinite(measured.specific_force_m_s2) || gyroscope.terminal()) {
-    if (estimate_.acceleration_used) stop_sliding();  // else nothing to forget
-    return;
+  if (!measured.has_acceleration || !std::isfinite(measured.specific_force_m_s2) ||
+      gyroscope.terminal()) {
+    if (compared_once_) {  // the filters forget: they start from 0 on the next sample
+      slide_relative_.fill(0);
+      slide_scale_.fill(0);
+      measured_force_ = 0;
+      compared_once_ = false;
+    }
+    return false;
   }
-  estimate_.acceleration_used = true;
+  compared_once_ = true;
   const bool rocking = gyroscope.rocking();
   const Real theta_ddot =
       previous_rate != nullptr ? (estimate_.rotation_rate - *previous_rate) / period_ : Real(0);
   const Real acceleration_noise = settings_.acceleration_noise_m_s2 * slide_noise_gain_;
-  bool explained = false;  // some member's base, sticking, explains the reading
-  Real closest = -1;       // the smallest |a_rel| / threshold, and its member's
-  Real closest_block = 0;  // the block's acceleration by that member's base
+  const Real alpha = slide_alpha_;
+  measured_force_ += alpha * (measured.specific_force_m_s2 - measured_force_);
   for (int m = 0; m < members_; ++m) {
     const auto k = static_cast<std::size_t>(m);
     const Scene& scene = members.member(m).scene();
-    // Sticking: the pivot (the corner it rocks about; at rest either) moves with the base as the
-    // member's own simulation moves it (its block's reaction on it included).
     const Real base = members.base_acceleration(m);
     const Vector2r from_pivot(scene.corner(gyroscope.corner).offset + mount_.offset_m,
                               mount_.height_m);
@@ -270,21 +289,41 @@ void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration g
                              rocking ? estimate_.rotation_rate : Real(0),
                              rocking ? theta_ddot : Real(0), scene.g)
             .x();
-    Real& relative = slide_relative_[k];
-    relative += slide_alpha_ * (measured.specific_force_m_s2 - predicted - relative);
-    slide_scale_[k] += slide_alpha_ * (std::fabs(predicted) - slide_scale_[k]);
+    slide_relative_[k] += alpha * (measured.specific_force_m_s2 - predicted - slide_relative_[k]);
+    slide_scale_[k] += alpha * (std::fabs(predicted) - slide_scale_[k]);
     // The filtered noise: the accelerometers', and rocking the differenced rate's at the lever.
     const Real rate_noise = rocking ? settings_.rate_noise_rad_s * from_pivot.norm() *
                                           slide_rate_noise_gain_
                                     : Real(0);
-    const Real noise =
+    slide_noise_[k] =
         std::sqrt(acceleration_noise * acceleration_noise + rate_noise * rate_noise);
-    const Real threshold = kSlideSigmas * noise + settings_.acceleration_bias_m_s2 +
+  }
+  return true;
+}
+
+// Sliding (a scene that can slide; on an isolated base only with slide_on_isolated_base):
+// once no member's base, sticking, explains the reading, debounced both ways. Needs this
+// sample's comparison (compare_with_bases).
+void StatueFilter::measure_sliding(const Ensemble& members, bool compared) {
+  const SceneParams& nominal = members.nominal().scene().params;
+  if (!kSlidingBuiltIn || !nominal.has_friction ||
+      (nominal.has_base && !settings_.slide_on_isolated_base) || !compared) {
+    if (estimate_.acceleration_used) stop_sliding();  // else nothing to forget
+    return;
+  }
+  estimate_.acceleration_used = true;
+  bool explained = false;  // some member's base, sticking, explains the reading
+  Real closest = -1;       // the smallest |a_rel| / threshold, and its member's
+  Real closest_block = 0;  // the block's acceleration by that member's base
+  for (int m = 0; m < members_; ++m) {
+    const auto k = static_cast<std::size_t>(m);
+    const Real relative = slide_relative_[k];
+    const Real threshold = kSlideSigmas * slide_noise_[k] + settings_.acceleration_bias_m_s2 +
                            settings_.slide_tolerance * slide_scale_[k];
     const Real ratio = std::fabs(relative) / threshold;
     if (closest < 0 || ratio < closest) {
       closest = ratio;
-      closest_block = base + relative;
+      closest_block = members.base_acceleration(m) + relative;
       estimate_.relative_acceleration = relative;
       estimate_.slide_threshold = threshold;
     }
@@ -301,9 +340,83 @@ void StatueFilter::measure_sliding(const Ensemble& members, GroundAcceleration g
   if (!sliding_ && slide_above_ >= slide_onset_samples_) sliding_ = true;
   if (sliding_ && slide_below_ >= slide_end_samples_) sliding_ = false;
   if (!sliding_) return;
-  estimate_.mode.phase = rocking ? Phase::kSlideRocking : Phase::kSliding;
+  estimate_.mode.phase = gyroscope_mode_.rocking() ? Phase::kSlideRocking : Phase::kSliding;
   // Kinetic friction opposes the slip: the block's acceleration has the sign of -x'.
   estimate_.mode.slide_direction = closest_block > 0 ? std::int8_t{-1} : std::int8_t{1};
+}
+
+// Does the accelerometer read what a block on one of the members' bases reads: sticking to it
+// (within follow_tolerance of the prediction, beside the sliding test's noise and bias terms),
+// or, for a member that can slide, sliding on it (|f| the friction's, mu (g + v_G''), Eqs 4-5,
+// between its kinetic and static coefficients, alike)? A frozen, loose, turned or misread sensor
+// does not, once the base moves beyond those terms.
+bool StatueFilter::follows_some_base(const Ensemble& members, GroundAcceleration ground) const {
+  for (int m = 0; m < members_; ++m) {
+    const auto k = static_cast<std::size_t>(m);
+    const Real floor = kSlideSigmas * slide_noise_[k] + settings_.acceleration_bias_m_s2;
+    if (std::fabs(slide_relative_[k]) <= floor + settings_.follow_tolerance * slide_scale_[k]) {
+      return true;
+    }
+    const SceneParams& p = members.member(m).scene().params;
+    if (!kSlidingBuiltIn || !p.has_friction) continue;
+    const Real normal = members.member(m).scene().g + ground.vertical;  // per unit mass
+    const Real low = p.friction.kinetic_coefficient * normal * (1 - settings_.follow_tolerance);
+    const Real high = p.friction.static_coefficient * normal * (1 + settings_.follow_tolerance);
+    const Real f = std::fabs(measured_force_);
+    if (f >= low - floor && f <= high + floor) return true;
+  }
+  return false;
+}
+
+// Corroboration (docs/statue-filter.md): refuted by the first that holds: no accelerometer
+// sample for follow_onset_s; the accelerometer following no member's base for follow_onset_s;
+// the statue measured in full contact while every member's own simulation rocks (|theta'| beyond
+// contradiction_rate_rad_s) or collapsed, for contradiction_s; no member explaining the
+// rotation. A refutation holds until every member and the statue stood in full contact, the
+// accelerometer following, for trust_again_s.
+void StatueFilter::corroborate(const Ensemble& members, bool compared, GroundAcceleration ground) {
+  if (compared) {
+    without_acceleration_ = 0;
+    estimate_.follows_base = follows_some_base(members, ground);
+    beyond_samples_ = estimate_.follows_base ? 0 : beyond_samples_ + 1;
+  } else if (!gyroscope_mode_.terminal()) {
+    ++without_acceleration_;
+  }
+  bool every_member_rocks = gyroscope_mode_.phase == Phase::kFullContact;
+  bool every_member_stands = true;
+  for (int m = 0; m < members_; ++m) {
+    const PlanarEstimator& e = members.member(m);
+    const Mode& own = e.mode();
+    const bool rocks = own.terminal() || (own.rocking() && std::fabs(e.state()[kThetaDot]) >
+                                                                settings_.contradiction_rate_rad_s);
+    every_member_rocks = every_member_rocks && rocks;
+    every_member_stands = every_member_stands && own.phase == Phase::kFullContact;
+  }
+  contradicting_samples_ = every_member_rocks ? contradicting_samples_ + 1 : 0;
+  StatueRefutation now = StatueRefutation::kNone;
+  if (without_acceleration_ >= follow_onset_samples_) {
+    now = StatueRefutation::kNoAccelerometer;
+  } else if (beyond_samples_ >= follow_onset_samples_) {
+    now = StatueRefutation::kDoesNotFollowBase;
+  } else if (contradicting_samples_ >= contradiction_samples_) {
+    now = StatueRefutation::kStillWhileMembersRock;
+  } else if (!estimate_.explained) {
+    now = StatueRefutation::kUnexplained;
+  }
+  if (now != StatueRefutation::kNone) {
+    estimate_.corroborated = false;
+    estimate_.refutation = now;
+    rest_agreeing_samples_ = 0;
+    return;
+  }
+  if (estimate_.corroborated) return;
+  const bool at_rest = every_member_stands && gyroscope_mode_.phase == Phase::kFullContact &&
+                       compared && estimate_.follows_base;
+  rest_agreeing_samples_ = at_rest ? rest_agreeing_samples_ + 1 : 0;
+  if (rest_agreeing_samples_ >= trust_again_samples_) {
+    estimate_.corroborated = true;
+    estimate_.refutation = StatueRefutation::kNone;
+  }
 }
 
 // The measured state as member `member` would have it: its own base and sliding (not measured),
@@ -368,7 +481,9 @@ void StatueFilter::on_sample(const Ensemble& members, GroundAcceleration ground,
   const bool had_previous = have_previous_;
   measure(members, measured);
   gyroscope_mode_ = estimate_.mode;
-  measure_sliding(members, ground, measured, had_previous ? &previous_rate : nullptr);
+  const bool compared =
+      compare_with_bases(members, ground, measured, had_previous ? &previous_rate : nullptr);
+  measure_sliding(members, compared);
   if (!have_previous_ || interval_count_ == 0) {
     interval_start_rate_ = estimate_.rotation_rate;
     interval_start_tilt_ = estimate_.tilt;
@@ -388,6 +503,7 @@ void StatueFilter::on_sample(const Ensemble& members, GroundAcceleration ground,
   estimate_.measuring = true;
   if (++interval_count_ > interval_samples_) finish_interval(members);
   weigh(members);
+  corroborate(members, compared, ground);
 }
 
 void StatueFilter::finish_interval(const Ensemble& members) {

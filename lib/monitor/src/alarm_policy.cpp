@@ -126,6 +126,42 @@ AckOutcome AlarmPolicy::acknowledge(const Acknowledgement& ack) {
                                                    : AckOutcome::kReleased;
 }
 
+// A person's statement, against the latest event they saw: the held collapse clears, unless an
+// input still says collapse.
+StandsOutcome AlarmPolicy::statue_stands(std::uint8_t sequence, bool collapse_now) {
+  if (!collapse_held_) return StandsOutcome::kNothingHeld;
+  if (!sequence_is_latest(sequence)) return StandsOutcome::kStale;
+  if (collapse_now) return StandsOutcome::kStillCollapsed;
+  collapse_held_ = false;
+  collapse_restored_ = false;
+  collapse_ = false;
+  condition_level_ = condition_level();
+  return StandsOutcome::kCleared;
+}
+
+AlarmMemory AlarmPolicy::memory() const {
+  return {latched_level_, latched_cause_, collapse_held_, next_sequence_};
+}
+
+void AlarmPolicy::restore(const AlarmMemory& m) {
+  const bool latch = m.latched_level == AlarmLevel::kWarning || m.latched_level == AlarmLevel::kAlarm;
+  latched_level_ = latch ? m.latched_level : AlarmLevel::kNormal;
+  latched_cause_ = latch ? AlarmCause::kRestored : AlarmCause::kNone;
+  collapse_held_ = m.collapse_held;
+  collapse_restored_ = m.collapse_held;
+  next_sequence_ = m.next_sequence;
+  restored_ = latch || m.collapse_held;
+  condition_level_ = condition_level();
+}
+
+// The highest level whose condition holds.
+AlarmLevel AlarmPolicy::condition_level() const {
+  return collapse_held_ || alarm_.active ? AlarmLevel::kAlarm
+         : warning_.active               ? AlarmLevel::kWarning
+         : advisory_.active              ? AlarmLevel::kAdvisory
+                                         : AlarmLevel::kNormal;
+}
+
 void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   // An invalid risk leaves the risk conditions as they were (their holds keep running).
   if (risk_valid) {
@@ -152,6 +188,10 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   }
   const bool collapse_began = in.collapse_detected && !collapse_;
   collapse_ = in.collapse_detected;
+  if (collapse_) {
+    collapse_held_ = true;
+    collapse_restored_ = collapse_restored_ && !collapse_began;
+  }
   out_of_contact_ = in.out_of_full_contact;
   not_calibrated_ = in.not_calibrated;
 
@@ -160,12 +200,13 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   fault_input_ = fault;
   fault_.update(fault, in.time_ns, 0, lower_hold_ns_);
   if (fault) fault_cause_ = risk_valid ? in.fault_cause : AlarmCause::kInternalFault;
+  const bool input_fault = in.input_fault != AlarmCause::kNone;
+  input_fault_input_ = input_fault;
+  input_fault_.update(input_fault, in.time_ns, 0, lower_hold_ns_);
+  if (input_fault) input_fault_cause_ = in.input_fault;
 
   const AlarmLevel previous = condition_level_;
-  condition_level_ = collapse_ || alarm_.active ? AlarmLevel::kAlarm
-                     : warning_.active          ? AlarmLevel::kWarning
-                     : advisory_.active         ? AlarmLevel::kAdvisory
-                                                : AlarmLevel::kNormal;
+  condition_level_ = condition_level();
 
   // Latch on a rise into a latching level (the highest one passed); a collapse latches the
   // alarm when it begins, whatever came before. A condition that stays up does not latch again.
@@ -186,25 +227,42 @@ void AlarmPolicy::evaluate_conditions(const AlarmInput& in, bool risk_valid) {
   }
 }
 
-// Alarm above all; then fault (held, or not calibrated); then the risk level.
+// Alarm above all; then a latched warning; then fault (held, or not calibrated); then the risk
+// level, or fault in its place while a refused input's trouble holds and the level is normal.
 AlarmLevel AlarmPolicy::shown_level() const {
   const AlarmLevel risk_level = higher(condition_level_, latched_level_);
   if (risk_level == AlarmLevel::kAlarm) return AlarmLevel::kAlarm;
-  if (fault_.active || not_calibrated_) return AlarmLevel::kFault;
+  if (fault_.active || not_calibrated_) {
+    return latched_level_ == AlarmLevel::kWarning ? AlarmLevel::kWarning : AlarmLevel::kFault;
+  }
+  if (input_fault_.active && risk_level == AlarmLevel::kNormal) return AlarmLevel::kFault;
   return risk_level;
+}
+
+// The trouble beside the level: a fault now, else not calibrated, else a refused input now;
+// while none is active but a fault or a refused input is still held (lower_hold_s), the trouble
+// last shown stays (a hold is no news).
+AlarmCause AlarmPolicy::trouble() const {
+  if (fault_input_) return fault_cause_;
+  if (not_calibrated_) return AlarmCause::kNotCalibrated;
+  if (input_fault_input_) return input_fault_cause_;
+  if (!fault_.active && !input_fault_.active) return AlarmCause::kNone;
+  if (trouble_shown_ != AlarmCause::kNone) return trouble_shown_;
+  return fault_.active ? fault_cause_ : input_fault_cause_;
 }
 
 // Why `level` holds now.
 AlarmCause AlarmPolicy::cause_of(AlarmLevel level) const {
   switch (level) {
     case AlarmLevel::kNormal: return AlarmCause::kNone;
-    case AlarmLevel::kFault:  // a fault now, else not calibrated, else a fault held
-      return fault_input_ || !not_calibrated_ ? fault_cause_ : AlarmCause::kNotCalibrated;
+    case AlarmLevel::kFault: return trouble();
     case AlarmLevel::kAdvisory:
       return out_of_contact_ ? AlarmCause::kPhaseChange : AlarmCause::kRiskThreshold;
     case AlarmLevel::kWarning:
     case AlarmLevel::kAlarm:
-      if (collapse_) return AlarmCause::kOverturnDetected;
+      if (collapse_held_ && level == AlarmLevel::kAlarm) {
+        return collapse_restored_ ? AlarmCause::kRestored : AlarmCause::kOverturnDetected;
+      }
       // Held by its latch alone: the cause it latched with.
       if (rank(condition_level_) < rank(level) && latched_level_ == level) return latched_cause_;
       return condition_cause(level);
@@ -224,30 +282,38 @@ AlarmCause AlarmPolicy::condition_cause(AlarmLevel level) const {
                                                        : AlarmCause::kRiskThreshold;
 }
 
-void AlarmPolicy::emit_if_changed(AlarmOutput& out, std::int64_t time_ns,
-                                  bool by_acknowledgement) {
+void AlarmPolicy::emit_if_changed(AlarmOutput& out, std::int64_t time_ns, AlarmCause by_person) {
   const AlarmLevel shown = shown_level();
   const bool latched = latched_level_ != AlarmLevel::kNormal;
-  if (shown == level_ && latched == latched_shown_) return;
+  const AlarmCause trouble_now = trouble();
+  if (shown == level_ && latched == latched_shown_ && trouble_now == trouble_shown_) return;
 
   AlarmEventRecord& e = out.events[out.event_count++];
   e.level = shown;
   e.previous_level = level_;
   e.latched = latched;
+  e.trouble = trouble_now;
   e.time_ns = time_ns;
   e.sequence = next_sequence_;
-  if (by_acknowledgement) {
-    e.cause = AlarmCause::kAcknowledged;
-  } else if (shown == level_) {
+  if (by_person != AlarmCause::kNone) {
+    e.cause = by_person;
+  } else if (restored_) {
+    e.cause = AlarmCause::kRestored;  // the first event after a restart that restored a level
+  } else if (shown != level_) {
+    e.cause = cause_of(shown);
+  } else if (latched != latched_shown_) {
     e.cause = latched_cause_;  // only the latch changed: a level latched beneath a fault
   } else {
-    e.cause = cause_of(shown);
+    // Only the trouble changed: its cause, or the level's own once it cleared.
+    e.cause = trouble_now != AlarmCause::kNone ? trouble_now : cause_of(shown);
   }
+  restored_ = false;
   last_event_sequence_ = next_sequence_;
   next_sequence_ = static_cast<std::uint8_t>(next_sequence_ + 1);
   any_event_ = true;
   level_ = shown;
   latched_shown_ = latched;
+  trouble_shown_ = trouble_now;
   // A change is reported at once: the next status is due now.
   if (time_ns < next_heartbeat_ns_) next_heartbeat_ns_ = time_ns;
 }
@@ -261,7 +327,10 @@ AlarmOutput AlarmPolicy::update(const AlarmInput& in) {
     last_time_ns_ = in.time_ns;
     if (in.acknowledged) {
       out.acknowledgement = acknowledge(in.acknowledgement);
-      emit_if_changed(out, in.time_ns, true);
+      emit_if_changed(out, in.time_ns, AlarmCause::kAcknowledged);
+    } else if (in.statue_stands) {
+      out.statue_stands = statue_stands(in.statue_stands_sequence, in.collapse_detected);
+      emit_if_changed(out, in.time_ns, AlarmCause::kStatueStands);
     }
     const bool risk_valid =
         valid_fraction(in.risk) && valid_fraction(in.probability) &&
@@ -269,10 +338,12 @@ AlarmOutput AlarmPolicy::update(const AlarmInput& in) {
         (!kRegionalAlertBuiltIn || valid_fraction(in.regional_probability));
     if (!risk_valid) out.input_problem = InputProblem::kRiskInvalid;
     evaluate_conditions(in, risk_valid);
-    emit_if_changed(out, in.time_ns, false);
+    emit_if_changed(out, in.time_ns, AlarmCause::kNone);
   }
   out.level = level_;
   out.latched_level = latched_level_;
+  out.trouble = trouble_shown_;
+  out.collapse_held = collapse_held_;
   return out;
 }
 

@@ -65,8 +65,9 @@ TEST(AlarmInputs, MotionAndCollapseOfAnyModelledAxis) {
   EXPECT_FALSE(sliding.collapse_detected);
 }
 
-// The primary's fault names its own cause and comes first; then a disagreement (or a plate
-// mismatch where it raises the fault), then the bus.
+// The primary's fault names its own cause and comes first; then a plate mismatch where it raises
+// the fault, then the bus. Ground sensors that disagree are an input fault beside them (the risk
+// follows the most dangerous healthy reading, still valid), before the statue sensor's.
 TEST(AlarmInputs, FaultsInTheirOrder) {
   BoxStatus s = healthy();
   MonitorConfig config;
@@ -78,7 +79,13 @@ TEST(AlarmInputs, FaultsInTheirOrder) {
   EXPECT_EQ(alarm_input(s, config, true).fault_cause, AlarmCause::kSensorDisagreement);
   s.plate_mismatch = false;
   s.disagreement = true;
-  EXPECT_EQ(alarm_input(s, config, true).fault_cause, AlarmCause::kSensorDisagreement);
+  s.input_fault = AlarmCause::kStatueSensorFault;
+  EXPECT_FALSE(alarm_input(s, config, false).fault_active);
+  EXPECT_EQ(alarm_input(s, config, false).input_fault, AlarmCause::kSensorDisagreement);
+  EXPECT_EQ(alarm_input(s, config, true).fault_cause, AlarmCause::kBusError);
+  s.disagreement = false;
+  EXPECT_EQ(alarm_input(s, config, false).input_fault, AlarmCause::kStatueSensorFault);
+  s.disagreement = true;
   s.sensor.state = HealthState::kFault;
   s.sensor.cause = HealthCause::kTimeout;
   const monitor::AlarmInput in = alarm_input(s, config, true);

@@ -120,8 +120,9 @@ TEST(MonitorSensors, TwoAgreeingGroundSensorsGiveTheSingleSensorResults) {
 }
 
 // The second sensor's x drifts away at 2 m/s2 per s from t = 3 s: the RMS difference passes
-// the 0.3 m/s2 tolerance within the 0.5 s window; the fault level says kSensorDisagreement,
-// the estimators run on.
+// the 0.3 m/s2 tolerance within the 0.5 s window; the trouble says kSensorDisagreement, the
+// estimators run on, and the alarm follows the more dangerous reading, the drifting one (a
+// drift that strong is an earthquake as far as one sensor can tell).
 TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   fw::Monitor monitor;
   ASSERT_TRUE(started(monitor, two_grounds()));
@@ -135,8 +136,7 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
          {monitor.on_sensor_sample(0, sample(n, ground_g(n))),
           monitor.on_sensor_sample(1, sample(n, ground_g(n) + drift_g, 1'000'000))}) {
       for (std::size_t i = 0; i < u.event_count; ++i) {
-        if (n > drift_from && u.events[i].level == monitor::AlarmLevel::kFault) {
-          EXPECT_EQ(u.events[i].cause, monitor::AlarmCause::kSensorDisagreement);
+        if (n > drift_from && u.events[i].trouble == monitor::AlarmCause::kSensorDisagreement) {
           fault_event = true;
         }
       }
@@ -150,7 +150,9 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   EXPECT_LT(reported - drift_from, std::lround(0.5 * kRate));
   EXPECT_TRUE(fault_event);
   const fw::BoxStatus& s = monitor.status();
-  EXPECT_EQ(s.alarm, monitor::AlarmLevel::kFault);
+  EXPECT_EQ(s.alarm, monitor::AlarmLevel::kAlarm);
+  EXPECT_EQ(s.trouble, monitor::AlarmCause::kSensorDisagreement);
+  EXPECT_EQ(s.risk_sensor, 1);
   EXPECT_TRUE(s.sensors[1].disagreeing);
   EXPECT_EQ(s.sensors[1].disagreements, 1U);
   EXPECT_GT(s.sensors[1].rms_m_s2, 0.3);
@@ -158,7 +160,8 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   EXPECT_EQ(s.primary, 0);
   EXPECT_EQ(s.estimator_restarts, 1U);
   // The primary falls silent: the drifting sensor takes over (the one left); the cross-check
-  // has no one to compare, so the disagreement ends and the fault level with it.
+  // has no one to compare, so the disagreement ends and its trouble with it (the alarm it raised
+  // stays latched).
   for (long n = 1200; n < 1400; ++n) {
     (void)monitor.on_sensor_sample(1, sample(n, ground_g(n) + 0.3, 1'000'000));
   }
@@ -166,7 +169,58 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   EXPECT_FALSE(monitor.status().disagreement);
   EXPECT_FALSE(monitor.status().sensors[1].disagreeing);
   EXPECT_EQ(monitor.status().sensors_state, monitor::HealthState::kDegraded);
-  EXPECT_NE(monitor.status().alarm, monitor::AlarmLevel::kFault);
+  EXPECT_NE(monitor.status().trouble, monitor::AlarmCause::kSensorDisagreement);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kAlarm);
+}
+
+// Two ground sensors under a slender block on the ground (the paper's, one axis), 1 Hz shaking
+// of 0.5 g on x that overturns it. The primary is turned 90 degrees about the vertical (the box
+// file says it is not): its x reads the ground's y, still. Alone it would say normal; the
+// sensors disagree, and the alarm follows the most dangerous healthy reading, the second
+// sensor's: alarm no later than a box with that sensor alone, the disagreement shown beside it.
+TEST(MonitorSensors, DisagreeingSensorsAlarmOnTheWorseReading) {
+  static const Scene block = testing::make(testing::paper_block());
+  const auto shaking_g = [](long n) {
+    const double t = static_cast<double>(n) / kRate - 1.0;
+    return t < 0.0 ? 0.0 : 0.5 * std::fmin(1.0, t) * std::sin(2.0 * kPi * t);
+  };
+  const auto turned = [](long n, double ax_g) {
+    monitor::SensorSample s = sample(n, 0.0);
+    s.acceleration_g = Eigen::Vector3d(0.0, ax_g, 1.0);  // its x is the ground's y
+    return s;
+  };
+  fw::Monitor dual;
+  ASSERT_TRUE(dual.start(two_grounds(), {&block, nullptr}).ok());
+  fw::Monitor correct_alone;
+  ASSERT_TRUE(correct_alone.start(single_config(), {&block, nullptr}).ok());
+  fw::Monitor turned_alone;
+  ASSERT_TRUE(turned_alone.start(single_config(), {&block, nullptr}).ok());
+  long dual_alarm = -1;
+  long alone_alarm = -1;
+  bool turned_alarmed = false;
+  bool followed = false;
+  for (long n = 0; n < 12 * static_cast<long>(kRate); ++n) {
+    (void)dual.on_sensor_sample(0, turned(n, shaking_g(n)));
+    (void)dual.on_sensor_sample(1, sample(n, shaking_g(n), 1'000'000));
+    (void)correct_alone.on_sample(sample(n, shaking_g(n)));
+    (void)turned_alone.on_sample(turned(n, shaking_g(n)));
+    if (dual_alarm < 0 && dual.status().alarm == monitor::AlarmLevel::kAlarm) dual_alarm = n;
+    if (alone_alarm < 0 && correct_alone.status().alarm == monitor::AlarmLevel::kAlarm) {
+      alone_alarm = n;
+    }
+    turned_alarmed = turned_alarmed || turned_alone.status().alarm == monitor::AlarmLevel::kAlarm;
+    if (dual.status().risk_sensor == 1) {
+      followed = true;
+      ASSERT_TRUE(dual.status().disagreement) << n;
+      ASSERT_EQ(dual.status().trouble, monitor::AlarmCause::kSensorDisagreement) << n;
+    }
+  }
+  EXPECT_FALSE(turned_alarmed);  // what one turned sensor alone says: nothing (docs/safety.md)
+  ASSERT_GE(alone_alarm, 0);
+  ASSERT_GE(dual_alarm, 0);
+  EXPECT_LE(dual_alarm, alone_alarm + 1);
+  EXPECT_TRUE(followed);
+  EXPECT_EQ(dual.status().primary, 0);  // the turned sensor still drives its own estimators
 }
 
 // The primary goes silent at t = 2.5 s: the second sensor (same values, 1 ms later on the bus)

@@ -39,7 +39,9 @@ MonitorConfig statue_config() {
 
 // The monitor on {paper's block, wide block}: 2 s quiet, then a 1 Hz sine of `amplitude_g`.
 // The statue's gyroscope reads `statue_rate(n)` about -y (axis 0) plus an offset of 0.01 rad/s
-// and noise; nullptr: no statue sample at all.
+// and noise; its accelerometer what a statue standing on the ground reads (the ground's
+// acceleration and gravity, a small offset and noise: the ground sensor corroborates it);
+// `statue` false: no statue sample at all.
 struct StatueRun {
   StatueRun() : scenes{make(paper_block()), wide_block()}, monitor(std::make_unique<Monitor>()) {}
   Error start(const MonitorConfig& c) {
@@ -62,11 +64,19 @@ struct StatueRun {
                                        static_cast<Real>(-rate + 0.01 + 0.003 * gauss(random)),
                                        static_cast<Real>(0.003 * gauss(random)));
       (void)monitor->on_statue_sample(s);
+      monitor::SensorSample f = ground;
+      if (!accelerometer_follows_ground) f.acceleration_g = Vector3r(0, 0, 1);
+      f.acceleration_g += Vector3r(static_cast<Real>(0.01 + 0.003 * gauss(random)),
+                                   static_cast<Real>(0.003 * gauss(random)),
+                                   static_cast<Real>(0.003 * gauss(random)));
+      if (feed_accelerometer) (void)monitor->on_statue_acceleration(f);
     }
     return *monitor->on_sample(ground).status;
   }
   std::vector<Scene> scenes;
   std::unique_ptr<Monitor> monitor;
+  bool accelerometer_follows_ground = true;  // false: it reads gravity alone (rest)
+  bool feed_accelerometer = true;            // false: its accelerometer sends nothing
   std::mt19937 random{24};
   std::normal_distribution<double> gauss;
 };
@@ -97,7 +107,33 @@ TEST(MonitorStatue, AStandingStatueTakesTheFragileMembersRiskAway) {
   EXPECT_LT(s.risk, 0.05);
   EXPECT_GT(run.monitor->statue_filter(0).estimate().weights[1], Real(0.9));
   EXPECT_FALSE(s.statue_unexplained);
+  EXPECT_TRUE(axis.statue.corroborated);
+  EXPECT_EQ(s.trouble, monitor::AlarmCause::kNone);
   EXPECT_NE(s.alarm, monitor::AlarmLevel::kAlarm);
+}
+
+// The same statue, its sensor reading rest (come off the statue: no rotation, its accelerometer
+// gravity alone, not the ground's shaking). The ground sensor does not corroborate it: the box
+// keeps the worst member's risk (the box without the sensor's) and names the sensor.
+TEST(MonitorStatue, ASensorReadingRestIsRefusedAndNamed) {
+  StatueRun run;
+  run.accelerometer_follows_ground = false;
+  ASSERT_TRUE(run.start(statue_config()).ok());
+  const auto still = [](long) { return 0.0; };
+  bool alarmed = false;
+  for (long n = 0; n < kQuiet + 1200; ++n) {
+    const BoxStatus& s = run.step(n, 0.5, still);
+    alarmed = alarmed || s.alarm == monitor::AlarmLevel::kAlarm;
+  }
+  const BoxStatus& s = *run.monitor->poll().status;
+  EXPECT_TRUE(s.axes[0].statue.measured);
+  EXPECT_FALSE(s.axes[0].statue.corroborated);
+  EXPECT_EQ(s.axes[0].statue.refutation, StatueRefutation::kDoesNotFollowBase);
+  EnsembleRisk r;
+  run.monitor->ensemble(0).risk(r);
+  EXPECT_GE(s.axes[0].risk.total, r.risk.total);
+  EXPECT_EQ(s.trouble, monitor::AlarmCause::kStatueSensorFault);
+  EXPECT_TRUE(alarmed);  // the paper's block, a member, overturns: the box without it alarms
 }
 
 // Without statue samples (a silent or absent node) the axis is not measured: the worst member's
@@ -115,9 +151,11 @@ TEST(MonitorStatue, ASilentStatueSensorLeavesTheWorstMembersRisk) {
   EXPECT_EQ(s.statue_sensor.rate.state, monitor::HealthState::kFault);  // timed out
 }
 
-// A loose sensor swinging on a quiet ground: no member explains it; the level is fault with
-// cause statue_unexplained, and the risk stays the worst member's (every member sits).
-TEST(MonitorStatue, ASwingingLooseSensorIsStatueUnexplained) {
+// A loose sensor swinging on a quiet ground: its accelerometer does not read what its gyroscope
+// says (no block rocks so on a still ground), and no member explains it. The sensor is refused:
+// the level is fault naming it (the box without it says normal), the risk stays the worst
+// member's (every member sits).
+TEST(MonitorStatue, ASwingingLooseSensorIsRefused) {
   StatueRun run;
   ASSERT_TRUE(run.start(statue_config()).ok());
   const auto swing = [](long n) {
@@ -126,13 +164,16 @@ TEST(MonitorStatue, ASwingingLooseSensorIsStatueUnexplained) {
   bool fault_said = false;
   for (long n = 0; n < kQuiet + 600; ++n) {
     const BoxStatus& s = run.step(n, 0.0, swing);
-    fault_said = fault_said || (s.statue_unexplained && s.alarm == monitor::AlarmLevel::kFault);
+    fault_said = fault_said || (s.alarm == monitor::AlarmLevel::kFault &&
+                                (s.trouble == monitor::AlarmCause::kStatueSensorFault ||
+                                 s.trouble == monitor::AlarmCause::kStatueUnexplained));
   }
-  EXPECT_TRUE(fault_said);
   const BoxStatus& s = *run.monitor->poll().status;
-  EXPECT_TRUE(s.statue_unexplained);
-  EXPECT_EQ(alarm_input(s, run.monitor->config(), false).fault_cause,
-            monitor::AlarmCause::kStatueUnexplained);
+  EXPECT_TRUE(fault_said);
+  EXPECT_FALSE(s.axes[0].statue.corroborated);
+  EXPECT_NE(alarm_input(s, run.monitor->config(), false).input_fault,
+            monitor::AlarmCause::kNone);
+  EXPECT_FALSE(alarm_input(s, run.monitor->config(), false).fault_active);
 }
 
 TEST(MonitorStatue, RefusesAStatueSensorOnAGroundSensorsNode) {
@@ -162,6 +203,7 @@ TEST(MonitorStatue, RefusesAStatueSensorOnAGroundSensorsNode) {
 // accelerometer is silent is measured, and the status says which stream is at fault.
 TEST(MonitorStatue, EachStreamHasItsOwnHealth) {
   StatueRun run;
+  run.feed_accelerometer = false;
   ASSERT_TRUE(run.start(statue_config()).ok());
   const auto still = [](long) { return 0.0; };
   for (long n = 0; n < kQuiet + 100; ++n) {
@@ -182,18 +224,23 @@ TEST(MonitorStatue, EachStreamHasItsOwnHealth) {
   EXPECT_EQ(s.statue_sensor.acceleration.counters.received, 100U);
   EXPECT_EQ(s.statue_sensor.acceleration.counters.saturated, 1U);
   EXPECT_TRUE(s.axes[0].statue.measured);
+  // Without its accelerometer nothing corroborates the gyroscope: refused, named.
+  EXPECT_EQ(s.axes[0].statue.refutation, StatueRefutation::kNoAccelerometer);
+  EXPECT_EQ(s.trouble, monitor::AlarmCause::kStatueSensorFault);
 }
 
-// The fault's place: after the sensors', the disagreement's, the bus's and outside_model's.
-TEST(MonitorStatue, StatueUnexplainedIsTheLastFault) {
+// The statue sensor's trouble is an input fault beside the faults that make the risk stale:
+// it never is one of them (the risk it leaves is the box's without the sensor, still valid).
+TEST(MonitorStatue, TheStatueSensorsTroubleIsAnInputFault) {
   BoxStatus s;
   s.estimating = true;
   s.calibrated = true;
   s.sensor.state = monitor::HealthState::kOk;
   s.statue_unexplained = true;
+  s.input_fault = monitor::AlarmCause::kStatueUnexplained;
   MonitorConfig config;
-  EXPECT_TRUE(alarm_input(s, config, false).fault_active);
-  EXPECT_EQ(alarm_input(s, config, false).fault_cause, monitor::AlarmCause::kStatueUnexplained);
+  EXPECT_FALSE(alarm_input(s, config, false).fault_active);
+  EXPECT_EQ(alarm_input(s, config, false).input_fault, monitor::AlarmCause::kStatueUnexplained);
   EXPECT_EQ(alarm_input(s, config, true).fault_cause, monitor::AlarmCause::kBusError);
   s.axes[0].outside_model = true;
   EXPECT_EQ(alarm_input(s, config, false).fault_cause, monitor::AlarmCause::kOutsideModel);
@@ -303,7 +350,8 @@ TEST(MonitorStatue, TheAccelerometerMeasuresSliding) {
 
 // The accelerometer falls silent while the statue slides: within max_age_s the phase is the
 // gyroscope's (full contact) and the status says the accelerometer is not used; its stream then
-// times out (fault). Sliding is never said from its last, stale sample.
+// times out (fault). Sliding is never said from its last, stale sample; once follow_onset_s
+// passes without it, the sensor is refused and the phase is the box's own (its nominal member's).
 TEST(MonitorStatue, ASilentAccelerometerFallsBackToTheGyroscope) {
   SlidingStatueRun run;
   ASSERT_TRUE(run.start().ok());
@@ -317,14 +365,17 @@ TEST(MonitorStatue, ASilentAccelerometerFallsBackToTheGyroscope) {
   const auto until_silent = [silent](long k) { return k < silent; };
   for (++n; n < silent + 100; ++n) {
     const BoxStatus& s = run.step(n, until_silent);
-    if (n >= silent + 2) {  // max_age_s 0.01 s: two samples
+    const long refused = silent + 30;  // follow_onset_s 0.15 s
+    if (n >= silent + 2 && n < refused) {  // max_age_s 0.01 s: two samples
       ASSERT_FALSE(s.axes[0].mode.sliding()) << n - silent;
       ASSERT_FALSE(s.axes[0].statue.acceleration_used) << n - silent;
       ASSERT_TRUE(s.axes[0].statue.measured) << n - silent;  // the gyroscope still is
     }
   }
-  EXPECT_EQ(run.monitor->poll().status->statue_sensor.acceleration.state,
-            monitor::HealthState::kFault);
+  const BoxStatus& s = *run.monitor->poll().status;
+  EXPECT_EQ(s.statue_sensor.acceleration.state, monitor::HealthState::kFault);
+  EXPECT_EQ(s.axes[0].statue.refutation, StatueRefutation::kNoAccelerometer);
+  EXPECT_EQ(s.axes[0].mode.phase, run.monitor->ensemble(0).nominal().mode().phase);
 }
 
 }  // namespace

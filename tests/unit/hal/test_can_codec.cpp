@@ -162,6 +162,24 @@ TEST(CanGolden, MonitorStatus) {
   EXPECT_EQ(d.sample_age_ms, 1234);
 }
 
+TEST(CanGolden, MonitorStatusTroubleAndCollapseHeld) {
+  // Axis 0: 0x320. Phase 0|4 = overturned (4), Corner 4|4 = none -> byte 0: 04
+  // AlarmLevel 8|4 = alarm (3), Trouble 12|1 = 1, CollapseHeld 13|1 = 1 -> byte 1: 0x33
+  // Risk 1.0 -> raw 10000 = 0x2710 -> bytes 2-3: 10 27; the rest 0.
+  const Bytes golden{0x04, 0x33, 0x10, 0x27, 0x00, 0x00, 0x00, 0x00};
+  MonitorStatus m;
+  m.phase = Phase::kOverturned;
+  m.alarm_level = AlarmLevel::kAlarm;
+  m.trouble = true;
+  m.collapse_held = true;
+  m.risk = 1.0;
+  MonitorStatus d;
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x320, golden, d));
+  EXPECT_TRUE(d.trouble);
+  EXPECT_TRUE(d.collapse_held);
+  EXPECT_EQ(d.alarm_level, AlarmLevel::kAlarm);
+}
+
 TEST(CanGolden, AlarmEvent) {
   // Identifier 0x330.
   // Level 0|4 = alarm (3), PreviousLevel 4|4 = advisory (1) -> byte 0: 13
@@ -185,6 +203,23 @@ TEST(CanGolden, AlarmEvent) {
   EXPECT_TRUE(d.latched);
   EXPECT_EQ(d.time_since_start_ms, 0xDEADBEEFU);
   EXPECT_EQ(d.sequence, 0x42);
+}
+
+TEST(CanGolden, AlarmEventWithTrouble) {
+  // Level alarm (3), PreviousLevel alarm (3) -> byte 0: 33; Cause statue_sensor_fault (16) -> 10
+  // Latched 16|1 = 1, Trouble 17|1 = 1 -> byte 2: 03; the rest 0.
+  const Bytes golden{0x33, 0x10, 0x03, 0x00, 0x00, 0x00, 0x00, 0x00};
+  AlarmEvent m;
+  m.level = AlarmLevel::kAlarm;
+  m.previous_level = AlarmLevel::kAlarm;
+  m.cause = AlarmCause::kStatueSensorFault;
+  m.latched = true;
+  m.trouble = true;
+  AlarmEvent d;
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x330, golden, d));
+  EXPECT_EQ(d.cause, AlarmCause::kStatueSensorFault);
+  EXPECT_TRUE(d.trouble);
+  EXPECT_TRUE(d.latched);
 }
 
 TEST(CanGolden, RegionalAlert) {
@@ -261,6 +296,19 @@ TEST(CanGolden, Acknowledge) {
   Acknowledge d;
   ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x340, golden, d));
   EXPECT_EQ(d.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(d.source_id, 0x21);
+  EXPECT_EQ(d.event_sequence, 0x42);
+}
+
+TEST(CanGolden, StatueStands) {
+  // Identifier 0x341. SourceId 0|8 = 0x21 -> byte 0; EventSequence 8|8 = 0x42 -> byte 1;
+  // bytes 2-7 reserved: 00
+  const Bytes golden{0x21, 0x42, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00};
+  StatueStands m;
+  m.source_id = 0x21;
+  m.event_sequence = 0x42;
+  StatueStands d;
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x341, golden, d));
   EXPECT_EQ(d.source_id, 0x21);
   EXPECT_EQ(d.event_sequence, 0x42);
 }
@@ -545,13 +593,14 @@ TEST(CanRoundTrip, MonitorStatusEveryRiskSequenceAndAge) {
 TEST(CanRoundTrip, AlarmEventEveryEnumCombinationAndTimeSweep) {
   for (unsigned l = 0; l <= 4; ++l) {
     for (unsigned p = 0; p <= 4; ++p) {
-      for (const unsigned c : {0U, 1U, 2U, 3U, 4U, 5U, 6U, 7U, 8U, 9U, 10U, 11U, 12U, 14U}) {
-        for (const bool latched : {false, true}) {
+      for (unsigned c = 0; c <= 18; ++c) {
+        for (const unsigned flags : {0U, 1U, 2U, 3U}) {
           AlarmEvent m;
           m.level = static_cast<AlarmLevel>(l);
           m.previous_level = static_cast<AlarmLevel>(p);
           m.cause = static_cast<AlarmCause>(c);
-          m.latched = latched;
+          m.latched = (flags & 1U) != 0;
+          m.trouble = (flags & 2U) != 0;
           CanFrame f;
           ASSERT_TRUE(encode(m, f).ok());
           AlarmEvent d;
@@ -559,7 +608,8 @@ TEST(CanRoundTrip, AlarmEventEveryEnumCombinationAndTimeSweep) {
           EXPECT_EQ(d.level, m.level);
           EXPECT_EQ(d.previous_level, m.previous_level);
           EXPECT_EQ(d.cause, m.cause);
-          EXPECT_EQ(d.latched, latched);
+          EXPECT_EQ(d.latched, m.latched);
+          EXPECT_EQ(d.trouble, m.trouble);
         }
       }
     }
@@ -687,7 +737,7 @@ TEST(CanRoundTrip, CollapseForecastEveryProbabilityCollapseInHorizonAndSequence)
 
 // A valid frame of every message kind.
 std::vector<CanFrame> valid_frames() {
-  std::vector<CanFrame> frames(9);
+  std::vector<CanFrame> frames(10);
   SensorAcceleration a;
   a.ax_g = 0.1;
   EXPECT_TRUE(encode(a, frames[0]).ok());
@@ -714,13 +764,17 @@ std::vector<CanFrame> valid_frames() {
   RegionalAlertOrigin o;
   o.magnitude = 6.5;
   EXPECT_TRUE(encode(o, frames[8]).ok());
+  StatueStands t;
+  t.source_id = 4;
+  t.event_sequence = 9;
+  EXPECT_TRUE(encode(t, frames[9]).ok());
   return frames;
 }
 
 // Decodes `f` as every message type; the result of the one `f.id` classifies as, or of all.
 struct AllDecodes {
   DecodeResult acceleration, heartbeat, status, event, acknowledge, forecast, rotation, regional,
-      origin;
+      origin, stands;
 };
 AllDecodes decode_all(const CanFrame& f) {
   SensorAcceleration a;
@@ -732,8 +786,9 @@ AllDecodes decode_all(const CanFrame& f) {
   StatueRotation r;
   RegionalAlert g;
   RegionalAlertOrigin o;
+  StatueStands t;
   return {decode(f, a), decode(f, h), decode(f, s), decode(f, e), decode(f, k),
-          decode(f, c), decode(f, r), decode(f, g), decode(f, o)};
+          decode(f, c), decode(f, r), decode(f, g), decode(f, o), decode(f, t)};
 }
 DecodeResult decode_as_own_kind(const CanFrame& f) {
   const AllDecodes all = decode_all(f);
@@ -743,6 +798,7 @@ DecodeResult decode_as_own_kind(const CanFrame& f) {
     case MessageKind::kMonitorStatus: return all.status;
     case MessageKind::kAlarmEvent: return all.event;
     case MessageKind::kAcknowledge: return all.acknowledge;
+    case MessageKind::kStatueStands: return all.stands;
     case MessageKind::kCollapseForecast: return all.forecast;
     case MessageKind::kStatueRotation: return all.rotation;
     case MessageKind::kRegionalAlert: return all.regional;
@@ -770,7 +826,7 @@ TEST(CanReject, EveryLengthButEight) {
 TEST(CanReject, UnknownIdentifiers) {
   std::set<std::uint32_t> known;
   for (std::uint32_t n = 1; n <= 15; ++n) known.insert({0x300 + n, 0x310 + n, 0x370 + n});
-  known.insert({0x320, 0x321, 0x330, 0x340, 0x350, 0x351, 0x360, 0x361});
+  known.insert({0x320, 0x321, 0x330, 0x340, 0x341, 0x350, 0x351, 0x360, 0x361});
   std::vector<std::uint32_t> ids;
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) ids.push_back(id);
   // Identifiers with flag bits (SocketCAN's extended / RTR flags) or beyond 11 bits.
@@ -792,8 +848,9 @@ TEST(CanReject, UnknownIdentifiers) {
     EXPECT_EQ(all.rotation.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.regional.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.origin.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.stands.error, CodecError::kUnknownIdentifier) << id;
   }
-  EXPECT_EQ(known.size(), 53U);
+  EXPECT_EQ(known.size(), 54U);
 }
 
 TEST(CanReject, AnotherMessagesIdentifier) {
@@ -816,6 +873,7 @@ TEST(CanReject, AnotherMessagesIdentifier) {
               kind != MessageKind::kRegionalAlert);
     EXPECT_EQ(all.origin.error == CodecError::kWrongMessage,
               kind != MessageKind::kRegionalAlertOrigin);
+    EXPECT_EQ(all.stands.error == CodecError::kWrongMessage, kind != MessageKind::kStatueStands);
   }
 }
 
@@ -899,7 +957,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
     EXPECT_STREQ(rk.signal, "Level");
   }
-  for (unsigned v = 16; v <= 255; ++v) {
+  for (unsigned v = 19; v <= 255; ++v) {
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -917,10 +975,11 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  e.cause = static_cast<AlarmCause>(16);
+  e.cause = static_cast<AlarmCause>(19);
   EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
   for (const AlarmCause cause :
-       {AlarmCause::kPWave, AlarmCause::kStatueUnexplained, AlarmCause::kRegionalAlert}) {
+       {AlarmCause::kPWave, AlarmCause::kStatueUnexplained, AlarmCause::kRegionalAlert,
+        AlarmCause::kStatueSensorFault, AlarmCause::kRestored, AlarmCause::kStatueStands}) {
     e.cause = cause;
     EXPECT_TRUE(encode(e, f).ok()) << static_cast<unsigned>(cause);
   }
@@ -1164,7 +1223,7 @@ TEST(CanReject, ErrorTexts) {
 
 TEST(CanDbc, EveryIdentifierTheCodecKnowsIsAMessageAndNoOther) {
   const Dbc& dbc = plinth_dbc();
-  ASSERT_EQ(dbc.messages.size(), 53U);
+  ASSERT_EQ(dbc.messages.size(), 54U);
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) {
     const MessageKind kind = classify(id);
     const auto it = dbc.messages.find(id);

@@ -65,6 +65,16 @@ class Policy {
     return policy.update(in);
   }
 
+  // A person states that the statue stands, quoting `sequence`.
+  AlarmOutput stands(std::int64_t time_ms, double risk, std::uint8_t sequence) {
+    AlarmInput in = base;
+    in.time_ns = time_ms * kMs;
+    in.risk = risk;
+    in.statue_stands = true;
+    in.statue_stands_sequence = sequence;
+    return policy.update(in);
+  }
+
   AlarmPolicy policy;
   AlarmInput base;
 };
@@ -294,22 +304,118 @@ TEST(AlarmPolicy, CollapseGoesStraightToAlarmAndLatches) {
   EXPECT_EQ(acked.acknowledgement, AckOutcome::kReleasedConditionHolds);
   EXPECT_EQ(acked.level, AlarmLevel::kAlarm);
   EXPECT_EQ(p.at(20, 0.3).latched_level, AlarmLevel::kNormal);  // not latched again
-  // The detector restarts (collapse cleared): the alarm follows at once, no latch left.
+  // The detector restarts (collapse cleared): the collapse is held all the same.
   p.base.collapse_detected = false;
-  EXPECT_EQ(p.at(30, 0.0).level, AlarmLevel::kNormal);
+  const AlarmOutput held = p.at(30, 0.0);
+  EXPECT_EQ(held.level, AlarmLevel::kAlarm);
+  EXPECT_TRUE(held.collapse_held);
+  // A person says the statue stands: the alarm follows its condition at once.
+  const AlarmOutput stood = p.stands(40, 0.0, 1);
+  EXPECT_EQ(stood.statue_stands, StandsOutcome::kCleared);
+  expect_change(stood, AlarmLevel::kNormal, AlarmLevel::kAlarm, AlarmCause::kStatueStands, false);
+  EXPECT_FALSE(stood.collapse_held);
 }
 
-TEST(AlarmPolicy, LatchedCollapseOutlivesItsDetection) {
+// A collapse outlives its detection, its acknowledgement and a fault: only a person's statement
+// that the statue stands clears it, quoting the latest event, and not while an input still
+// says collapse.
+TEST(AlarmPolicy, ACollapseIsHeldUntilAPersonSaysTheStatueStands) {
   Policy p(immediate());
   p.base.collapse_detected = true;
-  (void)p.at(0, 0.0);
+  (void)p.at(0, 0.0);  // event 0: alarm, overturn_detected, latched
+  EXPECT_EQ(p.stands(5, 0.0, 0).statue_stands, StandsOutcome::kStillCollapsed);
   p.base.collapse_detected = false;
   const AlarmOutput later = p.at(10, 0.0);
   EXPECT_EQ(later.level, AlarmLevel::kAlarm);
   EXPECT_EQ(later.latched_level, AlarmLevel::kAlarm);
-  const AlarmOutput acked = p.ack(20, 0.0, AlarmLevel::kAlarm, 0);
-  EXPECT_EQ(acked.acknowledgement, AckOutcome::kReleased);
-  EXPECT_EQ(acked.level, AlarmLevel::kNormal);
+  const AlarmOutput acked = p.ack(20, 0.0, AlarmLevel::kAlarm, 0);  // event 1: unlatched
+  EXPECT_EQ(acked.acknowledgement, AckOutcome::kReleasedConditionHolds);
+  EXPECT_EQ(acked.level, AlarmLevel::kAlarm);
+  // Not calibrated, a sensor fault: still the alarm, its cause the collapse.
+  p.base.not_calibrated = true;
+  p.base.fault_active = true;
+  const AlarmOutput faulty = p.at(30, 0.0);  // event 2: the trouble
+  EXPECT_EQ(faulty.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(faulty.trouble, AlarmCause::kSensorFault);
+  p.base.not_calibrated = false;
+  p.base.fault_active = false;
+  EXPECT_EQ(p.stands(40, 0.0, 1).statue_stands, StandsOutcome::kStale);  // event 3: trouble gone
+  EXPECT_EQ(p.at(41, 0.0).level, AlarmLevel::kAlarm);
+  const AlarmOutput stood = p.stands(42, 0.0, 3);  // event 4: normal
+  EXPECT_EQ(stood.statue_stands, StandsOutcome::kCleared);
+  EXPECT_EQ(stood.level, AlarmLevel::kNormal);
+  EXPECT_EQ(p.stands(50, 0.0, 4).statue_stands, StandsOutcome::kNothingHeld);
+}
+
+// What a restart must not lose comes back into a new policy: the latch, with cause restored,
+// and the held collapse; the events' numbering goes on.
+TEST(AlarmPolicy, MemoryRestoredAfterARestart) {
+  Policy p(latching(true, true));
+  p.base.collapse_detected = true;
+  (void)p.at(0, 0.9);  // event 0
+  const AlarmMemory m = p.policy.memory();
+  EXPECT_EQ(m.latched_level, AlarmLevel::kAlarm);
+  EXPECT_EQ(m.latched_cause, AlarmCause::kOverturnDetected);
+  EXPECT_TRUE(m.collapse_held);
+  EXPECT_EQ(m.next_sequence, 1);
+
+  Policy q(latching(true, true));
+  q.policy.restore(m);
+  q.base.not_calibrated = true;  // a restarted box: its estimators untrusted
+  const AlarmOutput first = q.at(0, 0.0);
+  expect_change(first, AlarmLevel::kAlarm, AlarmLevel::kNormal, AlarmCause::kRestored, true);
+  EXPECT_EQ(first.events[0].sequence, 1);
+  EXPECT_EQ(first.trouble, AlarmCause::kNotCalibrated);
+  EXPECT_TRUE(first.collapse_held);
+  // Acknowledged: the held collapse keeps the alarm; its cause says it was restored.
+  const AlarmOutput acked = q.ack(10, 0.0, AlarmLevel::kAlarm, 1);
+  EXPECT_EQ(acked.acknowledgement, AckOutcome::kReleasedConditionHolds);
+  EXPECT_EQ(acked.level, AlarmLevel::kAlarm);
+
+  // A latched warning alone comes back shown through the restart's not-calibrated fault.
+  AlarmMemory warning;
+  warning.latched_level = AlarmLevel::kWarning;
+  warning.latched_cause = AlarmCause::kRiskThreshold;
+  Policy r(latching(true, true));
+  r.policy.restore(warning);
+  r.base.not_calibrated = true;
+  expect_change(r.at(0, 0.0), AlarmLevel::kWarning, AlarmLevel::kNormal, AlarmCause::kRestored,
+                true);
+  // Nothing to restore: a fresh start.
+  Policy fresh(latching(true, true));
+  fresh.policy.restore(AlarmMemory{});
+  fresh.base.not_calibrated = true;
+  expect_change(fresh.at(0, 0.0), AlarmLevel::kFault, AlarmLevel::kNormal,
+                AlarmCause::kNotCalibrated, false);
+}
+
+// A supplementary input refused (input_fault): the trouble beside the level, never in its place
+// (the risk is the box's without that input); the fault level only while the level is normal.
+TEST(AlarmPolicy, ARefusedInputShowsTroubleBesideTheLevel) {
+  AlarmPolicySettings s = immediate();
+  s.lower_hold_s = 0.5;
+  Policy p(s);
+  p.base.input_fault = AlarmCause::kStatueSensorFault;
+  expect_change(p.at(0, 0.0), AlarmLevel::kFault, AlarmLevel::kNormal,
+                AlarmCause::kStatueSensorFault, false);
+  const AlarmOutput warning = p.at(10, 0.6);
+  expect_change(warning, AlarmLevel::kWarning, AlarmLevel::kFault, AlarmCause::kRiskThreshold,
+                false);
+  EXPECT_EQ(warning.trouble, AlarmCause::kStatueSensorFault);
+  EXPECT_EQ(warning.events[0].trouble, AlarmCause::kStatueSensorFault);
+  // The input corroborated again: the trouble clears after the lower hold, with an event.
+  p.base.input_fault = AlarmCause::kNone;
+  EXPECT_EQ(p.at(100, 0.6).trouble, AlarmCause::kStatueSensorFault);
+  EXPECT_EQ(p.at(599, 0.6).trouble, AlarmCause::kStatueSensorFault);
+  const AlarmOutput cleared = p.at(600, 0.6);
+  expect_change(cleared, AlarmLevel::kWarning, AlarmLevel::kWarning, AlarmCause::kRiskThreshold,
+                false);
+  EXPECT_EQ(cleared.trouble, AlarmCause::kNone);
+  // Beside an alarm: the trouble's own event, the level kept.
+  p.base.input_fault = AlarmCause::kStatueUnexplained;
+  const AlarmOutput alarm = p.at(700, 0.9);
+  EXPECT_EQ(alarm.level, AlarmLevel::kAlarm);
+  EXPECT_EQ(alarm.trouble, AlarmCause::kStatueUnexplained);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -364,36 +470,51 @@ TEST(AlarmPolicy, AFaultNeverHidesAnAlarm) {
   Policy p(latching(false, true));
   (void)p.at(0, 0.9);  // event 0: alarm
   p.base.fault_active = true;
+  // The level stays; the trouble shows beside it, with an event of its own.
   const AlarmOutput both = p.at(10, 0.9);
   EXPECT_EQ(both.level, AlarmLevel::kAlarm);
-  EXPECT_EQ(both.event_count, 0U);
+  expect_event(both, 0, AlarmLevel::kAlarm, AlarmLevel::kAlarm, AlarmCause::kSensorFault, true);
+  EXPECT_EQ(both.trouble, AlarmCause::kSensorFault);
   // The alarm latched, its condition gone, still above the fault...
   EXPECT_EQ(p.at(20, 0.0).level, AlarmLevel::kAlarm);
   // ...until acknowledged: then the fault shows.
-  const AlarmOutput acked = p.ack(30, 0.0, AlarmLevel::kAlarm, 0);
+  const AlarmOutput acked = p.ack(30, 0.0, AlarmLevel::kAlarm, 1);
   expect_change(acked, AlarmLevel::kFault, AlarmLevel::kAlarm, AlarmCause::kAcknowledged, false);
 }
 
-TEST(AlarmPolicy, AFaultHidesAWarningWhichShowsAgainAfterIt) {
+// A fault hides the live warning (its risk is stale), never a latched one: a warning raised
+// while the input was trusted stays shown until acknowledged.
+TEST(AlarmPolicy, AFaultHidesALiveWarningNotALatchedOne) {
   Policy p(latching(true, false));
   (void)p.at(0, 0.6);  // event 0: warning, latched
   p.base.fault_active = true;
   const AlarmOutput fault = p.at(10, 0.0);
-  expect_event(fault, 0, AlarmLevel::kFault, AlarmLevel::kWarning, AlarmCause::kSensorFault, true);
-  p.base.fault_active = false;
-  const AlarmOutput back = p.at(20, 0.0);
-  expect_event(back, 0, AlarmLevel::kWarning, AlarmLevel::kFault, AlarmCause::kRiskThreshold, true);
-  EXPECT_EQ(p.ack(30, 0.0, AlarmLevel::kWarning, 2).level, AlarmLevel::kNormal);
+  expect_event(fault, 0, AlarmLevel::kWarning, AlarmLevel::kWarning, AlarmCause::kSensorFault,
+               true);
+  EXPECT_EQ(fault.level, AlarmLevel::kWarning);
+  // Acknowledged under the fault: the fault shows.
+  expect_change(p.ack(20, 0.0, AlarmLevel::kWarning, 1), AlarmLevel::kFault, AlarmLevel::kWarning,
+                AlarmCause::kAcknowledged, false);
+  // A live warning (not latching) is hidden by the fault, and shows again after it.
+  Policy q(latching(false, false));
+  (void)q.at(0, 0.6);  // event 0: warning
+  q.base.fault_active = true;
+  expect_change(q.at(10, 0.6), AlarmLevel::kFault, AlarmLevel::kWarning, AlarmCause::kSensorFault,
+                false);
+  q.base.fault_active = false;
+  expect_change(q.at(20, 0.6), AlarmLevel::kWarning, AlarmLevel::kFault,
+                AlarmCause::kRiskThreshold, false);
 }
 
-TEST(AlarmPolicy, AWarningLatchedBeneathAFaultIsReported) {
+TEST(AlarmPolicy, AWarningLatchedBeneathAFaultShows) {
   Policy p(latching(true, false));
   p.base.fault_active = true;
   (void)p.at(0, 0.0);  // event 0: fault
   const AlarmOutput latched = p.at(10, 0.6);
-  expect_event(latched, 0, AlarmLevel::kFault, AlarmLevel::kFault, AlarmCause::kRiskThreshold,
-               true);
+  expect_change(latched, AlarmLevel::kWarning, AlarmLevel::kFault, AlarmCause::kRiskThreshold,
+                true);
   EXPECT_EQ(latched.latched_level, AlarmLevel::kWarning);
+  EXPECT_EQ(latched.trouble, AlarmCause::kSensorFault);
 }
 
 TEST(AlarmPolicy, AnInvalidRiskIsAnInternalFault) {

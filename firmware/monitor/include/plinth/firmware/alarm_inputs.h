@@ -16,11 +16,14 @@ namespace plinth::firmware {
 //    alert (regional_alert);
 //  - out of full contact (phase_change), collapse (overturn_detected): any axis's nominal statue;
 //  - fault, by the first that holds: the primary sensor's fault (its cause: sensor_timeout,
-//    sensor_fault), a ground sensor that disagrees with the primary or, with
-//    config.plate.raises_fault, a plate mismatch (sensor_disagreement), `bus_fault` (bus_error),
+//    sensor_fault), with config.plate.raises_fault a plate mismatch (sensor_disagreement),
+//    `bus_fault` (bus_error),
 //    an estimate outside the model (outside_model: a member of an axis's ensemble lifted off,
-//    while the estimators run: the box cannot vouch for what it no longer models), no member
-//    explaining the statue sensor's motion (statue_unexplained);
+//    while the estimators run: the box cannot vouch for what it no longer models);
+//  - input fault (trouble beside the level, the risk still valid): a ground sensor that disagrees
+//    with the primary (sensor_disagreement: the risk then follows the most dangerous healthy
+//    reading), else status.input_fault, which the monitor sets while the statue sensor is
+//    unusable or not corroborated (statue_sensor_fault, statue_unexplained; docs/safety.md);
 //  - not calibrated: the estimators do not run, or run on an untrusted start (the start-up rule).
 [[nodiscard]] monitor::AlarmInput alarm_input(const BoxStatus& status, const MonitorConfig& config,
                                               bool bus_fault);

@@ -34,6 +34,13 @@ struct StatueAxisStatus {
   // The accelerometer's sample tested sliding (fresh, healthy, a scene that can slide); else the
   // phase is the gyroscope's alone.
   bool acceleration_used = false;
+  // The ground sensors corroborate the statue sensor: its reading may lower the risk below the
+  // box's without it (docs/safety.md). Else why not, and whether it would lower it now (then the
+  // box shows the higher of the two and the trouble kStatueSensorFault or kStatueUnexplained).
+  bool corroborated = true;
+  StatueRefutation refutation = StatueRefutation::kNone;
+  bool lowering_refused = false;
+  Real risk_without = 0.0;  // the box's without the sensor (the ensemble's worst member's)
 };
 
 // The statue sensor's streams: its gyroscope's and accelerometer's health, its rate offset
@@ -79,6 +86,18 @@ struct SensorStatus {
   std::uint64_t disagreements = 0;  // entries into the disagreeing state
 };
 
+// A collapse the alarm policy holds (sticky until a person says the statue stands again):
+// what was seen, on which axis, and when.
+struct CollapseRecord {
+  bool held = false;
+  int axis = 0;
+  Mode mode;  // overturned or fell, and the corner
+  // Monitor time it was seen, ns; after a restart (restored), the time in the run that saw it
+  // is not this run's: the host keeps its wall-clock time beside it.
+  std::int64_t time_ns = 0;
+  bool restored = false;  // brought back from the box's saved state (Monitor::restore)
+};
+
 // The sensors' part of the box's status, which the SensorSet keeps (sensor_set.h).
 struct SensorSetStatus {
   // The primary's health (before the first primary: the first sensor's).
@@ -116,6 +135,17 @@ struct BoxStatus : SensorSetStatus {
   double collapse_forecast_s = -1.0;
   monitor::AlarmLevel alarm = monitor::AlarmLevel::kNormal;
   monitor::AlarmLevel latched = monitor::AlarmLevel::kNormal;
+  // The trouble shown beside the level (the alarm policy's; kNone: none), and the supplementary
+  // input refused now (alarm_inputs.h: the statue sensor's trouble, a disagreement).
+  monitor::AlarmCause trouble = monitor::AlarmCause::kNone;
+  monitor::AlarmCause input_fault = monitor::AlarmCause::kNone;
+  CollapseRecord collapse;
+  // While ground sensors disagree: the sensor whose reading the risk follows (the most
+  // dangerous healthy one; -1: the primary's, as without a disagreement).
+  int risk_sensor = -1;
+  // Frames the update could not carry (the codec refused one, or the update was full) since
+  // start(); never silently: MonitorUpdate::frames_lost says which update lost them.
+  std::uint64_t frames_not_encoded = 0;
   std::uint64_t estimator_restarts = 0;  // starts of the estimators (the first one included)
   std::int64_t estimator_start_ns = 0;   // monitor time of the estimators' latest start (t = 0)
   std::int64_t newest_sample_time_ns = 0;  // monitor time of the newest sample fed
@@ -125,6 +155,9 @@ struct BoxStatus : SensorSetStatus {
   bool has_statue_sensor = false;
   [[no_unique_address]] StatueSensorStatusField statue_sensor;
   bool statue_unexplained = false;
+  // Configured, the estimators calibrated and running, but its gyroscope unusable (a stream
+  // fault, no offset, a stale sample): the box runs without it (kStatueSensorFault).
+  bool statue_sensor_unusable = false;
   // Regional alerts: the worst held, its probability of collapse and time to the S arrival,
   // the counters (times in monitor time).
   // (Nothing in a build without regional alerts.)

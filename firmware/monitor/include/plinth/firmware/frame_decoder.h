@@ -26,6 +26,7 @@ struct FrameCounters {
   std::uint64_t other_nodes = 0;  // SensorAcceleration / StatueRotation of other nodes (not used)
   std::uint64_t heartbeats = 0;           // SensorHeartbeat of any node
   std::uint64_t acknowledgements = 0;     // Acknowledge frames, decoded
+  std::uint64_t statue_stands = 0;        // StatueStands frames, decoded
   std::uint64_t monitor_frames = 0;  // MonitorStatus / AlarmEvent / CollapseForecast (any box's)
   std::uint64_t regional_alerts = 0;  // RegionalAlert frames taken with their origin frame
   // RegionalAlert frames without their RegionalAlertOrigin (same event and version, within
@@ -43,6 +44,7 @@ struct FrameInput {
     kNone,             // no input (another message, another node, refused)
     kSensorSample,     // `sample` of sensor `sensor` (Monitor::on_sensor_sample)
     kAcknowledgement,  // `acknowledgement` (Monitor::acknowledge)
+    kStatueStands,     // `stands` (Monitor::statue_stands)
     kStatueRate,          // `statue` (Monitor::on_statue_sample)
     kStatueAcceleration,  // `sample` of the statue sensor (Monitor::on_statue_acceleration)
     kRegionalAlert,       // `regional` (Monitor::on_regional_alert at the frame's time)
@@ -53,6 +55,7 @@ struct FrameInput {
   monitor::SensorSample sample;
   StatueSample statue;
   monitor::Acknowledgement acknowledgement;
+  hal::can::StatueStands stands;
   monitor::RegionalAlert regional;
   const char* malformed_field = "";
 };

@@ -48,6 +48,11 @@ struct MonitorUpdate {
   bool status_due = false;
   // What came of an acknowledgement (Monitor::acknowledge); kNone for other inputs.
   monitor::AckOutcome acknowledgement = monitor::AckOutcome::kNone;
+  // What came of a statement that the statue stands (Monitor::statue_stands); kNone otherwise.
+  monitor::StandsOutcome statue_stands = monitor::StandsOutcome::kNone;
+  int stands_source = -1;  // a bus statement's SourceId (on_frame); -1: not from the bus
+  // Frames this update should have carried but could not (BoxStatus::frames_not_encoded).
+  std::size_t frames_lost = 0;
   // What came of a regional alert (Monitor::on_regional_alert, regional_alert_malformed), when
   // the input was one (regional_received).
   bool regional_received = false;
@@ -67,6 +72,13 @@ struct MonitorUpdate {
 // calibrated only when they start right after a window that passed conditioning's quietness
 // test; else the primary's conditioner verifies a new window, and until then the level is
 // fault, cause not_calibrated (docs/monitor.md, Start-up and restart).
+// What must outlive a restart of the box (Monitor::memory, restore): the alarm policy's latch
+// and held collapse, and what that collapse was.
+struct BoxMemory {
+  monitor::AlarmMemory alarm;
+  CollapseRecord collapse;
+};
+
 class Monitor {
  public:
   Monitor() = default;
@@ -106,6 +118,16 @@ class Monitor {
   // Modbus or MQTT): evaluated at once, at the current monitor time; the update says what came
   // of it (MonitorUpdate::acknowledgement).
   [[nodiscard]] MonitorUpdate acknowledge(const monitor::Acknowledgement& acknowledgement);
+  // A person on site states that the statue stands again (a command of its own, distinct from
+  // an acknowledgement), quoting the latest alarm event's sequence as an acknowledgement does:
+  // a held collapse clears unless a corroborated statue sensor still measures one;
+  // the estimators then start again at rest, trusted after a quiet window as at start-up. The
+  // update says what came of it (MonitorUpdate::statue_stands).
+  [[nodiscard]] MonitorUpdate statue_stands(std::uint8_t event_sequence);
+  // What a restart must not lose, and its return: restore() into a monitor just started,
+  // before its first input; its first update shows the restored level, cause kRestored.
+  [[nodiscard]] BoxMemory memory() const;
+  void restore(const BoxMemory& memory);
   // A regional alert (docs/regional.md), its times relative to its receipt at
   // `receive_time_ns` (the bus's frames) or, without one, now (the newest input's time: an alert
   // from MQTT); the update says what came of it (MonitorUpdate::regional).
@@ -170,6 +192,11 @@ class Monitor {
   void take_sample(int sensor, const monitor::SensorSample& sample, MonitorUpdate& update);
   void update_axis(int axis_index, AxisStatus& axis) const;
   void update_axes_status();
+  void note_statue_trouble();
+  void feed_other_reading(int sensor);
+  void follow_worst_reading();
+  void note_collapse(const monitor::AlarmInput& input);
+  void restart_estimators();
   void evaluate(MonitorUpdate& update);
   void report(MonitorUpdate& update);
   void report_state(MonitorUpdate& update);
@@ -181,6 +208,18 @@ class Monitor {
   SensorSet sensors_;
   Vector3r last_ground_ = Vector3r::Zero();  // the estimators' newest input, m/s2
   std::array<Ensemble, kMaxAxes> ensembles_{};
+  // Every other ground sensor's reading, estimated as the primary's is (its own ensembles, fed
+  // its own conditioned samples): while the sensors disagree the alarm follows the most
+  // dangerous healthy one (docs/safety.md). Slot i is sensor i's (the primary's idle); none in
+  // a build with one sensor.
+  struct OtherReading {
+    std::array<Ensemble, kMaxAxes> ensembles{};
+    bool running = false;   // started on one of its samples since its last seam or fault
+    std::uint64_t seen = 0;  // its conditioned samples taken
+    std::int64_t start_ns = 0;  // monitor time of its ensembles' latest start
+  };
+  static constexpr int kOtherReadings = kMaxSensors > 1 ? kMaxSensors : 0;
+  std::array<OtherReading, kOtherReadings> others_{};
   // The statue sensor and each axis's filter: none in a build without it, so that neither its
   // code nor its data take a microcontroller's room (statue_present() guards every use).
   struct StatueRoom {
@@ -206,6 +245,8 @@ class Monitor {
   bool bus_fault_ = false;
   bool evaluated_ = false;  // the alarm policy has evaluated an input since start()
   bool pending_ack_ = false;
+  bool pending_stands_ = false;
+  std::uint8_t stands_sequence_ = 0;
   monitor::Acknowledgement ack_;
   std::int64_t status_interval_ns_ = 100'000'000;
   std::int64_t next_status_ns_ = 0;   // monitor time of the next status at the interval

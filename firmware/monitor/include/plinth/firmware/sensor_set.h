@@ -33,6 +33,13 @@ struct EstimatorInput {
   int bridged = 0;
 };
 
+// A conditioned sample of one sensor (SensorSet::newest_reading): statue frame, m/s2.
+struct ConditionedReading {
+  std::int64_t time_ns = 0;  // receive clock
+  Vector3r ground_m_s2 = Vector3r::Zero();
+  bool restart = false;  // a seam: nothing before it connects to it
+};
+
 class SensorSet {
  public:
   SensorSet() = default;
@@ -71,6 +78,15 @@ class SensorSet {
   // again at rest on its newest sample. True when the primary changed (the estimators have
   // inputs from the new one).
   bool update_primary();
+  // The estimators were started again by the monitor (not on a seam): the primary's conditioner
+  // verifies a new quiet window before they are trusted (condition() says when).
+  void verify_primary();
+  // The newest conditioned sample of `sensor` when there is one newer than `seen` (the
+  // caller's count of its samples taken, updated); false otherwise.
+  [[nodiscard]] bool newest_reading(int sensor, std::uint64_t& seen,
+                                    ConditionedReading& out) const;
+  // A ground sensor's reading can be trusted to raise the alarm: not in fault, its offset known.
+  [[nodiscard]] bool healthy_ground(int sensor) const { return usable(sensor); }
   // The estimators' next input from the primary's history; false when they have taken all.
   [[nodiscard]] bool next_input(EstimatorInput& input);
   // The model's absolute base acceleration u'' + u_G'' (m/s2, per modelled axis in x, y) at

@@ -44,6 +44,7 @@ inline constexpr std::uint32_t kSensorHeartbeatBaseId = 0x310;     // + node (1.
 inline constexpr std::uint32_t kMonitorStatusBaseId = 0x320;       // + axis (0..1)
 inline constexpr std::uint32_t kAlarmEventId = 0x330;
 inline constexpr std::uint32_t kAcknowledgeId = 0x340;
+inline constexpr std::uint32_t kStatueStandsId = 0x341;
 inline constexpr std::uint32_t kCollapseForecastBaseId = 0x350;  // + axis (0..1)
 // A regional early-warning alert from the integrator's bridge: its origin part, then its
 // intensity part (docs/regional.md).
@@ -62,6 +63,7 @@ enum class MessageKind : std::uint8_t {
   kMonitorStatus,
   kAlarmEvent,
   kAcknowledge,
+  kStatueStands,
   kCollapseForecast,
   kStatueRotation,
   kRegionalAlert,
@@ -116,6 +118,9 @@ enum class AlarmCause : std::uint8_t {
   kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
   kStatueUnexplained = 14,  // no member of the ensemble explains the statue sensor's motion
   kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
+  kStatueSensorFault = 16,  // the statue sensor unhealthy or not corroborated: it may not lower
+  kRestored = 17,           // a latched level or a collapse restored after a restart
+  kStatueStands = 18,       // a person on site stated that the statue stands again
 };
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.
@@ -169,6 +174,8 @@ struct MonitorStatus {
   Phase phase = Phase::kFullContact;
   Corner corner = Corner::kNone;
   AlarmLevel alarm_level = AlarmLevel::kNormal;
+  bool trouble = false;        // trouble shown beside the level (a fault, a refused input)
+  bool collapse_held = false;  // a collapse is held until a StatueStands
   double risk = 0.0;  // overturning risk, 0..1 (dimensionless), resolution 1e-4
   std::uint8_t sequence = 0;
   std::uint16_t sample_age_ms = 0;  // age of the newest sensor sample the estimate used
@@ -180,6 +187,7 @@ struct AlarmEvent {
   AlarmLevel previous_level = AlarmLevel::kNormal;
   AlarmCause cause = AlarmCause::kNone;
   bool latched = false;                  // the level holds until acknowledged
+  bool trouble = false;                  // trouble shown beside the level after the event
   std::uint32_t time_since_start_ms = 0;  // monitor time, wraps after 2^32 ms (49.7 days)
   std::uint8_t sequence = 0;              // increments by one per event
 };
@@ -189,6 +197,12 @@ struct Acknowledge {
   AlarmLevel level = AlarmLevel::kNormal;  // the level acknowledged
   std::uint8_t source_id = 0;              // operator panel / supervisory system id
   std::uint8_t event_sequence = 0;         // AlarmEvent.sequence of the event acknowledged
+};
+
+// 0x341: a person on site states that the statue stands again (a held collapse clears).
+struct StatueStands {
+  std::uint8_t source_id = 0;       // operator panel id
+  std::uint8_t event_sequence = 0;  // AlarmEvent.sequence of the latest event seen
 };
 
 // 0x350 + axis: the forecast of one rocking plane, sent with its MonitorStatus while the
@@ -262,6 +276,7 @@ using DecodeResult = CodecResult;
 [[nodiscard]] EncodeResult encode(const MonitorStatus& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const AlarmEvent& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const Acknowledge& message, CanFrame& frame);
+[[nodiscard]] EncodeResult encode(const StatueStands& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const CollapseForecast& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const StatueRotation& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const RegionalAlertOrigin& message, CanFrame& frame);
@@ -274,6 +289,7 @@ using DecodeResult = CodecResult;
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, MonitorStatus& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, AlarmEvent& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, Acknowledge& message);
+[[nodiscard]] DecodeResult decode(const CanFrame& frame, StatueStands& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, CollapseForecast& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, StatueRotation& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, RegionalAlertOrigin& message);

@@ -87,6 +87,8 @@ struct ForecastOutcome {
   int worst_member = -1;       // the member that collapses first; -1: none does
   std::uint32_t collapsing_members = 0;  // bit m: member m collapses within the horizon
   double collapse_in_s = -1.0;  // s from start_time_s to that collapse; -1: none
+  // Each member's, s from start_time_s (read where collapsing_members has its bit).
+  std::array<float, kMaxEnsembleMembers> member_collapse_in_s{};
 };
 
 class Forecaster {

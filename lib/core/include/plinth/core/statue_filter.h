@@ -1,73 +1,6 @@
-// The statue sensor's use: the members of an ensemble (ensemble.h) weighted by how well each
-// explains the statue's measured rotation, the phase taken from the measurement, and the risk
-// of the weighted members.
-//
-// The measurement is the rotation rate theta' of one axis (a gyroscope on the block, in the
-// statue frame; its offset removed by the conditioning). The filter integrates it to the tilt
-// theta (set back to 0 once the block has sat still: full contact is theta = 0), and takes the
-// phase from the two: rocking about corner 1 or 2, full contact, overturned past every member's
-// critical angle.
-//
-// Each member is judged on its equations at the *measured* state, not on its own simulated
-// trajectory (which rocking's sensitivity to impacts soon separates from the statue's, right
-// member or not): over every interval of interval_s, the member's theta'' of Eq 8 (rocking_flow;
-// at rest, the rotation Eq 16's onset would start, or none) is integrated at the measured
-// theta, theta' and ground, with the member's own base (u, u'), and the predicted change of
-// theta' is compared with the measured one. An interval with an impact (the tilt changes sign)
-// says nothing about the flow and is skipped. The innovation's variance is the gyroscope's noise
-// at both ends plus the model's tolerance, a fraction of the larger change:
-//   nu = d_meas - d_pred,  s^2 = 2 rate_noise^2 + (model_tolerance * max(|d_pred|, |d_meas|))^2
-// and each member's evidence, a log likelihood with forgetting (memory_s), is
-//   L <- L exp(-interval / memory_s) - nu^2 / (2 s^2) - ln s.
-// The weights are exp(L - max L), normalised: a bank of fixed members with forgetting rather
-// than a particle filter that resamples and jitters them (the members are the corners of the
-// declared uncertainty, so the extremes are never lost; forgetting keeps the weights from
-// collapsing onto one member for good, as resampling would).
-//
-// Informative: the effective number of members 1 / sum w^2 is at most informative_fraction of
-// the members (uniform weights give all of them: nothing has been learned while the statue and
-// every member sit still). The risk is then the highest member risk that members holding at
-// least credible_weight of the weight reach (each member's overturning_risk at the measured
-// phase and state). Before, the worst member's over the members not ruled out, of the measured
-// state and of its own simulation, the latter only while the member's own theta' agrees with
-// the measured one (within 3 standard deviations of the innovation: a member its base's stops
-// just kicked into rocking while the statue stands is contradicted at once, before its next
-// interval's evidence); the forecast's probability likewise counts the others. A member is
-// ruled out once its weight is below ruled_out_fraction of the uniform 1 / members. Besides the
-// flow's innovations, an interval through which the statue stood in full contact weighs
-// against a member whose own simulation rocks (its theta' against the measured one): the
-// evidence that the members' own trajectories give while they still follow the statue's.
-//
-// Explained: the smallest member's mean normalised innovation nu^2 / s^2 (forgetting over
-// score_memory_s, over the intervals whose measured or predicted change is beyond 4 times the
-// rate's noise; near 1 for the right member) stays below unexplained_score. Above it (an
-// anchored, cracked or toppled statue, a loose sensor) no member explains the measurement: the
-// filter says so and its risk is the worst member's, never less.
-//
-// Sliding, from the accelerometer (its horizontal specific force f along the axis, statue
-// frame, offset removed). A block whose contact with its base sticks moves with the base: the
-// accelerometer reads what a point of a rigid body pivoting on the base reads, the base's
-// absolute acceleration a_b = u'' + u_G'' (the ground's on the ground; on an isolated base each
-// member's own, Ensemble::base_acceleration) plus the tilt's terms: the gravity's projection
-// g sin(theta) and, while it rocks, the lever arm's theta'' and centripetal theta'^2 terms about
-// the pivot (block_specific_force; theta and theta' from the gyroscope, theta'' their difference
-// over a sample, the same low-pass as the rest). A sliding block's acceleration is its
-// friction's, -mu_k sign(x') (g + v_G'') (Eqs 4-5), not the base's: the relative acceleration
-//   a_rel = f - f_predicted   (= x'' while it slides, 0 while it sticks)
-// stays away from 0. Low-passed over slide_filter_s, it is compared with
-//   4 sigma_f + acceleration_bias_m_s2 + slide_tolerance * |f_predicted|
-// (sigma_f the filtered noise of the accelerometers' and, rocking, of the differenced rate at
-// the lever arm; the tolerance the model's and the two sensors' timing), for every member's base
-// (the members span the declared uncertainty of an isolated base; on the ground they share it):
-// above for every member for slide_onset_s the block slides (slide-rocking while the gyroscope
-// says it rocks), within it for some member for slide_end_s it sticks again. An impact's jump of
-// the sensor's velocity is in the differenced rate too (theta'' h at theta = 0 about either
-// corner): the prediction carries it. The sliding direction is the opposite of the block's
-// acceleration's. Only for a scene that can slide ([friction]) and, by default, stands on the
-// ground: on an isolated base the members' simulated bases are not the statue's (no sensor
-// measures the plate), which gave sliding before the statue moved in 36 of 217 runs
-// (docs/forecast.md); slide_on_isolated_base turns it on there. Without a fresh accelerometer
-// sample the phase is the gyroscope's alone.
+// The statue sensor's use: the ensemble's members weighted by how well each explains the
+// statue's measured rotation, the phase from the measurement, sliding from its accelerometer,
+// and whether the ground sensors corroborate it. The method: docs/statue-filter.md.
 // Freestanding: no heap.
 #pragma once
 
@@ -78,6 +11,7 @@
 #include "plinth/core/error.h"
 #include "plinth/core/excitation.h"
 #include "plinth/core/forecast.h"
+#include "plinth/core/name_table.h"
 #include "plinth/core/real.h"
 #include "plinth/core/risk.h"
 #include "plinth/core/state.h"
@@ -92,28 +26,61 @@ namespace plinth {
 // about 10 KB) refuses one in its settings; the monitor's code for it is left out.
 inline constexpr bool kStatueSensorBuiltIn = PLINTH_STATUE_SENSOR != 0;
 
+// Each tunable that decides how far the sensor may lower the risk has bounds (validate(); the
+// ranges, and why: docs/statue-filter.md, "Bounds").
 struct StatueFilterSettings {
-  Real rate_noise_rad_s = Real(0.003);  // rad/s: one measured rate's noise (gyro noise, bias left)
-  Real model_tolerance = Real(0.25);   // the members' theta'' holds to this fraction, (0, 2]
+  Real rate_noise_rad_s = Real(0.003);  // rad/s: one measured rate's noise, [1e-4, 0.05]
+  Real model_tolerance = Real(0.25);   // the members' theta'' holds to this fraction, [0.05, 1]
   Real rest_rate_rad_s = Real(0.02);   // rad/s: |theta'| below this (and the tilt below
-  Real rest_tilt_rad = Real(0.002);    // rad: this) is at rest
+  Real rest_tilt_rad = Real(0.002);    // rad: this) is at rest; (0, 0.05] and (0, 0.01]
   double rest_time_s = 0.1;            // s: at rest this long with a small tilt sets theta to 0
   double interval_s = 0.05;            // s: the innovations' interval, [1 sample, 1 s]
-  double memory_s = 10.0;              // s: the evidence's forgetting time constant
+  double memory_s = 10.0;              // s: the evidence's forgetting time constant, [1, 600]
   double score_memory_s = 1.0;         // s: the innovations' mean score's time constant
   Real informative_fraction = Real(0.5);  // informative: effective members <= this * members
   Real credible_weight = Real(0.2);       // the risk: reached by members holding this weight
   Real unexplained_score = Real(6);       // mean nu^2 / s^2 of the best member above: unexplained
-  Real ruled_out_fraction = Real(0.1);    // weight below this x 1 / members: ruled out, (0, 1]
-  // Sliding from the accelerometer (above).
+  Real ruled_out_fraction = Real(0.1);    // weight below this x 1 / members: ruled out
+  // Sliding from the accelerometer (docs/statue-filter.md).
   Real acceleration_noise_m_s2 = Real(0.03);  // m/s2 rms: a sample of f less the ground's, noise
-  Real acceleration_bias_m_s2 = Real(0.15);   // m/s2: their biases left after the offsets, >= 0
+  Real acceleration_bias_m_s2 = Real(0.15);   // m/s2: their biases left after the offsets
   Real slide_tolerance = Real(0.15);  // the prediction holds to this fraction of itself, [0, 1)
   double slide_filter_s = 0.05;       // s: the relative acceleration's low-pass, (0, 1]
   double slide_onset_s = 0.05;        // s: above the threshold this long: sliding, (0, 1]
   double slide_end_s = 0.15;          // s: below it this long: stuck again, (0, 1]
-  bool slide_on_isolated_base = false;  // the test on an isolated base too (above)
+  bool slide_on_isolated_base = false;  // the sliding test on an isolated base too
+  // Corroboration by the ground sensors (docs/statue-filter.md, "Corroboration").
+  // The accelerometer follows a block sticking to some member's base to this fraction of the
+  // prediction (beside the noise and bias terms of the sliding test), [0.05, 0.7].
+  Real follow_tolerance = Real(0.4);
+  double follow_onset_s = 0.15;  // s: beyond it for every member's base this long, (0, 1]
+  // rad/s: every member's own |theta'| beyond this (or collapsed) while the statue is measured
+  // in full contact, for contradiction_s: a contradiction. [0.02, 0.5] rad/s, (0, 1] s.
+  Real contradiction_rate_rad_s = Real(0.05);
+  double contradiction_s = 0.1;
+  // s: a refuted sensor is trusted again once every member and the statue stood in full contact
+  // this long with the accelerometer following, [1, 600].
+  double trust_again_s = 10.0;
 };
+
+// Why the ground sensors do not corroborate the statue sensor (StatueEstimate::refutation).
+enum class StatueRefutation : std::uint8_t {
+  kNone = 0,
+  kNoAccelerometer,          // no fresh accelerometer sample for follow_onset_s
+  kDoesNotFollowBase,        // its specific force is no block's sticking to a member's base
+  kStillWhileMembersRock,    // measured in full contact while every member rocks or fell
+  kUnexplained,              // no member explains the measured rotation
+};
+inline constexpr NameTable<StatueRefutation, 5> kStatueRefutationNames{{{
+    {StatueRefutation::kNone, "none"},
+    {StatueRefutation::kNoAccelerometer, "no_accelerometer"},
+    {StatueRefutation::kDoesNotFollowBase, "does_not_follow_base"},
+    {StatueRefutation::kStillWhileMembersRock, "still_while_every_member_rocks"},
+    {StatueRefutation::kUnexplained, "unexplained"},
+}}};
+[[nodiscard]] constexpr const char* statue_refutation_name(StatueRefutation r) {
+  return kStatueRefutationNames.name(r);
+}
 
 // Where the statue sensor's accelerometer sits on the block (StatueSensorSettings' mounting):
 // its height above the block's base and its horizontal offset along the axis from the vertical
@@ -180,6 +147,11 @@ struct StatueEstimate {
   // reading best (the smallest ratio to its threshold), and that threshold.
   Real relative_acceleration = 0.0;
   Real slide_threshold = 0.0;
+  // Corroborated: the sensor's reading may lower the risk below the box's without it. Else the
+  // refutation that took that away (held until trust_again_s of rest; the latest one).
+  bool corroborated = true;
+  StatueRefutation refutation = StatueRefutation::kNone;
+  bool follows_base = true;  // the newest accelerometer sample followed some member's base
 };
 
 // The forecast's probability of a collapse with the members weighted: the weight of the members
@@ -212,8 +184,13 @@ class StatueFilter {
   void finish_interval(const Ensemble& members);
   void weigh(const Ensemble& members);
   [[nodiscard]] State measured_state(const PlanarEstimator& member) const;
-  void measure_sliding(const Ensemble& members, GroundAcceleration ground,
-                       const StatueMeasurement& measured, const Real* previous_rate);
+  // The accelerometer against a block sticking to each member's base: the filtered relative
+  // accelerations; false without a usable accelerometer sample.
+  bool compare_with_bases(const Ensemble& members, GroundAcceleration ground,
+                          const StatueMeasurement& measured, const Real* previous_rate);
+  void measure_sliding(const Ensemble& members, bool compared);
+  [[nodiscard]] bool follows_some_base(const Ensemble& members, GroundAcceleration ground) const;
+  void corroborate(const Ensemble& members, bool compared, GroundAcceleration ground);
   void stop_sliding();
 
   StatueFilterSettings settings_;
@@ -252,9 +229,20 @@ class StatueFilter {
   int slide_above_ = 0;
   int slide_below_ = 0;
   bool sliding_ = false;
-  // Per member (its base): a_rel and |f_predicted|, filtered, m/s2.
+  // Per member (its base): a_rel and |f_predicted|, filtered, m/s2; the filtered noise.
   std::array<Real, kMaxEnsembleMembers> slide_relative_{};
   std::array<Real, kMaxEnsembleMembers> slide_scale_{};
+  std::array<Real, kMaxEnsembleMembers> slide_noise_{};
+  Real measured_force_ = 0.0;  // m/s2, f filtered alike (the sliding block's friction)
+  bool compared_once_ = false;  // the filters hold a comparison since the last reset
+  // Corroboration.
+  int follow_onset_samples_ = 1;
+  int contradiction_samples_ = 1;
+  int trust_again_samples_ = 1;
+  int beyond_samples_ = 0;          // consecutive samples no member's base explains
+  int without_acceleration_ = 0;    // consecutive samples without an accelerometer sample
+  int contradicting_samples_ = 0;   // consecutive samples of the contradiction
+  int rest_agreeing_samples_ = 0;   // consecutive samples of rest, following (trust again)
 };
 
 }  // namespace plinth

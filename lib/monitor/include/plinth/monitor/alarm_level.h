@@ -37,6 +37,11 @@ enum class AlarmCause : std::uint8_t {
   kPWave = 13,              // the P-wave stage's probability of collapse crossed its threshold
   kStatueUnexplained = 14,  // no member of the ensemble explains the statue sensor's motion
   kRegionalAlert = 15,      // a regional alert's probability of collapse crossed its threshold
+  // The statue sensor is unhealthy or not corroborated by the ground sensors: its reading may
+  // not lower the level (docs/safety.md).
+  kStatueSensorFault = 16,
+  kRestored = 17,      // a latched level or a collapse restored from the box's saved state
+  kStatueStands = 18,  // a person on site stated that the statue stands again
 };
 
 // The names in status and alarm lines (also the DBC's VAL_ names).
@@ -48,7 +53,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 16> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 19> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -65,6 +70,9 @@ inline constexpr NameTable<AlarmCause, 16> kAlarmCauseNames{{{
     {AlarmCause::kPWave, "p_wave"},
     {AlarmCause::kStatueUnexplained, "statue_unexplained"},
     {AlarmCause::kRegionalAlert, "regional_alert"},
+    {AlarmCause::kStatueSensorFault, "statue_sensor_fault"},
+    {AlarmCause::kRestored, "restored"},
+    {AlarmCause::kStatueStands, "statue_stands"},
 }}};
 
 // The levels the risk raises, lowest first (neither normal nor fault): the ones plinth-eval

@@ -79,11 +79,18 @@ struct AlarmInput {
   // (Both read only in a build with their part: kPWaveStageBuiltIn, kRegionalAlertBuiltIn.)
   bool out_of_full_contact = false;  // the block slides or rocks (motion started)
   bool collapse_detected = false;    // the block overturned or fell
-  bool fault_active = false;         // sensor or bus trouble
+  bool fault_active = false;         // sensor or bus trouble: the risk is stale
   AlarmCause fault_cause = AlarmCause::kSensorFault;  // reported while fault_active
+  // A supplementary input refused (kNone: none): the risk given is the box's without it, still
+  // valid, so the trouble is shown beside the level, never in place of one (AlarmPolicy).
+  AlarmCause input_fault = AlarmCause::kNone;
   bool not_calibrated = false;  // no trusted offset or initial state (AlarmPolicy, below)
   bool acknowledged = false;  // `acknowledgement` arrived since the last update
   Acknowledgement acknowledgement;
+  // A person on site stated that the statue stands again: a held collapse is cleared, unless
+  // this input still says collapse (StandsOutcome).
+  bool statue_stands = false;
+  std::uint8_t statue_stands_sequence = 0;  // the latest event's sequence the person saw
 };
 
 enum class AckOutcome : std::uint8_t {
@@ -93,6 +100,15 @@ enum class AckOutcome : std::uint8_t {
   kStale,                   // the sequence is not the latest event's: nothing changed
   kWrongLevel,              // the level is not the latched one: nothing changed
   kNothingLatched,          // no level is latched: nothing changed
+};
+
+// What a person's statement that the statue stands again did.
+enum class StandsOutcome : std::uint8_t {
+  kNone = 0,          // no statement in this update
+  kCleared,           // the held collapse cleared; the level follows its conditions
+  kNothingHeld,       // no collapse was held: nothing changed
+  kStale,             // the sequence is not the latest event's: nothing changed
+  kStillCollapsed,    // an input still says overturned or fallen: nothing changed
 };
 
 enum class InputProblem : std::uint8_t {
@@ -116,6 +132,17 @@ inline constexpr NameTable<InputProblem, 3> kInputProblemNames{{{
     {InputProblem::kTimeWentBack, "time went back"},
 }}};
 
+inline constexpr NameTable<StandsOutcome, 5> kStandsOutcomeNames{{{
+    {StandsOutcome::kNone, "none"},
+    {StandsOutcome::kCleared, "cleared"},
+    {StandsOutcome::kNothingHeld, "no collapse held"},
+    {StandsOutcome::kStale, "stale sequence"},
+    {StandsOutcome::kStillCollapsed, "still collapsed"},
+}}};
+
+[[nodiscard]] constexpr const char* stands_outcome_name(StandsOutcome outcome) {
+  return kStandsOutcomeNames.name(outcome);
+}
 [[nodiscard]] constexpr const char* ack_outcome_name(AckOutcome outcome) {
   return kAckOutcomeNames.name(outcome);
 }
@@ -128,8 +155,20 @@ struct AlarmEventRecord {
   AlarmLevel previous_level = AlarmLevel::kNormal;
   AlarmCause cause = AlarmCause::kNone;
   bool latched = false;      // a level is latched, awaiting acknowledgement
+  // The trouble shown beside the level (kNone: none): a fault, not calibrated or a refused
+  // input, whatever level it leaves shown.
+  AlarmCause trouble = AlarmCause::kNone;
   std::int64_t time_ns = 0;  // the update's time
   std::uint8_t sequence = 0;
+};
+
+// What must outlive the process (AlarmPolicy::memory, restore): the latched level with its
+// cause, and a collapse seen.
+struct AlarmMemory {
+  AlarmLevel latched_level = AlarmLevel::kNormal;  // kNormal: nothing latched
+  AlarmCause latched_cause = AlarmCause::kNone;
+  bool collapse_held = false;
+  std::uint8_t next_sequence = 0;  // the events' numbering goes on where it stopped
 };
 
 inline constexpr std::size_t kMaxEventsPerUpdate = 2;
@@ -139,7 +178,10 @@ struct AlarmOutput {
   std::size_t event_count = 0;
   AlarmLevel level = AlarmLevel::kNormal;          // the level shown after this update
   AlarmLevel latched_level = AlarmLevel::kNormal;  // kNormal when nothing is latched
+  AlarmCause trouble = AlarmCause::kNone;          // shown beside the level (the events')
+  bool collapse_held = false;                      // a collapse holds the alarm (sticky)
   AckOutcome acknowledgement = AckOutcome::kNone;
+  StandsOutcome statue_stands = StandsOutcome::kNone;
   InputProblem input_problem = InputProblem::kNone;
 };
 
@@ -163,26 +205,33 @@ struct HeldCondition {
 //             stage's probability of collapse >= warning_pwave.on (p_wave.h), or the regional
 //             alert's probability of collapse >= warning_regional.on (never more than warning:
 //             both guess the coming ground, not the statue's physics)
-//   alarm     risk >= alarm.on, or probability >= alarm_forecast.on; or a collapse (overturned,
-//             fell): alarm at once, no hold, latched
+//   alarm     risk >= alarm.on, or probability >= alarm_forecast.on; or a collapse held
+// Collapse: collapse_detected raises the alarm at once (no hold) and latches it; the collapse
+// is then held, whatever later inputs, acknowledgements or restarts (restore) say, until a
+// person states that the statue stands again (statue_stands; refused while an input still says
+// collapse).
 // Latching: a rise of the condition level into warning (latch_warning) or alarm (latch_alarm,
 // any collapse) latches it: the level shown stays at least there until acknowledged. An
 // acknowledgement names the latched level and quotes the latest event's sequence, else it
 // changes nothing and the outcome says why; an accepted one releases the latch and the level
 // follows its condition (an alarm whose condition holds stays, and lowers later by itself).
-// Fault: fault_active (or an invalid risk input: an internal fault) shows the fault level at
-// once, until lower_hold_s after it clears. Not calibrated: not_calibrated shows the fault
-// level, cause kNotCalibrated, exactly while it lasts (no hold: a state of knowledge); an
-// active fault's own cause is reported instead. The level shown: alarm if the risk level
-// (condition or latch) is alarm, else fault while a fault or not_calibrated holds, else the
-// risk level: a fault never hides an alarm, it hides a warning or advisory (stale while the
-// input is not trusted), which show again with an event when it ends.
-// Events: one each time the level shown or its latched flag changes, at most two per update
-// (the acknowledgement first, against what the operator saw, then the new input); sequences
-// from 0, wrapping 255 -> 0. Cause: why the new level holds (risk_threshold; collapse_forecast
-// when the forecast alone holds it; p_wave when the P-wave stage alone holds the warning, else
-// regional_alert when the regional alert alone holds it; phase_change, overturn_detected, the
-// fault's cause), none back to normal, acknowledged for a change an acknowledgement made.
+// Trouble, shown beside the level (AlarmOutput::trouble, each event's):
+//  - fault_active (or an invalid risk input: an internal fault): the risk is stale. Shown at
+//    once, held lower_hold_s after it clears. The level: alarm if the risk level (condition or
+//    latch) is alarm, else a latched warning, else fault: a fault never hides an alarm or a
+//    latched warning; it hides the live warning or advisory, which show again when it ends.
+//  - not_calibrated: the same, cause kNotCalibrated, exactly while it lasts (no hold: a state
+//    of knowledge); an active fault's own cause is reported instead.
+//  - input_fault (a supplementary input refused; the risk is the box's without it): held as a
+//    fault; the level is the risk level, fault only while that is normal. It hides nothing.
+// Events: one each time the level shown, its latched flag or the trouble changes, at most two
+// per update (an acknowledgement or a statement first, against what the operator saw, then the
+// new input); sequences from 0, wrapping 255 -> 0. Cause: why the new level holds
+// (risk_threshold; collapse_forecast when the forecast alone holds it; p_wave when the P-wave
+// stage alone holds the warning, else regional_alert when the regional alert alone holds it;
+// phase_change, overturn_detected, the fault's cause; restored for a level a restart brought
+// back), none back to normal, acknowledged or statue_stands for a change a person made, the
+// trouble's cause when only the trouble changed.
 // Times are int64 ns of monitor time since start, never decreasing: an update with an earlier
 // time is refused (InputProblem::kTimeWentBack).
 class AlarmPolicy {
@@ -196,6 +245,16 @@ class AlarmPolicy {
 
   [[nodiscard]] AlarmLevel level() const { return level_; }
   [[nodiscard]] AlarmLevel latched_level() const { return latched_level_; }
+  [[nodiscard]] bool collapse_held() const { return collapse_held_; }
+  // `sequence` is the latest event's (what an acknowledgement or a statement must quote).
+  [[nodiscard]] bool sequence_is_latest(std::uint8_t sequence) const {
+    return any_event_ && sequence == last_event_sequence_;
+  }
+
+  // What a restart must not lose; restore() it into a new policy before its first update: the
+  // latch and the held collapse come back with cause kRestored, shown by the first update.
+  [[nodiscard]] AlarmMemory memory() const;
+  void restore(const AlarmMemory& memory);
   // Heartbeat: a status is due every heartbeat_period_s after the last heartbeat_sent(), and at
   // once after an event. When the next is due, ns (the lowest int64 before the first: due).
   [[nodiscard]] std::int64_t next_heartbeat_ns() const { return next_heartbeat_ns_; }
@@ -208,11 +267,15 @@ class AlarmPolicy {
 
  private:
   [[nodiscard]] AckOutcome acknowledge(const Acknowledgement& ack);
+  [[nodiscard]] StandsOutcome statue_stands(std::uint8_t sequence, bool collapse_now);
+  [[nodiscard]] AlarmLevel condition_level() const;
+  [[nodiscard]] AlarmCause trouble() const;
   void evaluate_conditions(const AlarmInput& input, bool risk_valid);
   [[nodiscard]] AlarmLevel shown_level() const;
   [[nodiscard]] AlarmCause cause_of(AlarmLevel level) const;
   [[nodiscard]] AlarmCause condition_cause(AlarmLevel level) const;
-  void emit_if_changed(AlarmOutput& out, std::int64_t time_ns, bool by_acknowledgement);
+  // by_person: the cause a person's command gives a change (kNone: the input's).
+  void emit_if_changed(AlarmOutput& out, std::int64_t time_ns, AlarmCause by_person);
 
   AlarmPolicySettings settings_;
   std::int64_t raise_hold_ns_ = 0;
@@ -223,7 +286,12 @@ class AlarmPolicy {
   detail::HeldCondition warning_;
   detail::HeldCondition alarm_;
   detail::HeldCondition fault_;
+  detail::HeldCondition input_fault_;  // a supplementary input refused (held as a fault)
+  AlarmCause input_fault_cause_ = AlarmCause::kNone;
+  bool input_fault_input_ = false;  // the latest input's input_fault
   bool collapse_ = false;      // the latest input's collapse_detected
+  bool collapse_held_ = false;  // a collapse seen, until a person says the statue stands
+  bool collapse_restored_ = false;  // the held collapse came from restore()
   // The forecast alone holds the warning / alarm condition; the P wave alone, else the regional
   // alert alone, the warning (for the cause).
   bool warning_by_forecast_ = false;
@@ -240,6 +308,8 @@ class AlarmPolicy {
 
   AlarmLevel level_ = AlarmLevel::kNormal;  // shown
   bool latched_shown_ = false;              // the latched flag of the last event
+  AlarmCause trouble_shown_ = AlarmCause::kNone;  // the trouble of the last event
+  bool restored_ = false;  // restore() brought something back: the first event says so
   bool any_event_ = false;
   std::uint8_t next_sequence_ = 0;
   std::uint8_t last_event_sequence_ = 0;
