@@ -11,9 +11,12 @@
 #if !defined(PLINTH_CORE_FLATTEN) || PLINTH_CORE_FLATTEN
 #define PLINTH_FLATTEN [[gnu::flatten]]
 #define PLINTH_FLATTENED_OUT [[gnu::noinline, gnu::cold]]
+#define PLINTH_CORE_ONE_INTERVAL 0
 #else
 #define PLINTH_FLATTEN
 #define PLINTH_FLATTENED_OUT
+// Nothing flattened, one interval for every phase kernel (kernels::Erased, step_interval.h).
+#define PLINTH_CORE_ONE_INTERVAL 1
 #endif
 
 // The scene feature sets compiled in (PLINTH_CORE_FEATURE_SETS): bit 4 * base + contact of

@@ -5,6 +5,9 @@
 // once.
 #pragma once
 
+#include <cstddef>
+#include <type_traits>
+
 #include "plinth/core/excitation.h"
 #include "plinth/core/internal/flows.h"
 #include "plinth/core/internal/full_contact_propagator.h"
@@ -194,6 +197,46 @@ struct SlideRocking : Turning {
     const SlideRockingSystem k = system(y, t);
     return {ag, t, slide_rocking_flow(*s, k, y, ag, moves), k.consistency()};
   }
+};
+
+// A phase kernel behind function pointers: one interval's code serves every kernel
+// (PLINTH_CORE_ONE_INTERVAL, a build that flattens nothing: the microcontroller's flash). The
+// kernel itself is made in place; its point and its advance by the stepper are called through
+// `Ops` (StepInterval::erased_interval), the ground directly.
+struct Erased {
+  static constexpr bool kExact = true;  // advances through Ops (the stepper on the kernel)
+  static constexpr Leading kLeading = Leading::kByMode;
+
+  struct Ops {
+    void (*make)(void* storage, const Context& c);
+    FlowPoint (*point)(const void* kernel, const State& y, GroundAcceleration ag);
+    State (*advance)(const void* kernel, Time t, const State& y, const FlowPoint& start, Real h,
+                     const GroundAcceleration* end_ground);
+  };
+
+  Erased(const Context& c, const Ops& kernel_ops) : excitation(&c.excitation), ops(&kernel_ops) {
+    kernel_ops.make(storage, c);
+  }
+
+  [[nodiscard]] GroundAcceleration ground(Time t) const { return Base::ground(*excitation, t); }
+  [[nodiscard]] FlowPoint point(const State& y, GroundAcceleration ag) const {
+    return ops->point(storage, y, ag);
+  }
+  [[nodiscard]] State advance(Time t, const State& y, const FlowPoint& start, Real h,
+                              const GroundAcceleration* end_ground) const {
+    return ops->advance(storage, t, y, start, h, end_ground);
+  }
+
+  // Room for the largest kernel, bytes; kernels hold pointers and numbers alone (nothing to
+  // destroy).
+  static constexpr std::size_t kStorageBytes = 160;
+  template <class K>
+  static constexpr bool kFits = sizeof(K) <= kStorageBytes && alignof(K) <= 8 &&
+                                std::is_trivially_destructible_v<K>;
+
+  const Excitation* excitation;
+  const Ops* ops;
+  alignas(8) unsigned char storage[kStorageBytes];
 };
 
 }  // namespace plinth::internal::kernels

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <new>
 
 #include "build_options.h"
 #include "crossing.h"
@@ -113,13 +114,41 @@ struct StepInterval {
 
   PLINTH_FLATTEN static bool advance_interval(Simulator& sim, Time& t0, Time t_end,
                                               bool guards_live, bool full_step) {
+    return advance_interval_of(sim, t0, t_end, guards_live, full_step);
+  }
+
+  // advance_interval through kernels::Erased (PLINTH_CORE_ONE_INTERVAL): this kernel's Ops and
+  // the one interval of them all.
+  static bool erased_interval(Simulator& sim, Time& t0, Time t_end, bool guards_live,
+                              bool full_step) {
+    static_assert(kernels::Erased::kFits<Kernel>);
+    static constexpr kernels::Erased::Ops kOps{
+        [](void* storage, const kernels::Context& c) { new (storage) Kernel(c); },
+        [](const void* k, const State& y, GroundAcceleration ag) {
+          return std::launder(static_cast<const Kernel*>(k))->point(y, ag);
+        },
+        [](const void* k, Time t, const State& y, const FlowPoint& start, Real h,
+           const GroundAcceleration* end_ground) {
+          return advance_state(*std::launder(static_cast<const Kernel*>(k)), t, y, start, h,
+                               end_ground);
+        }};
+    return StepInterval<Method, kernels::Erased>::advance_interval_of(sim, t0, t_end, guards_live,
+                                                                      full_step, kOps);
+  }
+
+  // KernelArgs: what the kernel is made from besides the interval's context (Erased: its Ops).
+  template <class... KernelArgs>
+  static bool advance_interval_of(Simulator& sim, Time& t0, Time t_end, bool guards_live,
+                                  bool full_step, const KernelArgs&... kernel_args) {
     const Scene& s = *sim.scene_;
     const Mode mode = sim.mode_;
     const State& y0 = sim.y_;  // replaced only once y1 (or the event's state) is complete
     // The interval's length, and below the offsets inside it, in Real; the times themselves in
     // Time.
     const auto h = static_cast<Real>(t_end - t0);
-    Kernel k({s, sim.excitation_, sim.propagator_, full_step ? h : Real(0), mode, y0});
+    Kernel k(kernels::Context{s, sim.excitation_, sim.propagator_, full_step ? h : Real(0), mode,
+                              y0},
+             kernel_args...);
     static constexpr ActiveGuards kNone{};
     const ActiveGuards& guards = guards_live ? sim.active_guards_ : kNone;
     // The start: kept from the end of the last step when it had no event.
