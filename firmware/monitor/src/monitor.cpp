@@ -466,6 +466,9 @@ void Monitor::evaluate(MonitorUpdate& update) {
     *shown = stage->status();
   }
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
+  // Not estimating, the axes keep what they last showed (a held collapse among it): no reading
+  // says collapse then (a person's statement after a restart on a silent bus is not refused).
+  if (!status_.estimating) input.collapse_detected = false;
   if (held_fault_ != monitor::AlarmCause::kNone) {
     input.fault_active = true;
     input.fault_cause = held_fault_;

@@ -396,5 +396,31 @@ TEST(FrameDecoder, ASweepCannotClearAHeldCollapse) {
   EXPECT_FALSE(monitor.status().collapse.held);
 }
 
+// A box restarted with a held collapse, on a silent bus (no estimator runs): a person's
+// statement clears it; the collapse the status shows is the memory's, not a reading.
+TEST(FrameDecoder, AStatementAfterARestartOnASilentBusClearsTheCollapse) {
+  const Scene scene = testing::make(testing::paper_block(0.0));
+  const MonitorConfig config = sweep_config();
+  Monitor monitor;
+  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
+  FrameDecoder decoder;
+  decoder.start(config);
+  std::int64_t t = 0;
+  (void)overturn(monitor, decoder, t);
+  ASSERT_TRUE(monitor.status().collapse.held);
+  const BoxMemory memory = monitor.memory();
+  Monitor restarted;
+  ASSERT_TRUE(restarted.start(config, {&scene, nullptr}).ok());
+  restarted.restore(memory);
+  const MonitorUpdate first = restarted.poll();
+  ASSERT_GT(first.event_count, 0U);
+  EXPECT_TRUE(restarted.status().collapse.held);
+  EXPECT_TRUE(restarted.status().axes[0].mode.collapsed()) << "the memory's collapse shown";
+  const std::uint8_t latest = first.events[first.event_count - 1].sequence;
+  const MonitorUpdate stated = restarted.statue_stands(latest);
+  EXPECT_EQ(stated.statue_stands, monitor::StandsOutcome::kCleared);
+  EXPECT_FALSE(restarted.status().collapse.held);
+}
+
 }  // namespace
 }  // namespace plinth::firmware
