@@ -126,7 +126,7 @@ if mqtt.get("events_dropped") or mqtt.get("events_undelivered"):
     problems.append(f"MQTT events dropped {mqtt.get('events_dropped')}, undelivered "
                     f"{mqtt.get('events_undelivered')}")
 rec = summary.get("recorder", {})
-if rec.get("captures_dropped") or rec.get("write_errors"):
+if rec.get("captures_dropped") or rec.get("write_errors") or rec.get("health", "ok") != "ok":
     problems.append(f"recorder: {rec}")
 # Every capture in the folder, whole; those of earlier runs unchanged.
 frame = re.compile(r"^\((\d+\.\d{6})\) \w+ [0-9A-F]{3}#[0-9A-F]{0,16}$")

@@ -1,13 +1,14 @@
-// The event recorder: the last pre_trigger_s of raw frames in a ring; on a trigger (an alarm)
-// it keeps that window and the following post_trigger_s, then hands the capture to a writer
-// thread that writes a candump log and a JSON summary. The real-time side (on_frame, trigger)
-// never allocates, blocks or does I/O: the ring and two capture buffers are allocated once at
-// start-up, and captures are handed over through a mutex held only for a pointer swap. When the
-// writer is still busy with an earlier capture, a new trigger extends the capture in progress;
-// a trigger while both buffers are full is counted (captures_dropped), never silently lost.
-// The folder (capture_store.h): numbers continue after the highest capture present, each file
-// appears under its final name only when complete, and the retention limit is kept after each
-// capture.
+// The event recorder: the last pre_trigger_s of raw frames in a ring; on a trigger (a warning or
+// an alarm) it keeps that window and the following post_trigger_s (a later trigger extends it),
+// then hands the capture to a writer thread that writes a candump log and a JSON summary. The
+// real-time side (on_frame, trigger) never blocks or does I/O: the ring and two capture buffers
+// are allocated once at start-up, and captures are handed over through a mutex held only for a
+// pointer swap. A window longer than a buffer goes on in the other buffer (the next capture
+// "continues" it); frames that find no buffer, a pre-trigger window the ring no longer holds,
+// and a trigger while both buffers are busy are counted and said, never silently lost. The
+// folder (capture_store.h) is locked against another box, checked and recreated, and kept to
+// its retention limit at start, after each capture and when a capture does not fit. status()
+// gives its health to the outputs (docs/monitor.md, "Event recorder").
 #pragma once
 
 #include <atomic>
@@ -20,6 +21,7 @@
 
 #include "capture_store.h"
 #include "plinth/hal/frame_io.h"
+#include "recorder_status.h"
 
 namespace plinth::firmware {
 
@@ -28,11 +30,16 @@ struct EventRecorderSettings {
   std::string interface_name = "can0";  // written in the candump log's lines
   double pre_trigger_s = 30.0;   // s of frames kept before the trigger
   double post_trigger_s = 60.0;  // s of frames kept after the (latest) trigger
-  double frame_rate_hz = 1000.0;  // upper bound of the frame rate, sizes the buffers
+  // Frames/s the buffers are sized for: every sensor's frames and the bus's other traffic
+  // (plinth-monitor: recorder_frame_rate_hz, monitor_config.h).
+  double frame_rate_hz = 1000.0;
   RetentionLimits retention;      // [recorder] max_captures, max_bytes
   // Members written already, added to each capture's JSON: what was running (the version, the
   // scene and box files' hashes; run_identity.h).
   std::string identity_json;
+  // s between checks of the folder off the loop (still there, locked, writable; recreated when
+  // gone); a capture checks it again before it is written.
+  double folder_check_period_s = 2.0;
   // recorder.test_pause_mid_write_s, TEST ONLY: the writer stops this long halfway through each
   // capture's log, so a test can kill the process while a file is being written; 0: never.
   double test_pause_mid_write_s = 0.0;
@@ -49,9 +56,11 @@ struct TriggerInfo {
 
 class EventRecorder {
  public:
-  // Throws plinth::host::InputError when the directory cannot be created or a setting is bad.
-  // Removes partial files a killed process left (partial_files_removed) and numbers the
-  // captures after the highest present.
+  // Throws plinth::host::InputError when a setting is bad. A folder it cannot use (not
+  // creatable, read-only, another box's) does not stop the box: it is said on stderr, status()
+  // is failed, and the folder is tried again at every check. With the folder: removes partial
+  // files a killed process left (partial_files_removed), numbers the captures after the highest
+  // present and applies the retention limit.
   explicit EventRecorder(EventRecorderSettings settings);
   ~EventRecorder();  // finishes any capture in progress and joins the writer
   EventRecorder(const EventRecorder&) = delete;
@@ -65,30 +74,55 @@ class EventRecorder {
   // flush(), then waits until the writer has written everything and stops it (idempotent).
   void close();
 
+  // Any thread, without a lock: health, its problem and the counters.
+  [[nodiscard]] RecorderStatus status() const;
   [[nodiscard]] std::uint64_t captures_written() const { return written_.load(); }
+  // Triggers that found both buffers busy (part of status().captures_lost).
   [[nodiscard]] std::uint64_t captures_dropped() const { return dropped_.load(); }
+  // Captures (or pieces) the writer could not write (part of status().captures_lost).
   [[nodiscard]] std::uint64_t write_errors() const { return write_errors_.load(); }
-  // Captures deleted to keep the retention limit.
+  // Frames of capture windows that no capture holds.
+  [[nodiscard]] std::uint64_t frames_lost() const { return frames_lost_.load(); }
+  // Captures deleted by retention (the limits, or room for a new capture).
   [[nodiscard]] std::uint64_t captures_deleted() const { return deleted_.load(); }
-  [[nodiscard]] int partial_files_removed() const { return partial_files_removed_; }
-  [[nodiscard]] int first_index() const { return first_index_; }
+  [[nodiscard]] int partial_files_removed() const { return partial_files_removed_.load(); }
+  // The number of this run's first capture (before any: the number the next one takes; 0: the
+  // folder was never usable).
+  [[nodiscard]] std::uint64_t first_index() const { return first_index_.load(); }
   // Paths of the files written so far (candump logs), for the summary.
   [[nodiscard]] std::vector<std::string> written_paths();
 
  private:
+  // One capture: a window, or a piece of a window longer than a buffer.
   struct Capture {
     std::vector<hal::TimedFrame> frames;  // capacity reserved once
-    TriggerInfo info;
+    TriggerInfo info;                     // the window's first trigger
     std::int64_t trigger_ns = 0;
-    std::int64_t end_ns = 0;  // frames up to this receive time belong to the capture
-    int index = 0;
-    bool reached_alarm = false;  // its trigger or a later one within it was the alarm level
+    bool reached_alarm = false;           // the window reached the alarm level by this piece's end
+    bool continuation = false;            // it continues the window's previous piece
+    bool continued = false;               // it was full: the next piece continues it
+    std::uint64_t frames_dropped = 0;     // frames of the window before it that no piece holds
+    std::int64_t pre_trigger_cut_ns = 0;  // of the pre-trigger window, what the ring had lost
   };
 
-  void hand_over();  // the active capture is complete
+  // Real-time side.
+  [[nodiscard]] bool take_buffer(bool may_wait);
+  void start_piece(bool continuation);
+  void hand_over(bool continued);  // the piece being filled is complete
+  void close_window();
+
+  // Writer side.
   void writer_loop();
-  void write(const Capture& capture);
+  void write(Capture& capture);
+  [[nodiscard]] WriteOutcome write_files(const std::string& stem, const std::string& log,
+                                         const std::string& json, bool alarm, std::string& error);
+  [[nodiscard]] bool make_room(std::uint64_t bytes, bool for_alarm);
+  void check_folder();
+  void folder_opened();
   void keep_retention();
+  void lose(const Capture& capture, RecorderProblem problem, const std::string& error);
+  void say_real_time_losses();
+  [[nodiscard]] bool real_time_losses_unsaid() const;
 
   EventRecorderSettings settings_;
   std::int64_t pre_ns_ = 0;
@@ -97,13 +131,17 @@ class EventRecorder {
   std::size_t ring_next_ = 0;
   std::size_t ring_count_ = 0;
   Capture buffers_[2];
-  Capture* active_ = nullptr;  // the capture being filled (real-time side only), or none
-  int next_index_ = 1;
-  int first_index_ = 1;
-  int partial_files_removed_ = 0;
+  // The window in progress (real-time side only).
+  bool window_open_ = false;
+  TriggerInfo window_info_;
+  std::int64_t window_trigger_ns_ = 0;
+  std::int64_t window_end_ns_ = 0;  // frames up to this receive time belong to it
+  bool window_alarm_ = false;
+  std::uint64_t window_dropped_ = 0;  // frames since the last piece that found no buffer
+  Capture* active_ = nullptr;         // the piece being filled, or none
 
-  // Under mutex_: buffers free for a new capture, and captures waiting for the writer (in
-  // order). Each buffer is in exactly one place: free, active, waiting or being written.
+  // Under mutex_: buffers free for a new piece, and pieces waiting for the writer (in order).
+  // Each buffer is in exactly one place: free, active, waiting or being written.
   std::mutex mutex_;
   std::condition_variable wake_;
   Capture* free_[2] = {};
@@ -111,12 +149,30 @@ class EventRecorder {
   Capture* waiting_[2] = {};
   int waiting_count_ = 0;
   bool stopping_ = false;
-  std::thread writer_;
   std::vector<std::string> paths_;
+
+  // Writer side only (and the constructor, before the writer starts).
+  CaptureFolder folder_;
+  std::uint64_t next_index_ = 1;
+  std::uint64_t previous_piece_ = 0;  // the number of the window's previous piece written
+  std::uint64_t room_needed_ = 0;     // bytes of the latest capture lost to a full disk
+  bool wrote_any_ = false;
+  std::uint64_t said_dropped_ = 0;
+  std::uint64_t said_frames_lost_ = 0;
+  std::thread writer_;
+
+  // Health, read by status() from any thread.
+  std::atomic<RecorderProblem> folder_problem_{RecorderProblem::kNone};  // the folder's now
+  std::atomic<RecorderProblem> write_problem_{RecorderProblem::kNone};   // until a capture fits
+  std::atomic<RecorderProblem> latest_loss_{RecorderProblem::kNone};
   std::atomic<std::uint64_t> written_{0};
   std::atomic<std::uint64_t> dropped_{0};
   std::atomic<std::uint64_t> write_errors_{0};
+  std::atomic<std::uint64_t> truncated_{0};
+  std::atomic<std::uint64_t> frames_lost_{0};
   std::atomic<std::uint64_t> deleted_{0};
+  std::atomic<std::uint64_t> first_index_{0};
+  std::atomic<int> partial_files_removed_{0};
 };
 
 }  // namespace plinth::firmware

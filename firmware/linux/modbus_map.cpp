@@ -87,7 +87,7 @@ constexpr std::array<Point, kPointCount> kPoints = {{
     word(reg::kCommands, "commands", "",
          "operator commands carried out (acknowledge and reset), modulo 65536"),
     word(reg::kAlarmEvents, "alarm_events", "", "alarm events so far, modulo 65536"),
-    word(reg::kMapVersion, "map_version", "", "the version of this map: 6"),
+    word(reg::kMapVersion, "map_version", "", "the version of this map: 7"),
     scaled(reg::kProbability, "probability", "0.0001", "", false, "status.probability",
            "the forecast's probability of a collapse within its horizon, 0 .. 1"),
     word(reg::kForecastAxis, "forecast_axis", "",
@@ -172,6 +172,19 @@ constexpr std::array<Point, kPointCount> kPoints = {{
            "nothing learned); 65535: no statue sensor"),
     scaled(reg::kStatueEffectiveMembersY, "statue_effective_members_y", "0.01", "", true, "",
            "the same of axis y; 65535 with one axis or no statue sensor"),
+    word(reg::kRecorderHealth, "recorder_health", "status.recorder.health",
+         "the event recorder's health (failed: the folder cannot take a capture now; degraded: "
+         "a capture was lost or cut short); 65535: no recorder (--record-dir)",
+         Codes::kRecorderHealth, true),
+    word(reg::kRecorderProblem, "recorder_problem", "status.recorder.problem",
+         "why the recorder failed, or its latest loss; 65535: no recorder",
+         Codes::kRecorderProblem, true),
+    counter(reg::kCapturesWritten, "captures_written", "status.recorder.captures_written",
+            "captures written whole (a long one in pieces)"),
+    counter(reg::kCapturesLost, "captures_lost", "status.recorder.captures_lost",
+            "captures, or pieces of one, that never reached the disk"),
+    counter(reg::kCapturesTruncated, "captures_truncated", "status.recorder.captures_truncated",
+            "captures on disk that miss frames of their window"),
     level_bit(monitor::AlarmLevel::kNormal, "level_normal"),
     level_bit(monitor::AlarmLevel::kAdvisory, "level_advisory"),
     level_bit(monitor::AlarmLevel::kWarning, "level_warning"),
@@ -199,7 +212,7 @@ constexpr bool contiguous() {
   return next == reg::kCount && bits == discrete::kCount;
 }
 static_assert(contiguous());
-static_assert(kMapVersion == 6, "the map_version row says 6");
+static_assert(kMapVersion == 7, "the map_version row says 7");
 
 void put16(std::uint16_t* r, int address, std::uint64_t value) {
   r[address] = static_cast<std::uint16_t>(value & 0xFFFFU);
@@ -280,6 +293,10 @@ std::string codes_text(const Point& p) {
       return "0=not_measured;1=uninformative;2=weighted;3=unexplained";
     case Codes::kRegionalRefusal:
       return codes_text(kRegionalRefusalCodes, monitor::kRegionalRefusalNames);
+    case Codes::kRecorderHealth:
+      return codes_text(kRecorderHealthCodes, kRecorderHealthNames);
+    case Codes::kRecorderProblem:
+      return codes_text(kRecorderProblemCodes, kRecorderProblemNames);
   }
   return "";
 }
@@ -393,6 +410,14 @@ void fill(const StatusSnapshot& s, std::uint64_t alarm_events, Image& out) {
                       std::clamp(static_cast<double>(a.effective_members), 0.0, 655.0) * 100.0))
                 : kNone);
   }
+  const RecorderStatus& recorder = s.recorder;
+  put16(r, reg::kRecorderHealth,
+        recorder.present ? kRecorderHealthCodes.code(recorder.health) : kNone);
+  put16(r, reg::kRecorderProblem,
+        recorder.present ? kRecorderProblemCodes.code(recorder.problem) : kNone);
+  put32(r, reg::kCapturesWritten, recorder.captures_written);
+  put32(r, reg::kCapturesLost, recorder.captures_lost);
+  put32(r, reg::kCapturesTruncated, recorder.captures_truncated);
   for (int i = 0; i < discrete::kCount; ++i) {
     out.discrete_inputs[static_cast<std::size_t>(i)] = kAlarmLevelCodes.code(s.level) == i ? 1 : 0;
   }

@@ -17,19 +17,21 @@
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/regional_alert.h"
 #include "plinth/monitor/sensor_health.h"
+#include "recorder_status.h"
 #include "run_identity.h"
 #include "status_outputs.h"
 
 namespace plinth::firmware::modbus {
 
 inline constexpr std::uint16_t kNone = 0xFFFF;  // a register with no value (yet)
-inline constexpr std::uint16_t kMapVersion = 6;  // register 31; 2: holding registers, discrete
+inline constexpr std::uint16_t kMapVersion = 7;  // register 31; 2: holding registers, discrete
                                                  // inputs, causes 10-11, forecast, version;
                                                  // 3: the files' digests; 4 (issue 26's branch):
                                                  // regional alerts (86-101), cause 15; 5: two
                                                  // maps, cause 13 on issue 26's branch, the
                                                  // statue sensor (102-108, cause 14; 86-101
-                                                 // reserved) on main; 6: both, no gap
+                                                 // reserved) on main; 6: both, no gap; 7: the
+                                                 // event recorder's health (109-116)
 
 template <class Enum>
 struct Code {
@@ -115,6 +117,24 @@ inline constexpr CodeTable<monitor::RegionalRefusal, monitor::kRegionalRefusalCo
         {monitor::RegionalRefusal::kNoRoom, 9},
     }}};
 
+inline constexpr CodeTable<RecorderHealth, 3> kRecorderHealthCodes{{{
+    {RecorderHealth::kOk, 0},
+    {RecorderHealth::kDegraded, 1},
+    {RecorderHealth::kFailed, 2},
+}}};
+inline constexpr CodeTable<RecorderProblem, 10> kRecorderProblemCodes{{{
+    {RecorderProblem::kNone, 0},
+    {RecorderProblem::kFolderMissing, 1},
+    {RecorderProblem::kNotWritable, 2},
+    {RecorderProblem::kFolderInUse, 3},
+    {RecorderProblem::kLockFile, 4},
+    {RecorderProblem::kDiskFull, 5},
+    {RecorderProblem::kWriteError, 6},
+    {RecorderProblem::kNumberingExhausted, 7},
+    {RecorderProblem::kWriterBehind, 8},
+    {RecorderProblem::kTruncated, 9},
+}}};
+
 // Every value the domain names has exactly one code, and no two values share one.
 template <class Enum, std::size_t N, std::size_t M>
 [[nodiscard]] constexpr bool pins_every_value(const CodeTable<Enum, N>& table,
@@ -138,6 +158,8 @@ static_assert(pins_every_value(kPhaseCodes, kPhaseNames));
 static_assert(pins_every_value(kHealthStateCodes, monitor::kHealthStateNames));
 static_assert(pins_every_value(kAckOutcomeCodes, monitor::kAckOutcomeNames));
 static_assert(pins_every_value(kRegionalRefusalCodes, monitor::kRegionalRefusalNames));
+static_assert(pins_every_value(kRecorderHealthCodes, kRecorderHealthNames));
+static_assert(pins_every_value(kRecorderProblemCodes, kRecorderProblemNames));
 
 // Registers (functions 03 and 04 read the same values), 0-based addresses. 32-bit values: two
 // registers, the high word first; 64-bit values: four, the highest word first; text: two ASCII
@@ -208,7 +230,15 @@ inline constexpr int kStatueWeightsX = 105;
 inline constexpr int kStatueWeightsY = 106;
 inline constexpr int kStatueEffectiveMembersX = 107;
 inline constexpr int kStatueEffectiveMembersY = 108;
-inline constexpr int kCount = 109;
+// The event recorder (kNone in health and problem without --record-dir): its health
+// (kRecorderHealthCodes), why it failed or its latest loss (kRecorderProblemCodes), and its
+// captures written, lost and cut short (32 bits each).
+inline constexpr int kRecorderHealth = 109;
+inline constexpr int kRecorderProblem = 110;
+inline constexpr int kCapturesWritten = 111;
+inline constexpr int kCapturesLost = 113;
+inline constexpr int kCapturesTruncated = 115;
+inline constexpr int kCount = 117;
 }  // namespace reg
 
 // Discrete inputs (function 02): one per alarm level, 1 while that level is shown (exactly one
@@ -236,6 +266,8 @@ enum class Codes : std::uint8_t {
   kAxis,
   kStatueWeights,
   kRegionalRefusal,
+  kRecorderHealth,
+  kRecorderProblem,
 };
 
 // What the statue sensor's weights say of an axis (StatueAxisStatus), pinned like the others.
@@ -264,7 +296,7 @@ struct Point {
 };
 
 // The rows, in the CSV's order: registers, discrete inputs, coils, each by address.
-inline constexpr std::size_t kPointCount = 64;
+inline constexpr std::size_t kPointCount = 69;
 [[nodiscard]] const std::array<Point, kPointCount>& points();
 
 // The values the server answers with.

@@ -152,7 +152,7 @@ void sensor_bindings(std::vector<Binding>& b, const std::string& mounting,
 }
 
 // [statue_sensor] (its mounting, its streams' health) and [statue_filter] (the gyroscope's noise,
-// the weighing of the members, the accelerometer's sliding test): statue_sensor.h,
+// the weighing of the members, the accelerometer's sliding test, the corroboration): statue_sensor.h,
 // statue_filter.h. The table's presence configures the sensor (load_monitor_text).
 void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int& node) {
   b.push_back({"statue_sensor.node", integer_into(node), "an integer"});
@@ -189,6 +189,11 @@ void statue_bindings(std::vector<Binding>& b, StatueSensorSettings& statue, int&
       {"statue_filter.slide_filter_s", &f.slide_filter_s},
       {"statue_filter.slide_onset_s", &f.slide_onset_s},
       {"statue_filter.slide_end_s", &f.slide_end_s},
+      {"statue_filter.follow_tolerance", &f.follow_tolerance},
+      {"statue_filter.follow_onset_s", &f.follow_onset_s},
+      {"statue_filter.contradiction_rate_rad_s", &f.contradiction_rate_rad_s},
+      {"statue_filter.contradiction_s", &f.contradiction_s},
+      {"statue_filter.trust_again_s", &f.trust_again_s},
   };
   for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
   b.push_back({"statue_filter.slide_on_isolated_base", flag_into(f.slide_on_isolated_base),
@@ -262,10 +267,20 @@ void regional_bindings(std::vector<Binding>& b, monitor::RegionalAlertSettings& 
   for (const auto& [key, value] : numbers) b.push_back({key, number_into(*value), "a number"});
 }
 
+// A key read apart (read_sensors, read_pwave_predictor), which checks its value's type; its
+// binding's `expected` names that type for the messages about keys under it.
+std::function<bool(const toml::node&)> read_apart() {
+  return [](const toml::node&) { return true; };
+}
+constexpr const char* kSensorsExpected = "[[sensor]] tables (an array of tables)";
+constexpr const char* kPredictorExpected =
+    "an array of tables { window_s, ln_pga_over_pa, tau_c_exponent, sigma_ln } (plinth-eval "
+    "pwave-fit prints one)";
+
 // The [pwave] table's keys but its predictor (read_pwave_predictor); `channel` its name.
 void pwave_bindings(std::vector<Binding>& b, monitor::PWaveSettings& p, std::string& channel) {
   b.push_back({"pwave.channel", string_into(channel), "a string, \"vertical\" or \"horizontal\""});
-  b.push_back({"pwave.predictor", [](const toml::node&) { return true; }, ""});  // read apart
+  b.push_back({"pwave.predictor", read_apart(), kPredictorExpected});
   const std::pair<const char*, double*> numbers[] = {
       {"pwave.highpass_hz", &p.highpass_hz},
       {"pwave.lowpass_hz", &p.lowpass_hz},
@@ -293,6 +308,7 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::
   MonitorConfig& c = f.config;
   monitor::AlarmPolicySettings& alarm = c.alarm;
   std::vector<Binding> b = {
+      {"sensor", read_apart(), kSensorsExpected},
       {"monitor.ground_node", integer_into(node), "an integer"},
       {"monitor.quiet_risk", number_into(c.quiet_risk), "a number"},
       {"monitor.status_interval_s", number_into(c.status_interval_s), "a number"},
@@ -339,6 +355,8 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::
                "an integer from 0 (no limit) to 2^53"});
   b.push_back({"recorder.max_bytes", count_into(f.recorder.retention.max_bytes),
                "an integer from 0 (no limit) to 2^53"});
+  b.push_back({"recorder.bus_frames_hz", number_into(f.recorder.bus_frames_hz),
+               "a number (frames/s)"});
   b.push_back({"recorder.test_pause_mid_write_s", number_into(f.recorder.test_pause_mid_write_s),
                "a number (s; test only)"});
   output_bindings(b, f.modbus, f.mqtt);
@@ -491,7 +509,10 @@ SensorConfig read_sensor(const toml::table& table, int index, const MonitorConfi
 void read_sensors(const toml::node& list, MonitorConfig& config, KeyLines& lines) {
   const toml::array* tables = list.as_array();
   if (tables == nullptr || !tables->is_array_of_tables()) {
-    lines.fail("sensor", "sensor: expected [[sensor]] tables");
+    lines.fail("sensor", cat("sensor: expected ", kSensorsExpected, ", got ",
+                             tables != nullptr && tables->empty()
+                                 ? std::string_view("an empty array")
+                                 : host::toml_type_name(list.type())));
   }
   if (lines.has("monitor.ground_node")) {
     lines.fail("monitor.ground_node",
@@ -603,8 +624,8 @@ void read_pwave_predictor(const toml::node& node, monitor::PWaveSettings& pwave,
   const char* key = "pwave.predictor";
   const toml::array* points = node.as_array();
   if (points == nullptr || (!points->empty() && !points->is_array_of_tables())) {
-    lines.fail(key, cat(key, ": expected an array of tables { window_s, ln_pga_over_pa, "
-                             "tau_c_exponent, sigma_ln } (plinth-eval pwave-fit prints one)"));
+    lines.fail(key, cat(key, ": expected ", kPredictorExpected, ", got ",
+                        host::toml_type_name(node.type())));
   }
   if (points->empty() || points->size() > monitor::kMaxPWavePredictorPoints) {
     lines.fail(key, cat(key, ": must have 1 to ",
@@ -690,6 +711,9 @@ void read_pwave(const toml::node& table, monitor::PWaveSettings& pwave, const st
   pwave.fragility = built->fragility;
   *built = pwave;
 }
+
+// recorder.bus_frames_hz's bound: a classic CAN bus's most frames/s, with room.
+constexpr double kMaxRecorderBusFramesHz = 25000.0;
 
 std::string number_text(double value) {
   char text[32];
@@ -777,13 +801,11 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   std::vector<Binding> known =
       bindings(file, node, statue_node, unit, relay_active_low, pwave, pwave_channel);
   const toml::node* sensor_list = doc.get("sensor");
-  const bool sensor_tables = sensor_list != nullptr && sensor_list->is_array();
   std::vector<std::pair<std::string, const toml::node*>> leaves;
   flatten(doc, "", leaves);
   KeyLines lines(origin);
   for (const auto& [key, node_ptr] : leaves) {
     lines.note(key, node_ptr->source().begin.line);
-    if (key == "sensor" && sensor_tables) continue;
     lines.store(known, key, key, *node_ptr);
     if (!monitor::kRegionalAlertBuiltIn && regional_key(key)) {
       lines.fail(key, cat(key, ": ", monitor::kRegionalAlertNotBuilt));
@@ -813,10 +835,27 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
     lines.fail("recorder.test_pause_mid_write_s",
                "recorder.test_pause_mid_write_s: must be a number of seconds in [0, 600]");
   }
+  if (!std::isfinite(file.recorder.bus_frames_hz) || file.recorder.bus_frames_hz < 0.0 ||
+      file.recorder.bus_frames_hz > kMaxRecorderBusFramesHz) {
+    lines.fail("recorder.bus_frames_hz",
+               cat("recorder.bus_frames_hz: must be a number of frames/s in [0, ",
+                   number_text(kMaxRecorderBusFramesHz), "] (a CAN bus at 1 Mbit/s carries at "
+                   "most about 21,000 frames/s)"));
+  }
   if (const toml::node* table = doc.get("pwave")) read_pwave(*table, pwave, pwave_channel, file.config, lines);
   check(file.config, lines);
   check_outputs(file, lines, origin);
   return file;
+}
+
+double recorder_frame_rate_hz(const MonitorFile& file) {
+  const MonitorConfig& c = file.config;
+  const int sensors = std::max(c.sensor_count, 1);  // the single ground sensor: one
+  const int statue = c.statue_sensor.present ? 1 : 0;
+  const double frames_a_sample = sensors + 2.0 * statue;
+  const double heartbeats_hz = sensors + statue;
+  return kRecorderClockMargin * frames_a_sample * c.estimator.sample_rate_hz + heartbeats_hz +
+         file.recorder.bus_frames_hz;
 }
 
 MonitorFile load_monitor_file(const std::string& path, const MonitorConfig& defaults) {

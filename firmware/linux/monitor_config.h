@@ -19,6 +19,9 @@ namespace plinth::firmware {
 // [recorder]: the event recorder's folder (docs/monitor.md, "Event recorder").
 struct RecorderFileSettings {
   RetentionLimits retention;  // recorder.max_captures, recorder.max_bytes (0: no limit)
+  // recorder.bus_frames_hz: frames/s of the bus's other traffic (other boxes, other devices)
+  // the capture buffers hold besides the configured sensors' (recorder_frame_rate_hz).
+  double bus_frames_hz = 2000.0;
   // recorder.test_pause_mid_write_s, TEST ONLY (event_recorder.h); a box never sets it.
   double test_pause_mid_write_s = 0.0;
 };
@@ -32,6 +35,14 @@ struct MonitorFile {
   ModbusSettings modbus;          // [modbus]
   MqttSettings mqtt;              // [mqtt]
 };
+
+// Frames/s the event recorder's buffers are sized for (event_recorder.h): every configured
+// sensor's frames at the sample rate (a ground or plate sensor one a sample, the statue sensor
+// two: its acceleration and its rotation, with the single ground sensor three), with
+// kRecorderClockMargin for sensor clocks that run fast, one heartbeat a second each, and the
+// file's recorder.bus_frames_hz of other traffic.
+inline constexpr double kRecorderClockMargin = 1.25;
+[[nodiscard]] double recorder_frame_rate_hz(const MonitorFile& file);
 
 // Reads `path` over `defaults`. Throws host::InputError naming the file, the line and the key
 // for: a missing file, TOML syntax, unknown tables or keys, wrong types, and every value that

@@ -286,7 +286,9 @@ void MqttPublisher::take_mailbox(std::int64_t now_ns) {
   if (!mailbox_.take_status(s)) return;
   const bool changed = !have_state_ || s.level != state_sent_.level ||
                        s.latched != state_sent_.latched || s.cause != state_sent_.cause ||
-                       s.phase != state_sent_.phase || s.resets != state_sent_.resets;
+                       s.phase != state_sent_.phase || s.resets != state_sent_.resets ||
+                       s.recorder.health != state_sent_.recorder.health ||
+                       s.recorder.problem != state_sent_.recorder.problem;
   state_ = s;
   have_state_ = true;
   if (changed || now_ns - state_sent_ns_ >= ns_of(settings_.state_interval_s)) state_due_ = true;
@@ -636,6 +638,7 @@ std::string MqttPublisher::state_json() const {
       .raw("statue_sensor", statue_sensor_state(s, axes))
       .count("estimator_restarts", s.estimator_restarts)
       .raw("regional", regional_state_json(s.regional))
+      .raw("recorder", s.recorder.present ? recorder_status_json(s.recorder) : "null")
       .count("heartbeat", s.statuses)
       .count("events_dropped", events_dropped_ + mailbox_.events_dropped())
       .raw("version", JsonObject()

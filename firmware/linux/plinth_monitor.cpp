@@ -171,8 +171,13 @@ class Outputs {
     if (state_ != nullptr) save_state();
     if (u.status_due) {
       // The first status line says what runs: the version, the scene and box files' digests.
-      print_line(snapshot_.statuses == 0 ? fw::with_members(fw::status_json(s, t_origin_), identity)
-                                         : fw::status_json(s, t_origin_));
+      std::string line = fw::status_json(s, t_origin_);
+      if (snapshot_.statuses == 0) line = fw::with_members(line, identity);
+      if (recorder_ != nullptr) {
+        const std::string health = fw::recorder_status_json(recorder_->status());
+        line = fw::with_members(line, std::string("\"recorder\": ").append(health));
+      }
+      print_line(line);
       ++snapshot_.statuses;
     }
     if (trace != nullptr) trace->after_update(u, monitor_);
@@ -306,6 +311,7 @@ class Outputs {
   void post_snapshot(const fw::BoxStatus& status) {
     if (outputs_.empty()) return;
     fw::copy_status(status, t_origin_, snapshot_);
+    if (recorder_ != nullptr) snapshot_.recorder = recorder_->status();
     ++snapshot_.updates;
     snapshot_.wall_time_ns = fw::wall_clock_ns();
     snapshot_.uptime_ns = fw::monotonic_ns() - start_ns_;
@@ -410,14 +416,13 @@ void start_monitor(fw::Monitor& monitor, fw::FrameDecoder& decoder,
 
 std::unique_ptr<fw::EventRecorder> make_recorder(const Options& opt, const fw::MonitorFile& file,
                                                  const std::string& identity) {
-  const fw::MonitorConfig& config = file.config;
   if (opt.record_dir.empty()) return nullptr;
   fw::EventRecorderSettings rs;
   rs.directory = opt.record_dir;
   rs.interface_name = opt.can_interface.empty() ? "can0" : opt.can_interface;
   rs.pre_trigger_s = opt.pre_trigger;
   rs.post_trigger_s = opt.post_trigger;
-  rs.frame_rate_hz = 2.0 * config.estimator.sample_rate_hz + 100.0;
+  rs.frame_rate_hz = fw::recorder_frame_rate_hz(file);
   rs.retention = file.recorder.retention;
   rs.test_pause_mid_write_s = file.recorder.test_pause_mid_write_s;
   rs.identity_json = identity;
@@ -501,11 +506,11 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
   if (input.sink() != nullptr) t.bus_send_errors += monitor.frames_not_encoded();
   if (recorder != nullptr) {
     t.recorder = true;
-    t.captures_written = recorder->captures_written();
+    t.recorder_status = recorder->status();
     t.captures_dropped = recorder->captures_dropped();
     t.recorder_write_errors = recorder->write_errors();
-    t.captures_deleted = recorder->captures_deleted();
-    t.recorder_first_index = static_cast<std::uint64_t>(recorder->first_index());
+    t.frames_lost = recorder->frames_lost();
+    t.recorder_first_index = recorder->first_index();
     t.partial_files_removed = static_cast<std::uint64_t>(recorder->partial_files_removed());
   }
   return t;

@@ -303,6 +303,17 @@ std::string collapse_json(const CollapseRecord& c) {
       .close();
 }
 
+std::string recorder_status_json(const RecorderStatus& r) {
+  return JsonObject()
+      .text("health", kRecorderHealthNames.name(r.health))
+      .text("problem", kRecorderProblemNames.name(r.problem))
+      .count("captures_written", r.captures_written)
+      .count("captures_lost", r.captures_lost)
+      .count("captures_truncated", r.captures_truncated)
+      .count("captures_deleted", r.captures_deleted)
+      .close();
+}
+
 std::string pwave_status_json(const monitor::PWaveStatus& p, std::int64_t start_ns,
                               double t_origin) {
   JsonObject out;
@@ -439,13 +450,19 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
                                   .close());
   }
   if (totals.recorder) {
+    const RecorderStatus& r = totals.recorder_status;
     line.raw("recorder", JsonObject()
-                             .count("captures_written", totals.captures_written)
+                             .count("captures_written", r.captures_written)
                              .count("captures_dropped", totals.captures_dropped)
                              .count("write_errors", totals.recorder_write_errors)
-                             .count("captures_deleted", totals.captures_deleted)
+                             .count("captures_deleted", r.captures_deleted)
                              .count("first_index", totals.recorder_first_index)
                              .count("partial_files_removed", totals.partial_files_removed)
+                             .text("health", kRecorderHealthNames.name(r.health))
+                             .text("problem", kRecorderProblemNames.name(r.problem))
+                             .count("captures_lost", r.captures_lost)
+                             .count("captures_truncated", r.captures_truncated)
+                             .count("frames_lost", totals.frames_lost)
                              .close());
   }
   for (const auto& [key, json] : totals.outputs) line.raw(key, json);

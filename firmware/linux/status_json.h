@@ -13,6 +13,7 @@
 #include "plinth/firmware/monitor.h"
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
+#include "recorder_status.h"
 
 namespace plinth::firmware {
 
@@ -43,6 +44,11 @@ class JsonObject {
 [[nodiscard]] std::string statue_weights_json(const StatueAxisStatus& axis);
 // A held collapse (BoxStatus::collapse): its axis, phase, corner, whether it was restored.
 [[nodiscard]] std::string collapse_json(const CollapseRecord& collapse);
+
+// The event recorder's health: {"health": "ok", "problem": "none", "captures_written": ..,
+// "captures_lost": .., "captures_truncated": .., "captures_deleted": ..} (the status line's
+// "recorder", after the monitor's members; the MQTT state's).
+[[nodiscard]] std::string recorder_status_json(const RecorderStatus& recorder);
 
 // {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
 [[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);
@@ -83,10 +89,10 @@ struct RunTotals {
   // summary then says "alarm": "fault" with this "input_fault".
   std::string input_fault;
   bool recorder = false;                 // the event recorder ran: its counters follow
-  std::uint64_t captures_written = 0;
-  std::uint64_t captures_dropped = 0;
-  std::uint64_t recorder_write_errors = 0;
-  std::uint64_t captures_deleted = 0;       // by the retention limit
+  RecorderStatus recorder_status;        // its health at the end, written, lost, cut, deleted
+  std::uint64_t captures_dropped = 0;    // triggers that found both buffers busy
+  std::uint64_t recorder_write_errors = 0;  // captures the writer could not write
+  std::uint64_t frames_lost = 0;            // frames of capture windows no capture holds
   std::uint64_t recorder_first_index = 0;   // this run's first capture number
   std::uint64_t partial_files_removed = 0;  // left by a process killed while writing
   // Members written already, after the others: the outputs' counters ("modbus": {...}, ...).

@@ -17,6 +17,7 @@
 #include "plinth/monitor/alarm_level.h"
 #include "plinth/monitor/alarm_policy.h"
 #include "plinth/monitor/sensor_health.h"
+#include "recorder_status.h"
 
 namespace plinth::firmware {
 
@@ -79,6 +80,7 @@ struct StatusSnapshot {
   std::uint64_t commands = 0;  // operator commands the loop carried out
   std::uint64_t resets = 0;
   RegionalSnapshot regional;
+  RecorderStatus recorder;  // the event recorder's health (present: --record-dir)
 };
 
 // One alarm event as the JSON alarm line writes it.

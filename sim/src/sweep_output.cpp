@@ -57,6 +57,18 @@ std::vector<std::string> resumable_rows(const std::string& path,
   }
   const std::string difference =
       plinth::host::settings_difference(table.settings, "the file", plan.settings, "this run");
+  const std::vector<const plinth::host::AddedColumn*> added =
+      plinth::host::columns_added_since(table);
+  if (difference.empty() && table.header != plan.header && !added.empty()) {
+    // The same sweep by an older plinth-sweep: said so, with why its rows cannot be reused.
+    const std::string kept = set_aside(path);
+    std::fprintf(stderr,
+                 "plinth-sweep: note: %s was %s; not resumed, as %s: its %zu row(s) are kept "
+                 "as %s\n",
+                 path.c_str(), plinth::host::older_version_text(added).c_str(), added.front()->why,
+                 table.rows.size(), kept.c_str());
+    return none;
+  }
   if (!difference.empty() || table.header != plan.header) {
     const std::string kept = set_aside(path);
     std::fprintf(stderr,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -224,6 +225,12 @@ bool ground_curves(Script& s, const Columns& c, const std::vector<GroundCurve>& 
   return drawn;
 }
 
+// A column an older plinth-sweep did not write (sweep_table.h, kAddedColumns).
+bool added_later(const std::string& name) {
+  return std::any_of(plinth::host::kAddedColumns.begin(), plinth::host::kAddedColumns.end(),
+                     [&](const plinth::host::AddedColumn& a) { return name == a.name; });
+}
+
 void common_setup(Script& s, const std::string& title) {
   s.line("set title " + quoted(title));
   s.line("set grid lc rgb '#d0d0d0'");
@@ -258,6 +265,7 @@ void thresholds_plot(Script& s, const Columns& c,
   std::vector<std::string> curves;
   for (std::size_t e = 0; e < plinth::host::kSweepEventCount; ++e) {
     const std::string name = plinth::host::kSweepEventNames.entries[e].name;  // the CSV's order
+    if (!has_column(c, name) && added_later(name)) continue;  // an older file: not searched
     const auto points = c.curve(c.index(name));
     if (points.empty()) continue;  // not up to pga_max anywhere: no entry in the key
     s.block(name, points);
@@ -508,6 +516,12 @@ std::string gnuplot_script(const SweepTable& table, const std::string& stem) {
 
 std::string plot_sweep(const SweepTable& table, const std::string& plot_path) {
   (void)find_gnuplot();
+  const std::vector<const plinth::host::AddedColumn*> added =
+      plinth::host::columns_added_since(table);
+  if (!added.empty()) {
+    std::fprintf(stderr, "plinth-sweep: note: the CSV was %s; plotted without it: %s\n",
+                 plinth::host::older_version_text(added).c_str(), added.front()->why);
+  }
   const std::string stem = plot_stem(plot_path);
   const std::string script_path = stem + ".gp";
   {

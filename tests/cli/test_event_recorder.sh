@@ -11,61 +11,8 @@
 set -u
 monitor=${1:?usage: $0 PLINTH_MONITOR SOURCE_DIR}
 src=${2:?usage: $0 PLINTH_MONITOR SOURCE_DIR}
-# shellcheck source=tests/cli/checks.sh
-source "$src/tests/cli/checks.sh"
-tmp=$(mktemp -d)
-pids=()
-cleanup() {
-  for pid in "${pids[@]}"; do kill -9 "$pid" 2>/dev/null; done
-  rm -rf "$tmp"
-}
-trap cleanup EXIT
-scene=$src/sim/scenes/paper-eccentric.toml
-record=$src/sim/data/records/friuli1976-09-15_buia_000.AT2
-replay=(--scene "$scene" --replay "$record" --scale 6.5 --pre-trigger 5 --post-trigger 2
-        --no-events --status-interval 1)
-
-# run DIR [ARGS...]: one replay recording into DIR; its JSON lines in $tmp/out.jsonl.
-run() {
-  local dir=$1
-  shift
-  "$monitor" "${replay[@]}" --record-dir "$dir" "$@" >"$tmp/out.jsonl" 2>"$tmp/err"
-}
-# json FILE EXPR: a Python expression over the JSON document `d` of FILE (one object), or over
-# the JSON lines `lines` of FILE (status lines `status`, the summary `summary`).
-json() {
-  python3 - "$1" "$2" <<'PY'
-import json, sys
-text = open(sys.argv[1]).read()
-try:
-    d = json.loads(text)
-except ValueError:
-    d = None
-lines = [json.loads(l) for l in text.splitlines() if l.startswith("{")]
-status = [l for l in lines if l.get("type") == "status"]
-summary = next((l for l in lines if l.get("type") == "summary"), {})
-print(eval(sys.argv[2]))
-PY
-}
-# whole DIR: every capture under a final name is complete (its log has the frames its JSON
-# counts, the JSON parses); prints what is not.
-whole() {
-  python3 - "$1" <<'PY'
-import glob, json, os, sys
-for j in sorted(glob.glob(os.path.join(sys.argv[1], "event-*.json"))):
-    log = j[:-5] + ".log"
-    try:
-        d = json.load(open(j))
-    except ValueError as e:
-        print("%s: %s" % (j, e)); continue
-    lines = sum(1 for _ in open(log)) if os.path.exists(log) else -1
-    if lines != d["frames"]:
-        print("%s: %d lines, its JSON says %d frames" % (log, lines, d["frames"]))
-for log in sorted(glob.glob(os.path.join(sys.argv[1], "event-*.log"))):
-    if not os.path.exists(log[:-4] + ".json"):
-        print("%s without its JSON" % log)
-PY
-}
+# shellcheck source=tests/cli/recorder_checks.sh
+source "$src/tests/cli/recorder_checks.sh"
 
 # 1. What runs, named: the build's version and the files' SHA-256.
 box=$tmp/box.toml
@@ -106,7 +53,7 @@ rm "$dir/event-041.json" "$dir/event-042."*
 # 3. SIGKILL while a capture is being written: the writer is held halfway through the log
 #    (recorder.test_pause_mid_write_s), the process killed there.
 printf '[recorder]\ntest_pause_mid_write_s = 60\n' >"$tmp/pause.toml"
-"$monitor" "${replay[@]}" --record-dir "$dir" --config "$tmp/pause.toml" \
+"$monitor" "${replay[@]}" --pre-trigger 5 --post-trigger 2 --record-dir "$dir" --config "$tmp/pause.toml" \
   >"$tmp/killed.jsonl" 2>"$tmp/killed.err" &
 pid=$!
 pids+=("$pid")
@@ -135,7 +82,7 @@ check "next start: the partial file removed, capture 3 written" $? "$got; $(ls -
 # SIGKILL at other moments (random, 0-0.6 s into the run): whatever is under a final name is
 # whole.
 for ((k = 0; k < 6; k++)); do
-  "$monitor" "${replay[@]}" --record-dir "$dir" >/dev/null 2>&1 &
+  "$monitor" "${replay[@]}" --pre-trigger 5 --post-trigger 2 --record-dir "$dir" >/dev/null 2>&1 &
   pid=$!
   sleep "0.$((RANDOM % 6))$((RANDOM % 10))"
   kill -9 "$pid" 2>/dev/null
@@ -160,7 +107,6 @@ for i in 1 2 3 4; do
   [ $((i % 2)) -eq 0 ] && level=warning
   fake "$dir/event-001" "$ret/event-00$i" "$level"
 done
-listing() { (cd "$1" && ls event-*.json 2>/dev/null | sed 's/event-0*\([0-9]*\).json/\1/' | tr '\n' ' '); }
 # limited NAME KEY=VALUE EXPECTED: a run with the retention limit [recorder] KEY=VALUE leaves the
 # captures EXPECTED ("1 3 5 ").
 limited() {

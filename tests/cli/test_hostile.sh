@@ -455,6 +455,20 @@ expect_failure "monitor: a number where a table belongs" \
   --scene "$ISOLATED" --replay "$AT2" --config wrong-type.toml
 expect_failure "monitor: a number for a whole table" 'wrong-table.toml:1: monitor: expected a table' \
   -- --scene "$ISOLATED" --replay "$AT2" --config wrong-table.toml
+# Issue 33: the same for the [[sensor]] tables, read apart; a candump line without its
+# interface is said to lack it, not to have a long one.
+printf 'sensor = 3\n' >sensor-number.toml
+printf '[sensor]\nnode = 1\n' >sensor-table.toml
+printf '(1.000000) 301#0011223344556677\n' >no-interface.log
+expect_failure "monitor: a number for the [[sensor]] tables" \
+  'sensor-number.toml:1: sensor: expected \[\[sensor\]\] tables \(an array of tables\), got an integer' \
+  -- --scene "$ISOLATED" --replay "$AT2" --config sensor-number.toml
+expect_failure "monitor: one [sensor] table for the [[sensor]] tables" \
+  'sensor: expected \[\[sensor\]\] tables \(an array of tables\), got a table' \
+  -- --scene "$ISOLATED" --replay "$AT2" --config sensor-table.toml
+expect_failure "monitor: a candump line without its interface" \
+  "no-interface.log:1: no interface name between the timestamp and the frame '301#0011223344556677'" \
+  -- --scene "$ISOLATED" --replay no-interface.log
 BIN=$SIM
 expect_failure "sim: a string for a number" 'gravity: expected a number, got a string' -- \
   --scene wrong-gravity.toml --record "$AT2"

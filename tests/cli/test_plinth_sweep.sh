@@ -125,6 +125,23 @@ sweep "${SMALL[@]}" --out notsweep.csv
 check "a file that is not a sweep CSV says so and is kept" \
   grep -q "notsweep.csv:1: not a plinth-sweep CSV.*not resumed: it is kept as notsweep.csv.kept" "$TMP/err.txt"
 check "unchanged" grep -qx 'not a sweep' notsweep.csv.kept
+# A file an older plinth-sweep wrote, before the lift_off column (whole.csv without it): not
+# resumed, its version named; its own shards merge; a shard of it and one of this version do
+# not, the older named; it plots without that column's curve, saying why (below, with gnuplot).
+awk 'NR == 1 { print; next } { sub(/,[^,]*$/, ""); print }' whole.csv >older.csv
+cp older.csv olderrun.csv
+sweep "${SMALL[@]}" --out olderrun.csv
+check "an older plinth-sweep's file is not resumed, its version named" \
+  grep -q "olderrun.csv was written by a plinth-sweep older than its lift_off column (plinth 0.1.0 from commit 4a3615a of 2026-11-28, when lift-off began to end a run); not resumed, as its runs went on past lift-off, where this version's end: its 4 row(s) are kept as olderrun.csv.kept" "$TMP/err.txt"
+check "and the run writes its own" cmp -s olderrun.csv whole.csv
+head -n 4 older.csv >older1.csv
+{ head -n 2 older.csv; tail -n 2 older.csv; } >older2.csv
+{ head -n 2 whole.csv; tail -n 2 whole.csv; } >newer2.csv
+sweep merge older1.csv older2.csv --out oldermerged.csv
+check "an older sweep's shards still merge" cmp -s oldermerged.csv older.csv
+refuses "an older shard and one of this version do not, the older named" \
+  "merge: newer2.csv and older1.csv have different headers \(older1.csv was written by a plinth-sweep older than its lift_off column" \
+  merge older1.csv newer2.csv --out mixed.csv
 sed '3s/^0\.2,/0.25,/' whole.csv >offgrid.csv
 cp offgrid.csv offgrid.orig
 refuses "a row off the grid stops the run, naming it" "offgrid.csv: row '0.25' is not a point of this sweep's grid" \
@@ -262,6 +279,10 @@ if command -v gnuplot >/dev/null 2>&1; then
   check "cmpmap2: the ground's map beside the scene's" grep -q "set multiplot layout 1,2" plot-cmpmap2.gp
   check "cmpmap2: its SVG has both panels" grep -q "on the ground" plot-cmpmap2.svg
   check "cmpicurve: the ground's overturning on the axis" grep -q "overturned_ground using 1:2 with points" plot-cmpicurve.gp
+  sweep plot older.csv --out plot-older.png
+  check "an older plinth-sweep's file plots" test "$RC" -eq 0 -a -s plot-older.png -a -s plot-older.svg
+  check "without the lift_off curve, saying why" \
+    grep -q "the CSV was written by a plinth-sweep older than its lift_off column .*; plotted without it: its runs went on past lift-off" "$TMP/err.txt"
   bash "$SRC/tools/plot-sweep.sh" whole.csv wrapped.png >"$TMP/out.txt" 2>"$TMP/err.txt"
   RC=$?
   check "tools/plot-sweep.sh plots a CSV" test "$RC" -eq 0 -a -s wrapped.png -a -s wrapped.svg

@@ -142,6 +142,20 @@ def main():
             else:  # statue_rate_health, statue_acceleration_health
                 stream = name[len("statue_"):-len("_health")]
                 expected = codes(row)[sensor[stream]["health"]]
+        elif name.startswith(("recorder_", "captures_")):
+            # The event recorder's: none (counts 0) without one; its health and problem as the
+            # status line's; its counts only count up, from that line's to the summary's.
+            recorder = status.get("recorder")
+            if recorder is None:
+                expected = 0 if name.startswith("captures_") else int(row["none"])
+            elif name.startswith("captures_"):
+                total = summary["recorder"][name]
+                if not recorder[name] <= value <= total:
+                    fail(row, "%d, not between the status line's %d and the summary's %d" % (
+                        value, recorder[name], total))
+                continue
+            else:
+                expected = codes(row)[recorder[name[len("recorder_"):]]]
         elif name.endswith("_given"):  # 1 while the digest that follows is the file's
             expected = 1 if name[:-len("given")] + "sha256" in first_status else 0
         elif name == "collapse_in":
@@ -173,7 +187,7 @@ def main():
         elif name == "alarm_events":
             expected = len(alarms)
         elif name == "map_version":
-            expected = 6  # map 6: regional 86-101 and statue 102-108
+            expected = 7  # map 7: regional 86-101, statue 102-108, recorder 109-116
         elif name == "forecast_axis":  # one axis: x once a forecast ran
             expected = 0 if status["collapse_forecast_t"] is not None else value
         elif name == "forecast_worst_member":  # one member: member 0 is the first to collapse

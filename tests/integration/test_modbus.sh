@@ -70,13 +70,14 @@ status_count() { grep -c '"type": "status"' "$TMP/box.out"; }
 #    alarm latched, risk 1, for the record's last 24 s, 12 s at --speed 2: time for the reads below
 #    even on a loaded machine), three clients polling at once, a coil write refused. A box file
 #    that sets a statue sensor that never sends (registers 102-108: its streams at fault, not
-#    measured): its digest in registers 81-85.
+#    measured): its digest in registers 81-85. The event recorder on (registers 109-116).
 PORT=$(free_port)
 printf '# monitor_modbus: the Modbus server from the command line\n[statue_sensor]\nnode = 2\n' \
   >"$TMP/run1.toml"
 STARTED=$(date +%s.%N)
 "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
-  --modbus "127.0.0.1:$PORT" --config "$TMP/run1.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
+  --modbus "127.0.0.1:$PORT" --config "$TMP/run1.toml" --record-dir "$TMP/captures" \
+  >"$TMP/box.out" 2>"$TMP/box.err" &
 BOX=$!
 if ! wait_listening "$PORT"; then
   fail "modbus: the server answers" "no answer on port $PORT; stderr: $(head -c 300 "$TMP/box.err")"

@@ -109,7 +109,8 @@ restart_replay() {
     local watcher=$!
     sleep 1
     "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
-      --config "$TMP/box.toml" >"$TMP/box.out" 2>"$TMP/box.err" &
+      --config "$TMP/box.toml" --record-dir "$TMP/captures-$box" >"$TMP/box.out" \
+      2>"$TMP/box.err" &
     BOX=$!
     local happened=1
     if wait_for "$TMP/events.out" '"level": "normal"' 30; then
@@ -184,6 +185,9 @@ assert state["box"] == "b1" and state["level"] == status["alarm"] == "alarm", st
 assert state["latched"] == "alarm" and state["cause"] == alarm["cause"], (state, alarm)
 assert state["phase"] == {"x": status["phase"]} and state["risk"] == status["risk"], state
 assert state["time"].endswith("Z") and abs(state["t"] - status["t"]) < 0.2, state
+recorder = state["recorder"]  # the event recorder's health, as the status lines'
+assert (recorder["health"], recorder["problem"]) == ("ok", "none"), state
+assert set(recorder) == set(status["recorder"]), (recorder, status["recorder"])
 PY
 )
 if [[ -z "$problem" ]]; then pass "mqtt: the retained state is the last status; offline after a clean stop"

@@ -15,9 +15,10 @@ namespace {
 #define PLINTH_TEXT(x) PLINTH_TEXT_OF(x)
 
 // The settings of a cross-check window: window_s at the sample rate in [2, max] samples, and a
-// finite positive tolerance.
+// finite positive tolerance of at most `max_tolerance_m_s2`.
 Error validate_check(double window_s, double tolerance_m_s2, double rate_hz,
-                     const char* window_field, const char* tolerance_field) {
+                     const char* window_field, const char* tolerance_field,
+                     double max_tolerance_m_s2) {
   const double samples = window_s * rate_hz;
   if (!std::isfinite(window_s) || samples < 2.0 ||
       samples > static_cast<double>(kMaxCheckWindowSamples)) {
@@ -27,6 +28,10 @@ Error validate_check(double window_s, double tolerance_m_s2, double rate_hz,
   }
   if (!std::isfinite(tolerance_m_s2) || tolerance_m_s2 <= 0.0) {
     return {ErrorCode::kOutOfRange, tolerance_field, "must be a positive acceleration, m/s2"};
+  }
+  if (tolerance_m_s2 > max_tolerance_m_s2) {
+    return {ErrorCode::kOutOfRange, tolerance_field, "is beyond its largest, m/s2",
+            max_tolerance_m_s2};
   }
   return ok_error();
 }
@@ -166,11 +171,14 @@ Error validate(const MonitorConfig& c, int* sensor_index) {
     return {ErrorCode::kOutOfRange, "estimator.sample_rate_hz", "must lie in [100, 1000] Hz"};
   }
   PLINTH_TRY(validate(c.forecast, c.estimator.sample_rate_hz));
+  // Ground sensors whose RMS difference stays below the tolerance are not followed to the worse
+  // reading (docs/safety.md): beyond 2 m/s2 (0.2 g) a sensor turned on a strong quake's ground
+  // would not count as disagreeing.
   PLINTH_TRY(validate_check(c.redundancy.window_s, c.redundancy.tolerance_m_s2,
                             c.estimator.sample_rate_hz, "redundancy.window_s",
-                            "redundancy.tolerance_m_s2"));
+                            "redundancy.tolerance_m_s2", kMaxDisagreementToleranceM_S2));
   PLINTH_TRY(validate_check(c.plate.window_s, c.plate.threshold_m_s2, c.estimator.sample_rate_hz,
-                            "plate.window_s", "plate.threshold_m_s2"));
+                            "plate.window_s", "plate.threshold_m_s2", kMaxPlateThresholdM_S2));
   PLINTH_TRY(validate_pwave(c));
   PLINTH_TRY(validate_sensors(c, sensor_index));
   return validate_statue_sensor(c);

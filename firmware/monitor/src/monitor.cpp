@@ -644,6 +644,7 @@ void Monitor::restart_estimators() {
       room().measured[k] = false;
     }
   }
+  for (OtherReading& other : others_) other.running = false;  // again on their next samples
   if (monitor::PWaveStage* stage = pwave_stage()) stage->restart();
   ++status_.estimator_restarts;
   status_.estimator_start_ns = status_.time_ns;

@@ -221,10 +221,22 @@ std::string parse_candump_line(std::string_view line, CandumpLine& out) {
   if (timestamp.front() != '(') {
     return join({"expected a line '(seconds.microseconds) interface id#data', got ", quoted(line)});
   }
+  const std::size_t close = timestamp.find(')');
+  if (close != std::string_view::npos && close + 1 < timestamp.size()) {
+    return join({"no space after the timestamp ", quoted(timestamp.substr(0, close + 1)),
+                 " in ", quoted(line)});
+  }
   std::string problem = parse_timestamp(timestamp, out.timestamp_ns);
   if (!problem.empty()) return problem;
   const std::string_view interface_name = next_token(rest);
   if (interface_name.empty()) return "missing the interface name after the timestamp";
+  // "(t) 301#00": the frame where the interface name belongs (a '#' in the next token, if any,
+  // says that one is the frame and this an odd interface name).
+  if (interface_name.find('#') != std::string_view::npos &&
+      std::string_view(rest).find('#') == std::string_view::npos) {
+    return join({"no interface name between the timestamp and the frame ",
+                 quoted(interface_name), " (candump -l writes '(seconds) interface id#data')"});
+  }
   if (interface_name.size() > kCandumpMaxInterfaceLength) {
     return join({"interface name ", quoted(interface_name), " is longer than 15 characters"});
   }

@@ -411,6 +411,34 @@ std::vector<std::string> place_rows(const std::vector<std::string>& rows,
   return placed;
 }
 
+std::vector<const AddedColumn*> columns_added_since(const SweepTable& table) {
+  std::vector<const AddedColumn*> missing;
+  std::string mode;
+  try {
+    mode = parse_settings(table.settings, "")["mode"];
+  } catch (const InputError&) {
+    return missing;  // not a plinth-sweep file: nothing to say of its version
+  }
+  const std::vector<std::string> header = csv_fields(table.header);
+  for (const AddedColumn& column : kAddedColumns) {
+    const bool of_mode = std::find(column.modes.begin(), column.modes.end(), mode) !=
+                         column.modes.end();
+    if (of_mode && std::find(header.begin(), header.end(), column.name) == header.end()) {
+      missing.push_back(&column);
+    }
+  }
+  return missing;
+}
+
+std::string older_version_text(const std::vector<const AddedColumn*>& missing) {
+  std::string text;
+  for (const AddedColumn* column : missing) {
+    text += text.empty() ? "written by a plinth-sweep older than its " : "; and its ";
+    text += std::string(column->name) + " column (" + column->since + ")";
+  }
+  return text;
+}
+
 SweepTable merge_sweep_tables(const std::vector<SweepTable>& parts,
                               const std::vector<std::string>& names) {
   if (parts.empty()) throw InputError("merge: no input files");
@@ -425,7 +453,14 @@ SweepTable merge_sweep_tables(const std::vector<SweepTable>& parts,
                        parts[p].settings + "\n  " + first.settings);
     }
     if (parts[p].header != first.header) {
-      throw InputError("merge: " + names[p] + " and " + names[0] + " have different headers");
+      // One of them an older plinth-sweep's: named, with the version that added the column.
+      std::string older;
+      for (const std::size_t q : {p, std::size_t{0}}) {
+        const std::string text = older_version_text(columns_added_since(parts[q]));
+        if (!text.empty()) older = " (" + names[q] + " was " + text + "; run its shard again)";
+      }
+      throw InputError("merge: " + names[p] + " and " + names[0] + " have different headers" +
+                       older);
     }
   }
   const std::vector<std::string> keys = grid_keys(parse_grid(first.settings, names[0]));

@@ -28,7 +28,8 @@ TEST(ModbusMap, TheShippedCsvIsTheCodesMap) {
 TEST(ModbusMap, EveryCauseHasItsCodeInTheCsv) {
   const std::string csv = map_csv();
   EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model;13=p_wave;"
-                     "14=statue_unexplained;15=regional_alert\""),
+                     "14=statue_unexplained;15=regional_alert;16=statue_sensor_fault;"
+                     "17=restored;18=statue_stands\""),
             std::string::npos);
   EXPECT_NE(csv.find("4=overturned;5=fell;6=lifted_off\""), std::string::npos);
   EXPECT_NE(csv.find("\"0=normal;1=advisory;2=warning;3=alarm;4=fault\""), std::string::npos);
@@ -94,7 +95,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 6);
+  EXPECT_EQ(at(reg::kMapVersion), 7);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";
@@ -115,7 +116,6 @@ TEST(ModbusMap, TheStatueSensorsRegisters) {
     EXPECT_EQ(at(r), kNone) << r;
   }
   EXPECT_EQ(reg::kStatueRateHealth, 102) << "after 86-101, the regional alerts'";
-  EXPECT_EQ(reg::kCount, 109);
   s.has_statue_sensor = true;
   s.axis_count = 1;
   s.statue_rate = monitor::HealthState::kOk;
@@ -151,6 +151,38 @@ TEST(ModbusMap, TheStatueSensorsRegisters) {
     for (int r = p.address; r < p.address + p.words; ++r) ++owners[static_cast<std::size_t>(r)];
   }
   for (int r = 0; r < reg::kCount; ++r) EXPECT_EQ(owners[static_cast<std::size_t>(r)], 1) << r;
+}
+
+// The event recorder's registers (109-116, map 7): kNone in health and problem without one
+// (--record-dir), else their pinned codes and the counts.
+TEST(ModbusMap, TheRecordersRegisters) {
+  StatusSnapshot s;
+  Image image;
+  fill(s, 0, image);
+  const auto at = [&](int address) { return image.registers[static_cast<std::size_t>(address)]; };
+  EXPECT_EQ(reg::kRecorderHealth, reg::kStatueEffectiveMembersY + 1);
+  EXPECT_EQ(reg::kCount, 117);
+  EXPECT_EQ(at(reg::kRecorderHealth), kNone);
+  EXPECT_EQ(at(reg::kRecorderProblem), kNone);
+  EXPECT_EQ(read32(image, reg::kCapturesWritten), 0U);
+  s.recorder.present = true;
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kRecorderHealth), 0) << "ok";
+  EXPECT_EQ(at(reg::kRecorderProblem), 0) << "none";
+  s.recorder.health = RecorderHealth::kFailed;
+  s.recorder.problem = RecorderProblem::kDiskFull;
+  s.recorder.captures_written = 3;
+  s.recorder.captures_lost = 0x10002;
+  s.recorder.captures_truncated = 1;
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kRecorderHealth), 2);
+  EXPECT_EQ(at(reg::kRecorderProblem), 5);
+  EXPECT_EQ(read32(image, reg::kCapturesWritten), 3U);
+  EXPECT_EQ(read32(image, reg::kCapturesLost), 0x10002U);
+  EXPECT_EQ(read32(image, reg::kCapturesTruncated), 1U);
+  EXPECT_EQ(kRecorderHealthCodes.code(RecorderHealth::kDegraded), 1);
+  EXPECT_EQ(kRecorderProblemCodes.code(RecorderProblem::kFolderInUse), 3);
+  EXPECT_EQ(kRecorderProblemCodes.code(RecorderProblem::kTruncated), 9);
 }
 
 std::uint64_t read64(const Image& image, int address) {

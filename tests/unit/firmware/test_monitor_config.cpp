@@ -246,11 +246,18 @@ TEST(MonitorConfigFile, TheStatueSensorsTables) {
             "/etc/plinth/box.toml:3: statue_sensor.health.max_bridge_samples: expected an "
             "integer");
   EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\nmemory_s = 0\n")
-                .rfind("/etc/plinth/box.toml:4: statue_filter.memory_s: must be finite and > 0",
+                .rfind("/etc/plinth/box.toml:4: statue_filter.memory_s: must lie in [1, 600] s",
                        0),
             0U);
   EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\nslide_tolerance = 1\n"),
-            "/etc/plinth/box.toml:4: statue_filter.slide_tolerance: must lie in [0, 1)");
+            "/etc/plinth/box.toml:4: statue_filter.slide_tolerance: must lie in [0, 0.5]");
+  // The keys that decide how far the sensor may lower the risk: bounded, the key named
+  // (docs/statue-filter.md, "Bounds").
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\n"
+                           "unexplained_score = 1e300\n"),
+            "/etc/plinth/box.toml:4: statue_filter.unexplained_score: must lie in [2, 50]");
+  EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\nrest_rate_rad_s = 100\n"),
+            "/etc/plinth/box.toml:4: statue_filter.rest_rate_rad_s: must lie in (0, 0.05] rad/s");
   EXPECT_EQ(box_file_error("[statue_sensor]\nnode = 2\n[statue_filter]\n"
                            "slide_on_isolated_base = 1\n"),
             "/etc/plinth/box.toml:4: statue_filter.slide_on_isolated_base: expected true or false");
@@ -331,6 +338,54 @@ TEST(MonitorConfigFile, EveryKeyOfTheWrongTypeIsSaidToBeOne) {
     EXPECT_NE(message.find(t + ": expected a table"), std::string::npos) << message;
   }
   EXPECT_GT(tables.size(), 12U);
+}
+
+// Issue 33: the recorder's buffers hold every configured sensor's frames (the statue sensor's
+// two a sample beside the ground sensor's) and recorder.bus_frames_hz of other traffic.
+TEST(MonitorConfigFile, TheRecordersFrameRateCountsEverySensor) {
+  MonitorFile file = load_monitor_text("[estimator]\nsample_rate_hz = 200.0\n", "box.toml",
+                                       MonitorConfig{});
+  EXPECT_DOUBLE_EQ(recorder_frame_rate_hz(file), 1.25 * 200 + 1 + 2000);
+  file = load_monitor_text(
+      "[estimator]\nsample_rate_hz = 200.0\n[statue_sensor]\nnode = 2\n[recorder]\n"
+      "bus_frames_hz = 0\n",
+      "box.toml", MonitorConfig{});
+  EXPECT_DOUBLE_EQ(recorder_frame_rate_hz(file), 1.25 * 3 * 200 + 2) << "three frames a sample";
+  file = load_monitor_text(
+      "[estimator]\nsample_rate_hz = 1000.0\n[[sensor]]\nnode = 1\n[[sensor]]\nnode = 3\n"
+      "role = \"plate\"\n[recorder]\nbus_frames_hz = 500\n",
+      "box.toml", MonitorConfig{});
+  EXPECT_DOUBLE_EQ(recorder_frame_rate_hz(file), 1.25 * 2 * 1000 + 2 + 500);
+  EXPECT_EQ(box_file_error("[recorder]\nbus_frames_hz = -1\n"),
+            "/etc/plinth/box.toml:2: recorder.bus_frames_hz: must be a number of frames/s in [0, "
+            "25000] (a CAN bus at 1 Mbit/s carries at most about 21,000 frames/s)");
+}
+
+// Issue 33: the keys read apart, arrays of tables, given a value or a table: their type is
+// named, never "unknown key" (sensor = 3 was one).
+TEST(MonitorConfigFile, AnArrayOfTablesOfTheWrongTypeIsSaidToBeOne) {
+  const struct {
+    const char* text;
+    const char* message;
+  } cases[] = {
+      {"sensor = 3\n",
+       "box.toml:1: sensor: expected [[sensor]] tables (an array of tables), got an integer"},
+      {"sensor = \"a\"\n", "sensor: expected [[sensor]] tables (an array of tables), got a string"},
+      {"sensor = []\n", "sensor: expected [[sensor]] tables (an array of tables), got an empty"},
+      {"sensor = [1, 2]\n", "sensor: expected [[sensor]] tables (an array of tables), got an array"},
+      {"[sensor]\nnode = 1\n",
+       "sensor: expected [[sensor]] tables (an array of tables), got a table"},
+      {"[pwave]\npredictor = 3\n", "pwave.predictor: expected an array of tables { window_s"},
+      {"[pwave.predictor]\nwindow_s = 1.0\n",
+       "pwave.predictor: expected an array of tables { window_s, ln_pga_over_pa, tau_c_exponent, "
+       "sigma_ln } (plinth-eval pwave-fit prints one), got a table"},
+  };
+  for (const auto& c : cases) {
+    const std::string message = box_file_error(c.text);
+    SCOPED_TRACE(c.text);
+    EXPECT_EQ(message.find("unknown key"), std::string::npos) << message;
+    EXPECT_NE(message.find(c.message), std::string::npos) << message;
+  }
 }
 
 // A directory was read as an empty file (the defaults, silently); /dev/zero grew memory.

@@ -120,8 +120,9 @@ TEST(MonitorSensors, TwoAgreeingGroundSensorsGiveTheSingleSensorResults) {
 }
 
 // The second sensor's x drifts away at 2 m/s2 per s from t = 3 s: the RMS difference passes
-// the 0.3 m/s2 tolerance within the 0.5 s window; the fault level says kSensorDisagreement,
-// the estimators run on.
+// the 0.3 m/s2 tolerance within the 0.5 s window; the trouble says kSensorDisagreement, the
+// estimators run on, and the alarm follows the more dangerous reading, the drifting one (a
+// drift that strong is an earthquake as far as one sensor can tell).
 TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   fw::Monitor monitor;
   ASSERT_TRUE(started(monitor, two_grounds()));
@@ -135,8 +136,7 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
          {monitor.on_sensor_sample(0, sample(n, ground_g(n))),
           monitor.on_sensor_sample(1, sample(n, ground_g(n) + drift_g, 1'000'000))}) {
       for (std::size_t i = 0; i < u.event_count; ++i) {
-        if (n > drift_from && u.events[i].level == monitor::AlarmLevel::kFault) {
-          EXPECT_EQ(u.events[i].cause, monitor::AlarmCause::kSensorDisagreement);
+        if (n > drift_from && u.events[i].trouble == monitor::AlarmCause::kSensorDisagreement) {
           fault_event = true;
         }
       }
@@ -150,7 +150,9 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   EXPECT_LT(reported - drift_from, std::lround(0.5 * kRate));
   EXPECT_TRUE(fault_event);
   const fw::BoxStatus& s = monitor.status();
-  EXPECT_EQ(s.alarm, monitor::AlarmLevel::kFault);
+  EXPECT_EQ(s.alarm, monitor::AlarmLevel::kAlarm);
+  EXPECT_EQ(s.trouble, monitor::AlarmCause::kSensorDisagreement);
+  EXPECT_EQ(s.risk_sensor, 1);
   EXPECT_TRUE(s.sensors[1].disagreeing);
   EXPECT_EQ(s.sensors[1].disagreements, 1U);
   EXPECT_GT(s.sensors[1].rms_m_s2, 0.3);
@@ -158,7 +160,8 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   EXPECT_EQ(s.primary, 0);
   EXPECT_EQ(s.estimator_restarts, 1U);
   // The primary falls silent: the drifting sensor takes over (the one left); the cross-check
-  // has no one to compare, so the disagreement ends and the fault level with it.
+  // has no one to compare, so the disagreement ends and its trouble with it (the alarm it raised
+  // stays latched).
   for (long n = 1200; n < 1400; ++n) {
     (void)monitor.on_sensor_sample(1, sample(n, ground_g(n) + 0.3, 1'000'000));
   }
@@ -166,7 +169,8 @@ TEST(MonitorSensors, DriftingSensorIsReportedWithinTheWindow) {
   EXPECT_FALSE(monitor.status().disagreement);
   EXPECT_FALSE(monitor.status().sensors[1].disagreeing);
   EXPECT_EQ(monitor.status().sensors_state, monitor::HealthState::kDegraded);
-  EXPECT_NE(monitor.status().alarm, monitor::AlarmLevel::kFault);
+  EXPECT_NE(monitor.status().trouble, monitor::AlarmCause::kSensorDisagreement);
+  EXPECT_EQ(monitor.status().alarm, monitor::AlarmLevel::kAlarm);
 }
 
 // Two ground sensors under a slender block on the ground (the paper's, one axis), 1 Hz shaking

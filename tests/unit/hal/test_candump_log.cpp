@@ -249,6 +249,11 @@ TEST(CandumpLine, EveryMalformedCaseIsRefusedWithItsReason) {
       {"(1.000000)", "missing the interface name"},
       {"(1.000000) vcan0", "missing the frame"},
       {"(1.000000) an_interface_name_far_too_long 301#00", "longer than 15"},
+      // The frame where the interface belongs is said as such, whatever its length.
+      {"(1.000000) 301#0011223344556677", "no interface name between the timestamp and the frame"},
+      {"(1.000000) 1FFFFFFF#0011223344556677", "no interface name"},
+      {"(1.000000) 301#00 R", "no interface name"},
+      {"(1.000000)vcan0 301#00", "no space after the timestamp '(1.000000)'"},
       {"(1.000000) vcan0 301#00 X", "only R or T"},
       {"(1.000000) vcan0 301#00 R extra", "unexpected text after the frame"},
   };

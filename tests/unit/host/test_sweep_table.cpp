@@ -143,6 +143,37 @@ TEST(SweepTable, MergeRefusesWhatDoesNotFit) {
               HasSubstr("no input files"));
 }
 
+// Issue 33: a file written before a column was added (lift_off) is named as an older
+// plinth-sweep's, for the modes whose files have that column only.
+TEST(SweepTable, AFileWithoutAnAddedColumnIsAnOlderVersions) {
+  const std::string events =
+      "mu_s,sliding,rocking,slide_rocking,out_of_base,base_stop_hit,slide_stop_hit,fell,overturned";
+  const std::string thresholds = SettingsLine("thresholds", {{"mu_s", 0.2, 0.5, 4}}).text();
+  const SweepTable older{thresholds, events, {}};
+  const std::vector<const AddedColumn*> missing = columns_added_since(older);
+  ASSERT_EQ(missing.size(), 1u);
+  EXPECT_STREQ(missing[0]->name, "lift_off");
+  EXPECT_EQ(older_version_text(missing),
+            "written by a plinth-sweep older than its lift_off column (plinth 0.1.0 from commit "
+            "4a3615a of 2026-11-28, when lift-off began to end a run)");
+  EXPECT_TRUE(columns_added_since({thresholds, events + ",lift_off", {}}).empty());
+  const std::string curve = SettingsLine("impulse_curve", {{"T", 1.0, 2.0, 2}}).text();
+  EXPECT_EQ(columns_added_since({curve, "T,rocking,overturned", {}}).size(), 1u);
+  // A map of one event, an impulse map, a file that is no sweep: nothing to say.
+  const std::string map = SettingsLine("threshold_map", {{"mu_s", 0.2, 0.5, 2}}).text();
+  EXPECT_TRUE(columns_added_since({map, "mu_s,T,overturned", {}}).empty());
+  EXPECT_TRUE(columns_added_since({"not a sweep", events, {}}).empty());
+  EXPECT_EQ(older_version_text({}), "");
+  // Merging it with a shard of this version names it.
+  SweepTable newer = older;
+  newer.header += ",lift_off";
+  EXPECT_THAT(testing::input_error_text([&] {
+                (void)merge_sweep_tables({newer, older}, {"new.csv", "old.csv"});
+              }),
+              HasSubstr("merge: old.csv and new.csv have different headers (old.csv was written "
+                        "by a plinth-sweep older than its lift_off column"));
+}
+
 // Messages about settings lines that differ name the settings, not just the lines.
 TEST(SweepTable, SettingsDifferenceNamesTheSettings) {
   const std::string plain = SettingsLine("thresholds", {{"mu_s", 0.1, 1.5, 50}})

@@ -68,11 +68,16 @@ struct SensorConfig {
   monitor::SensorHealthSettings sensor_health;  // its sample period is the estimator's
 };
 
+// The largest tolerance of the ground sensors' cross-check and threshold of the plate's, m/s2.
+inline constexpr double kMaxDisagreementToleranceM_S2 = 2.0;
+inline constexpr double kMaxPlateThresholdM_S2 = 20.0;
+
 // Ground sensors against the primary.
 struct RedundancySettings {
   // s: sliding window of the RMS difference, 2 to kMaxCheckWindowSamples samples
   double window_s = 0.5;
-  double tolerance_m_s2 = 0.3;   // m/s2, > 0: an RMS difference beyond this is a disagreement
+  // m/s2, (0, kMaxDisagreementToleranceM_S2]: an RMS difference beyond this is a disagreement
+  double tolerance_m_s2 = 0.3;
 };
 
 // The plate sensor against the model.

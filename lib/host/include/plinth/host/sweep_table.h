@@ -3,6 +3,7 @@
 // the same keys, whatever threads or shards made them; that is what resuming and merging check.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <iosfwd>
 #include <map>
@@ -95,11 +96,35 @@ inline constexpr std::size_t kMaxSweepTableBytes = std::size_t{256} << 20;  // 2
 // `dropped` is given, such rows (cut short by a kill) are skipped and counted instead.
 [[nodiscard]] SweepTable read_sweep_table(const std::string& path, std::size_t* dropped = nullptr);
 
+// A column plinth-sweep added to the files of some modes after files without it were written:
+// a file of such a mode without the column is an older plinth-sweep's. It can still be read
+// and plotted (the column's curve is left out), merged with its own shards, but not resumed:
+// its rows are not what this version computes (`why`).
+struct AddedColumn {
+  const char* name;
+  std::array<const char*, 2> modes;  // the settings line's modes whose files have it
+  const char* since;                 // the version that added it
+  const char* why;                   // why an older file's rows cannot be resumed
+};
+inline constexpr std::array<AddedColumn, 1> kAddedColumns{{
+    {"lift_off",
+     {"thresholds", "impulse_curve"},
+     "plinth 0.1.0 from commit 4a3615a of 2026-11-28, when lift-off began to end a run",
+     "its runs went on past lift-off, where this version's end"},
+}};
+
+// The columns of kAddedColumns that `table` (its settings line's mode) lacks: empty unless an
+// older plinth-sweep wrote it.
+[[nodiscard]] std::vector<const AddedColumn*> columns_added_since(const SweepTable& table);
+// "written by a plinth-sweep older than its lift_off column (plinth 0.1.0 from ...)", for
+// messages about such a table; "" when it lacks none.
+[[nodiscard]] std::string older_version_text(const std::vector<const AddedColumn*>& missing);
+
 // Writes the settings line, the header and the rows, each ended by '\n'.
 void write_sweep_table(std::ostream& out, const SweepTable& table);
 
 // Joins the tables of the shards of one sweep (`names` name them in messages): their settings
-// lines and headers must be identical, no key may appear twice, and together they must hold
+// lines and headers must be identical (a shard an older plinth-sweep wrote is named as such), no key may appear twice, and together they must hold
 // every key of the grid; the result is in grid order. Throws InputError naming the files and
 // keys at fault.
 [[nodiscard]] SweepTable merge_sweep_tables(const std::vector<SweepTable>& parts,

@@ -1,69 +1,7 @@
 // The on-site P-wave stage: from the first seconds of an earthquake at the box's own ground
-// sensor, a probability that the statue collapses in the strong shaking still to come (the S
-// waves), before that shaking arrives (docs/pwave.md; Kanamori 2005, Wu & Kanamori 2005).
-//
-// Input: the conditioned ground acceleration, statue frame, m/s2 (x, y horizontal, z = v_G''),
-// one sample per sample_period_s, in order. Every channel is band-passed first (2nd-order
-// Butterworth high-pass at highpass_hz, low-pass at lowpass_hz, both as topology-preserving
-// state-variable filters, exact and well conditioned in float at these low cut-offs):
-//   a   band-passed acceleration, m/s2
-// and from a candidate's first sample on, integrated from rest there (Kanamori's recursive
-// integration from the trigger: the noise before it does not enter the long periods):
-//   v   HP(integral of a), m/s         (a high-pass filter's band output over its corner)
-//   d   HP(integral of v), m           (a second stage, the same way)
-// The trigger channel is the vertical (z), or the horizontal pair (x, y) with
-// channel = kHorizontal, for a box without a vertical axis.
-//
-// Trigger (a state machine):
-//   idle       STA and LTA of a^2 (exponential averages over sta_s and lta_s). A candidate
-//              starts at the sample where STA >= trigger_ratio * max(LTA, noise_floor^2) and
-//              STA >= min_amplitude^2 (the start condition), provided it comes out of quiet:
-//              an excitation begins with a candidate, and lasts until the stage, idle, sees
-//              STA < detrigger_ratio * max(LTA, noise_floor^2) (quiet again: an STA/LTA
-//              trigger's off ratio); its later candidates (retries after a rejection) may start
-//              up to max_retry_s after its first. Past that the signal has been loud against
-//              the pre-event LTA for longer than a P onset lasts: the shaking under way, most
-//              likely the S waves (a record that begins in them, or a P wave too small to
-//              trigger); the excitation is refused (counted once), no candidate starts, and
-//              the LTA follows the shaking until quiet ends the excitation.
-//   candidate  the LTA is frozen; the window's sums start at the candidate's first sample.
-//              After confirm_s the candidate is judged: a trigger when
-//                tau_p = 2 pi sqrt(sum v^2 / sum a^2) >= min_tau_p_s (the window's predominant
-//                  period, Allen & Kanamori 2003's tau_p over the window: a floor's, a door's or
-//                  a truck's vibration is shorter; it needs one integration, not two, so the
-//                  sensor's noise does not lengthen it as it does tau_c on weak signals),
-//                tau_c = 2 pi sqrt(sum d^2 / sum v^2) <= max_tau_c_s (Wu & Kanamori 2005's
-//                  period parameter: longer is a drift, a tilt or a step, not a P wave),
-//                and, on the vertical channel, peak |a_z| >= min_vertical_ratio * peak |a_h|
-//                  (a P wave is steep; a bump of the plinth or a record that begins in the S
-//                  waves is horizontal);
-//              else it is rejected (counted by reason) and the stage is idle again (the next
-//              sample may start the next candidate: a P wave whose onset was judged too soon
-//              gets another chance).
-//   window     from the trigger on, every sample updates the early parameters over the window
-//              since the candidate's start: Pa = peak |a|, Pv = peak |v|, Pd = peak |d|, tau_c,
-//              and the prediction (below). The window closes at max_window_s, or on the
-//              vertical channel when the S waves arrive: peak |a_h| >= s_wave_ratio * peak |a_z|.
-//   holding    the probability is held for hold_s after the window closed (the LTA follows the
-//              shaking again, so its coda does not trigger anew); then idle, probability 0.
-//
-// Prediction (at W = time since the candidate's start, W >= confirm_s): the horizontal PGA,
-//   ln PGA = ln Pa + c0(W) + c1(W) ln(tau_c / 1 s),        sigma_ln(W) its scatter,
-// c0, c1, sigma_ln interpolated linearly in W between the table's points (held beyond its
-// ends). The ratio PGA / Pa does not change when a record is scaled, so neither does the
-// prediction's error: the table is fitted on records scaled to a PGA (plinth-eval pwave-fit),
-// as plinth-eval scales them (docs/pwave.md says why a regression of ln PGA on ln Pa, whose
-// slope is ~0.25 on unscaled records, is not used).
-//
-// Probability of collapse: the statue's fragility (lognormal in PGA: median_g, beta) under the
-// prediction's lognormal scatter, P = Phi(ln(PGA / median) / sqrt(beta^2 + sigma_ln^2)); the
-// stage reports the highest P of the event so far (a later, smaller estimate does not take a
-// warning back). Without a fragility (fragility_known false) the stage triggers and reports
-// its parameters, and its probability stays 0. The alarm policy raises `warning` (never
-// `alarm`) on it (alarm_policy.h, warning_pwave).
-//
-// Freestanding: no heap, no exceptions; every tunable is named with its unit and checked by
-// validate().
+// sensor, a probability that the statue collapses in the S waves still to come. Its filters,
+// trigger states, prediction and probability: docs/pwave.md, "The stage in detail".
+// Freestanding: no heap, no exceptions; every tunable named with its unit, checked by validate().
 #pragma once
 
 #include <array>
