@@ -68,7 +68,8 @@ if [ -z "$debs" ]; then
       build_dir=$work/package-build
       lap "the packages' build (cmake --preset $preset in $build_dir; $work/package-build.log)"
       { cmake --preset "$preset" -S "$src" -B "$build_dir" &&
-        cmake --build "$build_dir"; } >"$work/package-build.log" 2>&1 ||
+        cmake --build "$build_dir" --target plinth-monitor plinth-replay; } \
+        >"$work/package-build.log" 2>&1 ||
         { tail -n 30 "$work/package-build.log"; echo "$me: the packages' build failed" >&2
           exit 1; }
     fi
@@ -76,12 +77,14 @@ if [ -z "$debs" ]; then
   [ -f "$build_dir/CPackConfig.cmake" ] || skip "no build tree $build_dir"
   debs=$work/debs
   rm -rf "$debs"
+  # The image holds plinth-monitor alone: its component is all cpack needs built.
+  monitor_only=(-D CPACK_COMPONENTS_ALL=monitor)
   lap "the packages (cpack in $build_dir)"
-  (cd "$build_dir" && "$cpack" -G DEB -B "$debs") >"$work/cpack.log" 2>&1 ||
+  (cd "$build_dir" && "$cpack" -G DEB -B "$debs" "${monitor_only[@]}") >"$work/cpack.log" 2>&1 ||
     { tail -n 20 "$work/cpack.log"; echo "$me: cpack failed ($work/cpack.log)" >&2; exit 1; }
   if [ "$sequence" = full ]; then
-    (cd "$build_dir" && "$cpack" -G DEB -B "$debs/newer" -D CPACK_DEBIAN_PACKAGE_RELEASE=2) \
-      >>"$work/cpack.log" 2>&1 ||
+    (cd "$build_dir" && "$cpack" -G DEB -B "$debs/newer" "${monitor_only[@]}" \
+      -D CPACK_DEBIAN_PACKAGE_RELEASE=2) >>"$work/cpack.log" 2>&1 ||
       { tail -n 20 "$work/cpack.log"; echo "$me: cpack (revision 2) failed" >&2; exit 1; }
   fi
 fi

@@ -120,9 +120,9 @@ done
 arch=${arch:-$(dpkg --print-architecture)}
 case "$arch" in
   amd64) efi_target=x86_64-efi efi_loader=BOOTX64.EFI root_type=4f68bce3-e8cd-4db1-96e7-fbcaf984b709
-    console="console=tty0 console=ttyS0,115200" ;;
+    console="console=tty0 console=ttyS0,115200 quiet" ;;
   arm64) efi_target=arm64-efi efi_loader=BOOTAA64.EFI root_type=b921b045-1df0-41c3-af44-4c6f280d3fae
-    console="" ;;
+    console="quiet" ;;
   *) fail "--arch $arch: amd64 or arm64" ;;
 esac
 out=${out:-$src/build/image/plinth-box-$arch.img}
@@ -271,6 +271,8 @@ else
   step "Debian 12 for $arch: the base (mmdebstrap; $work/mmdebstrap.log)"
   "${mm[@]}" >"$work/mmdebstrap.log" 2>&1 ||
     { tail -n 40 "$work/mmdebstrap.log" >&2; fail "mmdebstrap failed ($work/mmdebstrap.log)"; }
+  # The downloaded .debs are in the cache (sync-out): not in the base.
+  rm -f "$root"/var/cache/apt/archives/*.deb
   if [ -n "$base_tar" ]; then
     rm -f "$cache/base-$arch-"*.tar.zst
     tar "${tar_options[@]}" -C "$root" -cf - . | zstd -q -T0 -3 >"$base_tar.part" &&
@@ -299,7 +301,8 @@ unshare --mount --propagation private -- bash -c '
   chroot "$root" $apt upgrade
   chroot "$root" sh -c "$apt install /var/tmp/plinth-debs/*.deb"
   chroot "$root" sh -c "cd /var/tmp && $apt download grub-efi-$arch-bin"
-  chroot "$root" $apt clean
+  # No apt clean here: with --cache, the archive is the cache (bind-mounted), kept for the next
+  # build; without, step 4 empties the image'"'"'s own.
 ' install "$root" "$cache" "$arch" >"$work/apt.log" 2>&1 ||
   { tail -n 40 "$work/apt.log" >&2; fail "apt could not install the plinth packages ($work/apt.log)"; }
 [ -z "$cache" ] || prune_debs "$cache/debs"
@@ -383,7 +386,8 @@ menuentry "plinth box, the previous kernel" {
 EOF
 
 step "filesystems"
-rm -rf "$root/var/cache/apt/archives/"*.deb "$root/var/lib/apt/lists/"* "$root/tmp/"*
+rm -rf "$root/var/cache/apt/archives/"*.deb "$root"/var/cache/apt/*.bin "$root/var/lib/apt/lists/"* \
+  "$root/tmp/"*
 mib_of() { du -s --block-size=1M --apparent-size "$1" | cut -f1; }
 # ext4's own blocks (inode tables, journal) on top of the files: about 10 %, and 16 MiB more.
 root_mib=$(( $(mib_of "$root") * 110 / 100 + 16 + root_free_mib ))
