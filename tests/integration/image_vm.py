@@ -384,6 +384,24 @@ def write_quake(args, path):
     write_csv(path, Path(args.record).stem, RATE_HZ, samples)
 
 
+# After the earthquake the sensor goes on sending its quiet samples, as a real one does: the
+# recorder closes a capture on the first frame past its window (post_trigger_s, 60 s), so a bus
+# left silent would keep it open.
+QUIET = "/var/tmp/quiet.csv"
+QUIET_S = 75.0
+
+
+def sensor_goes_on(guest):
+    """The quiet samples sent on can0 in the background (a transient unit of the guest's)."""
+    quiet = guest.work / "quiet.csv"
+    if not quiet.exists():
+        write_csv(quiet, "quiet", RATE_HZ, [DITHER[k % 4] * RESOLUTION_G * G0
+                                            for k in range(round(QUIET_S * RATE_HZ))])
+        guest.copy_in(quiet, QUIET)
+    guest.out(f"systemd-run --collect --unit=quiet-$(date +%s) plinth-replay --record {QUIET} "
+              f"--can can0 --speed 1")
+
+
 def replay_alarm(guest, checks, args, attempts=3):
     """plinth-replay sends the earthquake over can0; the box raises the alarm."""
     quake = guest.work / "quake.csv"
@@ -675,6 +693,7 @@ def main():
         replay_alarm(guest, checks, args)
         modbus(guest, checks)
         if args.sequence == "full":
+            sensor_goes_on(guest)
             finished = wait_capture(guest, 1, 600)
             checks.check(f"the alarm's capture finished ({', '.join(sorted(finished))})", True)
             interface_reappears(guest, checks)
