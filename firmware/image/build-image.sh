@@ -12,10 +12,11 @@
 # The image's own files are firmware/image/rootfs/ (networkd's CAN and Ethernet settings, the
 # journal's cap, the watchdog, the first boot, the read-only root's apt hook).
 #
-# Usage: firmware/image/build-image.sh --debs DIR [options]
+# Usage: firmware/image/build-image.sh [--debs DIR] [options]
 #   --debs DIR       the plinth packages: DIR/plinth-monitor_*_ARCH.deb (and with --with-tools
-#                    plinth-tools_*_ARCH.deb; cmake --workflow --preset package / package-arm64
-#                    write them to build/package/); with several versions there, the newest
+#                    plinth-tools_*_ARCH.deb); with several versions there, the newest. Without
+#                    it, they are built first: cmake --workflow --preset package (package-arm64
+#                    for arm64) into build/package/
 #   --arch A         amd64 or arm64 (default: this machine's)
 #   --out FILE       the image (default build/image/plinth-box-ARCH.img); beside it FILE.packages
 #                    (every package and version in it) and FILE.sha256
@@ -34,6 +35,9 @@
 # a tool missing, no way to run arm64 programs): the reason is printed.
 set -euo pipefail
 me=build-image
+# Debian's own programs first: mmdebstrap's helpers (mmtarfilter) run on the system's python3,
+# not on one a user's PATH puts before it (a pyenv shim costs a second for each package).
+export PATH=/usr/sbin:/usr/bin:/sbin:/bin:$PATH
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 src=$(cd "$here/../.." && pwd)
 self=$here/$(basename "${BASH_SOURCE[0]}")
@@ -115,8 +119,6 @@ while [ $# -gt 0 ]; do
     *) echo "$me: unknown option '$1'" >&2; usage ;;
   esac
 done
-[ -n "$debs" ] || { echo "$me: --debs DIR is required" >&2; usage; }
-[ -d "$debs" ] || fail "--debs $debs: no such folder"
 arch=${arch:-$(dpkg --print-architecture)}
 case "$arch" in
   amd64) efi_target=x86_64-efi efi_loader=BOOTX64.EFI root_type=4f68bce3-e8cd-4db1-96e7-fbcaf984b709
@@ -135,6 +137,17 @@ for tool in mmdebstrap mkfs.ext4 mkfs.vfat mmd mcopy sfdisk grub-mkimage; do
     cannot "$tool not found (tools/install-deps.sh installs mmdebstrap, e2fsprogs, dosfstools," \
       "mtools, fdisk and grub-common)"
 done
+
+# The packages, built here when no --debs names them.
+if [ -z "$debs" ]; then
+  preset=package$([ "$arch" = amd64 ] || echo "-$arch")
+  echo "$me: the packages: cmake --workflow --preset $preset (build/$preset.log)"
+  mkdir -p "$src/build"
+  (cd "$src" && cmake --workflow --preset "$preset") >"$src/build/$preset.log" 2>&1 ||
+    { tail -n 30 "$src/build/$preset.log" >&2; fail "the packages' build failed"; }
+  debs=$src/build/package
+fi
+[ -d "$debs" ] || fail "--debs $debs: no such folder"
 
 # The newest version of each plinth package for the architecture.
 newest_deb() {  # PACKAGE
@@ -172,6 +185,8 @@ if [ "$arch" != "$host_arch" ] && [ -z "${PLINTH_IMAGE_IN_USERNS:-}" ]; then
   fi
 fi
 if [ "$sandbox_binfmt" -eq 1 ]; then
+  tools_option=()
+  [ "$with_tools" -eq 0 ] || tools_option=(--with-tools)
   fifo=$(mktemp -u) && mkfifo "$fifo"
   # In the namespace: binfmt_misc mounted, qemu-aarch64 registered with F (the interpreter
   # opened now, so it need not exist inside the image), then this script again.
@@ -186,7 +201,7 @@ if [ "$sandbox_binfmt" -eq 1 ]; then
     echo "$rule" >"$mnt/register" || exit 77
     PLINTH_IMAGE_IN_USERNS=1 exec "$@"' "$fifo" "$self" --debs "$debs" --arch "$arch" \
     --out "$out" --mirror "$mirror" --security "$security" \
-    ${cache:+--cache "$cache"} ${work:+--work "$work"} $([ "$with_tools" -eq 0 ] || echo --with-tools) &
+    ${cache:+--cache "$cache"} ${work:+--work "$work"} "${tools_option[@]}" &
   pid=$!
   while [ "$(readlink "/proc/$pid/ns/user")" = "$(readlink /proc/self/ns/user)" ]; do
     kill -0 "$pid" 2>/dev/null || { wait "$pid"; exit $?; }
@@ -304,7 +319,8 @@ unshare --mount --propagation private -- bash -c '
   # No apt clean here: with --cache, the archive is the cache (bind-mounted), kept for the next
   # build; without, step 4 empties the image'"'"'s own.
 ' install "$root" "$cache" "$arch" >"$work/apt.log" 2>&1 ||
-  { tail -n 40 "$work/apt.log" >&2; fail "apt could not install the plinth packages ($work/apt.log)"; }
+  { tail -n 40 "$work/apt.log" >&2
+    fail "apt could not install the plinth packages ($work/apt.log)"; }
 [ -z "$cache" ] || prune_debs "$cache/debs"
 dpkg-deb -x "$root"/var/tmp/grub-efi-*-bin_*.deb "$work/grub"
 rm -rf "$root/var/tmp/plinth-debs" "$root"/var/tmp/grub-efi-*-bin_*.deb
@@ -386,8 +402,8 @@ menuentry "plinth box, the previous kernel" {
 EOF
 
 step "filesystems"
-rm -rf "$root/var/cache/apt/archives/"*.deb "$root"/var/cache/apt/*.bin "$root/var/lib/apt/lists/"* \
-  "$root/tmp/"*
+rm -rf "$root/var/cache/apt/archives/"*.deb "$root"/var/cache/apt/*.bin \
+  "$root/var/lib/apt/lists/"* "$root/tmp/"*
 mib_of() { du -s --block-size=1M --apparent-size "$1" | cut -f1; }
 # ext4's own blocks (inode tables, journal) on top of the files: about 10 %, and 16 MiB more.
 root_mib=$(( $(mib_of "$root") * 110 / 100 + 16 + root_free_mib ))
