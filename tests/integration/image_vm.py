@@ -525,39 +525,6 @@ def restored(guest, checks, after):
                  text.startswith("alarm level alarm, latched"), text)
 
 
-def operator_clears(guest, checks):
-    """A person on site states that the statue stands (StatueStands, 0x341), then acknowledges
-    the alarm (Acknowledge, 0x340), each quoting the latest event, as a panel on the bus does;
-    the box's state file says what each did."""
-    pid = unit_property(guest, "MainPID")
-    source = 0x42
-
-    def latest():
-        return int(alarm_entries(guest, pid)[-1]["PLINTH_ALARM_SEQUENCE"]) & 0xFF
-
-    def said(frame, done, what):
-        # A frame that quoted an event older than one the box raised meanwhile is stale (the
-        # box ignores it): sent again with the new one.
-        for _ in range(3):
-            guest.out(f"cansend can0 {frame(latest())}")
-            try:
-                return wait_for(what, done, 30)
-            except Failed:
-                continue
-        raise Failed(f"{what}: not after three frames")
-    said(lambda seq: f"341#{source:02X}{seq:02X}000000000000",
-         lambda: not box_state(guest).get("collapse", {}).get("held", False),
-         "the held collapse cleared by StatueStands (alarm-state.json)")
-    checks.check("StatueStands on can0: the held collapse cleared (alarm-state.json)", True)
-    said(lambda seq: f"340#03{source:02X}{seq:02X}0000000000",
-         lambda: box_state(guest).get("latched_level") != "alarm",
-         "the latched alarm released by Acknowledge (alarm-state.json)")
-    entries = [e for e in alarm_entries(guest, pid) if e.get("PLINTH_ALARM_CAUSE") ==
-               "acknowledged"]
-    checks.check("Acknowledge on can0: the latched alarm released, in the journal",
-                 bool(entries), str(box_state(guest)))
-
-
 def interface_reappears(guest, checks):
     first = unit_property(guest, "InvocationID")
     guest.out("ip link delete can0")
@@ -735,7 +702,6 @@ def main():
             restored(guest, checks, "can0 came back")
             watchdog(guest, checks)
             restored(guest, checks, "the watchdog's restart")
-            operator_clears(guest, checks)
             finished = power_cut(guest, checks)
             guest.power_on()
             guest.wait_ssh()
