@@ -47,6 +47,23 @@ print(eval(sys.argv[2]))
 PY
 }
 
+# paced OUT SCALE SPEED: a paced replay with the state directory in the background (its PID in
+# `pid`), its lines in OUT.
+paced() {
+  "$monitor" --scene "$scene" --replay "$record" --scale "$2" --speed "$3" --no-events \
+    --status-interval 1 --state-dir "$state" >"$1" 2>"$tmp/err" &
+  pid=$!
+}
+# wait_line FILE PATTERN TENTHS: until FILE holds PATTERN, at most TENTHS tenths of a second.
+wait_line() {
+  local _
+  for _ in $(seq 1 "$3"); do
+    grep -q "$2" "$1" 2>/dev/null && return 0
+    sleep 0.1
+  done
+  return 1
+}
+
 # 1. The quick start overturns the block: the state keeps the latched alarm and the collapse.
 run "$tmp/first.jsonl" --scale 6.5
 check "the overturning replay runs" $? "$(head -c 300 "$tmp/err")"
@@ -90,13 +107,8 @@ check "an acknowledged alarm's collapse is still held after a restart" $? "$got"
 # 4. SIGKILL right after the alarm (a crash, a power cut to the process): the state is whole,
 # the alarm in it.
 rm -rf "$state"
-"$monitor" --scene "$scene" --replay "$record" --scale 6.5 --speed 1 --no-events \
-  --status-interval 1 --state-dir "$state" >"$tmp/killed.jsonl" 2>"$tmp/err" &
-pid=$!
-for _ in $(seq 1 600); do
-  grep -q '"level": "alarm"' "$tmp/killed.jsonl" 2>/dev/null && break
-  sleep 0.1
-done
+paced "$tmp/killed.jsonl" 6.5 1
+wait_line "$tmp/killed.jsonl" '"level": "alarm"' 600
 kill -9 "$pid" 2>/dev/null
 wait "$pid" 2>/dev/null
 got=$(json "$state/alarm-state.json" 'd["latched_level"]')
@@ -124,14 +136,8 @@ check "the unreadable file is kept aside" $? "$(ls "$state")"
 # window's end) flushed it, which a restart on a quiet bus never writes, so a kill lost them (seen
 # in the image's test, docs/image.md). At a tenth of real time the start-up window (2 s of
 # samples) lasts 20 s; the restored line is waited for 10 s.
-"$monitor" --scene "$scene" --replay "$record" --scale 0.01 --speed 0.1 --no-events \
-  --status-interval 1 --state-dir "$state" >"$tmp/paced.jsonl" 2>"$tmp/err" &
-pid=$!
-for _ in $(seq 1 100); do
-  grep -q '"type": "restored"' "$tmp/paced.jsonl" 2>/dev/null && break
-  sleep 0.1
-done
-grep -q '"type": "restored"' "$tmp/paced.jsonl" && kill -0 "$pid" 2>/dev/null
+paced "$tmp/paced.jsonl" 0.01 0.1
+wait_line "$tmp/paced.jsonl" '"type": "restored"' 100 && kill -0 "$pid" 2>/dev/null
 check "paced: the restored line is out while the box runs" $? "$(head -c 300 "$tmp/paced.jsonl")"
 kill -9 "$pid" 2>/dev/null
 wait "$pid" 2>/dev/null
