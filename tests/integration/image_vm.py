@@ -617,6 +617,9 @@ def upgrade(guest, checks, newer_debs, finished):
         guest, "ActiveState") == "active" and unit_property(guest, "MainPID") not in (pid, "0"),
         180)
     checks.check("the upgrade restarted the service (postinst try-restart)", True)
+    registers, said = read_registers(guest)
+    checks.check("Modbus on port 502 answers after the upgrade (the socket kept)",
+                 len(registers) == 32, said)
     checks.check("/ read-only again after apt", read_only(guest, "/"))
 
 
