@@ -8,7 +8,7 @@
 #   --sequence S      short (default: the first boot, boot to monitoring, a replayed alarm in
 #                     systemctl status and the journal, Modbus from the host) or full (also the
 #                     interface coming back, the watchdog, a power cut mid-capture, an upgrade,
-#                     removal and purge; about 15 min under TCG)
+#                     removal and purge; about 11 min under TCG)
 #   --build-dir DIR   a build tree whose packages cpack makes (default build/package-ARCH, the
 #                     package / package-arm64 preset's, or else that preset configured and built
 #                     in WORK/package-build); full: the newer packages too, the same with the
