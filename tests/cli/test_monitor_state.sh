@@ -6,7 +6,8 @@
 # acknowledgement releases the latch but not the collapse, and the next start still holds it;
 # a process killed with SIGKILL right after its alarm leaves the state whole; an unreadable
 # state file is kept aside and taken for a latched alarm; paced, the restored line goes out at
-# once; a state directory that is a file is refused. Each overturning run replays the quick start (paper-eccentric.toml, Buia x6.5).
+# once; a state directory that is a file is refused. Each overturning run replays the quick
+# start (paper-eccentric.toml, Buia x6.5).
 # Usage: test_monitor_state.sh PLINTH_MONITOR SOURCE_DIR
 set -u
 monitor=${1:?usage: $0 PLINTH_MONITOR SOURCE_DIR}
