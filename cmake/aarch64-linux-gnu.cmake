@@ -1,7 +1,7 @@
 # Cross toolchain: Debian's aarch64-linux-gnu GCC for an arm64 board running Debian 12 (the
 # package-arm64 preset, docs/install.md). The libraries come from Debian's arm64 packages
 # installed beside the build machine's (multiarch: dpkg --add-architecture arm64, then e.g.
-# libmodbus-dev:arm64), in /usr/lib/aarch64-linux-gnu; tools/install-deps.sh installs them.
+# libmosquitto-dev:arm64), in /usr/lib/aarch64-linux-gnu; tools/install-deps.sh installs them.
 # qemu-aarch64 (qemu-user) runs the programs on the build machine (tools/arm64-replay.sh).
 set(CMAKE_SYSTEM_NAME Linux)
 set(CMAKE_SYSTEM_PROCESSOR aarch64)

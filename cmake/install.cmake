@@ -16,8 +16,8 @@ include(CMakePackageConfigHelpers)
 set(PLINTH_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/plinth)
 set(PLINTH_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/plinth)
 
-# The box: plinth-monitor and plinth-replay, its units, its user, its data.
-install(TARGETS plinth-monitor plinth-replay RUNTIME COMPONENT monitor)
+# The box: plinth-monitor, plinth-replay and plinth-commission, its units, its user, its data.
+install(TARGETS plinth-monitor plinth-replay plinth-commission RUNTIME COMPONENT monitor)
 # The units and the configuration name the install's own folders, decided at install time (a
 # Debian package installs the same build with the prefix /usr that `cmake --install` may give
 # another): @PLINTH_BINDIR@ is PREFIX/bin; @PLINTH_SYSCONFDIR@ is /etc for the prefix /usr

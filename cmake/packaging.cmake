@@ -30,15 +30,19 @@ set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION TRUE)
 
 # The C++ runtime and the shared libraries the programs link (Debian 12's packages).
 set(plinth_cxx_runtime "libc6 (>= 2.34), libgcc-s1 (>= 3.0), libstdc++6 (>= 12)")
-set(PLINTH_MONITOR_DEPENDS "${plinth_cxx_runtime}, libgpiod2 (>= 1.6), libmodbus5 (>= 3.1.6), libmosquitto1 (>= 2.0), libsystemd0 (>= 252), libtomlplusplus3 (>= 3.3), systemd")
+set(PLINTH_MONITOR_DEPENDS "${plinth_cxx_runtime}, libgpiod2 (>= 1.6), libmosquitto1 (>= 2.0), libsystemd0 (>= 252), libtomlplusplus3 (>= 3.3), systemd")
 
 set(CPACK_DEBIAN_MONITOR_PACKAGE_NAME plinth-monitor)
 set(CPACK_DEBIAN_MONITOR_PACKAGE_DEPENDS "${PLINTH_MONITOR_DEPENDS}")
+# plinth-commission draws its report's picture with gnuplot (docs/commissioning.md); without it
+# the report says so and has no picture.
+set(CPACK_DEBIAN_MONITOR_PACKAGE_RECOMMENDS "gnuplot-nox | gnuplot")
 set(CPACK_DEBIAN_MONITOR_PACKAGE_SUGGESTS "can-utils, mbpoll, mosquitto-clients")
 set(CPACK_COMPONENT_MONITOR_DESCRIPTION "plinth's monitor box: the statue's earthquake early warning
  plinth-monitor estimates the phase of motion and the overturning risk of a statue on its
  isolation base from accelerometers on a CAN bus, and raises alarms on CAN, relays, Modbus TCP
- and MQTT; plinth-replay sends recorded earthquakes on a bus. A systemd unit per CAN interface
+ and MQTT; plinth-commission checks the sensors on site against the box file before the box is
+ trusted; plinth-replay sends recorded earthquakes on a bus. A systemd unit per CAN interface
  (plinth-monitor@can0), its Modbus socket unit, the service's user, and the data: the CAN
  database, example scenes and box configuration.")
 set(plinth_debian ${CMAKE_CURRENT_LIST_DIR}/debian)

@@ -37,8 +37,8 @@ for tool in aarch64-linux-gnu-g++ qemu-aarch64; do
     exit 77
   fi
 done
-if ! PKG_CONFIG_LIBDIR=/usr/lib/aarch64-linux-gnu/pkgconfig pkg-config --exists libmodbus; then
-  echo "skipped: no arm64 libraries (tools/install-deps.sh installs libmodbus-dev:arm64 and the rest)"
+if ! PKG_CONFIG_LIBDIR=/usr/lib/aarch64-linux-gnu/pkgconfig pkg-config --exists libmosquitto; then
+  echo "skipped: no arm64 libraries (tools/install-deps.sh installs libmosquitto-dev:arm64 and the rest)"
   exit 77
 fi
 

@@ -31,7 +31,7 @@ for arg in "$@"; do
 done
 
 runtime=(
-  libmodbus5 libmosquitto1 libgpiod2 libsystemd0 libtomlplusplus3  # plinth-monitor's libraries
+  libmosquitto1 libgpiod2 libsystemd0 libtomlplusplus3  # plinth-monitor's libraries
   systemd  # the service, its user (systemd-sysusers)
   python3 gnuplot-nox  # plinth-event-plot draws with gnuplot
 )
@@ -39,7 +39,7 @@ build=(
   build-essential cmake ninja-build pkg-config git
   libeigen3-dev libcli11-dev libtomlplusplus-dev
   libgpiod-dev libsystemd-dev  # relays (libgpiod 1.6), sd_notify, sd_listen_fds, the journal
-  libmodbus-dev libmosquitto-dev  # plinth-monitor's Modbus TCP server and MQTT publisher
+  libmosquitto-dev  # plinth-monitor's MQTT client (its Modbus TCP server needs no library)
   nlohmann-json3-dev  # the MQTT command payloads (JSON; header-only)
   libsocketcan-dev  # the CAN controller's state (hal/socketcan)
 )
@@ -53,11 +53,12 @@ tests=(
   qemu-system-arm                                                            # runs it
   # (systemd, in the runtime set: systemd-analyze tests the units, systemd-socket-activate passes
   # the Modbus socket)
-  mbpoll  # the Modbus TCP server, tested with mbpoll (docs/integration.md)
+  mbpoll  # the Modbus TCP server, tested with mbpoll, a libmodbus client (docs/integration.md)
   mosquitto mosquitto-clients openssl  # the MQTT publisher, tested on a broker
   clang-14 libclang-rt-14-dev  # the sanitize preset: ASan + UBSan and libFuzzer (docs/fuzzing.md)
   dpkg-dev fakeroot  # the package preset (CPack DEB), its packages unpacked and checked
   python3-openpyxl  # tools/pwave-stations.py reads the NGA-West2 flatfile (xlsx; docs/regional.md)
+  stress-ng  # keeps the cores busy while the tests run, as on a user's laptop (README, can-e2e.md)
   # The box's disk image (firmware/image/build-image.sh, docs/image.md): mmdebstrap makes the
   # Debian system (zstd keeps its base between runs), mkfs.ext4, mkfs.vfat and mtools its
   # filesystems, sfdisk its partition table, grub-mkimage its boot loader; qemu-user-static runs
@@ -69,7 +70,7 @@ tests=(
   # The package-arm64 preset (docs/install.md): Debian's cross compiler, the libraries for arm64
   # (multiarch), and qemu-user, which runs the arm64 plinth-monitor on this machine.
   g++-aarch64-linux-gnu qemu-user
-  libtomlplusplus-dev:arm64 libgpiod-dev:arm64 libsystemd-dev:arm64 libmodbus-dev:arm64
+  libtomlplusplus-dev:arm64 libgpiod-dev:arm64 libsystemd-dev:arm64
   libmosquitto-dev:arm64 libsocketcan-dev:arm64
 )
 case "$set_name" in

@@ -507,7 +507,7 @@ def print_figures(out):
               f"{c.get('bad')} wrong, {c.get('late')} polls sent a period late, "
               f"round trip p50 {c.get('rtt_p50_ms') or 0:.2f} ms p99 {c.get('rtt_p99_ms') or 0:.2f}"
               f" ms; the server: {m.get('requests')} requests, {m.get('most_clients_at_once')} "
-              f"clients at once, {m.get('connections_refused')} refused")
+              f"clients at once, {m.get('closed_for_room')} closed for a new one")
         print(f"loaded: MQTT broker stalled at {e.get('broker_stall_s', 0):.0f} s, dropped at "
               f"{e.get('broker_drop_s', 0):.0f} s, back at {e.get('broker_restart_s', 0):.0f} s; "
               f"the box: {q.get('connections_lost')} connections lost, "

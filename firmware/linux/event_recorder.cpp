@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <limits>
 
 #include "plinth/hal/candump_log.h"
 #include "plinth/host/input_error.h"
@@ -148,8 +149,9 @@ void EventRecorder::start_piece(bool continuation) {
   window_dropped_ = 0;
 }
 
-void EventRecorder::on_frame(const hal::TimedFrame& frame) {
-  ring_[ring_next_] = frame;
+void EventRecorder::on_frame(const hal::TimedFrame& frame, std::uint64_t lost_before) {
+  const RecordedFrame recorded{frame, lost_before};
+  ring_[ring_next_] = recorded;
   ring_next_ = (ring_next_ + 1) % ring_.size();
   if (ring_count_ < ring_.size()) ++ring_count_;
   if (!window_open_) return;
@@ -170,7 +172,7 @@ void EventRecorder::on_frame(const hal::TimedFrame& frame) {
     }
     start_piece(true);
   }
-  active_->frames.push_back(frame);
+  active_->frames.push_back(recorded);
 }
 
 void EventRecorder::trigger(const TriggerInfo& info, std::int64_t time_ns) {
@@ -196,14 +198,16 @@ void EventRecorder::trigger(const TriggerInfo& info, std::int64_t time_ns) {
   const std::size_t first = (ring_next_ + ring_.size() - ring_count_) % ring_.size();
   const std::int64_t window_start_ns = time_ns - pre_ns_;
   for (std::size_t i = 0; i < ring_count_; ++i) {
-    const hal::TimedFrame& f = ring_[(first + i) % ring_.size()];
-    if (f.timestamp_ns >= window_start_ns && active_->frames.size() < active_->frames.capacity()) {
+    const RecordedFrame& f = ring_[(first + i) % ring_.size()];
+    if (f.timed.timestamp_ns >= window_start_ns &&
+        active_->frames.size() < active_->frames.capacity()) {
       active_->frames.push_back(f);
     }
   }
   // A full ring whose oldest frame is inside the window has written over the window's start.
-  if (ring_count_ == ring_.size() && ring_[first].timestamp_ns > window_start_ns) {
-    active_->pre_trigger_cut_ns = ring_[first].timestamp_ns - window_start_ns;
+  const std::int64_t oldest_ns = ring_[first].timed.timestamp_ns;
+  if (ring_count_ == ring_.size() && oldest_ns > window_start_ns) {
+    active_->pre_trigger_cut_ns = oldest_ns - window_start_ns;
   }
 }
 
@@ -437,22 +441,40 @@ void EventRecorder::write(Capture& c) {
   }
   std::string log;
   log.reserve(c.frames.size() * kLogLineBytes);
-  for (const hal::TimedFrame& f : c.frames) {
-    log += hal::format_candump_line(f.timestamp_ns, settings_.interface_name, f.frame);
+  // Frames the input lost: DROPCOUNT lines as candump writes them, before the frame that came
+  // next, their total counted from the capture's start (candump's counters are 32-bit: a larger
+  // loss takes several lines).
+  std::uint64_t input_lost = 0;
+  std::uint64_t input_loss_lines = 0;
+  std::uint32_t input_lost_total = 0;
+  for (const RecordedFrame& f : c.frames) {
+    for (std::uint64_t left = f.lost_before; left > 0;) {
+      const auto count = static_cast<std::uint32_t>(
+          std::min<std::uint64_t>(left, std::numeric_limits<std::uint32_t>::max()));
+      input_lost_total += count;  // wraps as candump's does
+      log += hal::format_candump_drop_line(count, settings_.interface_name, input_lost_total);
+      log += '\n';
+      left -= count;
+      ++input_loss_lines;
+    }
+    input_lost += f.lost_before;
+    log += hal::format_candump_line(f.timed.timestamp_ns, settings_.interface_name, f.timed.frame);
     log += '\n';
   }
   const auto seconds = [](std::int64_t ns) { return static_cast<double>(ns) * 1e-9; };
-  const double first = c.frames.empty() ? 0.0 : seconds(c.frames.front().timestamp_ns);
-  const double last = c.frames.empty() ? 0.0 : seconds(c.frames.back().timestamp_ns);
+  const double first = c.frames.empty() ? 0.0 : seconds(c.frames.front().timed.timestamp_ns);
+  const double last = c.frames.empty() ? 0.0 : seconds(c.frames.back().timed.timestamp_ns);
   const bool truncated = c.frames_dropped > 0 || c.pre_trigger_cut_ns > 0;
-  char numbers[512];
+  char numbers[640];
   std::snprintf(numbers, sizeof numbers,
                 "\"t\":%.6f,\"frames\":%zu,\"first_frame_time\":%.6f,\"last_frame_time\":%.6f,"
                 "\"pre_trigger_s\":%g,\"post_trigger_s\":%g,\"truncated\":%s,"
-                "\"frames_dropped\":%llu,\"pre_trigger_cut_s\":%.6f",
+                "\"frames_dropped\":%llu,\"pre_trigger_cut_s\":%.6f,\"input_frames_lost\":%llu,"
+                "\"input_loss_reports\":%llu",
                 c.info.t, c.frames.size(), first, last, settings_.pre_trigger_s,
                 settings_.post_trigger_s, truncated ? "true" : "false", ull(c.frames_dropped),
-                static_cast<double>(c.pre_trigger_cut_ns) * 1e-9);
+                static_cast<double>(c.pre_trigger_cut_ns) * 1e-9, ull(input_lost),
+                ull(input_loss_lines));
   std::string error = "no free capture number";
   WriteOutcome outcome = WriteOutcome::kNameTaken;
   std::uint64_t index = 0;

@@ -8,7 +8,9 @@
 // and a trigger while both buffers are busy are counted and said, never silently lost. The
 // folder (capture_store.h) is locked against another box, checked and recreated, and kept to
 // its retention limit at start, after each capture and when a capture does not fit. status()
-// gives its health to the outputs (docs/monitor.md, "Event recorder").
+// gives its health to the outputs (docs/monitor.md, "Event recorder"). Frames the input lost (a
+// live socket's overflow, a replayed log's DROPCOUNT lines) go into the capture as candump writes
+// them: a DROPCOUNT line before the next frame, and a count in its JSON.
 #pragma once
 
 #include <atomic>
@@ -66,8 +68,8 @@ class EventRecorder {
   EventRecorder(const EventRecorder&) = delete;
   EventRecorder& operator=(const EventRecorder&) = delete;
 
-  // Real-time side.
-  void on_frame(const hal::TimedFrame& frame);
+  // Real-time side. `lost_before`: frames the input lost just before this one.
+  void on_frame(const hal::TimedFrame& frame, std::uint64_t lost_before = 0);
   void trigger(const TriggerInfo& info, std::int64_t time_ns);
   // The input ended: the capture in progress is written with what it has.
   void flush();
@@ -93,9 +95,13 @@ class EventRecorder {
   [[nodiscard]] std::vector<std::string> written_paths();
 
  private:
+  struct RecordedFrame {
+    hal::TimedFrame timed;
+    std::uint64_t lost_before = 0;  // frames the input lost just before it
+  };
   // One capture: a window, or a piece of a window longer than a buffer.
   struct Capture {
-    std::vector<hal::TimedFrame> frames;  // capacity reserved once
+    std::vector<RecordedFrame> frames;    // capacity reserved once
     TriggerInfo info;                     // the window's first trigger
     std::int64_t trigger_ns = 0;
     bool reached_alarm = false;           // the window reached the alarm level by this piece's end
@@ -127,7 +133,7 @@ class EventRecorder {
   EventRecorderSettings settings_;
   std::int64_t pre_ns_ = 0;
   std::int64_t post_ns_ = 0;
-  std::vector<hal::TimedFrame> ring_;
+  std::vector<RecordedFrame> ring_;
   std::size_t ring_next_ = 0;
   std::size_t ring_count_ = 0;
   Capture buffers_[2];

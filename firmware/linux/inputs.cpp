@@ -28,6 +28,7 @@ using host::InputError;
 constexpr std::int64_t kLogTickNs = 10'000'000;          // ticks inside a log's gaps: timeouts
 constexpr int kBusReceiveTimeoutMs = 10;                 // the live loop ticks at least this often
 constexpr std::int64_t kBusFaultHoldNs = 2'000'000'000;  // after the latest report
+constexpr auto kInputFaultHoldNs = static_cast<std::int64_t>(kInputFaultHoldS * 1e9);
 
 // A record replayed sample by sample after the quiet lead-in (record_replay.h), so that the
 // estimator starts at the record's first sample and replay equals plinth-sim.
@@ -80,20 +81,25 @@ class RecordInput final : public MonitorInput {
 };
 
 // A candump log's frames at their logged times, with ticks inside its gaps (timeouts), and the
-// time policy of inputs.h: frames stamped back or still are counted and dropped, gaps beyond
-// kMaxLogGapS counted and not ticked through; each raises the input fault.
+// policies of inputs.h: frames stamped back or still are counted and dropped, gaps beyond
+// kMaxLogGapS counted and not ticked through, frames the log lost (DROPCOUNT) counted; each
+// raises the input fault.
 class LogInput final : public MonitorInput {
  public:
-  LogInput(hal::CandumpLogReader reader, double speed, hal::LogTimePolicy policy,
-           const volatile std::sig_atomic_t& stop)
-      : reader_(std::move(reader)), pacer_(speed), policy_(policy), stop_(stop) {}
+  LogInput(hal::CandumpLogReader reader, double speed, hal::LogPolicy time_policy,
+           hal::LogPolicy drop_policy, const volatile std::sig_atomic_t& stop)
+      : reader_(std::move(reader)),
+        pacer_(speed),
+        time_policy_(time_policy),
+        drop_policy_(drop_policy),
+        stop_(stop) {}
 
   bool next(InputItem& item) override {
     if (!pending_ && !read_frame()) return false;
-    if (fault_change_) {
-      fault_change_ = false;
+    if (fault_told_ != (fault_until_ns_ != 0)) {
+      fault_told_ = fault_until_ns_ != 0;
       item.kind = InputItem::Kind::kBusFault;
-      item.bus_fault = fault_until_ns_ != 0;
+      item.bus_fault = fault_told_;
       return true;
     }
     if (next_tick_ns_ < frame_.timestamp_ns) {
@@ -104,12 +110,15 @@ class LogInput final : public MonitorInput {
     }
     item.kind = InputItem::Kind::kFrame;
     item.frame = frame_;
+    item.lost_before = lost_before_;
+    lost_before_ = 0;
     pending_ = false;
     return true;
   }
 
   [[nodiscard]] const std::string& source() const override { return reader_.path(); }
   [[nodiscard]] InputTimeCounters time_counters() const override { return time_; }
+  [[nodiscard]] InputDropCounters drop_counters() const override { return drops_; }
 
  private:
   // The next classic standard frame (others are not ours) with a usable time, paced to it.
@@ -118,6 +127,7 @@ class LogInput final : public MonitorInput {
       const hal::IoStatus status = reader_.receive(frame_, 0);
       if (status == hal::IoStatus::kEndOfInput) return false;
       if (status == hal::IoStatus::kIoError) throw InputError(reader_.error());  // file:line
+      if (status == hal::IoStatus::kOverflow) take_drop_count();
       if (status != hal::IoStatus::kOk) continue;  // extended, RTR, FD, error frames: not ours
       if (usable_time()) break;
     }
@@ -126,9 +136,12 @@ class LogInput final : public MonitorInput {
       next_tick_ns_ = frame_.timestamp_ns + kLogTickNs;
       pacer_.start();
     }
-    if (fault_until_ns_ != 0 && frame_.timestamp_ns > fault_until_ns_) {
-      fault_until_ns_ = 0;
-      fault_change_ = true;
+    if (fault_until_ns_ != 0 && frame_.timestamp_ns > fault_until_ns_) fault_until_ns_ = 0;
+    // A loss, as a live box sees its socket's overflow: reported with the first frame after
+    // it, the fault raised before that frame and the ticks up to it (BusInput ticks at the
+    // newest frame's time), held kInputFaultHoldS from that frame.
+    if (lost_before_ > 0) {
+      fault_until_ns_ = std::max(fault_until_ns_, frame_.timestamp_ns + kInputFaultHoldNs);
     }
     time_check_.take(frame_.timestamp_ns, frame_.frame.id);
     pending_ = true;
@@ -143,7 +156,7 @@ class LogInput final : public MonitorInput {
     if (step.problem == hal::LogTimeProblem::kNone) return true;
     const std::string what = reader_.path() + ":" + std::to_string(reader_.line_number()) + ": " +
                              time_check_.describe(step, t);
-    if (policy_ == hal::LogTimePolicy::kRefuse) throw InputError(what + " (--log-time refuse)");
+    if (time_policy_ == hal::LogPolicy::kRefuse) throw InputError(what + " (--log-time refuse)");
     const std::int64_t max_gap_ns = std::llround(kMaxLogGapS * 1e9);
     switch (step.problem) {
       case hal::LogTimeProblem::kWentBack: ++time_.went_back; break;
@@ -159,14 +172,32 @@ class LogInput final : public MonitorInput {
                                                       : "");
     }
     if (time_.first.empty()) time_.first = what;
-    if (fault_until_ns_ == 0) fault_change_ = true;
-    fault_until_ns_ = std::max(t, time_check_.previous_ns()) + std::llround(kInputFaultHoldS * 1e9);
+    fault_until_ns_ = std::max(t, time_check_.previous_ns()) + kInputFaultHoldNs;
     return step.problem == hal::LogTimeProblem::kJumped;  // given; one back or still is not
+  }
+
+  // A DROPCOUNT line: counted and named (the first kLogDropWarnings), its frames lost before
+  // the next frame; or, refused, the end of the run.
+  void take_drop_count() {
+    const std::string what = reader_.path() + ":" + std::to_string(reader_.line_number()) + ": " +
+                             hal::describe_candump_drop(reader_.last_line());
+    if (drop_policy_ == hal::LogPolicy::kRefuse) throw InputError(what + " (--log-drops refuse)");
+    ++drops_.reports;
+    drops_.frames += reader_.dropped_frames();
+    lost_before_ += reader_.dropped_frames();
+    if (drops_.reports <= kLogDropWarnings) {
+      std::fprintf(stderr, "plinth-monitor: warning: %s%s\n", what.c_str(),
+                   drops_.reports == kLogDropWarnings
+                       ? " (further ones are counted in the summary)"
+                       : "");
+    }
+    if (drops_.first.empty()) drops_.first = what;
   }
 
   hal::CandumpLogReader reader_;
   hal::Pacer pacer_;
-  hal::LogTimePolicy policy_;
+  hal::LogPolicy time_policy_;
+  hal::LogPolicy drop_policy_;
   const volatile std::sig_atomic_t& stop_;
   hal::TimedFrame frame_;
   bool pending_ = false;  // frame_ is read, not yet given
@@ -174,8 +205,10 @@ class LogInput final : public MonitorInput {
   std::int64_t next_tick_ns_ = 0;
   hal::LogTimeCheck time_check_;  // the latest usable frame's time, and each identifier's
   std::int64_t fault_until_ns_ = 0;                                     // 0: no input fault held
-  bool fault_change_ = false;  // the fault is to be raised or cleared before the frame
+  bool fault_told_ = false;  // the fault as the monitor has it (a change goes before the frame)
   InputTimeCounters time_;
+  InputDropCounters drops_;
+  std::uint64_t lost_before_ = 0;  // frames lost (DROPCOUNT) before frame_
 };
 
 // A live SocketCAN bus. After each receive (at most kBusReceiveTimeoutMs): the frame, or the
@@ -254,10 +287,13 @@ class BusInput final : public MonitorInput {
         last_frame_ns_ = frame_.timestamp_ns;
         item.kind = InputItem::Kind::kFrame;
         item.frame = frame_;
+        item.lost_before = lost_before_;
+        lost_before_ = 0;
         return true;
       case hal::IoStatus::kBusError:
       case hal::IoStatus::kOverflow:
         ++(status_ == hal::IoStatus::kBusError ? counters_.bus_errors : counters_.overflows);
+        if (status_ == hal::IoStatus::kOverflow) lost_before_ += port_.dropped_frames();
         fault_until_ns_ = now_ns_ + kBusFaultHoldNs;
         item.kind = InputItem::Kind::kBusFault;
         item.bus_fault = true;
@@ -282,6 +318,7 @@ class BusInput final : public MonitorInput {
   std::int64_t now_ns_ = 0;
   std::int64_t last_frame_ns_ = 0;   // receive time of the newest frame
   std::int64_t fault_until_ns_ = 0;  // 0: no bus fault held
+  std::uint64_t lost_before_ = 0;    // the kernel's drops before the next frame
   BusCounters counters_;
 };
 
@@ -320,7 +357,8 @@ std::unique_ptr<MonitorInput> open_input(const InputOptions& opt, MonitorConfig&
     hal::CandumpLogReaderOpenResult opened = hal::CandumpLogReader::open(opt.replay_path);
     if (!opened.ok()) throw InputError(opened.message);
     return std::make_unique<LogInput>(std::move(*opened.reader), opt.speed,
-                                      opt.log_time.value_or(hal::LogTimePolicy::kWarn), stop);
+                                      opt.log_time.value_or(hal::LogPolicy::kWarn),
+                                      opt.log_drops.value_or(hal::LogPolicy::kWarn), stop);
   }
   hal::SocketCanOpenResult opened = hal::SocketCanPort::open(opt.can_interface);
   if (!opened.ok()) throw InputError(opened.message);

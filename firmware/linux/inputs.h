@@ -32,6 +32,9 @@ struct InputItem {
   bool has_frame = false;
   std::int64_t time_ns = 0;
   bool bus_fault = false;
+  // kFrame: frames lost just before this one (the kernel's drops on a live bus, a log's
+  // DROPCOUNT lines), for the event recorder; 0 otherwise.
+  std::uint64_t lost_before = 0;
   // A paced replay's item: the CLOCK_MONOTONIC time it was due at (--latency measures from it
   // too, the wake-up's lateness included); 0 otherwise.
   std::int64_t due_ns = 0;
@@ -62,6 +65,18 @@ struct InputTimeCounters {
   [[nodiscard]] std::uint64_t total() const { return went_back + stood_still + gaps; }
 };
 
+// The frames a log lost (docs/monitor.md, "Frames a log lost"; its DROPCOUNT lines, each the
+// logger's socket overflowing): with --log-drops warn (the default) each is named on stderr (the
+// first kLogDropWarnings, with the line and the count) and raises the bus fault, as a live
+// overflow does, held until kInputFaultHoldS after the next frame. With --log-drops refuse the
+// first one ends the run (host::InputError, the same text).
+inline constexpr std::uint64_t kLogDropWarnings = 10;
+struct InputDropCounters {
+  std::uint64_t reports = 0;  // DROPCOUNT lines
+  std::uint64_t frames = 0;   // the frames they say were lost
+  std::string first;          // "file:line: what" of the first
+};
+
 class MonitorInput {
  public:
   virtual ~MonitorInput() = default;
@@ -73,6 +88,7 @@ class MonitorInput {
   [[nodiscard]] virtual double t_origin() const { return 0.0; }
   [[nodiscard]] virtual BusCounters bus_counters() const { return {}; }
   [[nodiscard]] virtual InputTimeCounters time_counters() const { return {}; }
+  [[nodiscard]] virtual InputDropCounters drop_counters() const { return {}; }
   // Where the monitor's status and alarm frames go; nullptr: nowhere (a replay).
   [[nodiscard]] virtual hal::FrameSink* sink() { return nullptr; }
 };
@@ -88,8 +104,10 @@ struct InputOptions {
   double speed = 0.0;             // replay: a factor of real time; 0: as fast as possible
   double duration_s = 0.0;        // live: stop after this long; 0: at the stop flag only
   bool recorder_frames = false;   // record: also give each sample as its frame
-  // candump log: the policy for its time (above); not given: warn. Refused for other inputs.
-  std::optional<hal::LogTimePolicy> log_time;
+  // candump log: the policies for its time and for the frames it lost (above); not given:
+  // warn. Refused for other inputs.
+  std::optional<hal::LogPolicy> log_time;
+  std::optional<hal::LogPolicy> log_drops;
 };
 
 // A replay file that is a candump log (.log), not a record.

@@ -87,7 +87,7 @@ constexpr std::array<Point, kPointCount> kPoints = {{
     word(reg::kCommands, "commands", "",
          "operator commands carried out (acknowledge and reset), modulo 65536"),
     word(reg::kAlarmEvents, "alarm_events", "", "alarm events so far, modulo 65536"),
-    word(reg::kMapVersion, "map_version", "", "the version of this map: 7"),
+    word(reg::kMapVersion, "map_version", "", "the version of this map: 8"),
     scaled(reg::kProbability, "probability", "0.0001", "", false, "status.probability",
            "the forecast's probability of a collapse within its horizon, 0 .. 1"),
     word(reg::kForecastAxis, "forecast_axis", "",
@@ -185,6 +185,11 @@ constexpr std::array<Point, kPointCount> kPoints = {{
             "captures, or pieces of one, that never reached the disk"),
     counter(reg::kCapturesTruncated, "captures_truncated", "status.recorder.captures_truncated",
             "captures on disk that miss frames of their window"),
+    word(reg::kTrouble, "trouble", "status.trouble",
+         "the trouble shown beside the level: an input the box does not trust (docs/safety.md)",
+         Codes::kAlarmCause),
+    word(reg::kCollapseHeld, "collapse_held", "",
+         "1 while a collapse is held, until a person states that the statue stands (coil 2)"),
     level_bit(monitor::AlarmLevel::kNormal, "level_normal"),
     level_bit(monitor::AlarmLevel::kAdvisory, "level_advisory"),
     level_bit(monitor::AlarmLevel::kWarning, "level_warning"),
@@ -194,7 +199,12 @@ constexpr std::array<Point, kPointCount> kPoints = {{
                "write 1: acknowledge the latched level (register 3) quoting the latest event's "
                "sequence (register 5); needs modbus.writes"),
     coil_point(coil::kReset, "reset",
-               "write 1: the monitor starts again as at power-up; needs modbus.writes"),
+               "write 1: the monitor starts again with its memory (latch, collapse) restored; "
+               "refused while an alarm is latched and unacknowledged; needs modbus.writes"),
+    coil_point(coil::kStatueStands, "statue_stands",
+               "write 1: a person on site states that the statue stands again, quoting the "
+               "latest event's sequence (register 5); clears a held collapse; needs "
+               "modbus.writes"),
 }};
 
 // The registers follow each other without gaps up to reg::kCount, the discrete inputs are the level codes 0 .. discrete::kCount - 1.
@@ -212,7 +222,7 @@ constexpr bool contiguous() {
   return next == reg::kCount && bits == discrete::kCount;
 }
 static_assert(contiguous());
-static_assert(kMapVersion == 7, "the map_version row says 7");
+static_assert(kMapVersion == 8, "the map_version row says 8");
 
 void put16(std::uint16_t* r, int address, std::uint64_t value) {
   r[address] = static_cast<std::uint16_t>(value & 0xFFFFU);
@@ -418,6 +428,8 @@ void fill(const StatusSnapshot& s, std::uint64_t alarm_events, Image& out) {
   put32(r, reg::kCapturesWritten, recorder.captures_written);
   put32(r, reg::kCapturesLost, recorder.captures_lost);
   put32(r, reg::kCapturesTruncated, recorder.captures_truncated);
+  put16(r, reg::kTrouble, kAlarmCauseCodes.code(s.trouble));
+  put16(r, reg::kCollapseHeld, s.collapse_held ? 1 : 0);
   for (int i = 0; i < discrete::kCount; ++i) {
     out.discrete_inputs[static_cast<std::size_t>(i)] = kAlarmLevelCodes.code(s.level) == i ? 1 : 0;
   }

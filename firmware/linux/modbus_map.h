@@ -24,14 +24,16 @@
 namespace plinth::firmware::modbus {
 
 inline constexpr std::uint16_t kNone = 0xFFFF;  // a register with no value (yet)
-inline constexpr std::uint16_t kMapVersion = 7;  // register 31; 2: holding registers, discrete
+inline constexpr std::uint16_t kMapVersion = 8;  // register 31; 2: holding registers, discrete
                                                  // inputs, causes 10-11, forecast, version;
                                                  // 3: the files' digests; 4 (issue 26's branch):
                                                  // regional alerts (86-101), cause 15; 5: two
                                                  // maps, cause 13 on issue 26's branch, the
                                                  // statue sensor (102-108, cause 14; 86-101
                                                  // reserved) on main; 6: both, no gap; 7: the
-                                                 // event recorder's health (109-116)
+                                                 // event recorder's health (109-116); 8: the
+                                                 // trouble and the held collapse (117-118),
+                                                 // coil 2 statue_stands
 
 template <class Enum>
 struct Code {
@@ -59,7 +61,7 @@ inline constexpr CodeTable<monitor::AlarmLevel, 5> kAlarmLevelCodes{{{
     {monitor::AlarmLevel::kAlarm, 3},
     {monitor::AlarmLevel::kFault, 4},
 }}};
-inline constexpr CodeTable<monitor::AlarmCause, 19> kAlarmCauseCodes{{{
+inline constexpr CodeTable<monitor::AlarmCause, 20> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kNone, 0},
     {monitor::AlarmCause::kRiskThreshold, 1},
     {monitor::AlarmCause::kPhaseChange, 2},
@@ -79,6 +81,7 @@ inline constexpr CodeTable<monitor::AlarmCause, 19> kAlarmCauseCodes{{{
     {monitor::AlarmCause::kStatueSensorFault, 16},
     {monitor::AlarmCause::kRestored, 17},
     {monitor::AlarmCause::kStatueStands, 18},
+    {monitor::AlarmCause::kCommissioningFailed, 19},
 }}};
 inline constexpr CodeTable<Phase, 7> kPhaseCodes{{{
     {Phase::kFullContact, 0},
@@ -115,6 +118,7 @@ inline constexpr CodeTable<monitor::RegionalRefusal, monitor::kRegionalRefusalCo
         {monitor::RegionalRefusal::kDuplicate, 7},
         {monitor::RegionalRefusal::kOutOfOrder, 8},
         {monitor::RegionalRefusal::kNoRoom, 9},
+        {monitor::RegionalRefusal::kUnauthenticated, 10},
     }}};
 
 inline constexpr CodeTable<RecorderHealth, 3> kRecorderHealthCodes{{{
@@ -238,7 +242,11 @@ inline constexpr int kRecorderProblem = 110;
 inline constexpr int kCapturesWritten = 111;
 inline constexpr int kCapturesLost = 113;
 inline constexpr int kCapturesTruncated = 115;
-inline constexpr int kCount = 117;
+// The safety rule's (docs/safety.md): the trouble shown beside the level (an input the box
+// does not trust: kAlarmCauseCodes, 0 none), and 1 while a collapse is held.
+inline constexpr int kTrouble = 117;
+inline constexpr int kCollapseHeld = 118;
+inline constexpr int kCount = 119;
 }  // namespace reg
 
 // Discrete inputs (function 02): one per alarm level, 1 while that level is shown (exactly one
@@ -251,7 +259,8 @@ inline constexpr int kCount = 5;
 namespace coil {
 inline constexpr int kAcknowledge = 0;  // acknowledge the latched level (registers 3 and 5)
 inline constexpr int kReset = 1;        // start the monitor again as at power-up
-inline constexpr int kCount = 2;
+inline constexpr int kStatueStands = 2;  // a person on site states that the statue stands
+inline constexpr int kCount = 3;
 }  // namespace coil
 
 enum class Table : std::uint8_t { kRegister, kDiscreteInput, kCoil };
@@ -296,7 +305,7 @@ struct Point {
 };
 
 // The rows, in the CSV's order: registers, discrete inputs, coils, each by address.
-inline constexpr std::size_t kPointCount = 69;
+inline constexpr std::size_t kPointCount = 72;
 [[nodiscard]] const std::array<Point, kPointCount>& points();
 
 // The values the server answers with.

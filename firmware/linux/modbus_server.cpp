@@ -1,18 +1,16 @@
 #include "modbus_server.h"
 
-#include <modbus/modbus.h>
+#include <fcntl.h>
 #include <netdb.h>
-#include <sys/select.h>
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <poll.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <array>
 #include <cerrno>
-#include <cmath>
 #include <cstring>
-#include <vector>
 
-#include "modbus_map.h"
 #include "plinth/host/input_error.h"
 #include "socket_activation.h"
 #include "status_json.h"
@@ -21,39 +19,19 @@ namespace plinth::firmware {
 
 namespace {
 
-constexpr int kSelectTimeoutUs = 20'000;  // how soon the thread sees stop() and new snapshots
+constexpr int kPollTimeoutMs = 20;    // how soon the thread sees stop() and new snapshots
+constexpr int kFramesPerTurn = 4;     // a client's frames answered before the next client's
+// Connections taken each turn: every client's bytes are read between two such, so a client
+// that connects and asks at once is answered (and kept) before newer connections can push it
+// out as the idlest.
+constexpr int kAcceptsPerTurn = 2;
+constexpr int kListenBacklog = 64;
 
-bool is_coil_write(int function) {
-  return function == MODBUS_FC_WRITE_SINGLE_COIL || function == MODBUS_FC_WRITE_MULTIPLE_COILS;
-}
+std::int64_t ns_of(double seconds) { return static_cast<std::int64_t>(seconds * 1e9); }
 
-// The registers are read-only (the holding registers mirror the input registers).
-bool is_register_write(int function) {
-  switch (function) {
-    case MODBUS_FC_WRITE_SINGLE_REGISTER:
-    case MODBUS_FC_WRITE_MULTIPLE_REGISTERS:
-    case MODBUS_FC_MASK_WRITE_REGISTER:
-    case MODBUS_FC_WRITE_AND_READ_REGISTERS:
-      return true;
-    default:
-      return false;
-  }
-}
-
-// Resolves `endpoint` as the server will bind it, for a clear message before libmodbus's.
-void check_resolves(const Endpoint& endpoint, const std::string& where) {
-  addrinfo hints{};
-  hints.ai_family = AF_UNSPEC;
-  hints.ai_socktype = SOCK_STREAM;
-  hints.ai_flags = AI_PASSIVE;
-  addrinfo* list = nullptr;
-  const int rc =
-      getaddrinfo(endpoint.host.c_str(), std::to_string(endpoint.port).c_str(), &hints, &list);
-  if (rc != 0) {
-    throw host::InputError(where + ": cannot listen at " + endpoint.text() + ": " +
-                           gai_strerror(rc));
-  }
-  freeaddrinfo(list);
+void set_nonblocking(int socket) {
+  const int flags = fcntl(socket, F_GETFL, 0);
+  if (flags >= 0) (void)fcntl(socket, F_SETFL, flags | O_NONBLOCK);
 }
 
 }  // namespace
@@ -62,42 +40,65 @@ ModbusServer::ModbusServer(const ModbusSettings& settings, const RunIdentity& id
     : settings_(settings) {
   modbus::fill_identity(identity, image_);
   const Endpoint endpoint = parse_endpoint(settings.listen, settings.listen_where);
-  check_resolves(endpoint, settings.listen_where);
-  const std::string port = std::to_string(endpoint.port);
-  context_ = modbus_new_tcp_pi(endpoint.host.c_str(), port.c_str());
-  if (context_ == nullptr) {
-    throw host::InputError(settings.listen_where + ": cannot listen at " + endpoint.text() + ": " +
-                           modbus_strerror(errno));
+  for (const std::string& text : settings.write_from) {
+    std::optional<AddressPrefix> prefix = parse_address_prefix(text);
+    if (!prefix) {
+      throw host::InputError("modbus.write_from: \"" + text +
+                             "\" is not an address or ADDRESS/BITS prefix");
+    }
+    writers_.push_back(*prefix);
   }
   // Under systemd, the socket unit's listening socket (port 502 without privileges); else ours.
   listen_socket_ = inherited_listening_socket("modbus", endpoint.port, settings.listen_where);
-  if (listen_socket_ < 0) listen_socket_ = modbus_tcp_pi_listen(context_, settings.max_clients);
-  if (listen_socket_ < 0) {
-    const int error = errno;
-    modbus_free(context_);
-    context_ = nullptr;
-    throw host::InputError(settings.listen_where + ": cannot listen at " + endpoint.text() + ": " +
-                           std::strerror(error) +
-                           (error == EADDRINUSE ? " (another program has the port)" : ""));
-  }
-  // A client that stops in the middle of a request holds the thread for at most this long.
-  modbus_set_indication_timeout(context_, 1, 0);
-  map_ = modbus_mapping_new_start_address(0, modbus::coil::kCount, 0, modbus::discrete::kCount, 0,
-                                          modbus::reg::kCount, 0, modbus::reg::kCount);
-  if (map_ == nullptr) {
-    close(listen_socket_);
-    modbus_free(context_);
-    throw host::InputError(settings.listen_where + ": no memory for the register map");
-  }
+  if (listen_socket_ < 0) listen_at(endpoint.host, endpoint.port);
+  set_nonblocking(listen_socket_);
   publish_image();
   thread_ = std::thread([this] { serve(); });
 }
 
 ModbusServer::~ModbusServer() {
   stop();
-  if (map_ != nullptr) modbus_mapping_free(map_);
+  for (const Client& c : clients_) close(c.socket);
   if (listen_socket_ >= 0) close(listen_socket_);
-  if (context_ != nullptr) modbus_free(context_);
+}
+
+// Binds the first of `host`'s addresses that takes the port (as a server does for "localhost",
+// which resolves to ::1 and 127.0.0.1).
+void ModbusServer::listen_at(const std::string& host, int port) {
+  const std::string text = Endpoint{host, port}.text();
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE;
+  addrinfo* list = nullptr;
+  const int rc = getaddrinfo(host.empty() ? nullptr : host.c_str(), std::to_string(port).c_str(),
+                             &hints, &list);
+  if (rc != 0) {
+    throw host::InputError(settings_.listen_where + ": cannot listen at " + text + ": " +
+                           gai_strerror(rc));
+  }
+  int error = 0;
+  for (const addrinfo* a = list; a != nullptr && listen_socket_ < 0; a = a->ai_next) {
+    const int s = socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (s < 0) {
+      error = errno;
+      continue;
+    }
+    const int on = 1;
+    (void)setsockopt(s, SOL_SOCKET, SO_REUSEADDR, &on, sizeof on);
+    if (bind(s, a->ai_addr, a->ai_addrlen) == 0 && listen(s, kListenBacklog) == 0) {
+      listen_socket_ = s;
+    } else {
+      error = errno;
+      close(s);
+    }
+  }
+  freeaddrinfo(list);
+  if (listen_socket_ < 0) {
+    throw host::InputError(settings_.listen_where + ": cannot listen at " + text + ": " +
+                           std::strerror(error) +
+                           (error == EADDRINUSE ? " (another program has the port)" : ""));
+  }
 }
 
 void ModbusServer::stop() {
@@ -108,93 +109,187 @@ void ModbusServer::stop() {
 // The newest snapshot into the registers; alarm events counted.
 void ModbusServer::refresh() {
   AlarmNotice notice;
-  while (mailbox_.take_alarm(notice)) ++alarm_events_;
-  (void)mailbox_.take_status(snapshot_);
-  publish_image();
+  bool changed = false;
+  while (mailbox_.take_alarm(notice)) {
+    ++alarm_events_;
+    changed = true;
+  }
+  if (mailbox_.take_status(snapshot_)) changed = true;
+  if (changed) publish_image();
 }
 
-// The snapshot into the input registers, the holding registers (the same) and the discrete
-// inputs.
-void ModbusServer::publish_image() {
-  modbus::fill(snapshot_, alarm_events_, image_);
-  std::copy(image_.registers.begin(), image_.registers.end(), map_->tab_input_registers);
-  std::copy(image_.registers.begin(), image_.registers.end(), map_->tab_registers);
-  std::copy(image_.discrete_inputs.begin(), image_.discrete_inputs.end(), map_->tab_input_bits);
-}
+void ModbusServer::publish_image() { modbus::fill(snapshot_, alarm_events_, image_); }
 
 void ModbusServer::serve() {
-  std::vector<int> clients;
+  std::vector<pollfd> polled;
+  bool more = false;  // a client holds whole frames not answered yet: look again at once
   while (!stopping_.load(std::memory_order_relaxed)) {
     refresh();
-    fd_set readable;
-    FD_ZERO(&readable);
-    FD_SET(listen_socket_, &readable);
-    int highest = listen_socket_;
-    for (const int c : clients) {
-      FD_SET(c, &readable);
-      highest = std::max(highest, c);
+    polled.assign(1, pollfd{listen_socket_, POLLIN, 0});
+    for (const Client& c : clients_) polled.push_back({c.socket, POLLIN, 0});
+    if (poll(polled.data(), polled.size(), more ? 0 : kPollTimeoutMs) < 0 && errno != EINTR) {
+      break;
     }
-    timeval timeout{0, kSelectTimeoutUs};
-    if (select(highest + 1, &readable, nullptr, nullptr, &timeout) <= 0) continue;
-    if (FD_ISSET(listen_socket_, &readable)) {
-      int listener = listen_socket_;
-      const int client = modbus_tcp_pi_accept(context_, &listener);
-      if (client >= 0 && static_cast<int>(clients.size()) >= settings_.max_clients) {
-        close(client);
-        ++connections_refused_;
-      } else if (client >= 0) {
-        clients.push_back(client);
-        ++connections_;
-        max_clients_seen_ = std::max(max_clients_seen_, static_cast<int>(clients.size()));
+    const std::int64_t now = monotonic_ns();
+    more = false;
+    // Clients first (the indexes of `polled` are theirs), then new connections.
+    for (std::size_t i = clients_.size(); i-- > 0;) {
+      Client& c = clients_[i];
+      Closed closed = Closed::kNo;
+      if ((polled[i + 1].revents & (POLLIN | POLLHUP | POLLERR)) != 0) closed = read_from(c, now);
+      if (closed == Closed::kNo) {
+        refresh();
+        bool client_more = false;
+        closed = answer_frames(c, now, client_more);
+        more = more || client_more;
       }
+      if (closed != Closed::kNo) close_client(i);
     }
-    for (auto it = clients.begin(); it != clients.end();) {
-      if (FD_ISSET(*it, &readable) && !answer(*it)) {
-        close(*it);
-        it = clients.erase(it);
-      } else {
-        ++it;
-      }
-    }
+    if ((polled[0].revents & POLLIN) != 0) accept_clients(now);
+    close_expired(now);
   }
-  for (const int c : clients) close(c);
 }
 
-// One request of the client on `socket`; false when the connection ended.
-bool ModbusServer::answer(int socket) {
-  std::array<std::uint8_t, MODBUS_TCP_MAX_ADU_LENGTH> query{};
-  modbus_set_socket(context_, socket);
-  const int length = modbus_receive(context_, query.data());
-  if (length < 0) return false;
-  if (length == 0) return true;  // not for this unit
-  ++requests_;
-  const int function = query[static_cast<std::size_t>(modbus_get_header_length(context_))];
-  if (is_register_write(function) || (is_coil_write(function) && !settings_.writes)) {
-    ++writes_refused_;
-    return modbus_reply_exception(context_, query.data(), MODBUS_EXCEPTION_ILLEGAL_FUNCTION) >= 0;
+// Pending connections (kAcceptsPerTurn): a slot made for each (make_room), never a refusal.
+void ModbusServer::accept_clients(std::int64_t now_ns) {
+  for (int taken = 0; taken < kAcceptsPerTurn; ++taken) {
+    Client c;
+    socklen_t length = sizeof c.peer;
+    c.socket = accept4(listen_socket_, reinterpret_cast<sockaddr*>(&c.peer), &length,
+                       SOCK_NONBLOCK | SOCK_CLOEXEC);
+    if (c.socket < 0) return;  // EAGAIN: none left (or a transient error: next turn)
+    const int on = 1;
+    (void)setsockopt(c.socket, IPPROTO_TCP, TCP_NODELAY, &on, sizeof on);
+    c.may_write = settings_.writes && std::any_of(writers_.begin(), writers_.end(),
+                                                  [&](const AddressPrefix& p) {
+                                                    return p.contains(c.peer);
+                                                  });
+    c.connected_ns = now_ns;
+    if (static_cast<int>(clients_.size()) >= settings_.max_clients) make_room();
+    clients_.push_back(c);
+    ++connections_;
+    max_clients_seen_ = std::max(max_clients_seen_, static_cast<int>(clients_.size()));
   }
-  refresh();
-  if (modbus_reply(context_, query.data(), length, map_) < 0) return false;
-  if (is_coil_write(function)) act_on_coils();
-  return true;
 }
 
-// A coil written 1 becomes the loop's command; the coils read 0 again.
-void ModbusServer::act_on_coils() {
-  std::uint8_t* coils = map_->tab_bits;
-  for (const int coil : {modbus::coil::kAcknowledge, modbus::coil::kReset}) {
-    if (coils[coil] == 0) continue;
-    coils[coil] = 0;
-    CommandRequest request;
-    request.command =
-        coil == modbus::coil::kReset ? OperatorCommand::kReset : OperatorCommand::kAcknowledge;
-    request.level = snapshot_.latched;
-    request.event_sequence = snapshot_.event_sequence;
-    if (mailbox_.post_command(request)) {
-      ++commands_posted_;
+// Closes one client to take a new one: from the address that holds the most connections (one
+// host cannot starve the others), the one never answered that connected first, else the one
+// idle longest: a client that only connects, or only sends what is refused, gives its slot up
+// before one the box has served.
+void ModbusServer::make_room() {
+  const auto same_host = [](const Client& a, const Client& b) {
+    return AddressPrefix::same_address(a.peer, b.peer);
+  };
+  const auto rank = [](const Client& c) {
+    return std::pair<bool, std::int64_t>(c.answered, std::max(c.connected_ns, c.last_request_ns));
+  };
+  std::size_t chosen = 0;
+  std::size_t chosen_count = 0;
+  for (std::size_t i = 0; i < clients_.size(); ++i) {
+    const std::size_t count = static_cast<std::size_t>(
+        std::count_if(clients_.begin(), clients_.end(),
+                      [&](const Client& c) { return same_host(c, clients_[i]); }));
+    if (count > chosen_count ||
+        (count == chosen_count && rank(clients_[i]) < rank(clients_[chosen]))) {
+      chosen = i;
+      chosen_count = count;
+    }
+  }
+  ++closed_for_room_;
+  close_client(chosen);
+}
+
+ModbusServer::Closed ModbusServer::read_from(Client& c, std::int64_t now_ns) {
+  if (c.used == c.received.size()) return Closed::kNo;  // whole frames wait: answer them first
+  const ssize_t n = recv(c.socket, c.received.data() + c.used, c.received.size() - c.used, 0);
+  if (n == 0) return Closed::kByPeer;
+  if (n < 0) return errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR ? Closed::kNo
+                                                                                : Closed::kByPeer;
+  if (c.used == 0) c.frame_started_ns = now_ns;
+  c.used += static_cast<std::size_t>(n);
+  return Closed::kNo;
+}
+
+// Up to kFramesPerTurn of the client's whole frames answered; `more` when whole frames (or a
+// fault) remain.
+ModbusServer::Closed ModbusServer::answer_frames(Client& c, std::int64_t now_ns, bool& more) {
+  std::array<std::uint8_t, modbus::kMaxFrameBytes> out{};
+  for (int turn = 0; turn < kFramesPerTurn; ++turn) {
+    const std::span<const std::uint8_t> bytes(c.received.data(), c.used);
+    const modbus::FrameSpan frame = modbus::frame_at(bytes);
+    modbus::Answer a;
+    if (frame.fault != modbus::FrameFault::kNoFault) {
+      a.fault = frame.fault;
+    } else if (frame.bytes == 0) {
+      return Closed::kNo;  // the rest of the frame has not come yet
     } else {
-      ++commands_lost_;
+      ++requests_;
+      c.last_request_ns = now_ns;
+      a = modbus::answer(bytes.first(frame.bytes), image_, c.may_write, out);
     }
+    if (a.fault != modbus::FrameFault::kNoFault) {
+      ++malformed_;
+      refused_log_.say(peer_text(c.peer) + ": not a Modbus frame (" +
+                           modbus::kFrameFaultNames.name(a.fault) + "): connection closed",
+                       now_ns);
+      return Closed::kMalformed;
+    }
+    if (a.exception != modbus::Exception::kNoException) ++exceptions_;
+    if (a.write_refused) {
+      ++writes_refused_;
+      if (settings_.writes && !c.may_write) {
+        refused_log_.say(peer_text(c.peer) + ": coil write refused: not in modbus.write_from",
+                         now_ns);
+      }
+    }
+    if (a.exception == modbus::Exception::kNoException) c.answered = true;
+    const ssize_t sent = send(c.socket, out.data(), a.bytes, MSG_NOSIGNAL | MSG_DONTWAIT);
+    if (sent != static_cast<ssize_t>(a.bytes)) {
+      ++closed_unread_;  // the client does not read its answers (or is gone)
+      return Closed::kSlowReader;
+    }
+    if (a.acknowledge) post_command(OperatorCommand::kAcknowledge);
+    if (a.reset) post_command(OperatorCommand::kReset);
+    if (a.statue_stands) post_command(OperatorCommand::kStatueStands);
+    std::memmove(c.received.data(), c.received.data() + frame.bytes, c.used - frame.bytes);
+    c.used -= frame.bytes;
+    if (c.used > 0) c.frame_started_ns = now_ns;
+  }
+  const modbus::FrameSpan next = modbus::frame_at({c.received.data(), c.used});
+  more = next.bytes > 0 || next.fault != modbus::FrameFault::kNoFault;
+  return Closed::kNo;
+}
+
+// Clients silent for idle_timeout_s, or whose frame stays unfinished for kFrameTimeoutS.
+void ModbusServer::close_expired(std::int64_t now_ns) {
+  for (std::size_t i = clients_.size(); i-- > 0;) {
+    const Client& c = clients_[i];
+    if (c.used > 0 && now_ns - c.frame_started_ns > ns_of(kFrameTimeoutS)) {
+      ++closed_slow_;
+      close_client(i);
+    } else if (now_ns - std::max(c.connected_ns, c.last_request_ns) >
+               ns_of(settings_.idle_timeout_s)) {
+      ++closed_idle_;
+      close_client(i);
+    }
+  }
+}
+
+void ModbusServer::close_client(std::size_t index) {
+  close(clients_[index].socket);
+  clients_.erase(clients_.begin() + static_cast<std::ptrdiff_t>(index));
+}
+
+// A coil written 1 becomes the loop's command, quoting what the box shows.
+void ModbusServer::post_command(OperatorCommand command) {
+  CommandRequest request;
+  request.command = command;
+  request.level = snapshot_.latched;
+  request.event_sequence = snapshot_.event_sequence;
+  if (mailbox_.post_command(request)) {
+    ++commands_posted_;
+  } else {
+    ++commands_lost_;
   }
 }
 
@@ -203,9 +298,14 @@ std::string ModbusServer::summary_json() const {
       .text("listen", settings_.listen)
       .flag("writes", settings_.writes)
       .count("connections", connections_)
-      .count("connections_refused", connections_refused_)
       .count("most_clients_at_once", static_cast<std::uint64_t>(max_clients_seen_))
+      .count("closed_idle", closed_idle_)
+      .count("closed_slow", closed_slow_)
+      .count("closed_for_room", closed_for_room_)
+      .count("closed_unread", closed_unread_)
       .count("requests", requests_)
+      .count("exceptions", exceptions_)
+      .count("malformed", malformed_)
       .count("writes_refused", writes_refused_)
       .count("commands", commands_posted_)
       .count("commands_lost", commands_lost_)

@@ -16,6 +16,8 @@
 #include "plinth/host/limits.h"
 #include "plinth/host/text_file.h"
 #include "plinth/host/toml_names.h"
+#include "address_prefix.h"
+#include "log_text.h"
 #include "status_outputs.h"
 
 namespace plinth::firmware {
@@ -81,6 +83,21 @@ std::function<bool(const toml::node&)> string_into(std::string& target) {
   return [&target](const toml::node& n) {
     if (!n.is_string()) return false;
     target = n.value<std::string>().value_or("");
+    return true;
+  };
+}
+
+// An array of strings (possibly empty).
+std::function<bool(const toml::node&)> strings_into(std::vector<std::string>& target) {
+  return [&target](const toml::node& n) {
+    const toml::array* items = n.as_array();
+    if (items == nullptr) return false;
+    std::vector<std::string> values;
+    for (const toml::node& item : *items) {
+      if (!item.is_string()) return false;
+      values.push_back(item.value<std::string>().value_or(""));
+    }
+    target = std::move(values);
     return true;
   };
 }
@@ -228,7 +245,10 @@ void output_bindings(std::vector<Binding>& b, ModbusSettings& modbus, MqttSettin
   constexpr const char* kEndpoint = "a string, \"HOST:PORT\"";
   b.push_back({"modbus.listen", string_into(modbus.listen), kEndpoint});
   b.push_back({"modbus.writes", flag_into(modbus.writes), "true or false"});
+  b.push_back({"modbus.write_from", strings_into(modbus.write_from),
+               "an array of strings (addresses, \"10.0.4.7\" or \"10.0.4.0/24\")"});
   b.push_back({"modbus.max_clients", integer_into(modbus.max_clients), "an integer"});
+  b.push_back({"modbus.idle_timeout_s", number_into(modbus.idle_timeout_s), "a number"});
   b.push_back({"mqtt.broker", string_into(mqtt.broker), kEndpoint});
   const std::pair<const char*, std::string*> strings[] = {
       {"mqtt.box_id", &mqtt.box_id},
@@ -302,6 +322,26 @@ void pwave_bindings(std::vector<Binding>& b, monitor::PWaveSettings& p, std::str
   for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
 }
 
+// [commissioning] (commission_settings.h).
+void commissioning_bindings(std::vector<Binding>& b, CommissioningSettings& c) {
+  b.push_back({"commissioning.required", flag_into(c.required), "true or false"});
+  b.push_back({"commissioning.report", string_into(c.report), "a string (a report's path)"});
+  b.push_back({"commissioning.override", string_into(c.override_reason), "a string (the reason)"});
+  const std::pair<const char*, double*> numbers[] = {
+      {"commissioning.wedge_deg", &c.wedge_deg},
+      {"commissioning.wedge_tolerance_deg", &c.wedge_tolerance_deg},
+      {"commissioning.heading_tolerance_deg", &c.heading_tolerance_deg},
+      {"commissioning.gravity_tolerance", &c.gravity_tolerance},
+      {"commissioning.level_tolerance_deg", &c.level_tolerance_deg},
+      {"commissioning.statue_min_tilt_deg", &c.statue_min_tilt_deg},
+      {"commissioning.gyro_tolerance", &c.gyro_tolerance},
+      {"commissioning.seat_tolerance_deg", &c.seat_tolerance_deg},
+      {"commissioning.rest_s", &c.rest_s},
+      {"commissioning.hold_s", &c.hold_s},
+  };
+  for (const auto& [key, target] : numbers) b.push_back({key, number_into(*target), "a number"});
+}
+
 std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::string& unit,
                               std::array<bool, kRelayCount>& relay_active_low,
                               monitor::PWaveSettings& pwave, std::string& pwave_channel) {
@@ -344,6 +384,8 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::
   };
   if (auto* regional = monitor::built_part<monitor::RegionalAlertSettings>(c.regional)) {
     regional_bindings(b, *regional);
+    b.push_back({"regional_alert.key_file", string_into(f.regional_key_file),
+                 "a string (a file path)"});
   }
   sensor_bindings(b, "conditioning.", c.conditioning, c.sensor_health, unit);
   statue_bindings(b, c.statue_sensor, statue_node);
@@ -360,6 +402,7 @@ std::vector<Binding> bindings(MonitorFile& f, int& node, int& statue_node, std::
   b.push_back({"recorder.test_pause_mid_write_s", number_into(f.recorder.test_pause_mid_write_s),
                "a number (s; test only)"});
   output_bindings(b, f.modbus, f.mqtt);
+  commissioning_bindings(b, f.commissioning);
   pwave_bindings(b, pwave, pwave_channel);
   using monitor::built_part;
   using monitor::RiskThresholds;
@@ -436,6 +479,12 @@ class KeyLines {
   }
   [[noreturn]] void fail(const std::string& key, const std::string& message) const {
     throw InputError(cat(where(key), ": ", message));
+  }
+  // Every key of the file and where it stands.
+  [[nodiscard]] std::map<std::string, std::string> all_where() const {
+    std::map<std::string, std::string> out;
+    for (const auto& [key, line] : lines_) out[key] = where(key);
+    return out;
   }
 
  private:
@@ -729,11 +778,52 @@ void resolve_path(std::string& path, const std::string& origin) {
   }
 }
 
-// A topic level: not empty, no wildcard; `slashes`: may hold several levels.
-bool topic_part(const std::string& text, bool slashes) {
-  if (text.empty() || text.front() == '/' || text.back() == '/') return false;
-  return text.find_first_of(slashes ? "+#" : "+#/") == std::string::npos &&
-         text.find("//") == std::string::npos;
+// What is wrong with `text` as part of a topic name (mqtt_publisher.h), "" when nothing is: not
+// empty, at most `max_bytes`, UTF-8 without control characters (a NUL would cut the topic short:
+// another box's), no wildcard, no empty level; `levels`: may hold several ("a/b").
+std::string topic_problem(const std::string& text, bool levels, std::size_t max_bytes) {
+  if (text.empty()) return "empty";
+  if (text.size() > max_bytes) {
+    return cat("longer than ", std::to_string(max_bytes), " bytes (", std::to_string(text.size()),
+               ")");
+  }
+  if (std::any_of(text.begin(), text.end(), [](char c) {
+        return static_cast<unsigned char>(c) < 0x20 || c == 0x7F;
+      })) {
+    return "a control character (NUL, newline, ESC, ...)";
+  }
+  if (!valid_utf8(text)) return "not UTF-8";
+  if (text.find_first_of("+#") != std::string::npos) return "a wildcard ('+' or '#')";
+  if (!levels && text.find('/') != std::string::npos) return "a '/' (one topic level only)";
+  if (text.front() == '/' || text.back() == '/' || text.find("//") != std::string::npos) {
+    return "an empty topic level";
+  }
+  return "";
+}
+
+// regional_alert.key_file: its first line, 64 hex digits (32 bytes), is the key every regional
+// alert's HMAC must be made with (regional_alert.h, RegionalAuthentication).
+void read_regional_key(MonitorFile& file, const KeyLines& lines, const std::string& origin) {
+  auto* regional = monitor::built_part<monitor::RegionalAlertSettings>(file.config.regional);
+  if (regional == nullptr || !lines.has("regional_alert.key_file")) return;
+  resolve_path(file.regional_key_file, origin);
+  std::string text = host::read_text_file(file.regional_key_file, 4096,
+                                          "regional_alert.key_file (the alerts' HMAC key)");
+  text = text.substr(0, text.find_first_of("\r\n"));
+  monitor::RegionalAuthentication& auth = regional->authentication;
+  const auto fail = [&] {
+    lines.fail("regional_alert.key_file",
+               cat("regional_alert.key_file: ", file.regional_key_file,
+                   ": expected 64 hex digits (32 bytes, e.g. from `openssl rand -hex 32`) on its "
+                   "first line"));
+  };
+  if (text.size() != 2 * auth.key.size()) fail();
+  for (std::size_t i = 0; i < auth.key.size(); ++i) {
+    const std::string two = text.substr(2 * i, 2);
+    if (two.find_first_not_of("0123456789abcdefABCDEF") != std::string::npos) fail();
+    auth.key[i] = static_cast<std::uint8_t>(std::stoul(two, nullptr, 16));
+  }
+  auth.required = true;
 }
 
 // The [modbus] and [mqtt] keys: addresses, ranges, topic parts; paths resolved.
@@ -751,16 +841,47 @@ void check_outputs(MonitorFile& file, const KeyLines& lines, const std::string& 
     mqtt.broker_where = cat(lines.where("mqtt.broker"), ": mqtt.broker");
     (void)parse_endpoint(mqtt.broker, mqtt.broker_where);
   }
-  if (lines.has("mqtt.box_id") && !topic_part(mqtt.box_id, false)) {
-    lines.fail("mqtt.box_id", "mqtt.box_id: expected one topic level (no '/', '+' or '#')");
+  if (lines.has("mqtt.box_id")) {
+    const std::string problem = topic_problem(mqtt.box_id, false, kMaxBoxIdBytes);
+    if (!problem.empty()) {
+      lines.fail("mqtt.box_id", cat("mqtt.box_id: expected one topic level (no '/', '+' or '#'), ",
+                                    "printable UTF-8 of at most ", std::to_string(kMaxBoxIdBytes),
+                                    " bytes: ", problem));
+    }
   }
-  if (!topic_part(mqtt.topic_prefix, true)) {
-    lines.fail("mqtt.topic_prefix",
-               "mqtt.topic_prefix: expected topic levels (no '+' or '#', no empty level)");
+  for (const auto& [key, value] :
+       {std::pair<const char*, const std::string*>{"mqtt.topic_prefix", &mqtt.topic_prefix},
+        {"mqtt.discovery_prefix", &mqtt.discovery_prefix}}) {
+    const std::string problem = topic_problem(*value, true, kMaxTopicPrefixBytes);
+    if (!problem.empty()) {
+      lines.fail(key, cat(key, ": expected topic levels (no '+' or '#', no empty level): ",
+                          problem));
+    }
   }
-  if (!topic_part(mqtt.discovery_prefix, true)) {
-    lines.fail("mqtt.discovery_prefix",
-               "mqtt.discovery_prefix: expected topic levels (no '+' or '#', no empty level)");
+  if (lines.has("mqtt.regional_topic")) {
+    const std::string problem = topic_problem(mqtt.regional_topic, true, kMaxTopicPrefixBytes);
+    if (!problem.empty()) {
+      lines.fail("mqtt.regional_topic",
+                 cat("mqtt.regional_topic: expected one topic, without wildcards (the box takes "
+                     "alerts from one bridge's topic): ",
+                     problem));
+    }
+    if (!mqtt.regional_alerts) {
+      lines.fail("mqtt.regional_topic",
+                 "mqtt.regional_topic: names the regional alerts' topic, and mqtt.regional_alerts "
+                 "is false (set it to true to take them)");
+    }
+  }
+  for (const std::string& text : modbus.write_from) {
+    if (!parse_address_prefix(text)) {
+      lines.fail("modbus.write_from",
+                 cat("modbus.write_from: \"", printable(text),
+                     "\" is not an address (\"10.0.4.7\", \"::1\") or a prefix (\"10.0.4.0/24\") ",
+                     "with no host bit past it"));
+    }
+  }
+  if (!(modbus.idle_timeout_s >= 1.0 && modbus.idle_timeout_s <= 86400.0)) {
+    lines.fail("modbus.idle_timeout_s", "modbus.idle_timeout_s: must lie in [1, 86400]");
   }
   const auto range = [&](const char* key, double value, double low, double high) {
     if (!(value >= low && value <= high)) {
@@ -845,6 +966,17 @@ MonitorFile load_monitor_text(const std::string& text, const std::string& origin
   if (const toml::node* table = doc.get("pwave")) read_pwave(*table, pwave, pwave_channel, file.config, lines);
   check(file.config, lines);
   check_outputs(file, lines, origin);
+  if (const std::optional<SettingError> e = validate(file.commissioning)) {
+    lines.fail(e->key, e->message);
+  }
+  if (lines.has("commissioning.override") && file.commissioning.override_reason.empty()) {
+    lines.fail("commissioning.override",
+               "commissioning.override: give the reason the box monitors without a passing "
+               "commissioning (it is logged at each start)");
+  }
+  resolve_path(file.commissioning.report, origin);
+  read_regional_key(file, lines, origin);
+  file.key_where = lines.all_where();
   return file;
 }
 
@@ -867,6 +999,46 @@ MonitorFile load_monitor_file(const std::string& path, const MonitorConfig& defa
 
 namespace {
 
+// The keys that turn something on, refused while what they turn on is off (the file's line, or
+// the flag, named): a box file that says `writes = true` and serves no Modbus, or lets coils be
+// written by nobody, is a mistake, not a setting.
+void check_enabling_keys(const MonitorFile& file, const MonitorOverrides& o) {
+  const auto named = [&](const char* key, const char* flag, bool flag_given) {
+    if (flag_given) return std::string(flag);
+    const auto it = file.key_where.find(key);
+    return it == file.key_where.end() ? std::string(key) : cat(it->second, ": ", key);
+  };
+  const ModbusSettings& modbus = file.modbus;
+  if (modbus.listen.empty() && modbus.writes) {
+    throw InputError(cat(named("modbus.writes", "--modbus-writes", o.modbus_writes),
+                         ": lets the Modbus server's coils be written; the server is off "
+                         "(--modbus, or modbus.listen)"));
+  }
+  if (!modbus.write_from.empty() && !modbus.writes) {
+    throw InputError(cat(named("modbus.write_from", "--modbus-write-from",
+                               !o.modbus_write_from.empty()),
+                         ": names who may write the Modbus coils, and writes are off "
+                         "(modbus.writes, --modbus-writes)"));
+  }
+  if (modbus.writes && modbus.write_from.empty()) {
+    throw InputError(cat(named("modbus.writes", "--modbus-writes", o.modbus_writes),
+                         ": needs modbus.write_from (or --modbus-write-from), the addresses that "
+                         "may write the coils: Modbus has no authentication, and a write "
+                         "acknowledges or resets the box's alarm (docs/integration.md)"));
+  }
+  const MqttSettings& mqtt = file.mqtt;
+  if (mqtt.broker.empty()) {
+    for (const auto& [key, on] : {std::pair<const char*, bool>{"mqtt.commands", mqtt.commands},
+                                  {"mqtt.regional_alerts", mqtt.regional_alerts}}) {
+      if (on) {
+        throw InputError(cat(named(key, key, false),
+                             ": turns on a part of the MQTT client, which is off (--mqtt, or "
+                             "mqtt.broker)"));
+      }
+    }
+  }
+}
+
 // The [modbus] and [mqtt] flags over the file's keys.
 void apply_output_overrides(MonitorFile& file, const MonitorOverrides& o) {
   if (!o.modbus_listen.empty()) {
@@ -875,6 +1047,16 @@ void apply_output_overrides(MonitorFile& file, const MonitorOverrides& o) {
     (void)parse_endpoint(o.modbus_listen, "--modbus");
   }
   if (o.modbus_writes) file.modbus.writes = true;
+  if (!o.modbus_write_from.empty()) {
+    for (const std::string& text : o.modbus_write_from) {
+      if (!parse_address_prefix(text)) {
+        throw InputError(cat("--modbus-write-from: \"", printable(text),
+                             "\" is not an address (\"10.0.4.7\", \"::1\") or a prefix "
+                             "(\"10.0.4.0/24\") with no host bit past it"));
+      }
+    }
+    file.modbus.write_from = o.modbus_write_from;
+  }
   MqttSettings& mqtt = file.mqtt;
   if (!o.mqtt_broker.empty()) {
     mqtt.broker = o.mqtt_broker;
@@ -882,9 +1064,11 @@ void apply_output_overrides(MonitorFile& file, const MonitorOverrides& o) {
     (void)parse_endpoint(o.mqtt_broker, "--mqtt");
   }
   if (!o.mqtt_box_id.empty()) {
-    if (!topic_part(o.mqtt_box_id, false)) {
-      throw InputError("--mqtt-box-id: expected one topic level (no '/', '+' or '#'), got \"" +
-                       o.mqtt_box_id + "\"");
+    const std::string problem = topic_problem(o.mqtt_box_id, false, kMaxBoxIdBytes);
+    if (!problem.empty()) {
+      throw InputError(cat("--mqtt-box-id: expected one topic level (no '/', '+' or '#'), ",
+                           "printable UTF-8 of at most ", std::to_string(kMaxBoxIdBytes),
+                           " bytes: ", problem, ", got \"", printable(o.mqtt_box_id, 80), "\""));
     }
     mqtt.box_id = o.mqtt_box_id;
   }
@@ -901,6 +1085,7 @@ void apply_output_overrides(MonitorFile& file, const MonitorOverrides& o) {
     throw InputError("--modbus-writes: lets the Modbus server's coils be written; the server is "
                      "off (--modbus, or modbus.listen in the configuration file)");
   }
+  check_enabling_keys(file, o);
   for (const auto& [option, value] :
        {std::pair<const char*, const std::string*>{"--mqtt-box-id", &o.mqtt_box_id},
         {"--mqtt-username", &o.mqtt_username},

@@ -3,10 +3,13 @@
 // allocate and throw.
 #pragma once
 
+#include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "capture_store.h"
+#include "commission_settings.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/firmware/record_replay.h"
 #include "modbus_server.h"
@@ -34,6 +37,12 @@ struct MonitorFile {
   RecorderFileSettings recorder;  // [recorder]
   ModbusSettings modbus;          // [modbus]
   MqttSettings mqtt;              // [mqtt]
+  // regional_alert.key_file, resolved (its key is in config.regional's authentication).
+  std::string regional_key_file;
+  // Each key the file set, and where: "box.toml:12" (the checks after the command line name
+  // the line of a key that has no effect).
+  std::map<std::string, std::string> key_where;
+  CommissioningSettings commissioning;  // [commissioning] (docs/commissioning.md)
 };
 
 // Frames/s the event recorder's buffers are sized for (event_recorder.h): every configured
@@ -69,6 +78,7 @@ struct MonitorOverrides {
   bool no_relays = false;                   // --no-relays: the file's [relays] ignored
   std::string modbus_listen;                // --modbus HOST:PORT
   bool modbus_writes = false;               // --modbus-writes
+  std::vector<std::string> modbus_write_from;  // --modbus-write-from: replaces modbus.write_from
   std::string mqtt_broker;                  // --mqtt HOST:PORT
   std::string mqtt_box_id;                  // --mqtt-box-id
   std::string mqtt_username;                // --mqtt-username

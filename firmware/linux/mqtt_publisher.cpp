@@ -1,20 +1,26 @@
 #include "mqtt_publisher.h"
 
 #include <mosquitto.h>
+#include <mqtt_protocol.h>
+#include <sys/random.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cerrno>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <mutex>
 #include <nlohmann/json.hpp>
 
+#include "json_payload.h"
 #include "plinth/host/input_error.h"
 #include "plinth/host/json_text.h"
 #include "plinth/host/text_file.h"
+#include "plinth/monitor/hmac_sha256.h"
 #include "plinth/version/version.h"
 #include "regional_json.h"
 #include "status_json.h"
@@ -64,41 +70,111 @@ std::string error_text(int rc) {
   return text;
 }
 
+// The CONNACK's reason (MQTT 5 codes; the box speaks MQTT 5).
 std::string connack_text(int rc) {
   switch (rc) {
-    case 1:
-      return "unacceptable protocol version";
-    case 2:
+    case MQTT_RC_UNSUPPORTED_PROTOCOL_VERSION:
+      return "unsupported protocol version (the box speaks MQTT 5: mosquitto 1.6 or later, "
+             "EMQX, HiveMQ, ...)";
+    case MQTT_RC_CLIENTID_NOT_VALID:
       return "client identifier rejected";
-    case 3:
+    case MQTT_RC_SERVER_UNAVAILABLE:
       return "broker unavailable";
-    case 4:
+    case MQTT_RC_BAD_USERNAME_OR_PASSWORD:
       return "bad user name or password (mqtt.username, mqtt.password or password_file)";
-    case 5:
+    case MQTT_RC_NOT_AUTHORIZED:
       return "not authorised (mqtt.username, mqtt.password or password_file)";
     default:
-      return std::string("code ") + std::to_string(rc) + ": " + mosquitto_connack_string(rc);
+      return std::string("code ") + std::to_string(rc) + ": " + mosquitto_reason_string(rc);
   }
+}
+
+// 64 random bits as 16 hex digits (getrandom: the kernel's CSPRNG).
+std::string random_hex() {
+  std::uint64_t bits = 0;
+  if (getrandom(&bits, sizeof bits, 0) != static_cast<ssize_t>(sizeof bits)) {
+    throw host::InputError(std::string("mqtt: no random bits for the client id: ") +
+                           std::strerror(errno));
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(bits));
+  return text;
+}
+
+// The kRegionalHmacProperty of `properties`, "" without one (the first, if given twice).
+std::string hmac_property(const mosquitto_property* properties) {
+  std::string value;
+  bool first = true;
+  for (const mosquitto_property* p = properties; p != nullptr; first = false) {
+    char* name = nullptr;
+    char* text = nullptr;
+    p = mosquitto_property_read_string_pair(p, MQTT_PROP_USER_PROPERTY, &name, &text, !first);
+    if (p != nullptr && name != nullptr && value.empty() &&
+        std::strcmp(name, kRegionalHmacProperty) == 0 && text != nullptr) {
+      value = text;
+    }
+    std::free(name);
+    std::free(text);
+  }
+  return value;
 }
 
 extern "C" void connect_callback(mosquitto*, void* self, int rc) {
   static_cast<MqttPublisher*>(self)->on_connect(rc);
 }
-extern "C" void disconnect_callback(mosquitto*, void* self, int rc) {
+extern "C" void disconnect_callback(mosquitto*, void* self, int rc, const mosquitto_property*) {
   static_cast<MqttPublisher*>(self)->on_disconnect(rc);
 }
 extern "C" void publish_callback(mosquitto*, void* self, int mid) {
   static_cast<MqttPublisher*>(self)->on_publish(mid);
 }
-extern "C" void message_callback(mosquitto*, void* self, const mosquitto_message* message) {
+extern "C" void message_callback(mosquitto*, void* self, const mosquitto_message* message,
+                                 const mosquitto_property* properties) {
   if (message == nullptr || message->topic == nullptr) return;
   const std::size_t length =
       message->payload == nullptr ? 0U : static_cast<std::size_t>(message->payloadlen);
   const std::string payload(static_cast<const char*>(message->payload), length);
-  static_cast<MqttPublisher*>(self)->on_message(message->topic, payload);
+  static_cast<MqttPublisher*>(self)->on_message(message->topic, payload, message->retain,
+                                                hmac_property(properties));
 }
 extern "C" void log_callback(mosquitto*, void* self, int level, const char* text) {
   if ((level & MOSQ_LOG_ERR) != 0) static_cast<MqttPublisher*>(self)->on_error_log(text);
+}
+
+// Whether `hmac` (64 hex digits, either case) is the HMAC-SHA256 of `payload` with `key`.
+bool hmac_matches(const std::array<std::uint8_t, monitor::kRegionalKeyBytes>& key,
+                  const std::string& payload, const std::string& hmac) {
+  if (hmac.size() != 64) return false;
+  monitor::Sha256Digest given{};
+  for (std::size_t i = 0; i < given.size(); ++i) {
+    unsigned value = 0;
+    for (int k = 0; k < 2; ++k) {
+      const char c = hmac[2 * i + static_cast<std::size_t>(k)];
+      const int digit = c >= '0' && c <= '9'   ? c - '0'
+                        : c >= 'a' && c <= 'f' ? c - 'a' + 10
+                        : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                               : -1;
+      if (digit < 0) return false;
+      value = value << 4 | static_cast<unsigned>(digit);
+    }
+    given[i] = static_cast<std::uint8_t>(value);
+  }
+  const monitor::ByteSpan part{reinterpret_cast<const std::uint8_t*>(payload.data()),
+                               payload.size()};
+  const monitor::Sha256Digest expected = monitor::hmac_sha256(key, &part, 1);
+  return monitor::same_bytes(given.data(), expected.data(), given.size());
+}
+
+// How dangerous an alert is, to keep the most dangerous in a burst: its probability of collapse
+// under the statue's fragility (the room's own), its PGA without one.
+double danger_of(const monitor::RegionalAlertSettings& room, const monitor::RegionalAlert& a) {
+  if (!std::isfinite(a.pga_g) || !std::isfinite(a.sigma_ln) || a.pga_g < 0.0 ||
+      a.sigma_ln < 0.0) {
+    return 0.0;
+  }
+  return room.fragility_known
+             ? static_cast<double>(room.fragility.probability(a.pga_g, a.sigma_ln))
+             : static_cast<double>(a.pga_g);
 }
 
 // The state's statue sensor: null without one; its streams' health, its offset known, and per
@@ -161,15 +237,23 @@ MqttPublisher::MqttPublisher(const MqttSettings& settings, const RunIdentity& id
     throw host::InputError("mqtt.tls_cert_file (--mqtt-cert): needs mqtt.tls_ca_file (--mqtt-ca)");
   }
 
-  const std::string client_id = "plinth-" + settings_.box_id;
-  client_ = mosquitto_new(client_id.c_str(), true, this);
-  if (client_ == nullptr) throw host::InputError("mqtt: cannot create the client (no memory)");
+  check_topics();
+
+  // 64 random bits: a client that would take the box's session (a broker closes the older of
+  // two with one id) must first read the id off the box or the broker's log.
+  client_id_ = "plinth-" + settings_.box_id + "-" + random_hex();
+  client_ = mosquitto_new(client_id_.c_str(), true, this);
+  if (client_ == nullptr) {
+    throw host::InputError("mqtt: cannot create the client: " + std::string(std::strerror(errno)));
+  }
   const auto fail = [&](const std::string& what, int rc) {
     mosquitto_destroy(client_);
     client_ = nullptr;
     throw host::InputError(what + ": " + mosquitto_strerror(rc));
   };
-  int rc = mosquitto_will_set(client_, availability_topic_.c_str(), 7, "offline", kQos, true);
+  int rc = mosquitto_int_option(client_, MOSQ_OPT_PROTOCOL_VERSION, MQTT_PROTOCOL_V5);
+  if (rc != MOSQ_ERR_SUCCESS) fail("mqtt: MQTT 5", rc);
+  rc = mosquitto_will_set(client_, availability_topic_.c_str(), 7, "offline", kQos, true);
   if (rc != MOSQ_ERR_SUCCESS) fail("mqtt: the Last Will on " + availability_topic_, rc);
   if (!settings_.username.empty()) {
     rc = mosquitto_username_pw_set(client_, settings_.username.c_str(),
@@ -186,12 +270,59 @@ MqttPublisher::MqttPublisher(const MqttSettings& settings, const RunIdentity& id
     if (rc != MOSQ_ERR_SUCCESS) fail("mqtt.tls_ca_file " + settings_.ca_file + " (--mqtt-ca)", rc);
   }
   mosquitto_connect_callback_set(client_, connect_callback);
-  mosquitto_disconnect_callback_set(client_, disconnect_callback);
+  mosquitto_disconnect_v5_callback_set(client_, disconnect_callback);
   mosquitto_publish_callback_set(client_, publish_callback);
-  mosquitto_message_callback_set(client_, message_callback);
+  mosquitto_message_v5_callback_set(client_, message_callback);
   mosquitto_log_callback_set(client_, log_callback);
   backoff_s_ = settings_.reconnect_min_s;
   thread_ = std::thread([this] { run(); });
+}
+
+// The box's topics against each other: each distinct, the regional alerts' topic none of a
+// box's own (any box's: PREFIX/+/state, ...) nor under the discovery prefix, each a valid topic.
+void MqttPublisher::check_topics() const {
+  struct Named {
+    const char* key;  // how the message names it
+    std::string topic;
+  };
+  std::vector<Named> own = {{"state", state_topic_},
+                            {"events", events_topic_},
+                            {"availability", availability_topic_},
+                            {"command", command_topic_},
+                            {"command reply", reply_topic_}};
+  for (const Named& t : own) {
+    if (mosquitto_pub_topic_check2(t.topic.data(), t.topic.size()) != MOSQ_ERR_SUCCESS ||
+        mosquitto_validate_utf8(t.topic.data(), static_cast<int>(t.topic.size())) !=
+            MOSQ_ERR_SUCCESS) {
+      throw host::InputError("mqtt.topic_prefix, mqtt.box_id: the " + std::string(t.key) +
+                             " topic \"" + printable(t.topic) + "\" is not a valid topic");
+    }
+  }
+  if (!settings_.regional_alerts) return;
+  const std::string& regional = regional_topic_;
+  if (mosquitto_pub_topic_check2(regional.data(), regional.size()) != MOSQ_ERR_SUCCESS) {
+    throw host::InputError("mqtt.regional_topic: \"" + printable(regional) +
+                           "\" is not one topic (no wildcard, no empty level)");
+  }
+  const std::string prefix = settings_.topic_prefix;
+  const std::pair<std::string, const char*> patterns[] = {
+      {prefix + "/+/state", "a box's state"},
+      {prefix + "/+/events", "a box's events"},
+      {prefix + "/+/availability", "a box's availability"},
+      {prefix + "/+/command", "a box's command topic"},
+      {prefix + "/+/command/reply", "a box's command replies"},
+      {settings_.discovery_prefix + "/#", "the discovery prefix"},
+  };
+  for (const auto& [pattern, what] : patterns) {
+    bool matches = false;
+    if (mosquitto_topic_matches_sub(pattern.c_str(), regional.c_str(), &matches) ==
+            MOSQ_ERR_SUCCESS &&
+        matches) {
+      throw host::InputError("mqtt.regional_topic: \"" + printable(regional) + "\" is " + what +
+                             " (" + pattern + "): alerts would be mixed with the box's own "
+                             "messages; give the bridge a topic of its own");
+    }
+  }
 }
 
 MqttPublisher::~MqttPublisher() {
@@ -220,13 +351,31 @@ void MqttPublisher::on_connect(int rc) {
   const std::string problem = "connected to " + endpoint_text_;
   if (problem != last_problem_ && !last_problem_.empty()) say(problem);
   last_problem_ = problem;
+  // The box's own availability, its retained value first: after a session of this run that
+  // ended without the box's DISCONNECT, "offline" there is the box's Last Will, which the broker
+  // published while the box still ran (another client took its session, or the broker dropped
+  // it). Then "online".
+  checking_will_ = ended_uncleanly_;
+  ended_uncleanly_ = false;
+  if (mosquitto_subscribe_v5(client_, nullptr, availability_topic_.c_str(), kQos, 0, nullptr) !=
+      MOSQ_ERR_SUCCESS) {
+    checking_will_ = false;
+  }
   (void)publish(availability_topic_, "online", true, nullptr);
-  // Also while commands are off: the reply says so.
-  if (mosquitto_subscribe(client_, nullptr, command_topic_.c_str(), kQos) != MOSQ_ERR_SUCCESS) {
+  // Also while commands are off: the reply says so. No retained command is sent (a retained
+  // acknowledgement would be carried out at every connection), and one published retained
+  // shows as retained, to be refused; none of the box's own messages come back.
+  constexpr int kCommandOptions =
+      MQTT_SUB_OPT_SEND_RETAIN_NEVER | MQTT_SUB_OPT_RETAIN_AS_PUBLISHED | MQTT_SUB_OPT_NO_LOCAL;
+  if (mosquitto_subscribe_v5(client_, nullptr, command_topic_.c_str(), kQos, kCommandOptions,
+                             nullptr) != MOSQ_ERR_SUCCESS) {
     say("cannot subscribe to " + command_topic_);
   }
+  // Regional alerts may be retained (the bridge's latest, taken again at a connection: its
+  // origin time and the duplicate rule decide).
   if (settings_.regional_alerts &&
-      mosquitto_subscribe(client_, nullptr, regional_topic_.c_str(), kQos) != MOSQ_ERR_SUCCESS) {
+      mosquitto_subscribe_v5(client_, nullptr, regional_topic_.c_str(), kQos,
+                             MQTT_SUB_OPT_NO_LOCAL, nullptr) != MOSQ_ERR_SUCCESS) {
     say("cannot subscribe to " + regional_topic_);
   }
   publish_discovery();
@@ -236,6 +385,16 @@ void MqttPublisher::on_connect(int rc) {
 
 void MqttPublisher::on_disconnect(int rc) {
   if (connected_ && rc != 0 && !stopping_.load()) ++connections_lost_;
+  if (connected_ && rc != 0) ended_uncleanly_ = true;
+  if (rc == MQTT_RC_SESSION_TAKEN_OVER) {
+    ++takeovers_;
+    session_log_.say("the broker at " + endpoint_text_ + " closed the box's session: another "
+                         "client connected with its client id (" + client_id_ + ", " +
+                         std::to_string(takeovers_) + " times so far); the box connects again. "
+                         "Give the box credentials of its own and let the broker bind the id "
+                         "to them (docs/integration.md, \"What each surface trusts\")",
+                     monotonic_ns());
+  }
   connected_ = false;
 }
 
@@ -371,41 +530,74 @@ void MqttPublisher::publish_head(std::int64_t now_ns) {
 }
 
 // An operator's command (docs/integration.md, "Commands"): {"command": "acknowledge",
-// "level": .., "sequence": .., "id": ..}; level and sequence default to what the box shows.
-// A well-formed acknowledgement goes to the loop; the reply waits for its outcome.
-void MqttPublisher::on_message(const std::string& topic, const std::string& payload) {
-  if (settings_.regional_alerts && topic == regional_topic_) return on_regional_alert(payload);
+// "level": .., "sequence": .., "id": ..}, or {"command": "statue_stands", "sequence": ..,
+// "id": ..} (docs/safety.md); level and sequence default to what the box shows. A well-formed
+// command goes to the loop; the reply waits for its outcome.
+void MqttPublisher::on_message(const std::string& topic, const std::string& payload,
+                               bool retained, const std::string& hmac) {
+  if (topic == availability_topic_) {
+    // The first message after a connection is the retained value, if any; later ones are the
+    // box's own.
+    if (checking_will_ && retained && payload == "offline") {
+      ++wills_seen_;
+      session_log_.say("the broker published the box's Last Will (\"offline\" on " +
+                           availability_topic_ + ") while the box ran: another client " +
+                           "connected with its client id (" + client_id_ + "), or the broker " +
+                           "dropped the box's connection (" + std::to_string(wills_seen_) +
+                           " times so far)",
+                       monotonic_ns());
+    }
+    checking_will_ = false;
+    return;
+  }
+  if (settings_.regional_alerts && topic == regional_topic_) {
+    return on_regional_alert(payload, hmac);
+  }
   if (topic != command_topic_) return;
   ++commands_received_;
-  nlohmann::json command = nlohmann::json::parse(payload, nullptr, false);
   std::string id_json = "null";
+  std::string name = "acknowledge";  // the reply's "command"
   const auto refuse = [&](const std::string& why) {
-    reply(id_json, "refused", why, "");
-    say("command refused: " + why + ": " + payload.substr(0, 200));
+    reply(id_json, name, "refused", why, "");
+    incoming_log_.say("command refused: " + why + ": " + printable(payload), monotonic_ns());
   };
-  if (command.is_discarded()) return refuse("not JSON");
+  // Published retained, a command would be carried out again at every connection of the box.
+  if (retained) {
+    ++commands_retained_;
+    return refuse("retained (a command is carried out once, when published: publish it "
+                  "without the retain flag; an empty retained message clears it)");
+  }
+  const JsonPayload parsed = parse_json_payload(payload);
+  if (!parsed.problem.empty()) return refuse(parsed.problem);
+  const nlohmann::json& command = parsed.value;
   if (!command.is_object()) return refuse("expected a JSON object");
   if (command.contains("id")) {
     const nlohmann::json& id = command["id"];
     if (!id.is_string() && !id.is_number_integer()) {
       return refuse("id: expected a string or an integer");
     }
-    id_json = id.dump();
+    id_json = id.dump(-1, ' ', true);  // ASCII: \uXXXX for the rest
   }
   for (const auto& [key, value] : command.items()) {
     if (key != "command" && key != "level" && key != "sequence" && key != "id") {
-      return refuse("unknown member \"" + key + "\" (expected command, level, sequence, id)");
+      return refuse("unknown member \"" + printable(key, 64) +
+                    "\" (expected command, level, sequence, id)");
     }
   }
   if (!command.contains("command") || !command["command"].is_string()) {
-    return refuse("command: expected \"acknowledge\"");
+    return refuse("command: expected \"acknowledge\" or \"statue_stands\"");
   }
-  if (command["command"].get<std::string>() != "acknowledge") {
-    return refuse("command: unknown command " + command["command"].dump() +
-                  " (expected \"acknowledge\")");
+  CommandRequest request;
+  if (command["command"].get<std::string>() == "statue_stands") {
+    name = "statue_stands";
+    request.command = OperatorCommand::kStatueStands;
+    if (command.contains("level")) return refuse("level: statue_stands takes a sequence only");
+  } else if (command["command"].get<std::string>() != "acknowledge") {
+    return refuse("command: unknown command " +
+                  printable(command["command"].dump(-1, ' ', true), 64) +
+                  " (expected \"acknowledge\" or \"statue_stands\")");
   }
   if (!settings_.commands) return refuse("commands are off (mqtt.commands = false)");
-  CommandRequest request;
   request.level = state_.latched;
   request.event_sequence = state_.event_sequence;
   if (command.contains("level")) {
@@ -429,39 +621,87 @@ void MqttPublisher::on_message(const std::string& topic, const std::string& payl
   }
   request.id = next_command_id_++;
   if (!mailbox_.post_command(request)) return refuse("busy: the loop has not taken commands");
-  pending_[request.id] = {id_json, JsonObject()
-                                       .text("level", monitor::alarm_level_name(request.level))
-                                       .count("sequence", request.event_sequence)
-                                       .close()};
+  JsonObject details;
+  if (request.command == OperatorCommand::kAcknowledge) {
+    details.text("level", monitor::alarm_level_name(request.level));
+  }
+  pending_[request.id] = {id_json, request.command,
+                          details.count("sequence", request.event_sequence).close()};
 }
 
-// A regional alert (docs/regional.md, "MQTT"), its UTC times made relative to now: to the loop,
-// which checks its values (or counts it malformed when it is no alert at all).
-void MqttPublisher::on_regional_alert(const std::string& payload) {
+// A regional alert (docs/regional.md, "MQTT"), its UTC times made relative to now, its HMAC
+// checked when the box file asks for one: waits for the loop, which checks its values (or
+// counts it malformed or unauthenticated). In a burst the least dangerous waiting alert goes.
+void MqttPublisher::on_regional_alert(const std::string& payload, const std::string& hmac) {
+  const std::int64_t now = monotonic_ns();
   ++regional_received_;
-  const RegionalJson parsed = parse_regional_json(payload, wall_clock_ns());
-  RegionalRequest request;
-  request.alert = parsed.alert;
-  if (!parsed.ok) {
-    ++regional_malformed_;
-    request.malformed = true;
-    request.field = parsed.field;
-    say("regional alert malformed: " + parsed.problem + ": " + payload.substr(0, 200));
+  WaitingAlert waiting;
+  waiting.received_ns = now;
+  RegionalRequest& request = waiting.request;
+  const monitor::RegionalAuthentication& auth = settings_.regional.authentication;
+  if (auth.required && !hmac_matches(auth.key, payload, hmac)) {
+    ++regional_unauthenticated_;
+    request.refusal = monitor::RegionalRefusal::kUnauthenticated;
+    request.field = kRegionalHmacProperty;
+    incoming_log_.say(std::string("regional alert unauthenticated: ") +
+                          (hmac.empty() ? "no " : "a wrong ") + kRegionalHmacProperty +
+                          " user property: " + printable(payload),
+                      now);
+  } else {
+    const RegionalJson parsed = parse_regional_json(payload, wall_clock_ns());
+    request.alert = parsed.alert;
+    if (!parsed.ok) {
+      ++regional_malformed_;
+      request.refusal = monitor::RegionalRefusal::kMalformed;
+      request.field = parsed.field;
+      incoming_log_.say("regional alert malformed: " + parsed.problem + ": " + printable(payload),
+                        now);
+    } else {
+      waiting.danger = danger_of(settings_.regional, parsed.alert);
+    }
   }
-  if (!mailbox_.post_regional(request)) {
+  if (regional_waiting_.size() >= kRegionalHeldForLoop) {
+    // The least dangerous goes, the latest of equals (a burst's refusals before its alerts).
+    auto least = regional_waiting_.begin();
+    for (auto it = regional_waiting_.begin(); it != regional_waiting_.end(); ++it) {
+      if (it->danger <= least->danger) least = it;
+    }
     ++regional_lost_;
-    say("regional alert lost: the loop has not taken the " +
-        std::to_string(OutputMailbox::kRegionalSlots) + " before it");
+    incoming_log_.say("regional alerts arrive faster than the loop takes them: the least "
+                      "dangerous of " + std::to_string(kRegionalHeldForLoop + 1) +
+                          " waiting dropped (" + std::to_string(regional_lost_) + " so far)",
+                      now);
+    if (waiting.danger <= least->danger) return;
+    regional_waiting_.erase(least);
   }
+  regional_waiting_.push_back(waiting);
 }
 
-// {"id": .., "command": "acknowledge", "result": "accepted" | "refused", "reason": ..,
-// "level": .., "sequence": .., "outcome": ..}: `details` are the members after "reason".
-void MqttPublisher::reply(const std::string& id_json, const std::string& result,
-                          const std::string& why, const std::string& details) {
+// The waiting alerts into the loop's ring, in arrival order, as far as it has room; their
+// times made relative to now (they waited).
+void MqttPublisher::pass_regional_alerts(std::int64_t now_ns) {
+  std::size_t passed = 0;
+  for (WaitingAlert& w : regional_waiting_) {
+    const double waited_s = static_cast<double>(now_ns - w.received_ns) * 1e-9;
+    RegionalRequest request = w.request;
+    request.alert.origin_age_s += waited_s;
+    request.alert.s_arrival_in_s -= waited_s;
+    if (!mailbox_.post_regional(request)) break;
+    ++passed;
+  }
+  regional_waiting_.erase(regional_waiting_.begin(),
+                          regional_waiting_.begin() + static_cast<std::ptrdiff_t>(passed));
+}
+
+// {"id": .., "command": "acknowledge" | "statue_stands", "result": "accepted" | "refused",
+// "reason": .., "level": .., "sequence": .., "outcome": ..}: `details` are the members after
+// "reason".
+void MqttPublisher::reply(const std::string& id_json, const std::string& command,
+                          const std::string& result, const std::string& why,
+                          const std::string& details) {
   (result == "accepted" ? commands_accepted_ : commands_refused_) += 1;
   JsonObject line;
-  line.raw("id", id_json).text("command", "acknowledge").text("result", result);
+  line.raw("id", id_json).text("command", command).text("result", result);
   if (!why.empty()) line.text("reason", why);
   std::string text = line.close();
   if (!details.empty()) text.replace(text.size() - 1, 1, ", " + details.substr(1));
@@ -474,12 +714,17 @@ void MqttPublisher::take_results() {
   while (mailbox_.take_result(result)) {
     const auto it = pending_.find(result.id);
     if (it == pending_.end()) continue;
-    const bool released = result.outcome == monitor::AckOutcome::kReleased ||
-                          result.outcome == monitor::AckOutcome::kReleasedConditionHolds;
-    const std::string outcome = monitor::ack_outcome_name(result.outcome);
+    const bool stands = it->second.command == OperatorCommand::kStatueStands;
+    const bool accepted =
+        stands ? result.stands == monitor::StandsOutcome::kCleared
+               : result.outcome == monitor::AckOutcome::kReleased ||
+                     result.outcome == monitor::AckOutcome::kReleasedConditionHolds;
+    const std::string outcome = stands ? monitor::stands_outcome_name(result.stands)
+                                       : monitor::ack_outcome_name(result.outcome);
     std::string details = it->second.details;
     details.replace(details.size() - 1, 1, ", \"outcome\": " + host::json_quoted(outcome) + "}");
-    reply(it->second.id_json, released ? "accepted" : "refused", released ? "" : outcome, details);
+    reply(it->second.id_json, stands ? "statue_stands" : "acknowledge",
+          accepted ? "accepted" : "refused", accepted ? "" : outcome, details);
     pending_.erase(it);
   }
 }
@@ -587,6 +832,9 @@ std::string regional_state_json(const RegionalSnapshot& r) {
       .count("accepted", r.accepted)
       .count("refused", r.refused)
       .text("last_refusal", monitor::regional_refusal_name(r.last_refusal))
+      .raw("refused_dangerous", refused_dangerous_json(r.refused_dangerous,
+                                                       r.last_refused_dangerous,
+                                                       r.last_refused_dangerous_t))
       .close();
 }
 
@@ -628,6 +876,8 @@ std::string MqttPublisher::state_json() const {
       .text("level", monitor::alarm_level_name(s.level))
       .text("latched", monitor::alarm_level_name(s.latched))
       .text("cause", monitor::alarm_cause_name(s.cause))
+      .text("trouble", monitor::alarm_cause_name(s.trouble))
+      .flag("collapse_held", s.collapse_held)
       .fixed("risk", s.risk, 4)
       .raw("forecast", forecast_json.close())
       .raw("phase", phase.close())
@@ -641,6 +891,8 @@ std::string MqttPublisher::state_json() const {
       .raw("recorder", s.recorder.present ? recorder_status_json(s.recorder) : "null")
       .count("heartbeat", s.statuses)
       .count("events_dropped", events_dropped_ + mailbox_.events_dropped())
+      .count("session_takeovers", takeovers_)
+      .count("wills_while_running", wills_seen_)
       .raw("version", JsonObject()
                           .text("project", version::kProjectVersion)
                           .text("git", version::kGitDescription)
@@ -672,6 +924,7 @@ void MqttPublisher::run() {
       }
       if ((queue_.empty() && (!state_due_ || !connected_)) || now > flush_deadline_ns) break;
     }
+    pass_regional_alerts(now);
     if (!connected_) try_connect(now);
     if (connected_) {
       publish_state(now);
@@ -716,6 +969,8 @@ std::string MqttPublisher::summary_json() const {
       .count("connect_failures", connect_failures_)
       .count("refusals", refusals_)
       .count("connections_lost", connections_lost_)
+      .count("session_takeovers", takeovers_)
+      .count("wills_while_running", wills_seen_)
       .count("events_published", events_published_)
       .count("events_republished", events_republished_)
       .count("events_dropped", events_dropped_ + mailbox_.events_dropped())
@@ -726,9 +981,12 @@ std::string MqttPublisher::summary_json() const {
       .count("commands_received", commands_received_)
       .count("commands_accepted", commands_accepted_)
       .count("commands_refused", commands_refused_)
+      .count("commands_retained", commands_retained_)
       .count("regional_received", regional_received_)
       .count("regional_malformed", regional_malformed_)
+      .count("regional_unauthenticated", regional_unauthenticated_)
       .count("regional_lost", regional_lost_)
+      .count("regional_waiting", regional_waiting_.size())
       .close();
 }
 

@@ -11,9 +11,16 @@
 // Alarm events wait in a bounded queue while the broker is away (the oldest dropped and
 // counted when it is full) and go out one at a time, each once the broker acknowledged the one
 // before, so a broker restart loses none and keeps their order. Reconnects with exponential
-// back-off. Username/password and TLS (a CA, optionally a client certificate). Who may publish
-// a command is the broker's ACL: MQTT does not tell a subscriber who published. Topics and
-// payloads: docs/integration.md. Host code: allocates and throws.
+// back-off. Username/password and TLS (a CA, optionally a client certificate). MQTT 5: a
+// retained command is never taken (the subscription asks for none, and one published retained
+// is refused), the client id carries 64 random bits (no other client can take the session
+// without reading it off the box or the broker's log), and a takeover is said and counted: the
+// DISCONNECT's reason 0x8E where the broker sends one, else the box's own Last Will found
+// retained when it connects again (mosquitto 2.0.11 sends no reason, but publishes the Will).
+// Who may publish a command is the broker's ACL: MQTT does not tell a subscriber who published; a
+// regional alert can carry its own HMAC (docs/regional.md). What comes in is read strictly
+// (json_payload.h) and said escaped (log_text.h), a burst of alerts keeps the most dangerous.
+// Topics and payloads: docs/integration.md. Host code: allocates and throws.
 #pragma once
 
 #include <atomic>
@@ -24,12 +31,19 @@
 #include <thread>
 #include <vector>
 
+#include "log_text.h"
+#include "plinth/monitor/regional_alert.h"
 #include "run_identity.h"
 #include "status_outputs.h"
 
 struct mosquitto;
 
 namespace plinth::firmware {
+
+// The longest box id and topic prefix (mqtt.topic_prefix, discovery_prefix, regional_topic) a
+// box file may give: every topic stays far below MQTT's 65535 bytes.
+inline constexpr std::size_t kMaxBoxIdBytes = 64;
+inline constexpr std::size_t kMaxTopicPrefixBytes = 256;
 
 // The box's [mqtt] table (docs/integration.md). Off while `broker` is empty.
 struct MqttSettings {
@@ -58,7 +72,15 @@ struct MqttSettings {
   std::string regional_topic;
   bool discovery = true;          // mqtt.discovery: Home Assistant discovery configs
   std::string discovery_prefix = "homeassistant";  // mqtt.discovery_prefix
+  // The regional room's settings (plinth-monitor's configuration, not an [mqtt] key): its
+  // fragility ranks the alerts of a burst, its authentication says whether each must carry
+  // the bridge's HMAC.
+  monitor::RegionalAlertSettings regional;
 };
+
+// The user property that carries a regional alert's HMAC-SHA256 over its payload, 64 hex
+// digits (docs/regional.md, "Who may send an alert").
+inline constexpr const char* kRegionalHmacProperty = "hmac-sha256";
 
 class MqttPublisher final : public StatusOutput {
  public:
@@ -84,7 +106,12 @@ class MqttPublisher final : public StatusOutput {
   void on_disconnect(int rc);
   void on_publish(int mid);
   void on_error_log(const char* text);
-  void on_message(const std::string& topic, const std::string& payload);
+  // `hmac`: the kRegionalHmacProperty user property, "" when the message has none.
+  void on_message(const std::string& topic, const std::string& payload, bool retained,
+                  const std::string& hmac);
+
+  // Alerts of a burst held for the loop at most; beyond, the least dangerous goes.
+  static constexpr std::size_t kRegionalHeldForLoop = 64;
 
  private:
   struct QueuedEvent {
@@ -103,10 +130,12 @@ class MqttPublisher final : public StatusOutput {
   void back_off(std::int64_t now_ns);
   void say_offline();
   void publish_discovery();
-  void reply(const std::string& id_json, const std::string& result, const std::string& why,
-             const std::string& details);
+  void reply(const std::string& id_json, const std::string& command, const std::string& result,
+             const std::string& why, const std::string& details);
   void take_results();
-  void on_regional_alert(const std::string& payload);
+  void on_regional_alert(const std::string& payload, const std::string& hmac);
+  void pass_regional_alerts(std::int64_t now_ns);
+  void check_topics() const;
   [[nodiscard]] bool publish(const std::string& topic, const std::string& payload, bool retain,
                              int* mid);
   [[nodiscard]] std::string state_json() const;
@@ -123,6 +152,7 @@ class MqttPublisher final : public StatusOutput {
   int port_ = 0;
   std::string state_topic_, events_topic_, availability_topic_, command_topic_, reply_topic_;
   std::string regional_topic_;
+  std::string client_id_;  // "plinth-BOX-" and 16 random hex digits
   mosquitto* client_ = nullptr;
   OutputMailbox mailbox_;
   std::atomic<bool> stopping_{false};
@@ -132,6 +162,8 @@ class MqttPublisher final : public StatusOutput {
   bool socket_open_ = false;  // a connection attempt or session is under way
   bool connected_ = false;    // the broker accepted the session
   bool answered_ = false;     // the broker answered this attempt (CONNACK, accepted or not)
+  bool ended_uncleanly_ = false;  // the last session ended without the box's DISCONNECT
+  bool checking_will_ = false;    // the availability topic's retained value is still to come
   std::int64_t next_attempt_ns_ = 0;
   double backoff_s_ = 0.0;
   std::string last_problem_;  // the latest message printed (printed again only when it changes)
@@ -149,16 +181,32 @@ class MqttPublisher final : public StatusOutput {
   // operator quoted.
   struct PendingCommand {
     std::string id_json;
+    OperatorCommand command = OperatorCommand::kAcknowledge;
     std::string details;  // "level" and "sequence" members of the reply
   };
   std::map<std::uint32_t, PendingCommand> pending_;
   std::uint32_t next_command_id_ = 1;
+  // Regional alerts waiting for room in the loop's ring, in arrival order, each with when it
+  // came (its times are made relative to the handover) and how dangerous it is.
+  struct WaitingAlert {
+    RegionalRequest request;
+    std::int64_t received_ns = 0;
+    double danger = -1.0;  // its probability of collapse (its PGA without a fragility); -1: not
+                           // an alert
+  };
+  std::vector<WaitingAlert> regional_waiting_;
+  LogLimiter incoming_log_{"mqtt", 5, 10.0};  // refused commands and alerts, lost alerts
+  LogLimiter session_log_{"mqtt", 3, 60.0};   // takeovers
 
   // Counters, read after the thread ended.
   std::uint64_t connects_ = 0;
   std::uint64_t connect_failures_ = 0;  // attempts that did not reach the broker
   std::uint64_t refusals_ = 0;          // the broker refused the session (CONNACK)
   std::uint64_t connections_lost_ = 0;
+  std::uint64_t takeovers_ = 0;  // the broker closed the session: another client took the id
+  // At a reconnection, the box's Last Will retained on its availability topic: published while
+  // the box ran (a takeover by a broker that does not say so, as mosquitto 2.0.11, or a drop).
+  std::uint64_t wills_seen_ = 0;
   std::uint64_t events_published_ = 0;  // acknowledged by the broker
   std::uint64_t events_dropped_ = 0;    // the queue was full: the oldest went
   std::uint64_t next_drop_report_ = 1;     // say_dropped() speaks at this count
@@ -169,10 +217,12 @@ class MqttPublisher final : public StatusOutput {
   std::uint64_t commands_received_ = 0;
   std::uint64_t commands_accepted_ = 0;  // acknowledgements the monitor released a latch with
   std::uint64_t commands_refused_ = 0;
+  std::uint64_t commands_retained_ = 0;  // of which published retained
   std::uint64_t discovery_configs_ = 0;  // config messages published
   std::uint64_t regional_received_ = 0;   // messages on the regional topic
   std::uint64_t regional_malformed_ = 0;  // of which not an alert (handed on as malformed)
-  std::uint64_t regional_lost_ = 0;       // not handed on: the loop had not taken the earlier
+  std::uint64_t regional_unauthenticated_ = 0;  // no HMAC or a wrong one (handed on as such)
+  std::uint64_t regional_lost_ = 0;  // not handed on: kRegionalHeldForLoop more dangerous waited
 };
 
 }  // namespace plinth::firmware

@@ -18,13 +18,16 @@
 #include <vector>
 
 #include "box_state_store.h"
+#include "commission_gate.h"
 #include "event_recorder.h"
 #include "inputs.h"
 #include "latency_log.h"
+#include "log_text.h"
 #include "modbus_map.h"
 #include "modbus_server.h"
 #include "monitor_config.h"
 #include "mqtt_publisher.h"
+#include "plinth/firmware/can_frames.h"
 #include "plinth/firmware/frame_decoder.h"
 #include "plinth/firmware/monitor.h"
 #include "plinth/hal/candump_log.h"
@@ -61,7 +64,8 @@ struct Options {
   std::string pga;
   std::optional<double> scale;
   std::string speed = "max";
-  std::string log_time;  // --log-time: warn or refuse; empty: not given (warn)
+  std::string log_time;   // --log-time: warn or refuse; empty: not given (warn)
+  std::string log_drops;  // --log-drops: the same
   double duration = 0.0;
   std::string record_dir;
   std::string state_dir;
@@ -71,6 +75,7 @@ struct Options {
   double post_trigger = 60.0;
   bool quiet_events = false;
   bool latency = false;
+  std::string commissioning_override;  // --commissioning-override REASON
   fw::MonitorOverrides config;  // --config and the options that override it
 };
 
@@ -162,17 +167,17 @@ class Outputs {
       }
       post_alarm(e);
     }
-    if (u.statue_stands != mon::StandsOutcome::kNone && u.stands_source >= 0) {
-      print_line(command_line("statue_stands", "can:" + std::to_string(u.stands_source))
-                     .text("outcome", mon::stands_outcome_name(u.statue_stands))
-                     .close());
-    }
     if (u.frames_lost > 0) note_frames_lost(s, u.frames_lost);
     if (state_ != nullptr) save_state();
     if (u.status_due) {
-      // The first status line says what runs: the version, the scene and box files' digests.
+      // The first status line says what runs: the version, the scene and box files' digests,
+      // the commissioning; every line the commissioning while it refuses or is overridden.
       std::string line = fw::status_json(s, t_origin_);
-      if (snapshot_.statuses == 0) line = fw::with_members(line, identity);
+      if (snapshot_.statuses == 0) {
+        line = fw::with_members(line, identity);
+      } else if (!status_extra.empty()) {
+        line = fw::with_members(line, status_extra);
+      }
       if (recorder_ != nullptr) {
         const std::string health = fw::recorder_status_json(recorder_->status());
         line = fw::with_members(line, std::string("\"recorder\": ").append(health));
@@ -194,8 +199,9 @@ class Outputs {
       // Regional alerts (MQTT): at the loop's time now, relative to their receipt.
       fw::RegionalRequest r;
       while (output->mailbox().take_regional(r)) {
-        handle(r.malformed ? monitor.regional_alert_malformed(r.field)
-                           : monitor.on_regional_alert(r.alert));
+        handle(r.refusal != mon::RegionalRefusal::kNone
+                   ? monitor.regional_alert_refused(r.refusal, r.field)
+                   : monitor.on_regional_alert(r.alert));
       }
       fw::CommandRequest c;
       while (output->mailbox().take_command(c)) {
@@ -247,10 +253,72 @@ class Outputs {
   // The saved state (--state-dir): what the monitor must not forget, written when it changes.
   void keep_state_in(fw::BoxStateStore* state) { state_ = state; }
 
+  // A line for an Acknowledge frame from the bus (unauthenticated: docs/monitor.md), as for a
+  // command from MQTT or Modbus; the refused and the ignored (the bus locked out after refusals)
+  // at most kBusRefusalLines a minute, the next line shown saying how many were not.
+  void bus_acknowledgement(const plinth::hal::can::CanFrame& frame, const fw::MonitorUpdate& u,
+                           const fw::FrameCounters& before, const fw::FrameCounters& after) {
+    plinth::hal::can::Acknowledge ack;
+    if (!plinth::hal::can::decode(frame, ack).ok()) return;
+    const bool released = u.acknowledgement == mon::AckOutcome::kReleased ||
+                          u.acknowledgement == mon::AckOutcome::kReleasedConditionHolds;
+    const std::int64_t now = fw::monotonic_ns();
+    if (!released && !bus_refusals_.allow(now)) return;
+    const mon::Acknowledgement a = fw::acknowledgement_of(ack);
+    fw::JsonObject line;
+    line.text("type", "command")
+        .text("command", "acknowledge")
+        .text("source", "can")
+        .count("source_id", ack.source_id)
+        .text("level", mon::alarm_level_name(a.level))
+        .count("sequence", a.event_sequence)
+        .text("outcome", after.acknowledgements_ignored != before.acknowledgements_ignored
+                             ? "ignored: bus acknowledgements locked out"
+                             : mon::ack_outcome_name(u.acknowledgement));
+    if (after.acknowledgement_lockouts != before.acknowledgement_lockouts) {
+      line.flag("locks_out_the_bus", true);
+      std::fprintf(stderr,
+                   "plinth-monitor: can: %d acknowledgements refused within %g s: the bus's are "
+                   "ignored while %s stays latched (acknowledge at the box, over MQTT or Modbus)\n",
+                   fw::kRefusedStatementsBeforeLockout,
+                   static_cast<double>(fw::kRefusedStatementWindowNs) * 1e-9,
+                   mon::alarm_level_name(monitor_.status().latched));
+    }
+    if (!released) line.count("not_shown", bus_refusals_.take_not_shown());
+    print_line(line.close());
+  }
+
+  // A line for a StatueStands frame from the bus (unauthenticated, guarded as acknowledgements
+  // are: docs/monitor.md); the refused and the ignored share bus_acknowledgement's line budget.
+  void bus_statue_stands(const plinth::hal::can::CanFrame& frame, const fw::MonitorUpdate& u,
+                         const fw::FrameCounters& before, const fw::FrameCounters& after) {
+    plinth::hal::can::StatueStands stands;
+    if (!plinth::hal::can::decode(frame, stands).ok()) return;
+    const bool cleared = u.statue_stands == mon::StandsOutcome::kCleared;
+    if (!cleared && !bus_refusals_.allow(fw::monotonic_ns())) return;
+    fw::JsonObject line = command_line("statue_stands", "can:" + std::to_string(stands.source_id));
+    line.count("sequence", stands.event_sequence)
+        .text("outcome", after.statue_stands_ignored != before.statue_stands_ignored
+                             ? "ignored: bus statements locked out"
+                             : mon::stands_outcome_name(u.statue_stands));
+    if (after.statue_stands_lockouts != before.statue_stands_lockouts) {
+      line.flag("locks_out_the_bus", true);
+      std::fprintf(stderr,
+                   "plinth-monitor: can: %d statue-stands statements refused within %g s: the "
+                   "bus's are ignored while the collapse is held (state it at the box, over MQTT "
+                   "or Modbus)\n",
+                   fw::kRefusedStatementsBeforeLockout,
+                   static_cast<double>(fw::kRefusedStatementWindowNs) * 1e-9);
+    }
+    if (!cleared) line.count("not_shown", bus_refusals_.take_not_shown());
+    print_line(line.close());
+  }
+
   fw::RunTotals totals;
   fw::SampleTrace* trace = nullptr;  // --trace
   fw::Supervisor* supervisor = nullptr;  // STATUS= and the journal at each alarm change
   std::string identity;  // run_identity.h's members, in the first status line
+  std::string status_extra;  // members every later status line carries ("" none)
   std::int64_t last_frame_ns = 0;  // receive time of the newest frame (the recorder's clock)
 
  private:
@@ -329,6 +397,7 @@ class Outputs {
   fw::BoxStateStore* state_ = nullptr;
   bool state_failing_ = false;
   std::uint64_t frames_lost_ = 0;
+  fw::BurstLimit bus_refusals_{5, 60.0};  // bus_acknowledgement's refused lines
 };
 
 // The monitor takes one input item.
@@ -341,11 +410,20 @@ void take(const fw::InputItem& item, fw::Monitor& monitor, fw::FrameDecoder& dec
       outputs.handle(monitor.on_sample(item.sample));
       ++outputs.totals.samples;
       break;
-    case fw::InputItem::Kind::kFrame:
-      if (recorder != nullptr) recorder->on_frame(item.frame);
+    case fw::InputItem::Kind::kFrame: {
+      if (recorder != nullptr) recorder->on_frame(item.frame, item.lost_before);
       outputs.last_frame_ns = item.frame.timestamp_ns;
-      outputs.handle(fw::on_frame(monitor, decoder, item.frame));
+      const fw::FrameCounters before = decoder.counters();
+      const fw::MonitorUpdate u = fw::on_frame(monitor, decoder, item.frame);
+      if (decoder.counters().acknowledgements != before.acknowledgements) {
+        outputs.bus_acknowledgement(item.frame.frame, u, before, decoder.counters());
+      }
+      if (decoder.counters().statue_stands != before.statue_stands) {
+        outputs.bus_statue_stands(item.frame.frame, u, before, decoder.counters());
+      }
+      outputs.handle(u);
       break;
+    }
     case fw::InputItem::Kind::kTick:
       outputs.handle(monitor.on_tick(item.time_ns));
       break;
@@ -439,10 +517,10 @@ std::unique_ptr<fw::RelayOutputs> make_relays(const fw::RelaySettings& settings)
 // The loop: each input item taken, its latency noted (--latency), the network outputs' operator
 // commands carried out, the watchdog told of the progress. True when the estimators ran at some
 // point.
-template <typename Restart>
+template <typename Restart, typename Poll>
 bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, fw::FrameDecoder& decoder,
               Outputs& outputs, fw::EventRecorder* recorder, fw::Supervisor& supervisor,
-              fw::LatencyLog* latency, fw::LatencyLog* due_latency, Restart restart) {
+              fw::LatencyLog* latency, fw::LatencyLog* due_latency, Restart restart, Poll poll) {
   supervisor.ready("monitoring " + input.source());
   fw::InputItem item;
   bool estimated = false;
@@ -463,6 +541,7 @@ bool run_loop(fw::MonitorInput& input, fw::Monitor& monitor, fw::FrameDecoder& d
       continue;
     }
     supervisor.on_progress(now_ns);
+    poll(now_ns);
   }
   supervisor.stopping();
   return estimated;
@@ -481,8 +560,12 @@ fw::InputOptions input_options(const Options& opt) {
   in.duration_s = opt.duration;
   in.recorder_frames = !opt.record_dir.empty();
   if (!opt.log_time.empty()) {
-    in.log_time = plinth::host::parse_name<plinth::hal::kLogTimePolicyNames>(
+    in.log_time = plinth::host::parse_name<plinth::hal::kLogPolicyNames>(
         opt.log_time, "--log-time", "policy");
+  }
+  if (!opt.log_drops.empty()) {
+    in.log_drops = plinth::host::parse_name<plinth::hal::kLogPolicyNames>(
+        opt.log_drops, "--log-drops", "policy");
   }
   return in;
 }
@@ -500,6 +583,9 @@ fw::RunTotals run_totals(const Outputs& outputs, fw::MonitorInput& input,
   t.log_time_back = time.went_back;
   t.log_time_still = time.stood_still;
   t.log_time_gaps = time.gaps;
+  const fw::InputDropCounters drops = input.drop_counters();
+  t.log_drop_reports = drops.reports;
+  t.log_drop_frames = drops.frames;
   const fw::BusCounters bus = input.bus_counters();
   t.bus_errors = bus.bus_errors;
   t.bus_dropped_frames = bus.dropped_frames;
@@ -527,16 +613,22 @@ std::vector<std::unique_ptr<fw::StatusOutput>> start_outputs(const fw::MonitorFi
     outputs.push_back(std::make_unique<fw::ModbusServer>(file.modbus, identity));
   }
   if (!file.mqtt.broker.empty()) {
-    outputs.push_back(std::make_unique<fw::MqttPublisher>(file.mqtt, identity));
+    fw::MqttSettings mqtt = file.mqtt;
+    if (const auto* room = mon::built_part<mon::RegionalAlertSettings>(file.config.regional)) {
+      mqtt.regional = *room;  // its fragility ranks a burst, its key authenticates
+    }
+    outputs.push_back(std::make_unique<fw::MqttPublisher>(mqtt, identity));
   }
   return outputs;
 }
 
 // A file replay that ends without the box vouching for it: no estimator ever ran (an empty
-// log, no usable sensor frame), or the log's time could not be monitor time. Says why on
-// stderr; "" when the run is sound (a live bus is judged by its own fault levels).
+// log, no usable sensor frame), the log's time could not be monitor time, or the log lost
+// frames. Says why on stderr; "" when the run is sound (a live bus is judged by its own fault
+// levels).
 std::string input_fault(fw::MonitorInput& input, bool estimated) {
   const fw::InputTimeCounters time = input.time_counters();
+  const fw::InputDropCounters drops = input.drop_counters();
   if (time.total() > 0) {
     std::fprintf(stderr,
                  "plinth-monitor: fault: %s (%llu timestamps back, %llu standing still, %llu "
@@ -544,8 +636,15 @@ std::string input_fault(fw::MonitorInput& input, bool estimated) {
                  time.first.c_str(), static_cast<unsigned long long>(time.went_back),
                  static_cast<unsigned long long>(time.stood_still),
                  static_cast<unsigned long long>(time.gaps), fw::kMaxLogGapS);
-    return "log_time";
   }
+  if (drops.reports > 0) {
+    std::fprintf(stderr,
+                 "plinth-monitor: fault: %s (%llu frames lost in %llu DROPCOUNT lines in all)\n",
+                 drops.first.c_str(), static_cast<unsigned long long>(drops.frames),
+                 static_cast<unsigned long long>(drops.reports));
+  }
+  if (time.total() > 0) return "log_time";
+  if (drops.reports > 0) return "log_drops";
   if (!estimated && input.sink() == nullptr) {
     std::fprintf(stderr,
                  "plinth-monitor: fault: %s: no usable sensor data, the estimator never ran\n",
@@ -625,11 +724,22 @@ int run(const Options& opt, const CLI::App& app) {
   fw::MonitorConfig& config = file.config;
   config.axis_count = scene_y ? 2 : 1;
   set_fragility(config, scene_x, scene_y);
+  // The commissioning of this mounting (docs/commissioning.md), before a record replay reduces
+  // the sensors to its one.
+  fw::CommissioningGate gate(file.commissioning, opt.record_dir, fw::mounting_sha256(config),
+                             opt.commissioning_override);
+  gate.check();
+  gate.announce();
   const std::unique_ptr<fw::MonitorInput> input = fw::open_input(input_settings, config, g_stop);
 
   fw::Monitor monitor;
   fw::FrameDecoder decoder;
   start_monitor(monitor, decoder, config, scene_x, scene_y, app, opt.config.config_path);
+  const auto hold_commissioning = [&] {
+    monitor.hold_fault(gate.refuses() ? mon::AlarmCause::kCommissioningFailed
+                                      : mon::AlarmCause::kNone);
+  };
+  hold_commissioning();
   std::optional<fw::BoxStateStore> state;
   if (!opt.state_dir.empty()) restore_state(monitor, state.emplace(opt.state_dir));
   std::vector<AxisEvents> sinks;
@@ -640,7 +750,8 @@ int run(const Options& opt, const CLI::App& app) {
   }
   const fw::RunIdentity run_identity =
       fw::run_identity(opt.scene_path, file.second_scene_path, opt.config.config_path);
-  const std::string identity = fw::identity_members(run_identity);
+  const std::string identity =
+      fw::identity_members(run_identity) + ", " + gate.status_member();
   const std::unique_ptr<fw::EventRecorder> recorder = make_recorder(opt, file, identity);
   // --frames-out: the frames a replay sends, stamped with the receive time of the input that
   // caused them (what candump on the bus would show).
@@ -673,12 +784,28 @@ int run(const Options& opt, const CLI::App& app) {
   fw::Supervisor supervisor(file.watchdog);
   outputs.supervisor = &supervisor;
   outputs.identity = identity;
+  const auto commissioning_extra = [&] {
+    outputs.status_extra = gate.verdict().state == fw::GateState::kRefused ||
+                                   gate.verdict().state == fw::GateState::kOverridden
+                               ? gate.status_member()
+                               : "";
+  };
+  commissioning_extra();
   const auto restart = [&] {
     start_monitor(monitor, decoder, config, scene_x, scene_y, app, opt.config.config_path);
+    hold_commissioning();
+  };
+  // A newer report (plinth-commission ran) changes what the box vouches for, within
+  // kGateRescanS.
+  const auto poll = [&](std::int64_t now_ns) {
+    if (!gate.poll(now_ns)) return;
+    gate.announce();
+    hold_commissioning();
+    commissioning_extra();
   };
   const bool estimated = run_loop(*input, monitor, decoder, outputs, recorder.get(), supervisor,
                                   latency ? &*latency : nullptr,
-                                  due_latency ? &*due_latency : nullptr, restart);
+                                  due_latency ? &*due_latency : nullptr, restart, poll);
   if (trace) trace->close();
   if (recorder) recorder->close();  // every capture is on disk before the summary
   if (frames_log && !frames_log->flush()) throw InputError("--frames-out: " + frames_log->error());
@@ -689,6 +816,7 @@ int run(const Options& opt, const CLI::App& app) {
     totals.outputs.emplace_back(o->name(), o->summary_json());
   }
   if (latency) totals.outputs.emplace_back("latency", latency->summary_json());
+  totals.outputs.emplace_back("commissioning", gate.json());
   if (due_latency && input_settings.speed > 0.0) {
     totals.outputs.emplace_back("latency_from_due", due_latency->summary_json());
   }
@@ -713,6 +841,9 @@ void refuse_without_effect(const CLI::App& app, const Options& opt) {
   refuse_without_effect(app, {"--log-time"}, log,
                         "applies to a candump log replay only (a record's samples are timed by "
                         "its sampling interval, a bus's frames by the receive clock)");
+  refuse_without_effect(app, {"--log-drops"}, log,
+                        "applies to a candump log replay only (a record has no DROPCOUNT lines; a "
+                        "bus's drops are the kernel's, counted in bus_dropped_frames)");
   refuse_without_effect(app, {"--pre-trigger", "--post-trigger"}, !opt.record_dir.empty(),
                         "sets the event recorder's captures, which is off (--record-dir)");
 }
@@ -733,6 +864,10 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--log-time", opt.log_time,
                  "a candump log's timestamps that go back, stand still or jump: warn (default: "
                  "named, counted, the box's input fault raised) or refuse (stop at the first)");
+  app.add_option("--log-drops", opt.log_drops,
+                 "a candump log's DROPCOUNT lines (frames its logger lost): warn (default: named, "
+                 "counted, the box's bus fault raised as for a live overflow) or refuse (stop at "
+                 "the first)");
   app.add_option("--rate", c.rate_hz, "sensor rate, Hz (100-1000; default: the record's, or 200)")
       ->check(plinth::host::kFinitePositive);
   app.add_option("--steps", c.steps, "solver steps per sample (default 4)")
@@ -769,7 +904,11 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--modbus", c.modbus_listen,
                  "Modbus TCP server at HOST:PORT (modbus.listen; docs/integration.md)");
   app.add_flag("--modbus-writes", c.modbus_writes,
-               "the acknowledge and reset coils may be written (modbus.writes)");
+               "the acknowledge and reset coils may be written (modbus.writes) ...");
+  app.add_option("--modbus-write-from", c.modbus_write_from,
+                 "... by these addresses or prefixes only, comma-separated: 10.0.4.7,::1 "
+                 "(modbus.write_from)")
+      ->delimiter(',');
   app.add_flag_callback(
       "--modbus-map",
       [] {
@@ -787,6 +926,9 @@ void add_options(CLI::App& app, Options& opt) {
   app.add_option("--mqtt-key", c.mqtt_key_file, "TLS: its private key");
   app.add_flag("--no-forecast", c.no_forecast,
                "the box without the forecast (forecast.enabled = false; docs/forecast.md)");
+  app.add_option("--commissioning-override", opt.commissioning_override,
+                 "monitor whatever the commissioning report says, for this reason (logged at "
+                 "each start; commissioning.override; docs/commissioning.md)");
   app.add_flag("--latency", opt.latency,
                "the summary gives each sample's latency, arrival to status ready (median, p99)");
   app.add_option("--stuck-samples", c.stuck_samples,

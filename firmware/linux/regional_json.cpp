@@ -4,7 +4,8 @@
 #include <cmath>
 #include <limits>
 
-#include <nlohmann/json.hpp>
+#include "json_payload.h"
+#include "log_text.h"
 
 namespace plinth::firmware {
 
@@ -24,13 +25,14 @@ RegionalJson refused(const char* field, std::string problem) {
 }  // namespace
 
 RegionalJson parse_regional_json(const std::string& payload, std::int64_t now_utc_ns) {
-  const nlohmann::json j = nlohmann::json::parse(payload, nullptr, false);
-  if (j.is_discarded()) return refused("payload", "not JSON");
+  const JsonPayload parsed = parse_json_payload(payload);
+  if (!parsed.problem.empty()) return refused("payload", parsed.problem);
+  const nlohmann::json& j = parsed.value;
   if (!j.is_object()) return refused("payload", "expected a JSON object");
   for (const auto& [key, value] : j.items()) {
     bool known = false;
     for (const char* m : kMembers) known = known || key == m;
-    if (!known) return refused("payload", "unknown member \"" + key + "\"");
+    if (!known) return refused("payload", "unknown member \"" + printable(key, 64) + "\"");
   }
   RegionalJson out;
   const auto integer = [&](const char* name, std::uint64_t max, std::uint64_t& value) {

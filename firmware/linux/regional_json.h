@@ -23,7 +23,7 @@ struct RegionalJson {
 
 // Reads `payload` received at `now_utc_ns` (CLOCK_REALTIME). Values are checked by the room
 // (ranges, future-dated, stale); this refuses what is not an alert at all: not JSON, not an
-// object, a member missing, of the wrong type, or unknown.
+// object, a member missing, of the wrong type, unknown or given twice (json_payload.h).
 [[nodiscard]] RegionalJson parse_regional_json(const std::string& payload,
                                                std::int64_t now_utc_ns);
 

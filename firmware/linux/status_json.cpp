@@ -126,6 +126,15 @@ std::string frame_counters(const FrameCounters& f, std::uint64_t not_encoded) {
       .count("other_nodes", f.other_nodes)
       .count("heartbeats", f.heartbeats)
       .count("acknowledgements", f.acknowledgements)
+      .count("acknowledgements_refused", f.acknowledgements_refused)
+      .count("acknowledgements_ignored", f.acknowledgements_ignored)
+      .count("acknowledgement_lockouts", f.acknowledgement_lockouts)
+      .count("statue_stands", f.statue_stands)
+      .count("statue_stands_refused", f.statue_stands_refused)
+      .count("statue_stands_ignored", f.statue_stands_ignored)
+      .count("statue_stands_lockouts", f.statue_stands_lockouts)
+      .count("regional_tags", f.regional_tags)
+      .count("regional_unauthenticated", f.regional_unauthenticated)
       .count("monitor_frames", f.monitor_frames)
       .count("rejected", f.rejected)
       .count("unknown_identifiers", f.unknown_identifiers)
@@ -342,6 +351,21 @@ std::string pwave_status_json(const monitor::PWaveStatus& p, std::int64_t start_
   return out.close();
 }
 
+std::string refused_dangerous_json(std::uint64_t count, const monitor::RefusedRegionalAlert& d,
+                                   double t) {
+  return JsonObject()
+      .count("count", count)
+      .raw("latest", count == 0 ? "null"
+                                : JsonObject()
+                                      .count("event_id", d.event_id)
+                                      .count("version", d.version)
+                                      .fixed("probability", static_cast<double>(d.probability), 4)
+                                      .text("reason", monitor::regional_refusal_name(d.refusal))
+                                      .fixed("t", t, 3)
+                                      .close())
+      .close();
+}
+
 std::string regional_status_json(const monitor::RegionalAlertStatus& r, double t_origin) {
   JsonObject refused;
   for (const NamedValue<monitor::RegionalRefusal>& named : monitor::kRegionalRefusalNames) {
@@ -371,6 +395,9 @@ std::string regional_status_json(const monitor::RegionalAlertStatus& r, double t
       .raw("refused", refused.close())
       .text("last_refusal", monitor::regional_refusal_name(r.last_refusal))
       .text("last_refusal_field", r.last_refusal_field)
+      .raw("refused_dangerous",
+           refused_dangerous_json(r.refused_dangerous, r.last_refused_dangerous,
+                                  seconds(r.last_refused_dangerous.refused_ns, t_origin)))
       .close();
 }
 
@@ -379,6 +406,7 @@ std::string regional_json(const monitor::RegionalOutcome& o, const BoxStatus& s)
   line.text("type", "regional").text("result", o.accepted() ? "accepted" : "refused");
   if (!o.accepted()) {
     line.text("reason", monitor::regional_refusal_name(o.refusal)).text("field", o.field);
+    if (o.dangerous) line.flag("more_dangerous_than_held", true);
   } else {
     line.flag("replaced", o.replaced).flag("cancelled", o.cancelled);
   }
@@ -436,6 +464,10 @@ std::string summary_json(const Monitor& monitor, const RunTotals& totals, double
                            .count("stood_still", totals.log_time_still)
                            .count("gaps", totals.log_time_gaps)
                            .close())
+      .raw("log_drops", JsonObject()
+                            .count("reports", totals.log_drop_reports)
+                            .count("frames", totals.log_drop_frames)
+                            .close())
       .text("sensors_state", monitor::health_state_name(s.sensors_state))
       .count("failovers", s.failovers)
       .count("failovers_continued", s.failovers_continued)

@@ -50,6 +50,12 @@ class JsonObject {
 // "recorder", after the monitor's members; the MQTT state's).
 [[nodiscard]] std::string recorder_status_json(const RecorderStatus& recorder);
 
+// The refusals of regional alerts more dangerous than the worst held (regional_alert.h): their
+// count and the latest, refused at JSON time `t` (null: none).
+[[nodiscard]] std::string refused_dangerous_json(std::uint64_t count,
+                                                 const monitor::RefusedRegionalAlert& latest,
+                                                 double t);
+
 // {"type": "alarm", "t": .., "level": .., "previous": .., "cause": .., "latched": .., ...}.
 [[nodiscard]] std::string alarm_json(const monitor::AlarmEventRecord& event, double t_origin);
 // The P-wave stage's part of a status line ("pwave", when it runs): state, probability,
@@ -85,8 +91,10 @@ struct RunTotals {
   std::uint64_t log_time_back = 0;       // log frames stamped before the previous (dropped)
   std::uint64_t log_time_still = 0;      // log frames stamped at the previous time (dropped)
   std::uint64_t log_time_gaps = 0;       // log jumps forward beyond kMaxLogGapS
-  // Why the run cannot be vouched for ("no_sensor_data", "log_time"), "" when it can: the
-  // summary then says "alarm": "fault" with this "input_fault".
+  std::uint64_t log_drop_reports = 0;    // a log's DROPCOUNT lines (its logger lost frames)
+  std::uint64_t log_drop_frames = 0;     // the frames they say were lost
+  // Why the run cannot be vouched for ("no_sensor_data", "log_time", "log_drops"), "" when it
+  // can: the summary then says "alarm": "fault" with this "input_fault".
   std::string input_fault;
   bool recorder = false;                 // the event recorder ran: its counters follow
   RecorderStatus recorder_status;        // its health at the end, written, lost, cut, deleted

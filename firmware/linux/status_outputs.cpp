@@ -27,6 +27,8 @@ void copy_status(const BoxStatus& s, double t_origin, StatusSnapshot& snapshot) 
   snapshot.t = static_cast<double>(s.time_ns) * 1e-9 - t_origin;
   snapshot.level = s.alarm;
   snapshot.latched = s.latched;
+  snapshot.trouble = s.trouble;
+  snapshot.collapse_held = s.collapse.held;
   snapshot.risk = s.risk;
   snapshot.probability = s.probability;
   snapshot.forecast_axis = s.forecast_axis;
@@ -69,6 +71,10 @@ void copy_status(const BoxStatus& s, double t_origin, StatusSnapshot& snapshot) 
   out.time_to_s_arrival_s = static_cast<double>(r.time_to_s_arrival_s);
   out.s_arrival_t = static_cast<double>(r.worst.s_arrival_ns) * 1e-9 - t_origin;
   out.last_refusal = r.last_refusal;
+  out.refused_dangerous = r.refused_dangerous;
+  out.last_refused_dangerous = r.last_refused_dangerous;
+  out.last_refused_dangerous_t =
+      static_cast<double>(r.last_refused_dangerous.refused_ns) * 1e-9 - t_origin;
 }
 
 std::string Endpoint::text() const {

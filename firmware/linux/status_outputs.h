@@ -37,6 +37,10 @@ struct RegionalSnapshot {
   double time_to_s_arrival_s = 0.0;
   double s_arrival_t = 0.0;       // the JSON lines' time of its S arrival
   monitor::RegionalRefusal last_refusal = monitor::RegionalRefusal::kNone;
+  // Refusals of alerts more dangerous than the worst held (RegionalAlertStatus), the latest.
+  std::uint64_t refused_dangerous = 0;
+  monitor::RefusedRegionalAlert last_refused_dangerous;
+  double last_refused_dangerous_t = 0.0;  // the JSON lines' time of its refusal
 };
 
 // What the box shows after one update of the loop.
@@ -50,6 +54,8 @@ struct StatusSnapshot {
   monitor::AlarmLevel level = monitor::AlarmLevel::kNormal;    // shown
   monitor::AlarmLevel latched = monitor::AlarmLevel::kNormal;  // kNormal: nothing latched
   monitor::AlarmCause cause = monitor::AlarmCause::kNone;      // of the latest alarm event
+  monitor::AlarmCause trouble = monitor::AlarmCause::kNone;    // beside the level (safety.md)
+  bool collapse_held = false;  // a collapse held until a person states the statue stands
   std::uint8_t event_sequence = 0;  // of the latest alarm event (an acknowledgement quotes it)
   bool any_event = false;
   double risk = 0.0;
@@ -96,11 +102,11 @@ enum class OperatorCommand : std::uint8_t {
   kStatueStands,  // a person on site states that the statue stands again, quoting the sequence
 };
 
-// A regional alert an output received (MQTT), for the loop: the alert, or malformed (`field`,
-// a string literal, names what).
+// A regional alert an output received (MQTT), for the loop: the alert, or refused before it
+// was read (malformed, unauthenticated; `field`, a string literal, names what).
 struct RegionalRequest {
   monitor::RegionalAlert alert;
-  bool malformed = false;
+  monitor::RegionalRefusal refusal = monitor::RegionalRefusal::kNone;
   const char* field = "";
 };
 

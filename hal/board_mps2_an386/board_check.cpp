@@ -1,7 +1,8 @@
 // Checks the board layer on QEMU's mps2-an386 (ctest board_check): semihosting output, the tick
 // counter against a loop of known length (under -icount shift=0 one tick is 40 instructions),
-// the stack's high-water mark against a frame of known size, and the CAN stand-in's log line.
-// Prints what it measured; exits 0 when all hold.
+// the stack's high-water mark against a frame of known size, the CAN stand-in's log line, and
+// the runtime's 64-bit division (src/compact_runtime.cpp). Prints what it measured; exits 0 when
+// all hold.
 #include <cstddef>
 #include <cstdint>
 
@@ -37,6 +38,32 @@ constexpr std::size_t kStackProbeBytes = 1024;
   return block[kStackProbeBytes - 1];
 }
 
+// One 64-bit division through the runtime (__aeabi_uldivmod or __aeabi_ldivmod: the operands are
+// volatile, so nothing is folded) against its known quotient and remainder.
+template <class Int>
+bool divides(Int n, Int d, Int quotient, Int remainder) {
+  volatile Int dividend = n;
+  volatile Int divisor = d;
+  return dividend / divisor == quotient && dividend % divisor == remainder;
+}
+
+// Quotients of 0 to 64 bits, divisors of 1 to 64 bits, every sign, the extremes.
+bool long_division_holds() {
+  using U = std::uint64_t;
+  using S = std::int64_t;
+  constexpr U kMax = ~U{0};
+  constexpr S kMin = S{-0x7FFFFFFFFFFFFFFF} - 1;
+  return divides<U>(0, 7, 0, 0) && divides<U>(6, 7, 0, 6) && divides<U>(kMax, 1, kMax, 0) &&
+         divides<U>(kMax, 10, 0x1999999999999999, 5) && divides<U>(kMax, kMax, 1, 0) &&
+         divides<U>(kMax - 1, kMax, 0, kMax - 1) &&
+         divides<U>(86'400'000'000'123'456, 1'000'000, 86'400'000'000, 123'456) &&
+         divides<U>(U{1} << 63, 3, 0x2AAAAAAAAAAAAAAA, 2) &&
+         divides<U>(0x123456789ABCDEF0, 0x100000001, 0x12345678, 0x88888878) &&
+         divides<S>(-7, 2, -3, -1) && divides<S>(7, -2, -3, 1) && divides<S>(-7, -2, 3, -1) &&
+         divides<S>(kMin, 1, kMin, 0) && divides<S>(kMin, 10, -922337203685477580, -8) &&
+         divides<S>(-1'500'000'999, 1'000'000, -1'500, -999);
+}
+
 }  // namespace
 
 extern "C" int plinth_board_main() {
@@ -66,6 +93,11 @@ extern "C" int plinth_board_main() {
   ok = ok && port.send(frame) == plinth::hal::IoStatus::kOk && port.frames_sent() == 1;
   now_ns = -1;  // a negative time cannot be logged
   ok = ok && port.send(frame) == plinth::hal::IoStatus::kIoError;
+
+  const bool division = long_division_holds();
+  semihosting::write(division ? "board_check: 64-bit division: ok\n"
+                              : "board_check: 64-bit division: FAILED\n");
+  ok = ok && division;
 
   semihosting::write(ok ? "board_check: ok\n" : "board_check: FAILED\n");
   return ok ? 0 : 1;

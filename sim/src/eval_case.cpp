@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <optional>
 #include <random>
 #include <span>
 #include <string>
+#include <utility>
 
 #include "plinth/core/excitation.h"
 #include "plinth/core/simulator.h"
@@ -41,15 +43,31 @@ struct Truth {
   // the statue's x-z plane (simulated_specific_force), m/s2 ([0]: at rest, (0, g)).
   std::vector<double> specific_force_x;
   std::vector<double> specific_force_z;
+  // For the fault statue_on_plinth: the base's specific force at each step's end (the plinth's
+  // absolute acceleration u'' + u_G'' and the ground's vertical one, gravity added), m/s2.
+  std::vector<double> base_force_x;
+  std::vector<double> base_force_z;
+  // Where a collapsed or lifted-off statue rests after the model ended (read by the fault
+  // statue_neighbour: the neighbour's sensor goes on): lying on its side (theta = +-90 degrees)
+  // after a collapse, at its last tilt after a lift-off.
+  double ended_s = -1.0;  // -1: the model held to the end
+  Eigen::Vector2d resting_force{0.0, kStandardGravity};
 
   // theta' at time t (s from the record's start), linear between steps; 0 before the start,
-  // the last one after the end.
-  [[nodiscard]] double rate_at(double t) const { return at(rotation_rate, t, 0.0); }
+  // the last one after the end, 0 after a collapse or a lift-off.
+  [[nodiscard]] double rate_at(double t) const {
+    return after_end(t) ? 0.0 : at(rotation_rate, t, 0.0);
+  }
   [[nodiscard]] Eigen::Vector2d specific_force_at(double t) const {
+    if (after_end(t)) return resting_force;
     return {at(specific_force_x, t, 0.0), at(specific_force_z, t, kStandardGravity)};
+  }
+  [[nodiscard]] Eigen::Vector2d base_force_at(double t) const {
+    return {at(base_force_x, t, 0.0), at(base_force_z, t, kStandardGravity)};
   }
 
  private:
+  [[nodiscard]] bool after_end(double t) const { return ended_s >= 0.0 && t > ended_s; }
   [[nodiscard]] double at(const std::vector<double>& steps, double t, double before) const {
     if (t <= 0.0 || steps.empty()) return before;
     const double x = t / step_s;
@@ -66,19 +84,22 @@ Excitation scaled(const host::Record& record, double gamma) {
                             gamma);
 }
 
-// `mount`: where the statue sensor's accelerometer sits (nullptr: none to simulate).
-Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& settings,
-                     const StatueAccelerometerMount* mount) {
+// The solver on `statue` (the case's true statue, or the statue_neighbour fault's). `mount`:
+// where the statue sensor's accelerometer sits (nullptr: none to simulate); `base_force`: also
+// the base's specific force (statue_on_plinth).
+Truth simulate_truth(const EvalCase& c, const Scene& statue, double gamma,
+                     const TruthSettings& settings, const StatueAccelerometerMount* mount,
+                     bool base_force = false) {
   SolverSettings solver;
   solver.step = settings.step_s;
   Simulator sim;
-  const Error e = Simulator::create(*c.true_statue, scaled(*c.record, gamma), solver, sim);
+  const Error e = Simulator::create(statue, scaled(*c.record, gamma), solver, sim);
   if (!e.ok()) {
     throw InputError(c.scene_name + ", statue " + std::to_string(c.statue) + ": solver: " +
                      e.field + " " + e.reason);
   }
   sim.start_at_rest();
-  const Scene& s = *c.true_statue;
+  const Scene& s = statue;
   const double t_end = c.record->duration() + kFreeRockingTailS;
   Truth truth;
   truth.step_s = solver.step;
@@ -86,6 +107,10 @@ Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& setti
   if (mount != nullptr) {
     truth.specific_force_x.push_back(0.0);
     truth.specific_force_z.push_back(s.g);
+  }
+  if (base_force) {
+    truth.base_force_x.push_back(0.0);
+    truth.base_force_z.push_back(s.g);
   }
   while (sim.time() < t_end - 0.5 * solver.step && !sim.mode().terminal()) {
     sim.step();
@@ -95,6 +120,11 @@ Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& setti
                                                   sim.ground(sim.time()), *mount);
       truth.specific_force_x.push_back(f.x());
       truth.specific_force_z.push_back(f.y());
+    }
+    if (base_force) {
+      const GroundAcceleration ground = sim.ground(sim.time());
+      truth.base_force_x.push_back(sim.accelerations().u + ground.horizontal);
+      truth.base_force_z.push_back(ground.vertical + s.g);
     }
     if (truth.first_motion_s < 0.0 && sim.mode().phase != Phase::kFullContact) {
       truth.first_motion_s = sim.time();
@@ -111,7 +141,22 @@ Truth simulate_truth(const EvalCase& c, double gamma, const TruthSettings& setti
     truth.collapse_time_s = sim.time();
     truth.peak_ratio = std::max(truth.peak_ratio, 1.0);
   }
+  if (sim.mode().terminal()) {
+    // At rest where it ended, tilted by theta: f = R(-theta) (0, g) = g (sin theta, cos theta).
+    const double theta = sim.mode().collapsed()
+                             ? std::copysign(std::numbers::pi / 2.0, sim.state()[kTheta])
+                             : sim.state()[kTheta];
+    truth.ended_s = sim.time();
+    truth.resting_force = s.g * Eigen::Vector2d(std::sin(theta), std::cos(theta));
+  }
   return truth;
+}
+
+// The second ground sensor's node (the replay's ground sensor is node 1, its statue sensor 2).
+constexpr std::uint8_t kSecondGroundNode = 3;
+
+[[nodiscard]] bool two_ground_sensors(FaultKind kind) {
+  return kind == FaultKind::kGroundPairPrimary || kind == FaultKind::kGroundPairSecond;
 }
 
 // The box's configuration: a record replay's (firmware/box record_replay.h), as plinth-monitor
@@ -124,6 +169,14 @@ fw::MonitorConfig box_config(const BoxSettings& box) {
   config.conditioning.startup_window_s = box.startup_window_s;
   fw::configure_record_replay(config, box.rate_hz);
   if (box.statue_sensor) fw::configure_replay_statue_sensor(config);
+  if (two_ground_sensors(box.fault.kind)) {
+    // The replay's ideal sensor twice, in the sensor list: the first (preferred) is the primary.
+    config.sensor_count = 2;
+    for (std::size_t i = 0; i < 2; ++i) {
+      config.sensors[i] = {i == 0 ? config.ground_node : kSecondGroundNode,
+                           fw::SensorRole::kGround, config.conditioning, config.sensor_health};
+    }
+  }
   return config;
 }
 
@@ -218,6 +271,29 @@ void note_level(monitor::AlarmLevel shown, double t,
   }
 }
 
+// The box's trouble at t (`status`), `input` the fault's while it is on: when the statue sensor's
+// troubles and the faulted input's were first raised, and what shows now (the run's end, when
+// it is the last). The statue sensor's are raised when the box refuses it (input_fault), but not
+// on the estimators' first sample after a start (`starting`), which the filters have not yet
+// measured: there the box refuses it at every start, and shows it for lower_hold_s
+// (docs/safety.md, "Fault injection"). The other inputs' trouble is raised when shown.
+void note_trouble(const fw::BoxStatus& status, double t, bool starting, FaultedInput input,
+                  EvalRun::Faults& faults) {
+  using monitor::AlarmCause;
+  const auto first = [&](bool raised, double& first_s) {
+    if (raised && first_s < 0.0) first_s = t;
+  };
+  const AlarmCause refused = starting ? AlarmCause::kNone : status.input_fault;
+  first(refused == AlarmCause::kStatueSensorFault, faults.first_statue_fault_s);
+  first(refused == AlarmCause::kStatueUnexplained, faults.first_statue_unexplained_s);
+  const bool shown = names_faulted_input(input, status.trouble);
+  const bool raised =
+      input == FaultedInput::kStatueSensor ? shown && names_faulted_input(input, refused) : shown;
+  first(raised, faults.first_trouble_s);
+  faults.trouble_at_end = shown && faults.first_trouble_s >= 0.0;
+  faults.trouble_at_end_cause = status.trouble;
+}
+
 // The P-wave stage the box would run, with the scene's fragility (docs/pwave.md).
 monitor::PWaveStage pwave_stage(const EvalCase& c, double rate_hz) {
   if (!c.scene->fragility) {
@@ -234,22 +310,138 @@ monitor::PWaveStage pwave_stage(const EvalCase& c, double rate_hz) {
   return stage;
 }
 
-// The box on the case's motion; stops at the true collapse (what comes after cannot make a hit)
-// or the true statue's lift-off (nothing after it is known), else at the end of the record and
-// its tail.
-// `config`: box_config(box).
-void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
-             const fw::MonitorConfig& config, const host::CrossingGrids& grids,
-             const Truth& truth, EvalRun& run) {
-  const double stop_s = truth.collapsed ? truth.collapse_time_s : truth.lift_off_s;
+// When the run's fault begins, s from the record's t = 0 (FaultOnset): known from the start but
+// for the alarm's anchor, which the box's first alarm sets; never when its anchor never comes.
+class FaultClock {
+ public:
+  FaultClock(const Fault& fault, const EvalCase& c, const Truth& truth)
+      : alarm_offset_s_(fault.onset.offset_s) {
+    if (!fault.any()) return;
+    const double offset = fault.onset.offset_s;
+    switch (fault.onset.anchor) {
+      case FaultAnchor::kBoxStart: onset_s_ = -kNever; break;
+      case FaultAnchor::kRecord: onset_s_ = offset; break;
+      case FaultAnchor::kStrongMotion: onset_s_ = c.phases.strong_motion_s + offset; break;
+      case FaultAnchor::kMotion:
+        if (truth.first_motion_s >= 0.0) onset_s_ = truth.first_motion_s + offset;
+        break;
+      case FaultAnchor::kAlarm: waits_for_alarm_ = true; break;
+    }
+  }
+  // The box showed `alarm` first at t.
+  void alarm_shown(double t) {
+    if (waits_for_alarm_ && onset_s_ == kNever) onset_s_ = t + alarm_offset_s_;
+  }
+  // The fault is on at t_box (s from the record's t = 0, negative in the lead-in).
+  [[nodiscard]] bool on(double t_box) const { return t_box >= onset_s_; }
+
+ private:
+  static constexpr double kNever = std::numeric_limits<double>::infinity();
+  double alarm_offset_s_ = 0.0;
+  bool waits_for_alarm_ = false;
+  double onset_s_ = kNever;
+};
+
+// The statue sensor's two samples of one input.
+struct StatueReadings {
+  fw::StatueSample rate;
+  monitor::SensorSample acceleration;
+};
+
+// The statue sensor of a run as the fault leaves it: what it senses (the true statue; at rest,
+// the plinth or the neighbour while the fault is on, a delay more, or frozen at the onset)
+// through StatueImu's offsets and noise (drawn for every input, sent or not, so that a fault
+// changes nothing else of the run), then its reading changed (gain, bias, axes, sign) or not
+// sent (a drop-out).
+class FaultyStatueSensor {
+ public:
+  FaultyStatueSensor(const EvalCase& c, double rate_hz, const Fault& fault, const Truth& truth,
+                     const Truth* neighbour)
+      : imu_(c, rate_hz, StatueImuModel{}), fault_(fault), truth_(truth), neighbour_(neighbour) {}
+
+  // Input n at `t` (s from the record's t = 0; 0 in the lead-in, `lead_in`), the fault `on`
+  // since `began_s`; nullopt: nothing sent.
+  std::optional<StatueReadings> read(const fw::MonitorConfig& config, std::int64_t n, double t,
+                                     bool lead_in, bool on, double began_s) {
+    const FaultKind kind = on ? fault_.kind : FaultKind::kNone;
+    const double delay = imu_.delay_s() + (kind == FaultKind::kStatueDelay ? fault_.value : 0.0);
+    Sensed sensed = sense(lead_in ? 0.0 : t - delay, kind);
+    if (kind == FaultKind::kStatueStuck) {
+      if (!frozen_) frozen_ = sensed;
+      sensed = *frozen_;
+    }
+    StatueReadings r{imu_.sample(config, n, sensed.rate_rad_s),
+                     imu_.acceleration(config, n, sensed.force_m_s2)};
+    Vector3r& w = r.rate.rotation_rate_rad_s;
+    Vector3r& a = r.acceleration.acceleration_g;
+    switch (kind) {
+      case FaultKind::kStatueGain: w *= static_cast<Real>(fault_.value); break;
+      case FaultKind::kStatueBias: w += Vector3r::Constant(static_cast<Real>(fault_.value)); break;
+      case FaultKind::kStatueAxesSwapped:
+        std::swap(w.x(), w.y());
+        std::swap(a.x(), a.y());
+        break;
+      case FaultKind::kStatueSign:
+        w[fault_.axis] = -w[fault_.axis];
+        a[fault_.axis] = -a[fault_.axis];
+        break;
+      case FaultKind::kStatueDropout:
+        if (t < began_s + fault_.value) return std::nullopt;
+        break;
+      default: break;
+    }
+    return r;
+  }
+
+ private:
+  // What the sensor senses: theta' (rad/s) and the specific force in the statue's x-z plane.
+  struct Sensed {
+    double rate_rad_s = 0.0;
+    Eigen::Vector2d force_m_s2;
+  };
+  [[nodiscard]] Sensed sense(double then, FaultKind kind) const {
+    switch (kind) {
+      case FaultKind::kStatueAtRest: return {0.0, truth_.specific_force_at(0.0)};
+      case FaultKind::kStatueOnPlinth: return {0.0, truth_.base_force_at(then)};
+      case FaultKind::kStatueNeighbour:
+        return {neighbour_->rate_at(then), neighbour_->specific_force_at(then)};
+      default: return {truth_.rate_at(then), truth_.specific_force_at(then)};
+    }
+  }
+
+  StatueImu imu_;
+  const Fault& fault_;
+  const Truth& truth_;
+  const Truth* neighbour_;
+  std::optional<Sensed> frozen_;  // statue_stuck: what it sensed at the onset
+};
+
+// The box started with the case's members, and a restarted one's memory restored.
+std::unique_ptr<fw::Monitor> start_box(const EvalCase& c, const fw::MonitorConfig& config,
+                                       std::span<const Scene> members,
+                                       const fw::BoxMemory* memory = nullptr) {
   auto monitor = std::make_unique<fw::Monitor>();  // an ensemble is too big for the stack
-  const std::span<const Scene> members = box.knows_true_statue
-                                             ? std::span<const Scene>(c.true_statue, 1)
-                                             : std::span<const Scene>(c.scene->members);
   const Error e = monitor->start(config, {members, {}});
   if (!e.ok()) {
     throw InputError(c.scene_name + ": the box refuses it: " + e.field + " " + e.reason);
   }
+  if (memory != nullptr) monitor->restore(*memory);
+  return monitor;
+}
+
+// The box on the case's motion; stops at the true collapse (what comes after cannot make a hit)
+// or the true statue's lift-off (nothing after it is known), else at the end of the record and
+// its tail. The fault (box.fault) goes in through the box's inputs: the samples' values, the
+// samples sent, a restart with the box's memory (eval_fault.h).
+// `config`: box_config(box); `neighbour`: the statue_neighbour fault's truth.
+void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
+             const fw::MonitorConfig& config, const host::CrossingGrids& grids,
+             const Truth& truth, const Truth* neighbour, EvalRun& run) {
+  const double stop_s = truth.collapsed ? truth.collapse_time_s : truth.lift_off_s;
+  const std::span<const Scene> members = box.knows_true_statue
+                                             ? std::span<const Scene>(c.true_statue, 1)
+                                             : std::span<const Scene>(c.scene->members);
+  std::unique_ptr<fw::Monitor> monitor = start_box(c, config, members);
   const double rate = box.rate_hz;
   const std::size_t count = host::sample_count(c.record->duration() + kFreeRockingTailS, rate);
   const std::vector<double> h = host::resample(c.record->horizontal_signal(), rate, count);
@@ -260,8 +452,9 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
   run.risk_crossing_s.assign(grids.risk.size(), -1.0);
   run.probability_crossing_s.assign(grids.probability.size(), -1.0);
   run.nominal_risk_crossing_s.assign(grids.risk.size(), -1.0);
-  std::optional<StatueImu> imu;
-  if (box.statue_sensor) imu.emplace(c, rate, StatueImuModel{});
+  const Fault& fault = box.fault;
+  std::optional<FaultyStatueSensor> statue_sensor;
+  if (box.statue_sensor) statue_sensor.emplace(c, rate, fault, truth, neighbour);
   std::optional<monitor::PWaveStage> stage;
   if (box.pwave) {
     stage = pwave_stage(c, rate);
@@ -269,22 +462,68 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
     run.p_pick_s = c.phases.p_pick_s;
     run.strong_motion_s = c.phases.strong_motion_s;
   }
+  EvalRun::Faults& faults = run.faults.emplace();
+  if (fault.any()) {
+    faults.fault = kFaultKindNames.name(fault.kind);
+    faults.param = fault.param;
+    faults.at = fault.onset.text;
+  }
+  FaultClock clock(fault, c, truth);
+  const bool ground_fault =
+      fault.input() == FaultedInput::kGroundSensor && !two_ground_sensors(fault.kind);
+  std::uint8_t latest_event = 0;  // the sequence of the latest alarm event (an acknowledgement's)
+  const auto take = [&](const fw::MonitorUpdate& update) {
+    if (update.event_count > 0) latest_event = update.events[update.event_count - 1].sequence;
+  };
+  double down_until_s = -std::numeric_limits<double>::infinity();  // restart: the box is off
+  std::uint64_t restarts_seen = 0;  // the box's estimator_restarts at the previous sample
   const double lead_in_s = static_cast<double>(lead_in) / rate;
   for (std::size_t n = 0; n < lead_in + count; ++n) {
     const std::size_t k = n < lead_in ? 0 : n - lead_in;
+    const double t = static_cast<double>(k) / rate;
+    const double t_box = static_cast<double>(n) / rate - lead_in_s;
+    const bool on = clock.on(t_box);
+    if (on && !faults.began_s) {
+      faults.began_s = t_box;
+      if (happens_at_an_instant(fault.kind)) {
+        // plinth-monitor's reset (acknowledged first: anyone on the network may press both) or a
+        // restart after a crash: a new box with the memory the old one kept; a reset is refused
+        // while an alarm stays latched.
+        const fw::BoxStatus& before = monitor->status();
+        if (fault.kind == FaultKind::kReset && before.latched != monitor::AlarmLevel::kNormal) {
+          take(monitor->acknowledge({before.latched, latest_event}));
+        }
+        if (fault.kind == FaultKind::kRestart ||
+            monitor->status().latched != monitor::AlarmLevel::kAlarm) {
+          const fw::BoxMemory memory = monitor->memory();
+          monitor = start_box(c, config, members, &memory);
+          down_until_s = t_box + fault.value;
+          restarts_seen = 0;
+        }
+      }
+    }
+    const bool down = t_box < down_until_s;
     const Eigen::Vector3d ground(gamma * h[k], 0.0,
                                  kStandardGravity + (v.empty() ? 0.0 : gamma * v[k]));
-    const monitor::SensorSample s =
+    monitor::SensorSample s =
         fw::record_replay_sample(config, static_cast<std::int64_t>(n), ground, kStandardGravity);
-    const double t = static_cast<double>(k) / rate;
-    if (imu) {
-      const double then = n < lead_in ? 0.0 : t - imu->delay_s();
-      const auto i = static_cast<std::int64_t>(n);
-      (void)monitor->on_statue_sample(imu->sample(config, i, truth.rate_at(then)));
-      (void)monitor->on_statue_acceleration(
-          imu->acceleration(config, i, truth.specific_force_at(then)));
+    monitor::SensorSample second = s;
+    if (on && (ground_fault || two_ground_sensors(fault.kind))) {
+      monitor::SensorSample& wrong = fault.kind == FaultKind::kGroundPairSecond ? second : s;
+      wrong.acceleration_g = fault.ground.read(wrong.acceleration_g.cast<double>()).cast<Real>();
     }
-    const fw::MonitorUpdate update = monitor->on_sample(s);
+    if (statue_sensor) {
+      const std::optional<StatueReadings> r = statue_sensor->read(
+          config, static_cast<std::int64_t>(n), t, n < lead_in, on, faults.began_s.value_or(0.0));
+      if (r && !down) {
+        take(monitor->on_statue_sample(r->rate));
+        take(monitor->on_statue_acceleration(r->acceleration));
+      }
+    }
+    if (!down) {
+      take(monitor->on_sample(s));
+      if (two_ground_sensors(fault.kind)) take(monitor->on_sensor_sample(1, second));
+    }
     if (stage) {
       // What the box's conditioning gives it: the replay's lead-in is at rest (0 g horizontal,
       // 1 g vertical: record_replay_sample), its offset taken away, then the record as it is
@@ -303,8 +542,21 @@ void run_box(const EvalCase& c, double gamma, const BoxSettings& box,
     }
     if (n < lead_in) continue;
     if (stop_s >= 0.0 && t >= stop_s) break;
-    const fw::BoxStatus& status = *update.status;
+    if (down) {
+      faults.level_at_end = host::kBoxDown;
+      faults.trouble_at_end_cause = monitor::AlarmCause::kNone;
+      faults.trouble_at_end = false;
+      continue;
+    }
+    const fw::BoxStatus& status = monitor->status();
     note_level(status.alarm, t, run.first_shown_s);
+    faults.level_at_end = monitor::alarm_level_name(status.alarm);
+    const double alarm_s =
+        run.first_shown_s[monitor::risk_level_index(monitor::AlarmLevel::kAlarm)];
+    if (alarm_s >= 0.0) clock.alarm_shown(alarm_s);
+    const bool starting = status.estimator_restarts != restarts_seen;
+    restarts_seen = status.estimator_restarts;
+    note_trouble(status, t, starting, on ? fault.input() : FaultedInput::kNone, faults);
     if (!status.estimating) continue;
     note_crossings(grids.risk, status.risk, t, run.risk_crossing_s);
     note_crossings(grids.probability, status.probability, t, run.probability_crossing_s);
@@ -329,8 +581,9 @@ EvalRun::Regional regional_alert(const EvalCase& c, const host::RegionalAlertMod
 
 }  // namespace
 
-EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings& truth_settings,
-                 const host::CrossingGrids& grids) {
+std::optional<EvalRun> run_case(const EvalCase& c, const BoxSettings& box,
+                                const TruthSettings& truth_settings,
+                                const host::CrossingGrids& grids, BoxRuns runs) {
   const double peak = c.record->peak_horizontal();
   if (!(peak > 0.0)) throw InputError(c.record_name + ": the record is all zeros");
   const double gamma = c.scale_g * kStandardGravity / peak;
@@ -343,14 +596,22 @@ EvalRun run_case(const EvalCase& c, const BoxSettings& box, const TruthSettings&
   run.scale_g = c.scale_g;
   const fw::MonitorConfig config = box_config(box);
   const StatueAccelerometerMount mount = statue_accelerometer_mount(config);
-  const Truth truth =
-      simulate_truth(c, gamma, truth_settings, box.statue_sensor ? &mount : nullptr);
+  const Truth truth = simulate_truth(c, *c.true_statue, gamma, truth_settings,
+                                     box.statue_sensor ? &mount : nullptr,
+                                     box.fault.kind == FaultKind::kStatueOnPlinth);
   run.collapsed = truth.collapsed;
   run.collapse_time_s = truth.collapse_time_s;
   run.peak_ratio = truth.peak_ratio;
   run.model_valid_until_s = truth.lift_off_s;
   run.first_motion_s = truth.first_motion_s;
-  run_box(c, gamma, box, config, grids, truth, run);
+  if (runs == BoxRuns::kCollapses && !truth.collapsed) return std::nullopt;
+  std::optional<Truth> neighbour;
+  if (box.fault.kind == FaultKind::kStatueNeighbour) {
+    if (c.neighbour_statue == nullptr) throw InputError("statue_neighbour: no neighbour drawn");
+    neighbour = simulate_truth(c, *c.neighbour_statue, gamma, truth_settings, &mount);
+  }
+  run_box(c, gamma, box, config, grids, truth, neighbour ? &*neighbour : nullptr, run);
+  run.faults->collapses_only = runs == BoxRuns::kCollapses;
   if (box.regional) run.regional = regional_alert(c, *box.regional);
   return run;
 }

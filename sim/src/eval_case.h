@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "eval_fault.h"
 #include "plinth/core/forecast.h"
 #include "plinth/core/scene.h"
 #include "plinth/host/eval_metrics.h"
@@ -41,6 +42,8 @@ struct BoxSettings {
   // "Evaluation"): one alert per run, its probability from the box's regional room with the
   // scene's [fragility]. Needs each case's source.
   std::optional<host::RegionalAlertModel> regional;
+  // One fault injected into the box's inputs (plinth-eval run --fault; eval_fault.h).
+  Fault fault;
 };
 
 // A MEMS IMU a museum would mount on a statue. Its gyroscope: a Bosch BMI088's typical figures as
@@ -78,11 +81,20 @@ struct EvalCase {
   double scale_g = 0.0;  // the record's PGA in this run, g
   host::RecordPhases phases;  // the record's (the same at every scale)
   const host::RecordSource* source = nullptr;  // the record's earthquake (--record-info)
+  // The fault statue_neighbour: the statue the sensor is on, drawn as the true statues are.
+  const Scene* neighbour_statue = nullptr;
 };
 
-// The truth and the box's timeline for one case (times from the record's t = 0, s). Throws
-// InputError when the scaled record or the scene cannot be run (naming which).
-[[nodiscard]] host::EvalRun run_case(const EvalCase& c, const BoxSettings& box,
-                                     const TruthSettings& truth, const host::CrossingGrids& grids);
+// Which runs the box runs on: all, or only those whose truth collapsed (plinth-eval run
+// --collapses-only: a fault's silenced collapses and lost lead need no more).
+enum class BoxRuns { kAll, kCollapses };
+
+// The truth and the box's timeline for one case (times from the record's t = 0, s); nullopt
+// when `runs` is kCollapses and the truth stood (the box not run). Throws InputError when the
+// scaled record or the scene cannot be run (naming which).
+[[nodiscard]] std::optional<host::EvalRun> run_case(const EvalCase& c, const BoxSettings& box,
+                                                    const TruthSettings& truth,
+                                                    const host::CrossingGrids& grids,
+                                                    BoxRuns runs = BoxRuns::kAll);
 
 }  // namespace plinth::sim

@@ -18,6 +18,8 @@
 #include <vector>
 
 #include "eval_case.h"
+#include "eval_fault.h"
+#include "eval_fault_report.h"
 #include "eval_fragility.h"
 #include "eval_pwave.h"
 #include "eval_pwave_report.h"
@@ -42,6 +44,8 @@ using plinth::host::InputError;
 constexpr int kInterruptedExit = 130;  // 128 + SIGINT, as shells report it
 constexpr int kMaxStatues = 1000;
 constexpr int kMaxPgaSteps = 200;
+// The fault statue_neighbour's statues: drawn as the true statues, from another seed.
+constexpr unsigned kNeighbourSeedSalt = 0x6e656967U;  // "neig"
 
 struct RunOptions {
   std::vector<std::string> scene_paths;
@@ -70,6 +74,10 @@ struct RunOptions {
   double truth_step_s = 5e-4;
   std::optional<int> jobs;
   std::string shard = "1/1";
+  std::string fault = "none";  // KIND[:PARAM] (eval_fault.h)
+  std::string fault_at = "start";
+  bool collapses_only = false;
+  std::string collapses_of;  // run only the runs that collapsed in this runs file
 };
 
 struct ReportOptions {
@@ -89,6 +97,13 @@ struct FragilityOptions {
   std::string json_path;
   std::string plot_path;
   std::string collapse_intensity = "interval";
+};
+
+struct FaultReportOptions {
+  std::vector<std::string> runs_paths;
+  std::string against_path;
+  std::string json_path;
+  int list_silenced = 10;
 };
 
 struct MergeOptions {
@@ -148,6 +163,17 @@ plinth::sim::BoxSettings box_settings(const RunOptions& opt) {
     throw InputError("--pwave: expected on or off, got '" + opt.pwave + "'");
   }
   box.pwave = opt.pwave == "on";
+  box.fault = plinth::sim::parse_fault(opt.fault);
+  box.fault.onset = plinth::sim::parse_fault_onset(opt.fault_at);
+  if (plinth::sim::needs_statue_sensor(box.fault.kind) && !box.statue_sensor) {
+    throw InputError("--fault " + opt.fault + ": a fault of the statue sensor needs "
+                     "--statue-sensor");
+  }
+  if (plinth::sim::happens_at_an_instant(box.fault.kind) &&
+      box.fault.onset.anchor == plinth::sim::FaultAnchor::kBoxStart) {
+    throw InputError("--fault " + opt.fault + ": needs --fault-at, when it happens (a time in s, "
+                     "strong, motion or alarm+S): at the box's start it changes nothing");
+  }
   if (opt.regional != "on" && opt.regional != "off") {
     throw InputError("--regional: expected on or off, got '" + opt.regional + "'");
   }
@@ -179,11 +205,12 @@ std::vector<plinth::Scene> draw_statues(const plinth::host::UncertainScene& scen
 }
 
 void write_runs(const std::string& path, const plinth::host::CrossingGrids& grids,
-                const std::vector<std::vector<EvalRun>>& results, bool with_grid = true) {
+                const std::vector<std::vector<EvalRun>>& results, bool with_grid = true,
+                bool with_faults = true) {
   const std::string temporary = path + ".tmp";
   std::FILE* out = std::fopen(temporary.c_str(), "w");
   if (out == nullptr) throw InputError(path + ": cannot write (does its folder exist?)");
-  plinth::host::write_eval_csv_header(out, grids, with_grid);
+  plinth::host::write_eval_csv_header(out, grids, with_grid, with_faults);
   for (const std::vector<EvalRun>& job : results) {
     for (const EvalRun& run : job) plinth::host::write_eval_csv_row(out, run);
   }
@@ -215,6 +242,36 @@ void write_motion(const std::string& path, const std::vector<std::vector<EvalRun
   if (std::fclose(out) != 0 || !ok) throw InputError(path + ": cannot write");
 }
 
+// --collapses-of FILE: per case index (`case_key(index)`: record|scene|statue), the grid points
+// at which the file's runs collapsed. The file must be of this run's seed and grid.
+template <class CaseKey>
+std::map<std::size_t, std::set<int>> collapsing_points(const RunOptions& opt,
+                                                      const plinth::host::PgaGrid& grid,
+                                                      std::size_t job_count,
+                                                      CaseKey case_key) {
+  const EvalTable table = plinth::host::read_eval_csv(opt.collapses_of);
+  if (!table.has_grid) {
+    throw InputError(opt.collapses_of + ": no seed and pga grid columns (a plinth-eval before "
+                     "the collapse margin wrote it): --collapses-of needs them");
+  }
+  std::map<std::string, std::size_t> index_of;
+  for (std::size_t i = 0; i < job_count; ++i) index_of.emplace(case_key(i), i);
+  std::map<std::size_t, std::set<int>> points;
+  for (const EvalRun& r : table.runs) {
+    if (!r.collapsed) continue;
+    if (r.seed != opt.seed || !(r.grid == grid)) {
+      throw InputError(opt.collapses_of + ": " + r.record + ", " + r.scene + ", statue " +
+                       std::to_string(r.statue) + " ran with --seed " + std::to_string(r.seed) +
+                       " on another grid or seed than this run's (--seed " +
+                       std::to_string(opt.seed) + ", --pga-from/--pga-to/--pga-steps)");
+    }
+    const auto it = index_of.find(r.record + "|" + r.scene + "|" + std::to_string(r.statue));
+    if (it == index_of.end()) continue;  // a case this run does not have (another shard's)
+    points[it->second].insert(grid.index_of(r.scale_g));
+  }
+  return points;
+}
+
 int run_eval(const RunOptions& opt) {
   const plinth::host::PgaGrid grid = pga_grid(opt);
   refuse_repeated_names(opt.scene_paths, "--scene");
@@ -228,9 +285,14 @@ int run_eval(const RunOptions& opt) {
   truth.step_s = opt.truth_step_s;
   std::vector<plinth::host::UncertainScene> scenes;
   std::vector<std::vector<plinth::Scene>> statues;
+  std::vector<std::vector<plinth::Scene>> neighbours;  // the fault statue_neighbour's
   for (std::size_t s = 0; s < opt.scene_paths.size(); ++s) {
     scenes.push_back(plinth::host::load_uncertain_scene_file(opt.scene_paths[s]));
-    statues.push_back(draw_statues(scenes.back(), opt.statues, opt.seed + 7919U * static_cast<unsigned>(s)));
+    const unsigned seed = opt.seed + 7919U * static_cast<unsigned>(s);
+    statues.push_back(draw_statues(scenes.back(), opt.statues, seed));
+    if (box.fault.kind == plinth::sim::FaultKind::kStatueNeighbour) {
+      neighbours.push_back(draw_statues(scenes.back(), opt.statues, seed ^ kNeighbourSeedSalt));
+    }
   }
   const std::vector<plinth::host::Record> records =
       plinth::sim::read_records(opt.record_paths, opt.vertical_paths);
@@ -261,13 +323,31 @@ int run_eval(const RunOptions& opt) {
     const std::size_t r = index / per_record;
     const std::size_t s = index % per_record / static_cast<std::size_t>(opt.statues);
     const auto j = static_cast<int>(index % static_cast<std::size_t>(opt.statues));
-    return plinth::sim::EvalCase{&records[r],   file_name(opt.record_paths[r]),
-                                  &scenes[s],    file_name(opt.scene_paths[s]),
-                                  j,             opt.seed,
-                                  grid,          &statues[s][static_cast<std::size_t>(j)],
-                                  pga,           phases[r],
-                                  sources[r]};
+    const auto statue = static_cast<std::size_t>(j);
+    return plinth::sim::EvalCase{&records[r],
+                                 file_name(opt.record_paths[r]),
+                                 &scenes[s],
+                                 file_name(opt.scene_paths[s]),
+                                 j,
+                                 opt.seed,
+                                 grid,
+                                 &statues[s][statue],
+                                 pga,
+                                 phases[r],
+                                 sources[r],
+                                 neighbours.empty() ? nullptr : &neighbours[s][statue]};
   };
+  const bool collapses_only = opt.collapses_only || !opt.collapses_of.empty();
+  const plinth::sim::BoxRuns box_runs =
+      collapses_only ? plinth::sim::BoxRuns::kCollapses : plinth::sim::BoxRuns::kAll;
+  // --collapses-of: the grid points of each case that collapsed there (by case index).
+  std::map<std::size_t, std::set<int>> collapsing;  // read by the jobs only once filled
+  if (!opt.collapses_of.empty()) {
+    collapsing = collapsing_points(opt, grid, job_count, [&](std::size_t index) {
+      const plinth::sim::EvalCase c = case_of(index, 0.0);
+      return c.record_name + "|" + c.scene_name + "|" + std::to_string(c.statue);
+    });
+  }
   run.stop = plinth::host::install_stop_handlers("plinth-eval");
   plinth::host::ProgressBar progress(indices.size(), 0, "cases");
   std::size_t done = 0;
@@ -279,7 +359,21 @@ int run_eval(const RunOptions& opt) {
         std::vector<EvalRun> job;
         for (int i = 0; i < grid.steps; ++i) {
           if (run.stop->load()) throw plinth::host::JobCancelled();
-          job.push_back(plinth::sim::run_case(case_of(index, grid.at(i)), box, truth, grids));
+          if (!opt.collapses_of.empty()) {
+            const auto points = collapsing.find(index);
+            if (points == collapsing.end() || points->second.count(i) == 0) continue;
+          }
+          std::optional<EvalRun> r =
+              plinth::sim::run_case(case_of(index, grid.at(i)), box, truth, grids, box_runs);
+          if (!r && !opt.collapses_of.empty()) {
+            throw InputError(opt.collapses_of + ": says " + case_of(index, 0.0).record_name +
+                             ", " + case_of(index, 0.0).scene_name + ", statue " +
+                             std::to_string(case_of(index, 0.0).statue) + " collapsed at " +
+                             plinth::host::number_text(grid.at(i)) +
+                             " g; here its truth stood (another --truth-step?)");
+          }
+          if (!r) continue;  // --collapses-only: the truth stood
+          job.push_back(std::move(*r));
           if (job.back().collapsed && !opt.all_scales) break;
         }
         results[index] = std::move(job);
@@ -325,6 +419,14 @@ void write_text(const std::string& path, const std::string& text) {
   if (!ok || ec) throw InputError(path + ": cannot write");
 }
 
+// A runs file of collapses alone (run --collapses-only) cannot be scored by `what`.
+void refuse_collapses_only(const EvalTable& table, const std::string& path, const char* what) {
+  if (table.collapses_only) {
+    throw InputError(path + ": holds only the runs whose truth collapsed (plinth-eval run "
+                     "--collapses-only), and " + what + "; fault-report reads it");
+  }
+}
+
 int run_report(const ReportOptions& opt) {
   plinth::sim::CalibrationTargets targets;
   if (!plinth::host::parse_false_alarm(opt.false_alarm, targets.false_alarm)) {
@@ -332,11 +434,13 @@ int run_report(const ReportOptions& opt) {
   }
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
+  refuse_collapses_only(table, opt.runs_path, "report scores the runs that stood too");
   plinth::sim::require_margins(table, targets, opt.runs_path);
   EvalTable calibration;
   if (!opt.calibration_path.empty()) {
     calibration = plinth::host::read_eval_csv(opt.calibration_path);
     if (calibration.runs.empty()) throw InputError(opt.calibration_path + ": no runs");
+    refuse_collapses_only(calibration, opt.calibration_path, "a calibration needs every run");
     plinth::sim::require_margins(calibration, targets, opt.calibration_path + " (--calibrate-on)");
   }
   const plinth::sim::Report report = plinth::sim::make_report(
@@ -375,11 +479,55 @@ int run_fragility(const FragilityOptions& opt) {
   }
   const EvalTable table = plinth::host::read_eval_csv(opt.runs_path);
   if (table.runs.empty()) throw InputError(opt.runs_path + ": no runs");
+  refuse_collapses_only(table, opt.runs_path, "a fragility needs the runs that stood");
   const std::vector<plinth::sim::SceneFragility> scenes =
       plinth::sim::scene_fragilities(table, opt.runs_path, rule);
   std::fputs(plinth::sim::fragility_text(scenes, rule).c_str(), stdout);
   if (!opt.json_path.empty()) write_text(opt.json_path, plinth::sim::fragility_json(scenes, rule));
   if (!opt.plot_path.empty()) plinth::sim::plot_fragility(scenes, opt.plot_path);
+  return 0;
+}
+
+// Shards of one run share its fault, and a file of collapses alone holds a run once.
+void refuse_other_faults(const std::vector<EvalRun>& runs, const std::vector<std::string>& inputs) {
+  std::set<std::string> seen;
+  for (const EvalRun& r : runs) {
+    if (!r.faults) return;
+    const EvalRun::Faults& f = *r.faults;
+    const EvalRun::Faults& first = *runs.front().faults;
+    if (f.fault != first.fault || f.param != first.param || f.at != first.at) {
+      throw InputError("merge: " + r.record + ", " + r.scene + ", statue " +
+                       std::to_string(r.statue) + ": fault " + f.fault + " (" + f.param + ", " +
+                       f.at + "), where the first run has " + first.fault + " (" + first.param +
+                       ", " + first.at + "): the inputs are not shards of one run");
+    }
+    if (f.collapses_only) {
+      const std::string key = r.record + "|" + r.scene + "|" + std::to_string(r.statue) + "|" +
+                              std::to_string(r.seed) + "|" + plinth::host::number_text(r.scale_g);
+      if (!seen.insert(key).second) {
+        throw InputError("merge (a run in two inputs?): " + r.record + ", " + r.scene +
+                         ", statue " + std::to_string(r.statue) + " at " +
+                         plinth::host::number_text(r.scale_g) + " g twice among " +
+                         std::to_string(inputs.size()) + " inputs");
+      }
+    }
+  }
+}
+
+int run_fault_report(const FaultReportOptions& opt) {
+  std::optional<EvalTable> against;
+  if (!opt.against_path.empty()) against = plinth::host::read_eval_csv(opt.against_path);
+  std::vector<plinth::sim::FaultClassReport> reports;
+  for (const std::string& path : opt.runs_paths) {
+    reports.push_back(plinth::sim::make_fault_report(plinth::host::read_eval_csv(path), path,
+                                                     against ? &*against : nullptr,
+                                                     opt.against_path));
+  }
+  std::fputs(plinth::sim::fault_report_text(reports, opt.against_path, opt.list_silenced).c_str(),
+             stdout);
+  if (!opt.json_path.empty()) {
+    write_text(opt.json_path, plinth::sim::fault_report_json(reports, opt.against_path));
+  }
   return 0;
 }
 
@@ -390,6 +538,19 @@ int run_merge(const MergeOptions& opt) {
     if (i == 0) {
       merged.grids = part.grids;
       merged.has_grid = part.has_grid;
+      merged.has_faults = part.has_faults;
+      merged.collapses_only = part.collapses_only;
+    } else if (part.has_faults != merged.has_faults) {
+      throw InputError(opt.inputs[i] + ": " + (part.has_faults ? "has" : "has no") +
+                       " fault columns, " + opt.inputs[0] + " " +
+                       (part.has_faults ? "has none" : "has them") +
+                       " (a plinth-eval before fault injection wrote one of them)");
+    } else if (part.collapses_only != merged.collapses_only) {
+      throw InputError(opt.inputs[i] + ": " +
+                       (part.collapses_only ? "collapses only" : "every run") + ", " +
+                       opt.inputs[0] + " " +
+                       (merged.collapses_only ? "collapses only" : "every run") +
+                       " (run --collapses-only wrote one of them)");
     } else if (part.grids.risk != merged.grids.risk ||
                part.grids.probability != merged.grids.probability ||
                part.grids.pwave != merged.grids.pwave ||
@@ -405,10 +566,11 @@ int run_merge(const MergeOptions& opt) {
     for (EvalRun& r : part.runs) merged.runs.push_back(std::move(r));
   }
   // A case in two inputs (shards of one run never share one) would not be one case.
-  if (merged.has_grid) {
+  if (merged.has_grid && !merged.collapses_only) {
     (void)plinth::host::eval_cases(merged.runs, "merge (a case in two inputs?)");
   }
-  write_runs(opt.out_path, merged.grids, {merged.runs}, merged.has_grid);
+  refuse_other_faults(merged.runs, opt.inputs);
+  write_runs(opt.out_path, merged.grids, {merged.runs}, merged.has_grid, merged.has_faults);
   std::printf("plinth-eval merge: %zu runs from %zu files -> %s\n", merged.runs.size(),
               opt.inputs.size(), opt.out_path.c_str());
   return 0;
@@ -476,6 +638,20 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.0, 10.0));
   run->add_option("--truth-step", opt.truth_step_s, "the truth's solver step, s (default 5e-4)")
       ->check(kFinitePositive);
+  run->add_option("--fault", opt.fault,
+                  "one fault injected into the box's inputs, KIND[:PARAM] (docs/safety.md, "
+                  "\"Fault injection\"): " +
+                      std::string(plinth::joined_names<plinth::sim::kFaultKindNames>("").data()));
+  run->add_option("--fault-at", opt.fault_at,
+                  "when the fault begins: start (default), a time in s from the record's start, "
+                  "or strong, motion or alarm (the record's strong motion, the true statue's "
+                  "first motion, the box's first alarm), each with an optional +S (or -S)");
+  run->add_flag("--collapses-only", opt.collapses_only,
+                "run the box only where the truth collapses and write those runs alone (what "
+                "fault-report needs; report refuses such a file)");
+  run->add_option("--collapses-of", opt.collapses_of,
+                  "run only the runs that collapsed in this runs file of the same cases (its "
+                  "truth: no other scale is simulated); implies --collapses-only");
   run->add_option("--jobs", opt.jobs, "threads (default: the hardware's)");
   run->add_option("--shard", opt.shard, "run only part i of N of the cases, as i/N");
   ReportOptions report;
@@ -509,6 +685,19 @@ int main(int argc, char** argv) {
   fragility_command->add_option("--collapse-intensity", fragility.collapse_intensity,
                                 "interval (between the grid point below the lowest collapsing PGA "
                                 "and it; default) or grid (the lowest collapsing PGA itself)");
+  FaultReportOptions fault_report;
+  CLI::App* fault_report_command = app.add_subcommand(
+      "fault-report", "per fault class (run --fault), its silenced collapses and lost lead");
+  fault_report_command->add_option("runs", fault_report.runs_paths,
+                                   "runs CSVs, one fault class each")->required();
+  fault_report_command->add_option("--against", fault_report.against_path,
+                                   "the runs CSV of the box to measure the lead against (the same "
+                                   "cases, e.g. without the fault or without the statue sensor)");
+  fault_report_command->add_option("--json", fault_report.json_path,
+                                   "also write the report as JSON");
+  fault_report_command->add_option("--list", fault_report.list_silenced,
+                                   "silenced collapses listed per class (default 10)")
+      ->check(CLI::Range(0, 1000000));
   MergeOptions merge;
   CLI::App* merge_command = app.add_subcommand("merge", "join the runs CSVs of shards");
   merge_command->add_option("--out", merge.out_path, "merged CSV")->required();
@@ -522,6 +711,8 @@ int main(int argc, char** argv) {
         {"--record-info", "--regional-latency", "--regional-latency-sd", "--regional-bias",
          "--regional-sigma"},
         opt.regional != "off", "sets the simulated regional alerts, and --regional is off");
+    plinth::host::refuse_without_effect(*run, {"--fault-at"}, opt.fault != "none",
+                                        "says when the fault begins, and no --fault is given");
   };
   if (const std::optional<int> exit_code =
           plinth::host::parse_command_line(app, argc, argv, checks)) {
@@ -531,6 +722,7 @@ int main(int argc, char** argv) {
     if (report_command->parsed()) return run_report(report);
     if (fragility_command->parsed()) return run_fragility(fragility);
     if (merge_command->parsed()) return run_merge(merge);
+    if (fault_report_command->parsed()) return run_fault_report(fault_report);
     if (pwave_fit.command->parsed()) return pwave_fit.run();
     return run_eval(opt);
   });

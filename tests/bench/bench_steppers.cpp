@@ -3,7 +3,9 @@
 // Linked into plinth-bench with bench_solver.cpp (which has main).
 #include <benchmark/benchmark.h>
 
+#include <Eigen/Dense>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <exception>
 #include <string>
@@ -128,6 +130,95 @@ const bool kPhaseStepsRegistered = [] {
   }
   return true;
 }();
+
+// ---------------------------------------------------------------------------------------------
+// The yardstick the step costs are given against (docs/performance.md,
+// tools/step-cost-compare.sh): a plain fixed-size Eigen RK4 step of the rocking equations on the
+// base (Eq 8 about corner 1, the paper's isolated scene, no excitation) as a textbook integrator
+// writes it, BM_PlainRk4Step/rocking_base: the solver's State (an Eigen 6-vector), at every stage
+// the lever arms (Eq 9) from std::sin and std::cos and the 2x2 mass matrix solved by Eigen's LU
+// (partialPivLu, what Matrix::lu() gives), dy/dt assembled as a 6-vector, and
+// y + h/6 (k1 + 2 k2 + 2 k3 + k4); no guards, no events, no reuse of the last stage.
+// BM_PlainRk4Step/rocking_base_inverse is the leanest plain form: the state (u, theta, u',
+// theta') alone and the 2x2's closed-form inverse. Each iteration rocks from theta = 0.05 rad
+// (start_in's) until theta reaches 0, where the solver's rocking_base has its first impact,
+// timed by hand like BM_PhaseStep.
+template <int kSize>
+struct PlainRocking {
+  using Vector = Eigen::Matrix<double, kSize, 1>;
+  // Where theta, u' and theta' sit in the state.
+  static constexpr Eigen::Index kAngle = kSize == 6 ? Eigen::Index{kTheta} : 1;
+  static constexpr Eigen::Index kRate = kSize == 6 ? Eigen::Index{kUDot} : 2;
+  static constexpr Eigen::Index kAngleRate = kSize == 6 ? Eigen::Index{kThetaDot} : 3;
+
+  double m, total_mass, damping, stiffness, g, h, offset, inertia;
+
+  explicit PlainRocking(const Scene& s)
+      : m(s.m),
+        total_mass(s.total_mass),
+        damping(s.damping),
+        stiffness(s.stiffness),
+        g(s.g),
+        h(s.h),
+        offset(s.corner1.offset),
+        inertia(s.corner1.inertia) {}
+
+  // dy/dt by Eq 8: [M, -m h'; -m h', I_1] (u'', theta'') = (-c u' - k u + m theta'^2 b',
+  // -m g b'), the ground still.
+  [[nodiscard]] Vector derivative(const Vector& y) const {
+    const double sin_t = std::sin(y[kAngle]);
+    const double cos_t = std::cos(y[kAngle]);
+    const double arm_h = offset * cos_t - h * sin_t;  // b'_1
+    const double arm_v = offset * sin_t + h * cos_t;  // h'_1
+    Eigen::Matrix2d mass;
+    mass << total_mass, -m * arm_v, -m * arm_v, inertia;
+    const Eigen::Vector2d force(
+        -damping * y[kRate] - stiffness * y[0] + m * y[kAngleRate] * y[kAngleRate] * arm_h,
+        -m * g * arm_h);
+    Vector d;
+    if constexpr (kSize == 6) {
+      const Eigen::Vector2d acc = mass.partialPivLu().solve(force);
+      d << y.template tail<3>(), acc[0], 0.0, acc[1];
+    } else {
+      const Eigen::Vector2d acc = mass.inverse() * force;
+      d << y[kRate], y[kAngleRate], acc[0], acc[1];
+    }
+    return d;
+  }
+
+  [[nodiscard]] Vector step(const Vector& y, double dt) const {
+    const Vector k1 = derivative(y);
+    const Vector k2 = derivative(y + 0.5 * dt * k1);
+    const Vector k3 = derivative(y + 0.5 * dt * k2);
+    const Vector k4 = derivative(y + dt * k3);
+    return y + (dt / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4);
+  }
+};
+
+template <int kSize>
+void BM_PlainRk4Step(benchmark::State& state) {
+  const Scene scene = testing::make(testing::paper_isolated());
+  const PlainRocking<kSize> rocking(scene);
+  using Vector = typename PlainRocking<kSize>::Vector;
+  const double theta0 = start_in(Phase::kRocking, scene.params).y[kTheta];
+  constexpr double kStep = 1e-4;  // s, the solver's default
+  std::int64_t steps = 0;
+  for (auto _ : state) {
+    Vector y = Vector::Zero();
+    y[PlainRocking<kSize>::kAngle] = theta0;
+    const auto begin = std::chrono::steady_clock::now();
+    while (y[PlainRocking<kSize>::kAngle] > 0.0) {
+      y = rocking.step(y, kStep);
+      ++steps;
+    }
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count());
+    benchmark::DoNotOptimize(y);
+  }
+  set_ns_per_step(state, steps);
+}
+BENCHMARK(BM_PlainRk4Step<6>)->Name("BM_PlainRk4Step/rocking_base")->UseManualTime();
+BENCHMARK(BM_PlainRk4Step<4>)->Name("BM_PlainRk4Step/rocking_base_inverse")->UseManualTime();
 
 // ---------------------------------------------------------------------------------------------
 // Only what the scene needs: the same run (Brienza 000, 12 s, the block rocking) with the

@@ -6,11 +6,15 @@ same sample, one Sequence for both, counting from 0.
 
     statue_frames.py IN.log OUT.log [--node 2] [--ground-node 1] [--offset-rad-s 0.01]
         [--noise-rad-s 0.003] [--rock-rad-s 0] [--silent-after-s S] [--garble-every K]
+        [--accelerometer ground|rest]
 
-The statue stands (rates: the offset about y plus noise; the accelerometer reads 1 g up) unless
+The statue stands (rates: the offset about y plus noise; the accelerometer reads what the ground
+sensor reads, plus noise: a statue in full contact moves with the ground) unless
 --rock-rad-s gives a 3 Hz swing of that amplitude about y from the log's fifth second (a loose
 sensor: no member explains it). --silent-after-s: no IMU frame after S seconds of the log.
 --garble-every K: every K-th StatueRotation is cut to 7 bytes (the box refuses and counts it).
+--accelerometer rest: the accelerometer reads 1 g up and nothing else (a sensor come off the
+statue, frozen at rest: the ground sensor does not corroborate it).
 Prints the frames added.
 """
 import argparse
@@ -29,6 +33,16 @@ def signed16(value, step):
     if not -32768 <= raw <= 32767:
         raise ValueError(f"{value} beyond the signal's range")
     return raw & 0xFFFF
+
+
+def unframe(data_hex, step):
+    """The three signed 16-bit values of a frame's first six bytes, in units of `step`."""
+    word = int.from_bytes(bytes.fromhex(data_hex), "little")
+    values = []
+    for i in range(3):
+        raw = (word >> (16 * i)) & 0xFFFF
+        values.append((raw - 0x10000 if raw & 0x8000 else raw) * step)
+    return values
 
 
 def frame(values, step, sequence):
@@ -50,6 +64,7 @@ def main():
     p.add_argument("--rock-rad-s", type=float, default=0.0)
     p.add_argument("--silent-after-s", type=float, default=-1.0)
     p.add_argument("--garble-every", type=int, default=0)
+    p.add_argument("--accelerometer", choices=("ground", "rest"), default="ground")
     args = p.parse_args()
     noise = random.Random(24)
     out = []
@@ -72,7 +87,8 @@ def main():
             rates = [noise.gauss(0, args.noise_rad_s),
                      args.offset_rad_s + swing + noise.gauss(0, args.noise_rad_s),
                      noise.gauss(0, args.noise_rad_s)]
-            accel = [noise.gauss(0, 0.0005), noise.gauss(0, 0.0005), 1 + noise.gauss(0, 0.0005)]
+            ground = unframe(m.group(5), G_STEP) if args.accelerometer == "ground" else [0, 0, 1]
+            accel = [g + noise.gauss(0, 0.0005) for g in ground]
             rotation = frame(rates, RATE_STEP, sequence)
             added += 1
             if args.garble_every > 0 and added % args.garble_every == 0:

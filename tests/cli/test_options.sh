@@ -8,7 +8,8 @@
 # Prints "ok - <name>" or "not ok - <name>: <why>" per check, then "N passed, M failed".
 #
 # Environment: PLINTH_SIM, PLINTH_SWEEP, PLINTH_EVAL, PLINTH_ACCURACY, PLINTH_MONITOR,
-# PLINTH_REPLAY, PLINTH_EMBED (the binaries); PLINTH_SOURCE_DIR, the repository root.
+# PLINTH_REPLAY, PLINTH_EMBED, PLINTH_COMMISSION (the binaries); PLINTH_SOURCE_DIR, the
+# repository root.
 set -u
 
 # shellcheck source=tests/cli/harness.sh
@@ -20,10 +21,11 @@ ACCURACY=${PLINTH_ACCURACY:-}
 MONITOR=${PLINTH_MONITOR:-}
 REPLAY=${PLINTH_REPLAY:-}
 EMBED=${PLINTH_EMBED:-}
-for binary in "$SWEEP" "$EVAL" "$ACCURACY" "$MONITOR" "$REPLAY" "$EMBED"; do
+COMMISSION=${PLINTH_COMMISSION:-}
+for binary in "$SWEEP" "$EVAL" "$ACCURACY" "$MONITOR" "$REPLAY" "$EMBED" "$COMMISSION"; do
   if [[ ! -x "$binary" ]]; then
-    echo "PLINTH_SWEEP, PLINTH_EVAL, PLINTH_ACCURACY, PLINTH_MONITOR, PLINTH_REPLAY, PLINTH_EMBED:" \
-      "'$binary' is not an executable" >&2
+    echo "PLINTH_SWEEP, PLINTH_EVAL, PLINTH_ACCURACY, PLINTH_MONITOR, PLINTH_REPLAY, PLINTH_EMBED," \
+      "PLINTH_COMMISSION: '$binary' is not an executable" >&2
     exit 2
   fi
 done
@@ -112,6 +114,7 @@ walk plinth-accuracy "$ACCURACY" -- --quick
 walk plinth-monitor "$MONITOR" -- --scene "$S" --replay "$AT2"
 walk plinth-replay "$REPLAY" -- --record "$AT2" --log out.log
 walk plinth-embed-record "$EMBED" -- --name n --scene "$S" --replay "$AT2" --out out.cpp
+walk plinth-commission "$COMMISSION" -- --config box.toml --log log.log
 
 echo "# 2. an option with no effect in the mode chosen: refused with the reason"
 # refused NAME BINARY PATTERN -- ARGS...: exit 1 or 2, stderr matching PATTERN.
@@ -156,6 +159,10 @@ refused "monitor: --modbus-writes without a server" "$MONITOR" \
   '--modbus-writes: .*the server is off' -- --scene "$S" --replay "$AT2" --modbus-writes
 refused "replay: --rate with a candump log" "$REPLAY" '--rate: does not apply to a candump log' \
   -- --record log.log --log out.log --rate 200
+refused "commission: --hold-s on a log" "$COMMISSION" "--hold-s: times a live session's" \
+  -- --config box.toml --log log.log --hold-s 5
+refused "commission: --window live" "$COMMISSION" "--window: gives a step's window in a log" \
+  -- --config box.toml --can vcan0 --window rest=0:10
 
 echo "# 3. compound values: split as documented, an unknown part named"
 refused "replay: --node-record with an unknown axis" "$REPLAY" \

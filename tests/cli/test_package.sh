@@ -45,7 +45,7 @@ field() { dpkg-deb -f "$(deb "$1")" "$2"; }
   [ "$(field plinth-monitor Architecture)" = "$(dpkg --print-architecture)" ]
 check "plinth-monitor: Package, Version $version, Architecture $arch" $? \
   "$(dpkg-deb -f "$(deb plinth-monitor)")"
-for dep in libmodbus5 libmosquitto1 libgpiod2 libsystemd0 libtomlplusplus3 systemd; do
+for dep in libmosquitto1 libgpiod2 libsystemd0 libtomlplusplus3 systemd; do
   field plinth-monitor Depends | tr ',' '\n' | grep -q "^ *$dep\b"
   check "plinth-monitor Depends: $dep" $? "$(field plinth-monitor Depends)"
 done
@@ -66,6 +66,7 @@ dpkg-deb -x "$(deb plinth-tools)" "$tmp/x-tools"
 dpkg-deb -x "$(deb libplinth-dev)" "$tmp/x-dev"
 missing=""
 for f in x-monitor/usr/bin/plinth-monitor x-monitor/usr/bin/plinth-replay \
+  x-monitor/usr/bin/plinth-commission \
   x-monitor/etc/plinth/box.toml x-monitor/usr/lib/systemd/system/plinth-monitor@.service \
   x-monitor/usr/lib/systemd/system/plinth-monitor@.socket \
   x-monitor/usr/lib/sysusers.d/plinth-monitor.conf x-monitor/usr/lib/udev/rules.d/60-plinth-gpio.rules \

@@ -173,9 +173,10 @@ fi
   >"$TMP/stdout" 2>"$TMP/stderr" &
 replay_pid=$!
 # Interrupted once some frames are logged (on a loaded machine the start-up alone can take a
-# while): poll the log for up to 20 s rather than sleeping a fixed time.
-for _ in $(seq 200); do
-  (($(wc -l <"$TMP/interrupted.log" 2>/dev/null || echo 0) > 100)) && break
+# while): poll the log being written (interrupted.log.partial-PID until it ends) for up to
+# 120 s rather than sleeping a fixed time.
+for _ in $(seq 1200); do
+  (($(cat "$TMP"/interrupted.log.partial-* 2>/dev/null | wc -l) > 100)) && break
   sleep 0.1
 done
 kill -INT "$replay_pid"

@@ -4,7 +4,8 @@
 # worked out in the comments), plinth-monitor replays the log. Checks: an alert frame without its
 # origin frame is a malformed alert; the pair is accepted and raises warning, cause
 # regional_alert, on the JSON lines and on the bus (AlarmEvent Cause 15); the status shows the
-# alert and its S arrival.
+# alert and its S arrival; with the bridge's key, only a pair followed by its tag is taken, and a
+# replayed tag is refused.
 #
 # Environment: PLINTH_MONITOR, PLINTH_REPLAY, PLINTH_SIM, PLINTH_SOURCE_DIR.
 set -u
@@ -58,6 +59,52 @@ if expect_success "a log with regional alert frames replays" --scene "$TMP/statu
     pass "the status shows the alert, its S arrival at 30 s and the malformed one counted"
   else
     fail "status" "$(grep -o '"regional": {[^}]*' <<<"$status")"
+  fi
+fi
+
+# Signed alerts (regional_alert.key_file): each pair must be followed by its RegionalAlertTag
+# (0x362: Counter, then the first 4 bytes of HMAC-SHA256(key, origin data, alert data, Counter
+# bytes)). An unsigned pair at 15 s (refused when the next origin comes), the signed triple at
+# 20 s (taken), the same triple replayed at 25 s (its Counter not above the last: refused).
+KEY=000102030405060708090a0b0c0d0e0f101112131415161718191a1b1c1d1e1f
+echo "$KEY" >"$TMP/bridge.key"
+printf '[regional_alert]\nkey_file = "bridge.key"\n' >"$TMP/signed.toml"
+TAG=$(python3 -c 'import hmac, hashlib, sys
+key, origin, alert = (bytes.fromhex(a) for a in sys.argv[1:4])
+counter = (7).to_bytes(4, "little")
+tag = hmac.new(key, origin + alert + counter, hashlib.sha256).digest()[:4]
+print("362#" + (counter + tag).hex().upper())' \
+  "$KEY" "${ORIGIN#*#}" "${ALERT#*#}")
+awk -v origin="$ORIGIN" -v alert="$ALERT" -v tag="$TAG" '
+  NR == 1 { t0 = substr($1, 2, 17) + 0 }
+  { t = substr($1, 2, 17) + 0 }
+  function triple(signed) {
+    printf "(%.6f) %s %s\n(%.6f) %s %s\n", t - 0.0004, $2, origin, t - 0.0003, $2, alert
+    if (signed) printf "(%.6f) %s %s\n", t - 0.0002, $2, tag
+  }
+  !a && t >= t0 + 15 { triple(0); a = 1 }
+  !b && t >= t0 + 20 { triple(1); b = 1 }
+  !c && t >= t0 + 25 { triple(1); c = 1 }
+  1' "$TMP/quiet.log" >"$TMP/signed.log"
+if expect_success "a log with signed regional alerts replays" --scene "$TMP/statue.toml" \
+  --replay "$TMP/signed.log" --no-events --config "$TMP/signed.toml"; then
+  problem=$(python3 - "$TMP/stdout" 2>&1 <<'PY'
+import json, sys
+lines = [json.loads(l) for l in open(sys.argv[1])]
+got = [(l["result"], l.get("reason"), l.get("field")) for l in lines if l["type"] == "regional"]
+assert got == [("refused", "unauthenticated", "RegionalAlertTag"), ("accepted", None, None),
+               ("refused", "unauthenticated", "Counter")], got
+warning = [l for l in lines if l["type"] == "alarm" and l["level"] == "warning"]
+assert warning and warning[0]["cause"] == "regional_alert", warning
+assert 19.9 < warning[0]["t"] < 20.1, warning
+frames = lines[-1]["frames"]
+assert frames["regional_tags"] == 2 and frames["regional_unauthenticated"] == 2, frames
+PY
+)
+  if [[ -z "$problem" ]]; then
+    pass "with a key: an unsigned pair refused, the signed triple taken, its replay refused"
+  else
+    fail "signed alerts" "$problem"
   fi
 fi
 

@@ -2,11 +2,14 @@
 # The statue sensor's frames through candump logs (issue 24 item 3): a ground sensor's log from
 # plinth-replay, the IMU's SensorAcceleration and StatueRotation frames added by
 # statue_frames.py (its own encoder), replayed by plinth-replay --log and through plinth-monitor
-# with a box file's [statue_sensor]. The standing statue keeps the box at normal where the box
-# without the sensor raises advisory (the nominal member rocks); a sensor swinging on its own is
-# statue_unexplained, on the JSON lines and as AlarmEvent Cause 14 on the bus (--frames-out);
-# a sensor that falls silent or sends garbled frames is said and counted, the box going on as
-# one without it; box files with a bad [statue_sensor] are refused naming the key.
+# with a box file's [statue_sensor]. The standing statue (its accelerometer following the ground:
+# corroborated) keeps the box at normal where the box without the sensor raises advisory (the
+# nominal member rocks); a sensor swinging on its own, or reading rest while the ground shakes,
+# is refused: the trouble statue_unexplained or statue_sensor_fault beside the box's own level,
+# on the JSON lines and in the AlarmEvent frames on the bus (--frames-out); a sensor that falls
+# silent or sends garbled frames is said and counted, the box going on as one without it with
+# the trouble statue_sensor_fault; box files with a bad [statue_sensor] are refused naming the
+# key (docs/safety.md).
 #
 # Environment: PLINTH_MONITOR, PLINTH_REPLAY, PLINTH_SOURCE_DIR.
 set -u
@@ -33,6 +36,7 @@ python3 "$FRAMES" "$TMP/ground.log" "$TMP/standing.log" >/dev/null
 python3 "$FRAMES" "$TMP/ground.log" "$TMP/loose.log" --rock-rad-s 0.3 >/dev/null
 python3 "$FRAMES" "$TMP/ground.log" "$TMP/silent.log" --silent-after-s 8 --garble-every 100 \
   >/dev/null
+python3 "$FRAMES" "$TMP/ground.log" "$TMP/rest.log" --accelerometer rest >/dev/null
 SAMPLES=6997
 cat >"$TMP/box.toml" <<'EOF'
 [statue_sensor]
@@ -79,7 +83,8 @@ if expect_success "standing statue: replay exit 0" "${ARGS[@]}" --config "$TMP/b
   if [[ "$state" == "ok ok True True full_contact" ]]; then
     pass "standing statue: both streams ok, offset known, measured, full contact"
   else fail "standing statue: the status's statue_sensor" "$state"; fi
-  if [[ -z "$(alarms "$TMP/standing.jsonl" | grep -v -e '^fault sensor_timeout' -e '^normal none')" ]]; then
+  if [[ -z "$(alarms "$TMP/standing.jsonl" |
+    grep -v -e '^fault sensor_timeout' -e '^fault not_calibrated' -e '^normal none')" ]]; then
     pass "standing statue: no level raised (the measured phase is full contact)"
   else fail "standing statue: levels" "$(alarms "$TMP/standing.jsonl" | tr '\n' ';')"; fi
 fi
@@ -91,22 +96,39 @@ if expect_success "the same log without [statue_sensor]" "${ARGS[@]}" --replay "
   else fail "without the sensor" "other nodes $other; $(alarms "$TMP/stdout" | tr '\n' ';')"; fi
 fi
 
-# 3. A sensor swinging on its own (3 Hz, 0.3 rad/s about y): no member explains it; the fault
-#    with cause statue_unexplained, on the JSON lines and on the bus as Cause 14.
+# 3. A sensor swinging on its own (3 Hz, 0.3 rad/s about y): its accelerometer does not read the
+#    swing and no member explains it: refused, the trouble statue_unexplained or
+#    statue_sensor_fault named on the JSON lines and on the bus (AlarmEvent Cause 14 or 16 with
+#    the Trouble bit), beside the box's own level.
 if expect_success "loose sensor: replay exit 0" "${ARGS[@]}" --config "$TMP/box.toml" \
   --replay "$TMP/loose.log" --frames-out "$TMP/loose-frames.log"; then
-  if alarms "$TMP/stdout" | grep -q '^fault statue_unexplained' &&
-    [[ "$(grep -c '"unexplained": true' "$TMP/stdout")" -gt 0 ]]; then
-    pass "loose sensor: fault, cause statue_unexplained"
+  if alarms "$TMP/stdout" | grep -qE '^[a-z]+ statue_(unexplained|sensor_fault)' &&
+    [[ "$(grep -c '"corroborated": false' "$TMP/stdout")" -gt 0 ]]; then
+    pass "loose sensor: refused, the trouble named"
   else fail "loose sensor" "$(alarms "$TMP/stdout" | tr '\n' ';')"; fi
-  # AlarmEvent: Level 4 (fault) in bits 0-3, Cause 14 in bits 8-15.
-  if grep -qE ' 330#[0-9A-F]4 ?0E' "$TMP/loose-frames.log"; then
-    pass "loose sensor: AlarmEvent with Level fault and Cause 14 (statue_unexplained) on the bus"
-  else fail "loose sensor: frames" "no AlarmEvent fault/statue_unexplained frame"; fi
+  # AlarmEvent: Cause 14 or 16 in bits 8-15, Trouble (bit 17) in byte 2.
+  if grep -qE ' 330#[0-9A-F]{2}(0E|10)0[23]' "$TMP/loose-frames.log"; then
+    pass "loose sensor: AlarmEvent with Cause 14 or 16 and the Trouble bit on the bus"
+  else fail "loose sensor: frames" "no AlarmEvent naming the statue sensor"; fi
+fi
+
+# 3b. A sensor reading rest while the ground shakes (come off the statue): refused, the box
+#     shows what it shows without the sensor (advisory: the nominal member rocks), the trouble
+#     statue_sensor_fault beside it. Its accelerometer minus the ground's never settles, so its
+#     offset is never known (no_accelerometer); once known, it does_not_follow_base.
+if expect_success "resting sensor: replay exit 0" "${ARGS[@]}" --config "$TMP/box.toml" \
+  --replay "$TMP/rest.log"; then
+  refutation=$(field "$TMP/stdout" status "d['statue_sensor']['weights']['refutation']")
+  if alarms "$TMP/stdout" | grep -q '^advisory phase_change' &&
+    alarms "$TMP/stdout" | grep -q 'statue_sensor_fault' &&
+    [[ "$refutation" == "does_not_follow_base" || "$refutation" == "no_accelerometer" ]]; then
+    pass "resting sensor: refused ($refutation), advisory as without it, trouble named"
+  else fail "resting sensor" "$refutation; $(alarms "$TMP/stdout" | tr '\n' ';')"; fi
 fi
 
 # 4. Silent after 8 s, every 100th StatueRotation cut to 7 bytes: refused and counted, bridged
-#    as a gap, then a timeout said on the status line; the box raises no fault for it.
+#    as a gap, then a timeout said on the status line; the box shows the trouble
+#    statue_sensor_fault (the level fault while the box without the sensor would say normal).
 if expect_success "silent sensor: replay exit 0" "${ARGS[@]}" --config "$TMP/box.toml" \
   --replay "$TMP/silent.log"; then
   summary=$(field "$TMP/stdout" summary \
@@ -117,9 +139,9 @@ if expect_success "silent sensor: replay exit 0" "${ARGS[@]}" --config "$TMP/box
   at_10=$(python3 -c "
 import json, sys
 d = next(json.loads(l) for l in open(sys.argv[1]) if '\"t\": 10.000000' in l and '\"status\"' in l)
-print(d['statue_sensor']['rate']['health'], d['statue_sensor']['rate']['cause'], d['statue_sensor']['weights']['measured'], d['alarm'])" "$TMP/stdout")
-  if [[ "$at_10" == "fault timeout False normal" ]]; then
-    pass "silent sensor: at 10 s its rate stream timed out, not measured, the box normal"
+print(d['statue_sensor']['rate']['health'], d['statue_sensor']['rate']['cause'], d['statue_sensor']['weights']['measured'], d['alarm'], d['trouble'])" "$TMP/stdout")
+  if [[ "$at_10" == "fault timeout False fault statue_sensor_fault" ]]; then
+    pass "silent sensor: at 10 s its rate stream timed out, not measured, the trouble named"
   else fail "silent sensor: status at 10 s" "$at_10"; fi
 fi
 

@@ -161,8 +161,9 @@ def prepare(work, dbc, scene, rate, lead_in_s):
     return {"REGIONAL_SCENE": str(Path(scene).resolve()),
             "REGIONAL_CONFIG": str(work / "regional.toml"),
             "REGIONAL_WAIT": f"{wait_s:.3f}",
-            # the gap before each frame, us (the guest's check that the bus kept them)
+            # the gap before each frame, us (rig_losses.awk: the bus kept them)
             "REGIONAL_GAPS_US": " ".join(gaps)}
+
 
 
 def bus_index(s, ident, data, after=-1):

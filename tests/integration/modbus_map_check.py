@@ -187,7 +187,9 @@ def main():
         elif name == "alarm_events":
             expected = len(alarms)
         elif name == "map_version":
-            expected = 7  # map 7: regional 86-101, statue 102-108, recorder 109-116
+            expected = 8  # map 8: regional 86-101, statue 102-108, recorder 109-116, 117-118
+        elif name == "collapse_held":
+            expected = 1 if "collapse" in status else 0
         elif name == "forecast_axis":  # one axis: x once a forecast ran
             expected = 0 if status["collapse_forecast_t"] is not None else value
         elif name == "forecast_worst_member":  # one member: member 0 is the first to collapse

@@ -9,7 +9,8 @@ lines, one for one:
   1. one journal entry per alarm change, PRIORITY alert (1) for alarm, crit (2) for warning and
      fault, warning (4) for advisory, notice (5) for normal; fields PLINTH_ALARM_LEVEL,
      PLINTH_ALARM_PREVIOUS, PLINTH_ALARM_CAUSE, PLINTH_ALARM_T (the line's t),
-     SYSLOG_IDENTIFIER=plinth-monitor and a MESSAGE;
+     SYSLOG_IDENTIFIER=plinth-monitor and a MESSAGE; and one for the commissioning's verdict at
+     start (PLINTH_COMMISSIONING=none: no report, a warning);
   2. a STATUS= after each change naming the level (what `systemctl status` shows), the last one
      the final level;
   3. without INVOCATION_ID (not a service) nothing reaches the journal socket.
@@ -106,9 +107,16 @@ def main():
               "the quick start runs under INVOCATION_ID (%d alarm lines; exit %d: %s)"
               % (len(alarms), result.returncode, result.stderr.decode().strip()[:200]))
         alarm_entries = [e for e in entries if "PLINTH_ALARM_LEVEL" in e]
-        check(len(alarm_entries) == len(alarms) == len(entries),
+        # Besides them, the commissioning's verdict at start (docs/commissioning.md): no report
+        # in the recorder's folder, none required, a warning.
+        verdicts = [e for e in entries if "PLINTH_COMMISSIONING" in e]
+        check(len(alarm_entries) == len(alarms) == len(entries) - 1,
               "one journal entry per alarm change: %d entries, %d alarm lines"
               % (len(entries), len(alarms)))
+        check(len(verdicts) == 1 and verdicts[0].get("PLINTH_COMMISSIONING") == "none" and
+              verdicts[0].get("PRIORITY") == "4" and
+              "no commissioning report" in verdicts[0].get("MESSAGE", ""),
+              "the commissioning's verdict once at start, a warning: %s" % verdicts)
         for line, entry in zip(alarms, alarm_entries):
             want = {"PRIORITY": str(PRIORITY[line["level"]]),
                     "PLINTH_ALARM_LEVEL": line["level"],

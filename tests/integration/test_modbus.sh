@@ -5,7 +5,12 @@
 # registers equal the input registers, one discrete input per level; the files' digests as
 # sha256sum prints them, with and without a second scene and a box file; several clients at once, a
 # coil write refused while writes are off, register writes always refused, acknowledge and
-# reset when writes are on, and bad addresses refused with a message naming the key or flag.
+# reset when writes are on from a listed address (refused from another), and bad addresses
+# refused with a message naming the key or flag. Hostile clients (modbus_hostile.py, raw frames
+# from other loopback addresses): frames that are not Modbus close their connection unanswered,
+# functions the box does not serve get their exception, exceptions cost no sleep, a silent
+# client and an unfinished frame are closed, and under 8 idle plus 8 malformed clients a BMS
+# polling every 50 ms still gets its answers (the fraction and the times are printed).
 #
 # Environment: PLINTH_MONITOR, PLINTH_SIM, PLINTH_SOURCE_DIR. Exit 77 (skip) when mbpoll is
 # missing, unless CI=true.
@@ -18,6 +23,7 @@ ISOLATED=$SCENES/paper-isolated.toml
 ECCENTRIC=$SCENES/paper-eccentric.toml
 
 MAP=$SRC/firmware/linux/modbus-map.csv
+HOSTILE=$(dirname "${BASH_SOURCE[0]}")/modbus_hostile.py
 # The map's extent: registers, discrete inputs, coils.
 read -r REGISTERS DISCRETE COILS < <(python3 - "$MAP" <<'PY'
 import csv, sys
@@ -178,13 +184,15 @@ fi
 kill -INT "$BOX" 2>/dev/null
 wait "$BOX" 2>/dev/null
 
-# 2. Writes on (the configuration file): acknowledge releases the latch (the collapse holds the
-#    alarm), reset starts the monitor again.
+# 2. Writes on (the configuration file) from 127.0.0.1 only: a write from another address is
+#    refused and leaves the latch; acknowledge releases the latch (the collapse holds the alarm),
+#    reset starts the monitor again.
 PORT=$(free_port)
 cat >"$TMP/box.toml" <<EOF
 [modbus]
 listen = "127.0.0.1:$PORT"
 writes = true
+write_from = ["127.0.0.1"]
 EOF
 fresh "$TMP/box.out"  # the run before overturned too
 "$BIN" --scene "$ISOLATED" --replay "$AT2" --scale 20 --speed 2 --no-events \
@@ -192,6 +200,15 @@ fresh "$TMP/box.out"  # the run before overturned too
 BOX=$!
 if wait_listening "$PORT" && wait_for "$TMP/box.out" '"phase": "overturned"' 30; then
   latched=$(register "$PORT" 3)
+  other=$(python3 "$HOSTILE" write "$PORT" 127.0.0.2)
+  if [[ "$other" == *'"outcome": 1'* ]] && [[ "$(register "$PORT" 3)" == 3 ]] &&
+    ! grep -q '"type": "command"' "$TMP/box.out" &&
+    grep -q "127.0.0.2:[0-9]*: coil write refused: not in modbus.write_from" "$TMP/box.err"; then
+    pass "modbus: a coil write from an address not in write_from: Illegal function, latch kept"
+  else
+    fail "modbus: write from another address" \
+      "$other; latched $(register "$PORT" 3); $(tail -n 2 "$TMP/box.err")"
+  fi
   mbpoll -m tcp -t 0 -0 -r 0 -1 -p "$PORT" 127.0.0.1 1 >"$TMP/write.out" 2>&1
   rc=$?
   if ((rc == 0)) && wait_for "$TMP/box.out" '"command": "acknowledge"' 5; then
@@ -236,10 +253,14 @@ PY
 import sys
 regs = dict(tuple(map(int, l.split())) for l in open(sys.argv[1]) if l.strip())
 assert regs[29] == 2, "commands %d" % regs[29]
-assert regs[7] == 0 and regs[3] == 0, "phase %d, latched %d after the reset" % (regs[7], regs[3])
+# The memory restored (docs/safety.md): the held collapse still shown, alarm, cause restored
+# (or, once the estimators start again, the trouble not_calibrated beside the held alarm).
+assert regs[7] == 4 and regs[0] == 3 and regs[4] in (17, 11), \
+    "phase %d, level %d, cause %d after the reset" % (regs[7], regs[0], regs[4])
 PY
 )
-    if [[ -z "$problem" ]]; then pass "modbus: the reset coil starts the monitor again"
+    if [[ -z "$problem" ]]; then
+      pass "modbus: the reset coil starts the monitor again, the held collapse restored"
     else fail "modbus: reset" "$problem"; fi
   else
     fail "modbus: reset" "no reset line: $(tail -n 2 "$TMP/write.out")"
@@ -250,7 +271,95 @@ fi
 kill -INT "$BOX" 2>/dev/null
 wait "$BOX" 2>/dev/null
 
-# 3. Bad input: a message naming the key or flag.
+# 3. Hostile clients, on a box whose silent clients are closed after 2 s.
+PORT=$(free_port)
+printf '[modbus]\nlisten = "127.0.0.1:%s"\nidle_timeout_s = 2\n' "$PORT" >"$TMP/hostile.toml"
+fresh "$TMP/box.out"
+"$BIN" --scene "$ISOLATED" --replay "$AT2" --speed 1 --no-events --config "$TMP/hostile.toml" \
+  >"$TMP/box.out" 2>"$TMP/box.err" &
+BOX=$!
+if wait_listening "$PORT"; then
+  python3 "$HOSTILE" frames "$PORT" >"$TMP/frames.out"
+  wrong=$(python3 -c 'import json, sys
+for line in open(sys.argv[1]):
+    f = json.loads(line)
+    if f["outcome"] != f["expected"]:
+        print("%s: %s, expected %s" % (f["frame"], f["outcome"], f["expected"]))' "$TMP/frames.out")
+  if [[ -z "$wrong" && $(wc -l <"$TMP/frames.out") -ge 13 ]]; then
+    pass "modbus: not Modbus (protocol id 1, 0xFFFF, a bad or mismatched length): closed\
+ unanswered; 0x11, 0x07, 0x2B, 06, FC15 x 2000: exception 01; quantity 0 or 126: 03;\
+ past the map: 02"
+  else
+    fail "modbus: hostile frames" "$wrong"
+  fi
+  # libmodbus slept 0.5 s after each exception, in the one thread: 40 took 20 s.
+  burst=$(python3 "$HOSTILE" exceptions "$PORT" 40)
+  if python3 -c 'import json, sys
+b = json.loads(sys.argv[1])
+sys.exit(not (b["answered"] == 40 and b["total_ms"] < 4000))' "$burst"; then
+    pass "modbus: 40 exceptions back to back answered without a sleep ($burst)"
+  else
+    fail "modbus: exceptions cost a sleep" "$burst"
+  fi
+  silent=$(python3 "$HOSTILE" silent "$PORT")
+  if python3 -c 'import json, sys
+s = json.loads(sys.argv[1])
+sys.exit(not (s["idle_s"] is not None and 1.5 <= s["idle_s"] <= 6 and
+              s["partial_frame_s"] is not None and 0.8 <= s["partial_frame_s"] <= 5))' \
+    "$silent"; then
+    pass "modbus: closed: a silent client after idle_timeout_s (2 s), an unfinished frame\
+ after 1 s ($silent)"
+  else
+    fail "modbus: timeouts" "$silent"
+  fi
+  # The siege: the BMS polls registers 0-31 every 50 ms on one connection while 8 clients
+  # connect and send nothing and 8 send the hostile frames, each again as soon as it is closed,
+  # from other hosts (loopback addresses); mbpoll, a new connection per read, polls as well.
+  python3 "$HOSTILE" siege "$PORT" 10 8 8 >"$TMP/siege.json" &
+  SIEGE=$!
+  sleep 1
+  reads=0
+  for ((i = 0; i < 20; i++)); do
+    timeout 5 mbpoll -m tcp -t 3 -0 -r 0 -c 32 -1 -o 1 -p "$PORT" 127.0.0.1 2>&1 |
+      grep -q '^\[31\]:' && reads=$((reads + 1))
+  done
+  wait "$SIEGE"
+  echo "siege: $(cat "$TMP/siege.json"); mbpoll: $reads of 20 reads answered"
+  # At least 95 % of the polls answered; each answer within 100 ms, with 5 % allowed past it
+  # on this shared, loaded machine (a scheduler stall of the box's thread, not the server).
+  if python3 -c 'import json, sys
+s = json.loads(sys.argv[1])
+sys.exit(not (s["answered_fraction"] >= 0.95 and s["within_100_ms"] >= 0.95 * s["answered"] and
+              s["hostile"]["hostile_frames"] > 100 and s["hostile"]["idle_connections"] > 8))' \
+    "$(cat "$TMP/siege.json")" && ((reads >= 19)); then
+    pass "modbus: under 8 idle and 8 malformed clients the BMS got >= 95 % of its answers,\
+ >= 95 % within 100 ms; mbpoll $reads of 20"
+  else
+    fail "modbus: siege" "$(cat "$TMP/siege.json"); mbpoll $reads of 20"
+  fi
+else
+  fail "modbus: hostile clients" "no server; stderr: $(head -c 300 "$TMP/box.err")"
+fi
+kill -INT "$BOX" 2>/dev/null
+wait "$BOX" 2>/dev/null
+problem=$(python3 - "$TMP/box.out" "$TMP/box.err" 2>&1 <<'PY'
+import json, sys
+m = json.loads(open(sys.argv[1]).read().splitlines()[-1])["modbus"]
+assert m["malformed"] >= 5 and m["closed_idle"] >= 1 and m["closed_slow"] >= 1, m
+assert m["closed_for_room"] >= 1 and m["exceptions"] >= 48, m
+lines = open(sys.argv[2]).read().splitlines()
+said = [l for l in lines if "not a Modbus frame" in l]
+assert said and len(said) <= 60, "%d lines of %d malformed frames" % (len(said), m["malformed"])
+assert any("like it not shown" in l for l in said), said[-3:]
+PY
+)
+if [[ -z "$problem" ]]; then
+  pass "modbus: the summary counts malformed, timed-out and displaced clients; bounded lines"
+else
+  fail "modbus: hostile summary" "$problem"
+fi
+
+# 4. Bad input: a message naming the key or flag.
 run_args=(--scene "$ISOLATED" --replay "$AT2")
 expect_failure "modbus: no port" "--modbus" "HOST:PORT" -- "${run_args[@]}" --modbus 127.0.0.1
 expect_failure "modbus: port out of range" "--modbus" "65535" -- \
@@ -265,6 +374,14 @@ expect_failure "modbus: bad listen in the file" "bad.toml:4" "modbus.listen" "HO
 printf '[modbus]\nwrites = "yes"\n' >"$TMP/bad.toml"
 expect_failure "modbus: writes not a boolean" "bad.toml:2" "modbus.writes" "true or false" -- \
   "${run_args[@]}" --config "$TMP/bad.toml"
+printf '[modbus]\nlisten = "127.0.0.1:1502"\nwrites = true\n' >"$TMP/bad.toml"
+expect_failure "modbus: writes without write_from" "bad.toml:3" "modbus.writes" "write_from" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+printf '[modbus]\nwrites = true\nwrite_from = ["127.0.0.1"]\n' >"$TMP/bad.toml"
+expect_failure "modbus: writes without listen" "bad.toml:2" "modbus.writes" "server is off" -- \
+  "${run_args[@]}" --config "$TMP/bad.toml"
+expect_failure "modbus: a write_from that is no address" "--modbus-write-from" "localhost" -- \
+  "${run_args[@]}" --modbus 127.0.0.1:1502 --modbus-writes --modbus-write-from localhost
 printf '[modbus]\nmax_clients = 0\n' >"$TMP/bad.toml"
 expect_failure "modbus: max_clients out of range" "bad.toml:2" "modbus.max_clients" -- \
   "${run_args[@]}" --config "$TMP/bad.toml"

@@ -52,7 +52,9 @@ static_assert(same_number(AlarmCause::kRegionalAlert, can::AlarmCause::kRegional
 static_assert(same_number(AlarmCause::kStatueSensorFault, can::AlarmCause::kStatueSensorFault));
 static_assert(same_number(AlarmCause::kRestored, can::AlarmCause::kRestored));
 static_assert(same_number(AlarmCause::kStatueStands, can::AlarmCause::kStatueStands));
-static_assert(monitor::kAlarmCauseNames.size() == 19);
+static_assert(same_number(AlarmCause::kCommissioningFailed,
+                          can::AlarmCause::kCommissioningFailed));
+static_assert(monitor::kAlarmCauseNames.size() == 20);
 
 // The sensors' status bits (SensorAcceleration.Status): passed through as they are.
 static_assert(monitor::sensor_flags::kSaturated == can::sensor_status::kSaturated);

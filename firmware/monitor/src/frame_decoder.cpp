@@ -1,6 +1,7 @@
 #include "plinth/firmware/frame_decoder.h"
 
 #include "plinth/firmware/can_frames.h"
+#include "plinth/monitor/hmac_sha256.h"
 
 namespace plinth::firmware {
 
@@ -18,6 +19,78 @@ void FrameDecoder::start(const MonitorConfig& config) {
   statue_node_ = statue != nullptr && statue->present ? statue->node : -1;
   counters_ = FrameCounters{};
   have_origin_ = false;
+  if (auto* tags = monitor::built_part<RegionalTagCheck>(tags_)) {
+    const auto* room = monitor::built_part<monitor::RegionalAlertSettings>(config.regional);
+    *tags = RegionalTagCheck{};
+    if (room != nullptr) tags->authentication = room->authentication;
+  }
+  ack_guard_ = BusStatementGuard{};
+  stands_guard_ = BusStatementGuard{};
+}
+
+bool BusStatementGuard::admits(monitor::AlarmLevel held) {
+  // The lockout holds while what it began under stays held.
+  if (locked_ && held != locked_level_) locked_ = false;
+  return !locked_;
+}
+
+bool BusStatementGuard::refused(std::int64_t time_ns, monitor::AlarmLevel held) {
+  refused_ns_[static_cast<std::size_t>(next_)] = time_ns;
+  next_ = (next_ + 1) % kRefusedStatementsBeforeLockout;
+  if (refused_count_ < kRefusedStatementsBeforeLockout) ++refused_count_;
+  // The oldest of the last kRefusedStatementsBeforeLockout refusals, within the window.
+  const std::int64_t oldest = refused_ns_[static_cast<std::size_t>(next_)];
+  if (refused_count_ < kRefusedStatementsBeforeLockout ||
+      time_ns - oldest > kRefusedStatementWindowNs || held == monitor::AlarmLevel::kNormal) {
+    return false;
+  }
+  locked_ = true;
+  locked_level_ = held;
+  refused_count_ = 0;
+  return true;
+}
+
+MonitorUpdate FrameDecoder::acknowledge(Monitor& target,
+                                        const monitor::Acknowledgement& acknowledgement,
+                                        std::int64_t time_ns) {
+  const monitor::AlarmLevel latched = target.status().latched;
+  if (!ack_guard_.admits(latched)) {
+    ++counters_.acknowledgements_ignored;
+    return target.poll();
+  }
+  MonitorUpdate update = target.acknowledge(acknowledgement);
+  if (update.acknowledgement == monitor::AckOutcome::kStale ||
+      update.acknowledgement == monitor::AckOutcome::kWrongLevel) {
+    ++counters_.acknowledgements_refused;
+    if (ack_guard_.refused(time_ns, latched)) ++counters_.acknowledgement_lockouts;
+  }
+  return update;
+}
+
+namespace {
+
+// What a held collapse is to the stands guard: the level it holds, or nothing.
+monitor::AlarmLevel collapse_held(const Monitor& target) {
+  return target.status().collapse.held ? monitor::AlarmLevel::kAlarm
+                                       : monitor::AlarmLevel::kNormal;
+}
+
+}  // namespace
+
+MonitorUpdate FrameDecoder::statue_stands(Monitor& target, const can::StatueStands& stands,
+                                          std::int64_t time_ns) {
+  const monitor::AlarmLevel held = collapse_held(target);
+  if (!stands_guard_.admits(held)) {
+    ++counters_.statue_stands_ignored;
+    return target.poll();
+  }
+  MonitorUpdate update = target.statue_stands(stands.event_sequence);
+  update.stands_source = stands.source_id;
+  if (update.statue_stands == monitor::StandsOutcome::kStale) {
+    ++counters_.statue_stands_refused;
+    if (stands_guard_.refused(time_ns, held)) ++counters_.statue_stands_lockouts;
+  }
+  return update;
 }
 
 template <typename Message>
@@ -118,15 +191,19 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
         ++counters_.unknown_identifiers;
         break;
       }
+      drop_untagged(input);  // the alert before never got its tag
       can::RegionalAlertOrigin message;
       have_origin_ = decoded(frame, message);
       if (have_origin_) {
         origin_ = message;
+        origin_bytes_ = frame.data;
         origin_time_ns_ = timed.timestamp_ns;
       } else {
         ++counters_.regional_malformed;
-        input.kind = FrameInput::Kind::kRegionalMalformed;
-        input.malformed_field = refused_regional("RegionalAlertOrigin");
+        if (input.kind == FrameInput::Kind::kNone) {  // one input a frame: the untagged's first
+          input.kind = FrameInput::Kind::kRegionalMalformed;
+          input.malformed_field = refused_regional("RegionalAlertOrigin");
+        }
       }
       break;
     }
@@ -136,6 +213,13 @@ FrameInput FrameDecoder::decode(const hal::TimedFrame& timed) {
         break;
       }
       decode_regional(timed, input);
+      break;
+    case can::MessageKind::kRegionalAlertTag:
+      if constexpr (monitor::kRegionalAlertBuiltIn) {
+        decode_tag(timed, input);
+      } else {
+        ++counters_.unknown_identifiers;  // no room, no tag, no SHA-256 in the image
+      }
       break;
     case can::MessageKind::kUnknown:
       ++counters_.unknown_identifiers;
@@ -163,6 +247,56 @@ void FrameDecoder::decode_regional(const hal::TimedFrame& timed, FrameInput& inp
   ++counters_.regional_alerts;
   input.kind = FrameInput::Kind::kRegionalAlert;
   input.regional = regional_alert_of(origin_, message, static_cast<double>(gap_ns) * 1e-9);
+  RegionalTagCheck* tags = monitor::built_part<RegionalTagCheck>(tags_);
+  if (tags == nullptr || !tags->authentication.required) return;
+  // Held for its tag; an alert before it still waiting is refused now.
+  FrameInput held = input;
+  input = FrameInput{};
+  drop_untagged(input);
+  tags->pending = true;
+  tags->alert = held;
+  tags->origin_bytes = origin_bytes_;
+  tags->alert_bytes = timed.frame.data;
+  tags->alert_time_ns = timed.timestamp_ns;
+}
+
+void FrameDecoder::drop_untagged(FrameInput& input) {
+  RegionalTagCheck* tags = monitor::built_part<RegionalTagCheck>(tags_);
+  if (tags == nullptr || !tags->pending) return;
+  tags->pending = false;
+  ++counters_.regional_unauthenticated;
+  input.kind = FrameInput::Kind::kRegionalUnauthenticated;
+  input.malformed_field = "RegionalAlertTag";  // missing
+}
+
+void FrameDecoder::decode_tag(const hal::TimedFrame& timed, FrameInput& input) {
+  can::RegionalAlertTag message;
+  if (!decoded(timed.frame, message)) return;  // only its length can be wrong: counted
+  ++counters_.regional_tags;
+  RegionalTagCheck* tags = monitor::built_part<RegionalTagCheck>(tags_);
+  if (tags == nullptr || !tags->authentication.required || !tags->pending) return;  // ignored
+  const std::int64_t gap_ns = timed.timestamp_ns - tags->alert_time_ns;
+  if (gap_ns < 0 || gap_ns > kRegionalPairWindowNs) return drop_untagged(input);
+  tags->pending = false;
+  const monitor::ByteSpan parts[] = {{tags->origin_bytes.data(), tags->origin_bytes.size()},
+                                     {tags->alert_bytes.data(), tags->alert_bytes.size()},
+                                     {timed.frame.data.data(), 4}};
+  const monitor::Sha256Digest mac =
+      monitor::hmac_sha256(tags->authentication.key, parts, sizeof parts / sizeof parts[0]);
+  const bool replayed = tags->any_counter && message.counter <= tags->last_counter;
+  if (!monitor::same_bytes(mac.data(), timed.frame.data.data() + 4, 4) || replayed) {
+    ++counters_.regional_unauthenticated;
+    input.kind = FrameInput::Kind::kRegionalUnauthenticated;
+    input.malformed_field = replayed ? "Counter" : "Tag";
+    return;
+  }
+  tags->any_counter = true;
+  tags->last_counter = message.counter;
+  input = tags->alert;
+  // Its times were relative to the alert frame; the tag came `gap` later.
+  const auto gap_s = static_cast<Real>(static_cast<double>(gap_ns) * 1e-9);
+  input.regional.origin_age_s += gap_s;
+  input.regional.s_arrival_in_s -= gap_s;
 }
 
 MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::TimedFrame& frame) {
@@ -171,12 +305,9 @@ MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::Timed
     case FrameInput::Kind::kSensorSample:
       return monitor.on_sensor_sample(input.sensor, input.sample);
     case FrameInput::Kind::kAcknowledgement:
-      return monitor.acknowledge(input.acknowledgement);
-    case FrameInput::Kind::kStatueStands: {
-      MonitorUpdate update = monitor.statue_stands(input.stands.event_sequence);
-      update.stands_source = input.stands.source_id;
-      return update;
-    }
+      return decoder.acknowledge(monitor, input.acknowledgement, frame.timestamp_ns);
+    case FrameInput::Kind::kStatueStands:
+      return decoder.statue_stands(monitor, input.stands, frame.timestamp_ns);
     case FrameInput::Kind::kStatueRate:
       return monitor.on_statue_sample(input.statue);
     case FrameInput::Kind::kStatueAcceleration:
@@ -185,6 +316,9 @@ MonitorUpdate on_frame(Monitor& monitor, FrameDecoder& decoder, const hal::Timed
       return monitor.on_regional_alert(input.regional, frame.timestamp_ns);
     case FrameInput::Kind::kRegionalMalformed:
       return monitor.regional_alert_malformed(input.malformed_field);
+    case FrameInput::Kind::kRegionalUnauthenticated:
+      return monitor.regional_alert_refused(plinth::monitor::RegionalRefusal::kUnauthenticated,
+                                            input.malformed_field);
     case FrameInput::Kind::kNone:
       break;
   }

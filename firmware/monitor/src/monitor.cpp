@@ -37,6 +37,10 @@ double first_counted_collapse(const ForecastOutcome& f, std::uint32_t counted, i
   return first;
 }
 
+// s beyond the statue sensor's offset window that its offset may take before its absence is
+// trouble (a window restarts whenever the statue or the sensor moves).
+constexpr double kStatueOffsetGraceS = 10.0;
+
 // The smallest probability a CollapseForecast frame carries above 0 (its resolution, 1e-4):
 // below half of it the frame says 0, and so does the status.
 constexpr double kSmallestShownProbability = 0.5e-4;
@@ -119,6 +123,7 @@ Error Monitor::start(const MonitorConfig& config,
   frames_not_encoded_ = 0;
   have_epoch_ = false;
   bus_fault_ = false;
+  held_fault_ = monitor::AlarmCause::kNone;
   pending_ack_ = false;
   pending_stands_ = false;
   evaluated_ = false;
@@ -377,7 +382,19 @@ void Monitor::note_statue_trouble() {
   for (int i = 0; i < status_.axis_count; ++i) {
     measured_any = measured_any || room().measured[static_cast<std::size_t>(i)];
   }
-  if (!measured_any) {
+  // Usable since the last ground sample: measured from the next one on.
+  if (!measured_any && !room().sensor.usable(status_.time_ns + epoch_ns_)) {
+    // Sending, its offset still being estimated: a state of knowledge for a while (as
+    // not_calibrated is for the ground's), then trouble. Silent or at fault: trouble at once.
+    const StatueSensorSettings* statue =
+        monitor::built_part<StatueSensorSettings>(config_.statue_sensor);
+    const double waited_s =
+        static_cast<double>(status_.time_ns - status_.estimator_start_ns) * 1e-9;
+    const bool sending = room().sensor.rate_health().state != monitor::HealthState::kFault;
+    if (sending && !room().sensor.ready() && statue != nullptr &&
+        waited_s < statue->offset_window_s + kStatueOffsetGraceS) {
+      return;
+    }
     status_.statue_sensor_unusable = true;
     status_.input_fault = monitor::AlarmCause::kStatueSensorFault;
     return;
@@ -449,6 +466,10 @@ void Monitor::evaluate(MonitorUpdate& update) {
     *shown = stage->status();
   }
   monitor::AlarmInput input = alarm_input(status_, config_, bus_fault_);
+  if (held_fault_ != monitor::AlarmCause::kNone) {
+    input.fault_active = true;
+    input.fault_cause = held_fault_;
+  }
   input.acknowledged = pending_ack_;
   input.acknowledgement = ack_;
   input.statue_stands = pending_stands_;
@@ -581,7 +602,7 @@ MonitorUpdate Monitor::on_statue_acceleration(const monitor::SensorSample& sampl
     return update;
   }
   status_.time_ns = monitor_time(sample.receive_time_ns);
-  room().sensor.on_acceleration(sample, !status_.estimating || quiet());
+  room().sensor.on_acceleration(sample, !status_.estimating || quiet(), last_ground_);
   note_statue_health();
   evaluate(update);
   return update;
@@ -687,12 +708,17 @@ MonitorUpdate Monitor::on_regional_alert(const monitor::RegionalAlert& alert) {
 }
 
 MonitorUpdate Monitor::regional_alert_malformed(const char* field) {
+  return regional_alert_refused(monitor::RegionalRefusal::kMalformed, field);
+}
+
+MonitorUpdate Monitor::regional_alert_refused(monitor::RegionalRefusal refusal,
+                                              const char* field) {
   MonitorUpdate update = new_update();
   if (auto* regional_state = monitor::built_part<monitor::RegionalAlertState>(regional_)) {
-    regional_state->refuse_malformed(field);
+    regional_state->refuse_unread(refusal, field);
   }
   update.regional_received = true;
-  update.regional = {monitor::RegionalRefusal::kMalformed, field};
+  update.regional = {refusal, field};
   evaluate(update);
   return update;
 }

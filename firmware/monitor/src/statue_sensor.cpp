@@ -170,14 +170,16 @@ void QuietWindowOffset::add(const Vector3r& value, bool quiet) {
   }
 }
 
-void StatueSensor::on_acceleration(const monitor::SensorSample& sample, bool quiet) {
+void StatueSensor::on_acceleration(const monitor::SensorSample& sample, bool quiet,
+                                   const Vector3r& ground_m_s2) {
   const monitor::SensorUpdate update = acceleration_tracker_.on_sample(sample);
   acceleration_health_ = update.health;
   for (std::size_t i = 0; i < update.fed_count; ++i) {
     const monitor::FedSample& fed = update.fed[i];
     const Vector3r statue = sensor_to_statue_ * fed.acceleration_g * kStandardGravity;  // m/s2
-    // At rest the horizontal specific force is 0: only x and y have an offset to remove.
-    acceleration_offset_.add(Vector3r(statue.x(), statue.y(), Real(0)), quiet);
+    // Standing, the horizontal specific force is the ground's: only x and y have an offset.
+    acceleration_offset_.add(
+        Vector3r(statue.x() - ground_m_s2.x(), statue.y() - ground_m_s2.y(), Real(0)), quiet);
     const Vector3r& offset = acceleration_offset_.offset();
     specific_force_ = Vector3r(statue.x() - offset.x(), statue.y() - offset.y(), statue.z());
     acceleration_saturated_ = fed.saturated;

@@ -89,7 +89,7 @@ enum EventSignal : std::size_t {
 constexpr std::array<SignalLayout, 7> kEventSignals{{
     {"Level", 0, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
     {"PreviousLevel", 4, 4, false, 1.0, 0.0, 0, 4, "", true, kNoSpecialRaw},
-    {"Cause", 8, 8, false, 1.0, 0.0, 0, 18, "", true, kNoSpecialRaw},
+    {"Cause", 8, 8, false, 1.0, 0.0, 0, 19, "", true, kNoSpecialRaw},
     {"Latched", 16, 1, false, 1.0, 0.0, 0, 1, "", true, kNoSpecialRaw},
     {"Trouble", 17, 1, false, 1.0, 0.0, 0, 1, "", false, kNoSpecialRaw},
     {"TimeSinceStart", 24, 32, false, 1.0, 0.0, 0, kU32Max, "ms", false, kNoSpecialRaw},
@@ -155,6 +155,13 @@ constexpr std::array<SignalLayout, 5> kRegionalSignals{{
     {"Pga", 24, 16, false, 0.0001, 0.0, 0, kU16Max, "g", false, kNoSpecialRaw},
     {"SigmaLn", 40, 8, false, 0.01, 0.0, 0, kU8Max, "", false, kNoSpecialRaw},
     {"SArrivalIn", 48, 16, true, 0.01, 0.0, -32768, 32767, "s", false, kNoSpecialRaw},
+}};
+
+// RegionalAlertTag (0x362)
+enum TagSignal : std::size_t { kCounter, kTag };
+constexpr std::array<SignalLayout, 2> kTagSignals{{
+    {"Counter", 0, 32, false, 1.0, 0.0, 0, kU32Max, "", false, kNoSpecialRaw},
+    {"Tag", 32, 32, false, 1.0, 0.0, 0, kU32Max, "", false, kNoSpecialRaw},
 }};
 
 // ---------------------------------------------------------------------------------------------
@@ -293,7 +300,7 @@ constexpr bool undefined_status_flags(std::uint8_t status) {
 }
 
 // The DBC message names, without node or axis suffix.
-constexpr NameTable<MessageKind, 10> kMessageKindNames{{{
+constexpr NameTable<MessageKind, 11> kMessageKindNames{{{
     {MessageKind::kSensorAcceleration, "SensorAcceleration"},
     {MessageKind::kSensorHeartbeat, "SensorHeartbeat"},
     {MessageKind::kMonitorStatus, "MonitorStatus"},
@@ -304,6 +311,7 @@ constexpr NameTable<MessageKind, 10> kMessageKindNames{{{
     {MessageKind::kStatueRotation, "StatueRotation"},
     {MessageKind::kRegionalAlert, "RegionalAlert"},
     {MessageKind::kRegionalAlertOrigin, "RegionalAlertOrigin"},
+    {MessageKind::kRegionalAlertTag, "RegionalAlertTag"},
 }}};
 
 constexpr NameTable<CodecError, 8> kCodecErrorTexts{{{
@@ -346,6 +354,7 @@ MessageKind classify(std::uint32_t id) {
     case kRegionalAlertId:
       return index == 0   ? MessageKind::kRegionalAlert
              : index == 1 ? MessageKind::kRegionalAlertOrigin
+             : index == 2 ? MessageKind::kRegionalAlertTag
                           : MessageKind::kUnknown;
     default:
       return MessageKind::kUnknown;
@@ -370,6 +379,7 @@ std::span<const SignalLayout> signal_layouts(MessageKind kind) {
     case MessageKind::kStatueRotation: return kRotationSignals;
     case MessageKind::kRegionalAlert: return kRegionalSignals;
     case MessageKind::kRegionalAlertOrigin: return kOriginSignals;
+    case MessageKind::kRegionalAlertTag: return kTagSignals;
     case MessageKind::kUnknown: break;
   }
   return {};
@@ -725,6 +735,24 @@ DecodeResult decode(const CanFrame& frame, RegionalAlert& message) {
   m.pga_g = unpacker.physical(s[kPga]);
   m.sigma_ln = unpacker.physical(s[kSigmaLn]);
   m.s_arrival_in_s = unpacker.physical(s[kSArrivalIn]);
+  if (unpacker.result().ok()) message = m;
+  return unpacker.result();
+}
+
+EncodeResult encode(const RegionalAlertTag& message, CanFrame& frame) {
+  const auto& s = kTagSignals;
+  Packer packer;
+  packer.integer(message.counter, s[kCounter]);
+  packer.integer(message.tag, s[kTag]);
+  return packer.finish(kRegionalAlertTagId, frame);
+}
+
+DecodeResult decode(const CanFrame& frame, RegionalAlertTag& message) {
+  const auto& s = kTagSignals;
+  Unpacker unpacker(frame, MessageKind::kRegionalAlertTag, s);
+  RegionalAlertTag m;
+  m.counter = unpacker.integer<std::uint32_t>(s[kCounter]);
+  m.tag = unpacker.integer<std::uint32_t>(s[kTag]);
   if (unpacker.result().ok()) message = m;
   return unpacker.result();
 }

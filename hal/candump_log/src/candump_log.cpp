@@ -210,7 +210,90 @@ std::string parse_frame(std::string_view token, CandumpLine& out) {
   return {};
 }
 
+// candump -d's report of frames its socket lost (candump.c, "check for (unlikely) dropped
+// frames"): "DROPCOUNT: dropped %u CAN frame%s on '%s' socket (total drops %u)".
+constexpr std::string_view kDropTag = "DROPCOUNT:";
+constexpr std::string_view kDropCountHead = "DROPCOUNT: dropped ";
+constexpr std::string_view kDropFrames = " CAN frame";
+constexpr std::string_view kDropSocket = " on '";
+constexpr std::string_view kDropTotal = "' socket (total drops ";
+constexpr std::uint64_t kMaxDropCounter = 0xFFFFFFFF;  // candump's counters are 32-bit
+
+bool take_prefix(std::string_view& rest, std::string_view prefix) {
+  if (rest.substr(0, prefix.size()) != prefix) return false;
+  rest.remove_prefix(prefix.size());
+  return true;
+}
+
+// A decimal number from `least` to 2^32 - 1 (candump prints its counters with %u; before
+// can-utils 2023.03 with %d, so a count past 2^31 came out negative). "" or the reason.
+std::string parse_drop_counter(std::string_view text, std::string_view what, std::uint64_t least,
+                               std::uint32_t& out) {
+  std::uint64_t value = 0;
+  bool digits = !text.empty() && text.size() <= 10;
+  for (const char c : text) {
+    digits = digits && is_digit(c);
+    if (digits) value = value * 10 + static_cast<std::uint64_t>(c - '0');
+  }
+  if (!digits || value < least || value > kMaxDropCounter) {
+    return join({"DROPCOUNT line: ", what, " ", quoted(text), " is not a number of frames from ",
+                 std::to_string(least), " to ", std::to_string(kMaxDropCounter)});
+  }
+  out = static_cast<std::uint32_t>(value);
+  return {};
+}
+
+// "DROPCOUNT: dropped N CAN frame[s] on 'SOCKET' socket (total drops T)"; "" or the reason.
+std::string parse_drop_count(std::string_view line, CandumpLine& out) {
+  const std::string shape =
+      join({"expected a DROPCOUNT line as candump -d writes it, 'DROPCOUNT: dropped N CAN frames "
+            "on 'vcan0' socket (total drops T)', got ",
+            quoted(line)});
+  std::string_view rest = line;
+  if (!take_prefix(rest, kDropCountHead)) return shape;
+  const std::size_t count_end = rest.find(' ');
+  if (count_end == std::string_view::npos) return shape;
+  const std::string_view count = rest.substr(0, count_end);
+  rest.remove_prefix(count_end);
+  if (!take_prefix(rest, kDropFrames)) return shape;
+  take_prefix(rest, "s");  // "frame" for 1, else "frames"
+  if (!take_prefix(rest, kDropSocket)) return shape;
+  const std::size_t name_end = rest.find(kDropTotal);
+  if (name_end == std::string_view::npos || name_end == 0) return shape;
+  const std::string_view socket_name = rest.substr(0, name_end);
+  rest.remove_prefix(name_end + kDropTotal.size());
+  if (rest.empty() || rest.back() != ')') return shape;
+  const std::string_view total = rest.substr(0, rest.size() - 1);
+  std::string problem = parse_drop_counter(count, "the count", 1, out.dropped_frames);
+  if (!problem.empty()) return problem;
+  problem = parse_drop_counter(total, "the total", 0, out.total_dropped_frames);
+  if (!problem.empty()) return problem;
+  out.interface_name = std::string(socket_name);
+  out.kind = CandumpFrameKind::kDropCount;
+  return {};
+}
+
+std::string frames_text(std::uint64_t count) {
+  return std::to_string(count) + (count == 1 ? " CAN frame" : " CAN frames");
+}
+
 }  // namespace
+
+std::string format_candump_drop_line(std::uint32_t dropped_frames, std::string_view socket_name,
+                                     std::uint32_t total_dropped_frames) {
+  if (dropped_frames == 0 || socket_name.empty() ||
+      socket_name.find_first_of("'\r\n") != std::string_view::npos) {
+    return {};
+  }
+  return join({kDropCountHead, frames_text(dropped_frames), kDropSocket, socket_name,
+               kDropTotal, std::to_string(total_dropped_frames), ")"});
+}
+
+std::string describe_candump_drop(const CandumpLine& line) {
+  return join({"candump lost ", frames_text(line.dropped_frames), " on '", line.interface_name,
+               "' before this line (its socket overflowed; ",
+               std::to_string(line.total_dropped_frames), " in all so far)"});
+}
 
 std::string parse_candump_line(std::string_view line, CandumpLine& out) {
   out = CandumpLine{};
@@ -218,6 +301,10 @@ std::string parse_candump_line(std::string_view line, CandumpLine& out) {
   std::string_view rest = line;
   const std::string_view timestamp = next_token(rest);
   if (timestamp.empty() || timestamp.front() == '#') return {};  // blank or comment
+  if (timestamp == kDropTag) {
+    while (!line.empty() && is_blank(line.front())) line.remove_prefix(1);
+    return parse_drop_count(line, out);
+  }
   if (timestamp.front() != '(') {
     return join({"expected a line '(seconds.microseconds) interface id#data', got ", quoted(line)});
   }
@@ -339,6 +426,9 @@ IoStatus CandumpLogReader::receive(TimedFrame& out, int /*timeout_ms*/) {
         for (std::size_t i = 0; i < line_.length; ++i) out.frame.data[i] = line_.data[i];
         return IoStatus::kOk;
       case CandumpFrameKind::kErrorFrame: return IoStatus::kBusError;
+      case CandumpFrameKind::kDropCount:
+        total_dropped_frames_ += line_.dropped_frames;
+        return IoStatus::kOverflow;
       default: return IoStatus::kNotPlinth;
     }
   }

@@ -134,7 +134,7 @@ bool RecordSchedule::next(ScheduledFrame& out) {
 }
 
 LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s,
-                                       hal::LogTimePolicy policy) {
+                                       hal::LogPolicy time_policy, hal::LogPolicy drop_policy) {
   hal::CandumpLogReaderOpenResult opened = hal::CandumpLogReader::open(path);
   if (!opened.ok()) throw host::InputError(opened.message);
   hal::CandumpLogReader& reader = *opened.reader;
@@ -157,6 +157,19 @@ LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s,
                              " sensor frames or " + host::number_text(host::kMaxReplayLogLines, 3) +
                              " lines); use --t-end, or split it");
     }
+    if (status == hal::IoStatus::kOverflow) {  // a DROPCOUNT line
+      const std::string what = path + ":" + std::to_string(reader.line_number()) + ": " +
+                               hal::describe_candump_drop(reader.last_line());
+      if (drop_policy == hal::LogPolicy::kRefuse) {
+        throw host::InputError(what + " (--log-drops refuse)");
+      }
+      ++out.drop_reports;
+      out.dropped_frames += reader.dropped_frames();
+      if (out.drop_warnings.size() < kLogTimeWarnings) {
+        out.drop_warnings.push_back(what + ": not in the log, not sent");
+      }
+      continue;
+    }
     const can::MessageKind kind =
         status == hal::IoStatus::kOk ? can::classify(timed.frame.id) : can::MessageKind::kUnknown;
     if (kind != can::MessageKind::kSensorAcceleration &&
@@ -171,7 +184,7 @@ LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s,
       const bool back = step.problem == hal::LogTimeProblem::kWentBack;
       std::string what = path + ":" + std::to_string(reader.line_number()) + ": " +
                          time_check.describe(step, timed.timestamp_ns);
-      if (policy == hal::LogTimePolicy::kRefuse) {
+      if (time_policy == hal::LogPolicy::kRefuse) {
         throw host::InputError(what + " (--log-time refuse)");
       }
       ++(back ? out.went_back : out.jumps);

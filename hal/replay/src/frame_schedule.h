@@ -81,25 +81,32 @@ class RecordSchedule final : public FrameSchedule {
 // The sensor frames (SensorAcceleration, SensorHeartbeat and StatueRotation of any node: the
 // ground sensors' and the statue sensor's) of a candump log, sent again as logged, at their
 // logged times relative to the first of them. Other lines are skipped and counted. Their time is
-// checked (hal::LogTimeCheck): with LogTimePolicy::kWarn a frame stamped before the previous one
+// checked (hal::LogTimeCheck): with LogPolicy::kWarn a frame stamped before the previous one
 // is sent at the previous one's time, and a jump forward beyond hal::kMaxLogGapS is shortened to
 // that gap (the replay does not sit through a logger's pause or a clock step), each one named in
 // `time_warnings` (the first kLogTimeWarnings) and counted; with kRefuse the first one throws.
-// Frames of an identifier at the same microsecond are sent as logged.
+// Frames of an identifier at the same microsecond are sent as logged. The frames the log lost
+// (its DROPCOUNT lines: the logger's socket overflowed) cannot be sent: with `drop_policy`
+// kWarn each line is named in `drop_warnings` (the first kLogTimeWarnings) and counted, the
+// frames after it sent at their times; with kRefuse the first one throws.
 inline constexpr std::size_t kLogTimeWarnings = 10;
 struct LoggedFrames {
   std::vector<ScheduledFrame> frames;  // virtual_ns relative to the first
   std::int64_t skipped = 0;            // non-sensor, non-plinth, error-frame lines
   std::int64_t went_back = 0;          // frames stamped before the previous one
   std::int64_t jumps = 0;              // jumps forward beyond hal::kMaxLogGapS
+  std::int64_t drop_reports = 0;       // DROPCOUNT lines
+  std::int64_t dropped_frames = 0;     // the frames they say the log lost
   std::vector<std::string> time_warnings;  // "file:line: what, by how much: what was done"
+  std::vector<std::string> drop_warnings;  // "file:line: what was lost"
 };
 
-// Reads the log; throws host::InputError "file:line: what" for a malformed line, for a time the
-// policy refuses, and when the log holds no sensor frame. Frames later than `t_end_s`
-// (relative, s; <0: no limit) are left out.
+// Reads the log; throws host::InputError "file:line: what" for a malformed line, for a time or
+// a loss the policies refuse, and when the log holds no sensor frame. Frames later than
+// `t_end_s` (relative, s; <0: no limit) are left out.
 [[nodiscard]] LoggedFrames read_logged_sensor_frames(const std::string& path, double t_end_s,
-                                                     hal::LogTimePolicy policy);
+                                                     hal::LogPolicy time_policy,
+                                                     hal::LogPolicy drop_policy);
 
 // `loops` times over the logged frames; each loop starts one mean frame interval after the
 // previous loop's last frame (1 s when the log holds a single frame).

@@ -62,7 +62,8 @@ struct Options {
   std::string can_interface;
   std::string log_path;
   std::string log_interface = "vcan0";
-  std::string log_time;  // --log-time: warn or refuse; empty: not given (warn)
+  std::string log_time;   // --log-time: warn or refuse; empty: not given (warn)
+  std::string log_drops;  // --log-drops: the same
   bool report_json = false;
 };
 
@@ -300,6 +301,8 @@ struct Report {
   std::int64_t rotation_frames = 0;  // StatueRotation, from a log
   std::int64_t send_errors = 0;
   std::int64_t skipped_log_lines = 0;
+  std::int64_t log_drop_reports = 0;    // the log's DROPCOUNT lines
+  std::int64_t log_dropped_frames = 0;  // the frames they say it lost (not sent)
   std::size_t clipped_samples = 0;
   std::string first_send_error;
   double virtual_time_s = 0.0;
@@ -345,11 +348,13 @@ void print_report(const Options& opt, const Report& r, const plinth::hal::Pacer&
   std::printf(
       "{\"frames_sent\": %lld, \"acceleration_frames\": %lld, \"heartbeat_frames\": %lld, "
       "\"rotation_frames\": %lld, \"send_errors\": %lld, \"skipped_log_lines\": %lld, "
+      "\"log_drop_reports\": %lld, \"log_dropped_frames\": %lld, "
       "\"clipped_samples\": %zu, \"virtual_time_s\": %.6f, "
       "\"wall_time_s\": %.6f, \"speed\": %s, \"loops\": %lld, \"interrupted\": %s, %s}\n",
       static_cast<long long>(r.frames_sent), static_cast<long long>(r.acceleration_frames),
       static_cast<long long>(r.heartbeat_frames), static_cast<long long>(r.rotation_frames),
       static_cast<long long>(r.send_errors), static_cast<long long>(r.skipped_log_lines),
+      static_cast<long long>(r.log_drop_reports), static_cast<long long>(r.log_dropped_frames),
       r.clipped_samples, r.virtual_time_s, r.wall_time_s,
       opt.speed == "max" ? "\"max\"" : opt.speed.c_str(), static_cast<long long>(opt.loops),
       r.interrupted ? "true" : "false", jitter);
@@ -404,6 +409,8 @@ struct Input {
   std::string description;
   std::size_t clipped_samples = 0;
   std::int64_t skipped_log_lines = 0;
+  std::int64_t log_drop_reports = 0;
+  std::int64_t log_dropped_frames = 0;
 };
 
 Input open_input(const Options& opt, const CLI::App& app) {
@@ -412,6 +419,10 @@ Input open_input(const Options& opt, const CLI::App& app) {
     if (app.count("--log-time") > 0) {
       throw InputError("--log-time: applies to a candump log input only (" + opt.record_path +
                        " is a record: its samples' time is its sampling interval)");
+    }
+    if (app.count("--log-drops") > 0) {
+      throw InputError("--log-drops: applies to a candump log input only (" + opt.record_path +
+                       " is a record: it has no DROPCOUNT lines)");
     }
     RecordPlan plan = plan_records(opt);
     input.description = plan.description;
@@ -427,15 +438,29 @@ Input open_input(const Options& opt, const CLI::App& app) {
                        opt.record_path + "): its sensor frames are sent again as logged");
     }
   }
-  const plinth::hal::LogTimePolicy policy =
-      opt.log_time.empty() ? plinth::hal::LogTimePolicy::kWarn
-                           : plinth::host::parse_name<plinth::hal::kLogTimePolicyNames>(
-                                 opt.log_time, "--log-time", "policy");
+  const auto policy = [](const std::string& text, const char* option) {
+    return text.empty() ? plinth::hal::LogPolicy::kWarn
+                        : plinth::host::parse_name<plinth::hal::kLogPolicyNames>(text, option,
+                                                                                 "policy");
+  };
   plinth::hal::replay::LoggedFrames logged = plinth::hal::replay::read_logged_sensor_frames(
-      opt.record_path, opt.t_end_s.value_or(-1.0), policy);
+      opt.record_path, opt.t_end_s.value_or(-1.0), policy(opt.log_time, "--log-time"),
+      policy(opt.log_drops, "--log-drops"));
   for (const std::string& warning : logged.time_warnings) {
     std::fprintf(stderr, "plinth-replay: warning: %s\n", warning.c_str());
   }
+  for (const std::string& warning : logged.drop_warnings) {
+    std::fprintf(stderr, "plinth-replay: warning: %s\n", warning.c_str());
+  }
+  if (logged.drop_reports > 0) {
+    std::fprintf(stderr,
+                 "plinth-replay: warning: %s: %lld frames lost in %lld DROPCOUNT lines, not sent "
+                 "(--log-drops refuse stops at the first)\n",
+                 opt.record_path.c_str(), static_cast<long long>(logged.dropped_frames),
+                 static_cast<long long>(logged.drop_reports));
+  }
+  input.log_drop_reports = logged.drop_reports;
+  input.log_dropped_frames = logged.dropped_frames;
   if (logged.went_back + logged.jumps > 0) {
     std::fprintf(stderr,
                  "plinth-replay: warning: %s: %lld timestamps went back, %lld jumped forward "
@@ -545,6 +570,8 @@ int run(const Options& opt, const CLI::App& app) {
   install_stop_handlers();
   Report report;
   report.skipped_log_lines = input.skipped_log_lines;
+  report.log_drop_reports = input.log_drop_reports;
+  report.log_dropped_frames = input.log_dropped_frames;
   report.clipped_samples = input.clipped_samples;
   plinth::hal::Pacer pacer(speed);
   pacer.start();
@@ -601,6 +628,9 @@ int main(int argc, char** argv) {
   app.add_option("--log-time", opt.log_time,
                  "a candump log's timestamps that go back or jump beyond 10 s: warn (default: "
                  "named on stderr, sent at the previous time / as a 10 s gap) or refuse");
+  app.add_option("--log-drops", opt.log_drops,
+                 "a candump log's DROPCOUNT lines (frames its logger lost, which cannot be "
+                 "sent): warn (default: named on stderr, counted) or refuse");
   app.add_flag("--report-json", opt.report_json,
                "also print the report as one JSON line on stdout");
   if (const std::optional<int> exit_code = plinth::host::parse_command_line(app, argc, argv)) {

@@ -501,26 +501,35 @@ struct EventLogic {
     }
   }
 
+  // The interval of Method on Kernel: flattened, or through kernels::Erased.
+  template <class Method, class Kernel>
+  static constexpr Simulator::IntervalFn interval() {
+    if constexpr (PLINTH_CORE_ONE_INTERVAL) {
+      return &StepInterval<Method, Kernel>::erased_interval;
+    } else {
+      return &StepInterval<Method, Kernel>::advance_interval;
+    }
+  }
+
   template <class Method>
   static void bind_intervals(Simulator& sim, bool exact_full_contact) {
     auto& fns = sim.interval_fns_;
     constexpr auto at = [](Phase p) { return static_cast<std::size_t>(p); };
     if constexpr (F.base) {
-      fns[at(Phase::kFullContact)] =
-          exact_full_contact ? &StepInterval<Method, kernels::ExactFullContact>::advance_interval
-                             : &StepInterval<Method, kernels::FullContact>::advance_interval;
+      fns[at(Phase::kFullContact)] = exact_full_contact
+                                         ? interval<Method, kernels::ExactFullContact>()
+                                         : interval<Method, kernels::FullContact>();
     } else {
       (void)exact_full_contact;  // nothing moves in full contact on the ground
-      fns[at(Phase::kFullContact)] = &StepInterval<Method, kernels::FullContact>::advance_interval;
+      fns[at(Phase::kFullContact)] = interval<Method, kernels::FullContact>();
     }
-    fns[at(Phase::kRocking)] = &StepInterval<Method, kernels::Rocking>::advance_interval;
+    fns[at(Phase::kRocking)] = interval<Method, kernels::Rocking>();
     if constexpr (F.sliding) {
-      fns[at(Phase::kSliding)] = &StepInterval<Method, kernels::Sliding>::advance_interval;
-      fns[at(Phase::kSlideRocking)] =
-          &StepInterval<Method, kernels::SlideRocking>::advance_interval;
+      fns[at(Phase::kSliding)] = interval<Method, kernels::Sliding>();
+      fns[at(Phase::kSlideRocking)] = interval<Method, kernels::SlideRocking>();
     } else {
-      fns[at(Phase::kSliding)] = &StepInterval<Method, kernels::Frozen>::advance_interval;
-      fns[at(Phase::kSlideRocking)] = &StepInterval<Method, kernels::Frozen>::advance_interval;
+      fns[at(Phase::kSliding)] = interval<Method, kernels::Frozen>();
+      fns[at(Phase::kSlideRocking)] = interval<Method, kernels::Frozen>();
     }
   }
 };

@@ -5,6 +5,9 @@
 // once.
 #pragma once
 
+#include <cstddef>
+#include <type_traits>
+
 #include "plinth/core/excitation.h"
 #include "plinth/core/internal/flows.h"
 #include "plinth/core/internal/full_contact_propagator.h"
@@ -23,8 +26,12 @@ struct Context {
   const State& y0;
 };
 
+// Which leading guards (guards.h, leading_guards) a kernel's modes have.
+enum class Leading { kRocking, kOnsets, kByMode };
+
 struct Base {
   static constexpr bool kExact = false;  // true: the kernel propagates itself (no stepper)
+  static constexpr Leading kLeading = Leading::kOnsets;
 
   const Scene* s;
   const Excitation* excitation;
@@ -47,6 +54,7 @@ struct Base {
 // the points where an event is located) from those of its start, theta0, computed once by
 // sin_cos (not carried over from the last step: no drift of roundings).
 struct Turning : Base {
+  static constexpr Leading kLeading = Leading::kRocking;
   Real theta0;
   SinCos trig0;
 
@@ -74,6 +82,7 @@ struct FullContact : Base {
 // A phase the scene's features do not have (a sliding phase without friction, set by
 // start_from): it stays still.
 struct Frozen : Base {
+  static constexpr Leading kLeading = Leading::kByMode;  // sliding or slide-rocking
   explicit Frozen(const Context& c) : Base(c) {}
 
   [[nodiscard]] State derivative(GroundAcceleration /*ag*/, const State& y) const {
@@ -188,6 +197,46 @@ struct SlideRocking : Turning {
     const SlideRockingSystem k = system(y, t);
     return {ag, t, slide_rocking_flow(*s, k, y, ag, moves), k.consistency()};
   }
+};
+
+// A phase kernel behind function pointers: one interval's code serves every kernel
+// (PLINTH_CORE_ONE_INTERVAL, a build that flattens nothing: the microcontroller's flash). The
+// kernel itself is made in place; its point and its advance by the stepper are called through
+// `Ops` (StepInterval::erased_interval), the ground directly.
+struct Erased {
+  static constexpr bool kExact = true;  // advances through Ops (the stepper on the kernel)
+  static constexpr Leading kLeading = Leading::kByMode;
+
+  struct Ops {
+    void (*make)(void* storage, const Context& c);
+    FlowPoint (*point)(const void* kernel, const State& y, GroundAcceleration ag);
+    State (*advance)(const void* kernel, Time t, const State& y, const FlowPoint& start, Real h,
+                     const GroundAcceleration* end_ground);
+  };
+
+  Erased(const Context& c, const Ops& kernel_ops) : excitation(&c.excitation), ops(&kernel_ops) {
+    kernel_ops.make(storage, c);
+  }
+
+  [[nodiscard]] GroundAcceleration ground(Time t) const { return Base::ground(*excitation, t); }
+  [[nodiscard]] FlowPoint point(const State& y, GroundAcceleration ag) const {
+    return ops->point(storage, y, ag);
+  }
+  [[nodiscard]] State advance(Time t, const State& y, const FlowPoint& start, Real h,
+                              const GroundAcceleration* end_ground) const {
+    return ops->advance(storage, t, y, start, h, end_ground);
+  }
+
+  // Room for the largest kernel, bytes; kernels hold pointers and numbers alone (nothing to
+  // destroy).
+  static constexpr std::size_t kStorageBytes = 160;
+  template <class K>
+  static constexpr bool kFits = sizeof(K) <= kStorageBytes && alignof(K) <= 8 &&
+                                std::is_trivially_destructible_v<K>;
+
+  const Excitation* excitation;
+  const Ops* ops;
+  alignas(8) unsigned char storage[kStorageBytes];
 };
 
 }  // namespace plinth::internal::kernels

@@ -5,9 +5,10 @@
 
 #include <cmath>
 #include <cstddef>
-#include <limits>
+#include <new>
 
 #include "build_options.h"
+#include "crossing.h"
 #include "phase_kernels.h"
 #include "plinth/core/internal/flows.h"
 #include "plinth/core/internal/guards.h"
@@ -40,17 +41,31 @@ struct StepInterval {
 
   // evaluate_guards at the interval's end, and whether any guard may have crossed since the start:
   // negative or zero there and not negative now (both zero: resting on the surface). The
-  // step-end methods need a strict start; earliest_crossing sorts that out.
+  // step-end methods need a strict start; earliest_crossing sorts that out. The kernel's leading
+  // guards (guards.h) are evaluated with their ids known here, the rest by their ids' switch.
   static bool evaluate_end_guards(const Scene& s, const Mode& mode, const ActiveGuards& guards,
                                   const State& y, const FlowPoint& p, const GuardValues& start,
                                   GuardValues& out) {
     bool any = false;
-    for (int i = 0; i < guards.count; ++i) {
-      const auto k = static_cast<std::size_t>(i);
-      const Real b = step_guard_value(guards.ids[k], s, mode, y, p);
+    const auto check = [&](std::size_t k, GuardId id) {
+      const Real b = step_guard_value(id, s, mode, y, p);
       const Real a = start[k];
       out[k] = b;
       any = any || (a <= Real(0) && b >= Real(0) && (a < Real(0) || b > Real(0)));
+    };
+    int i = 0;
+    if constexpr (Kernel::kLeading != kernels::Leading::kByMode) {
+      if (guards.count >= kLeadingGuards) {
+        constexpr auto kIds = leading_guards(Kernel::kLeading == kernels::Leading::kRocking);
+        check(0, kIds[0]);
+        check(1, kIds[1]);
+        check(2, kIds[2]);
+        i = kLeadingGuards;
+      }
+    }
+    for (; i < guards.count; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      check(k, guards.ids[k]);
     }
     return any;
   }
@@ -61,102 +76,79 @@ struct StepInterval {
     return guard_value(id, *sim.scene_, mode, y, p.ground, p.acc, p.trig);
   }
 
-  // Time tau in (a, b] at which guard `id` reaches 0 on the method's solution from (t0, y0):
-  // the witness tau -> g(t0 + tau, advance_state(y0, tau)) is bracketed by g(a) < 0 <= g(b) and its
-  // root found by the Illinois variant of regula falsi, with a bisection whenever an update
-  // fails to halve the bracket. Returns the bracket's upper end, where the guard holds.
-  [[gnu::noinline]] static Real locate_crossing(const Simulator& sim, const Kernel& k,
-                                                const Mode& mode, GuardId id, Time t0,
-                                                const State& y0, const FlowPoint& start, Real a,
-                                                Real fa, Real b, Real fb) {
-    const Real tolerance =
-        sim.settings_.event_time_tolerance * static_cast<Real>(sim.settings_.step);
-    int last_side = 0;
-    bool bisect = false;
-    for (int iteration = 0; iteration < 200 && b - a > tolerance; ++iteration) {
-      const Real width = b - a;
-      Real c = bisect ? Real(0.5) * (a + b) : (a * fb - b * fa) / (fb - fa);
-      if (!(c > a && c < b)) c = Real(0.5) * (a + b);
-      const Real fc = guard_at_time(sim, k, mode, id, t0 + static_cast<Time>(c),
-                                    advance_state(k, t0, y0, start, c));
-      if (fc >= Real(0)) {
-        b = c;
-        fb = fc;
-        if (last_side == 1) fa *= Real(0.5);
-        last_side = 1;
-      } else {
-        a = c;
-        fa = fc;
-        if (last_side == -1) fb *= Real(0.5);
-        last_side = -1;
-      }
-      bisect = (b - a) > Real(0.5) * width;
-    }
-    return b;
-  }
+  // The interval as crossing location (crossing.h) sees it: a guard's witness at tau.
+  struct Interval {
+    const Simulator& sim;
+    const Kernel& k;
+    const Mode& mode;
+    Time t0;
+    const State& y0;
+    const FlowPoint& start;
 
-  // Crossing time of a guard that is negative or exactly zero at the start and non-negative
-  // at the end. Exactly zero means a reset has just put the state on the guard's surface
-  // (theta = 0 after an impact, u = +-u_max after a stop hit): the motion leaves the surface
-  // and may come back within the same step, so the step is probed for the excursion below 0
-  // and the return is located from there. An excursion too small to see is taken as an event
-  // at the end of the interval.
-  static Real crossing_time(const Simulator& sim, const Kernel& k, const Mode& mode, GuardId id,
-                            Time t0, const State& y0, const FlowPoint& start, Real h, Real g_start,
-                            Real g_end) {
-    if (g_start < Real(0))
-      return locate_crossing(sim, k, mode, id, t0, y0, start, Real(0), g_start, h, g_end);
-    for (const Real fraction : {Real(0.0625), Real(0.25), Real(0.5), Real(0.75)}) {
-      const Real tau = fraction * h;
-      const Real g = guard_at_time(sim, k, mode, id, t0 + static_cast<Time>(tau),
-                                   advance_state(k, t0, y0, start, tau));
-      if (g < Real(0)) return locate_crossing(sim, k, mode, id, t0, y0, start, tau, g, h, g_end);
+    static Real witness(const void* interval, GuardId id, Real tau) {
+      const auto& i = *static_cast<const Interval*>(interval);
+      return guard_at_time(i.sim, i.k, i.mode, id, i.t0 + static_cast<Time>(tau),
+                           advance_state(i.k, i.t0, i.y0, i.start, tau));
     }
-    return h;
-  }
-
-  // The guard that crossed first, and when (tau from t0); tau is infinite when none did.
-  struct Crossing {
-    GuardId id = GuardId::kRockingImpact;
-    Real tau = std::numeric_limits<Real>::infinity();
   };
 
-  // Out of line: the step's hot path only checks that no guard changed sign (evaluate_end_guards).
-  [[gnu::noinline]] static Crossing earliest_crossing(const Simulator& sim, const Kernel& k,
-                                                      const Mode& mode, const ActiveGuards& guards,
-                                                      Time t0, const State& y0,
-                                                      const FlowPoint& start, Real h,
-                                                      const GuardValues& g_start,
-                                                      const GuardValues& g_end) {
-    Crossing first;
-    for (int i = 0; i < guards.count; ++i) {
-      const auto j = static_cast<std::size_t>(i);
-      const Real a = g_start[j];
-      const Real b = g_end[j];
-      if constexpr (Method::kLocated) {
-        if (a > Real(0) || b < Real(0) || (a == Real(0) && b == Real(0))) continue;
-        const Real tau = crossing_time(sim, k, mode, guards.ids[j], t0, y0, start, h, a, b);
-        if (tau < first.tau) first = {guards.ids[j], tau};
-      } else {
-        // No location: the crossing seen at the step's end; the guards are ranked by where
-        // their straight line between the ends crosses zero.
-        if (!(a < Real(0) && b >= Real(0))) continue;
-        const Real tau = h * (a / (a - b));
-        if (tau < first.tau) first = {guards.ids[j], tau};
-      }
-    }
-    return first;
+  // Out of line where the interval is flattened: its hot path only checks that no guard changed
+  // sign.
+  PLINTH_FLATTENED_OUT static Crossing earliest_crossing(const Simulator& sim, const Kernel& k,
+                                                         const Mode& mode,
+                                                         const ActiveGuards& guards, Time t0,
+                                                         const State& y0, const FlowPoint& start,
+                                                         Real h, const GuardValues& g_start,
+                                                         const GuardValues& g_end) {
+    const Interval interval{sim, k, mode, t0, y0, start};
+    const CrossingSearch search{
+        {&Interval::witness, &interval},
+        *sim.scene_,
+        mode,
+        y0,
+        start,
+        sim.settings_.event_time_tolerance * static_cast<Real>(sim.settings_.step),
+        Method::kLocated};
+    return internal::earliest_crossing(search, guards, h, g_start, g_end);
   }
 
   PLINTH_FLATTEN static bool advance_interval(Simulator& sim, Time& t0, Time t_end,
                                               bool guards_live, bool full_step) {
+    return advance_interval_of(sim, t0, t_end, guards_live, full_step);
+  }
+
+  // advance_interval through kernels::Erased (PLINTH_CORE_ONE_INTERVAL): this kernel's Ops and
+  // the one interval of them all.
+  static bool erased_interval(Simulator& sim, Time& t0, Time t_end, bool guards_live,
+                              bool full_step) {
+    static_assert(kernels::Erased::kFits<Kernel>);
+    static constexpr kernels::Erased::Ops kOps{
+        [](void* storage, const kernels::Context& c) { new (storage) Kernel(c); },
+        [](const void* k, const State& y, GroundAcceleration ag) {
+          return std::launder(static_cast<const Kernel*>(k))->point(y, ag);
+        },
+        [](const void* k, Time t, const State& y, const FlowPoint& start, Real h,
+           const GroundAcceleration* end_ground) {
+          return advance_state(*std::launder(static_cast<const Kernel*>(k)), t, y, start, h,
+                               end_ground);
+        }};
+    return StepInterval<Method, kernels::Erased>::advance_interval_of(sim, t0, t_end, guards_live,
+                                                                      full_step, kOps);
+  }
+
+  // KernelArgs: what the kernel is made from besides the interval's context (Erased: its Ops).
+  template <class... KernelArgs>
+  static bool advance_interval_of(Simulator& sim, Time& t0, Time t_end, bool guards_live,
+                                  bool full_step, const KernelArgs&... kernel_args) {
     const Scene& s = *sim.scene_;
     const Mode mode = sim.mode_;
     const State& y0 = sim.y_;  // replaced only once y1 (or the event's state) is complete
     // The interval's length, and below the offsets inside it, in Real; the times themselves in
     // Time.
     const auto h = static_cast<Real>(t_end - t0);
-    Kernel k({s, sim.excitation_, sim.propagator_, full_step ? h : Real(0), mode, y0});
+    Kernel k(kernels::Context{s, sim.excitation_, sim.propagator_, full_step ? h : Real(0), mode,
+                              y0},
+             kernel_args...);
     static constexpr ActiveGuards kNone{};
     const ActiveGuards& guards = guards_live ? sim.active_guards_ : kNone;
     // The start: kept from the end of the last step when it had no event.

@@ -106,6 +106,43 @@ bool grid_value(std::string_view column, std::string_view prefix, double& value)
   return r.ec == std::errc{} && r.ptr == column.data() + column.size();
 }
 
+// The fault block from f[c] on (kFaultColumns' order), each checked.
+EvalRun::Faults parse_faults(const std::vector<std::string>& f, std::size_t c,
+                             const std::string& where) {
+  const auto column = [&](std::size_t i) { return std::string(kFaultColumns[i]); };
+  EvalRun::Faults x;
+  x.fault = f[c];
+  x.param = f[c + 1];
+  x.at = f[c + 2];
+  if (x.fault.empty()) throw InputError(where + ": fault: expected a kind or none, got nothing");
+  if (!f[c + 3].empty()) x.began_s = parse_number(f[c + 3], where, kFaultColumns[3]);
+  if (x.fault == "none" && (!x.param.empty() || !x.at.empty() || x.began_s)) {
+    throw InputError(where + ": fault none: its parameter, onset and began_s must be empty");
+  }
+  x.first_trouble_s = parse_time(f[c + 4], where, kFaultColumns[4]);
+  if (f[c + 5] != "0" && f[c + 5] != "1") {
+    throw InputError(where + ": " + column(5) + ": expected 0 or 1, got \"" + f[c + 5] + "\"");
+  }
+  x.trouble_at_end = f[c + 5] == "1";
+  x.first_statue_fault_s = parse_time(f[c + 6], where, kFaultColumns[6]);
+  x.first_statue_unexplained_s = parse_time(f[c + 7], where, kFaultColumns[7]);
+  monitor::AlarmLevel level{};
+  if (f[c + 8] != kBoxDown && !monitor::kAlarmLevelNames.parse(f[c + 8], level)) {
+    throw InputError(where + ": " + column(8) + ": expected a level or " +
+                     std::string(kBoxDown) + ", got \"" + f[c + 8] + "\"");
+  }
+  x.level_at_end = f[c + 8];
+  if (!monitor::kAlarmCauseNames.parse(f[c + 9], x.trouble_at_end_cause)) {
+    throw InputError(where + ": " + column(9) + ": expected a cause, got \"" + f[c + 9] + "\"");
+  }
+  if (f[c + 10] != "all" && f[c + 10] != "collapses") {
+    throw InputError(where + ": " + column(10) + ": expected all or collapses, got \"" +
+                     f[c + 10] + "\"");
+  }
+  x.collapses_only = f[c + 10] == "collapses";
+  return x;
+}
+
 }  // namespace
 
 CrossingGrids default_crossing_grids() {
@@ -448,7 +485,8 @@ void assign_case_collapses(std::vector<EvalRun>& runs, const std::string& where)
   }
 }
 
-void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with_grid) {
+void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with_grid,
+                           bool with_faults) {
   std::string line;
   for (std::string_view c : kFixedColumns) {
     if (!line.empty()) line += ',';
@@ -480,6 +518,11 @@ void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with
   }
   for (std::string_view c : grids.regional ? std::span<const std::string_view>(kRegionalColumns)
                                            : std::span<const std::string_view>()) {
+    line += ',';
+    line += c;
+  }
+  for (std::string_view c : with_faults ? std::span<const std::string_view>(kFaultColumns)
+                                        : std::span<const std::string_view>()) {
     line += ',';
     line += c;
   }
@@ -522,6 +565,20 @@ void write_eval_csv_row(std::FILE* out, const EvalRun& r) {
       add(format(v));
     }
   }
+  if (r.faults) {
+    const EvalRun::Faults& f = *r.faults;
+    add(csv_field(f.fault));
+    add(csv_field(f.param));
+    add(csv_field(f.at));
+    add(f.began_s ? format(*f.began_s) : "");
+    add(format(f.first_trouble_s));
+    add(f.trouble_at_end ? "1" : "0");
+    add(format(f.first_statue_fault_s));
+    add(format(f.first_statue_unexplained_s));
+    add(csv_field(f.level_at_end));
+    add(monitor::alarm_cause_name(f.trouble_at_end_cause));
+    add(f.collapses_only ? "collapses" : "all");
+  }
   std::fprintf(out, "%s\n", line.c_str());
 }
 
@@ -549,11 +606,19 @@ EvalTable read_eval_csv(const std::string& path) {
                               f.begin() + static_cast<std::ptrdiff_t>(first_extra));
   const std::size_t first_grid = first_extra + (table.has_grid ? kGridColumns.size() : 0);
   bool pwave_block = false;  // p_pick_s, strong_motion_s, pwave_trigger_s, then pwave_ge_
-  // The regional columns, when present, end the header.
+  // The fault block, when present, ends the header; the regional columns, when present, come
+  // before it.
   std::size_t header_end = f.size();
-  if (f.size() >= first_grid + kRegionalColumns.size() &&
-      std::equal(kRegionalColumns.begin(), kRegionalColumns.end(),
-                 f.end() - static_cast<std::ptrdiff_t>(kRegionalColumns.size()))) {
+  const auto ends_with = [&](std::span<const std::string_view> block) {
+    return header_end >= first_grid + block.size() &&
+           std::equal(block.begin(), block.end(),
+                      f.begin() + static_cast<std::ptrdiff_t>(header_end - block.size()));
+  };
+  if (ends_with(kFaultColumns)) {
+    table.has_faults = true;
+    header_end -= kFaultColumns.size();
+  }
+  if (ends_with(kRegionalColumns)) {
     table.grids.regional = true;
     header_end -= kRegionalColumns.size();
   }
@@ -664,9 +729,23 @@ EvalTable read_eval_csv(const std::string& path) {
       }
     }
     if (table.grids.regional) r.regional = parse_regional(f, c, where);
+    c += table.grids.regional ? kRegionalColumns.size() : 0;
+    if (table.has_faults) {
+      r.faults = parse_faults(f, c, where);
+      if (table.runs.empty()) table.collapses_only = r.faults->collapses_only;
+      if (r.faults->collapses_only != table.collapses_only) {
+        throw InputError(where + ": runs_written: \"" + f[c + kFaultColumns.size() - 1] +
+                         "\" where the rows above say \"" +
+                         (table.collapses_only ? "collapses" : "all") + "\"");
+      }
+      if (table.collapses_only && !r.collapsed) {
+        throw InputError(where + ": runs_written \"collapses\", but this run did not collapse");
+      }
+    }
     table.runs.push_back(std::move(r));
   }
-  if (table.has_grid) assign_case_collapses(table.runs, path);
+  // A file of collapses alone has, by design, no rows of the runs that stood.
+  if (table.has_grid && !table.collapses_only) assign_case_collapses(table.runs, path);
   return table;
 }
 

@@ -69,7 +69,8 @@ const RegionalAlertState::SeenEvent* RegionalAlertState::seen(std::uint32_t even
 void RegionalAlertState::remember(std::uint32_t event_id, std::uint32_t version) {
   for (std::size_t i = 0; i < seen_count_; ++i) {
     if (seen_[i].event_id == event_id) {
-      seen_[i].version = version;
+      // The highest version seen: an older one taken for its danger leaves it.
+      seen_[i].version = version > seen_[i].version ? version : seen_[i].version;
       return;
     }
   }
@@ -95,7 +96,12 @@ void RegionalAlertState::drop(int slot) {
   --held_count_;
 }
 
-RegionalOutcome RegionalAlertState::check(const RegionalAlert& a) const {
+Real RegionalAlertState::probability_of(const RegionalAlert& a) const {
+  return settings_.fragility_known ? settings_.fragility.probability(a.pga_g, a.sigma_ln)
+                                   : Real(0);
+}
+
+RegionalOutcome RegionalAlertState::check(const RegionalAlert& a, Real& probability) const {
   using R = RegionalRefusal;
   struct Number {
     Real value;
@@ -121,6 +127,7 @@ RegionalOutcome RegionalAlertState::check(const RegionalAlert& a) const {
   }
   // The S waves leave with the origin: their arrival comes after it.
   if (a.s_arrival_in_s < -a.origin_age_s) return {R::kInconsistent, "s_arrival_in_s"};
+  probability = probability_of(a);
   if (a.origin_age_s < -Real(settings_.future_tolerance_s)) {
     return {R::kFutureDated, "origin_age_s"};
   }
@@ -129,9 +136,15 @@ RegionalOutcome RegionalAlertState::check(const RegionalAlert& a) const {
                             shaking_duration_s(settings_, a.magnitude, a.distance_km) +
                             settings_.expiry_margin_s;
   if (!a.cancelled && expires_in_s <= 0.0) return {R::kStale, "s_arrival_in_s"};
-  if (const SeenEvent* e = seen(a.event_id)) {
-    if (a.version == e->version) return {R::kDuplicate, "version"};
-    if (a.version < e->version) return {R::kOutOfOrder, "version"};
+  if (const SeenEvent* e = seen(a.event_id); e != nullptr && a.version <= e->version) {
+    // Unauthenticated: what the room holds of the event (nothing once cancelled or expired)
+    // is no more dangerous than this version, or it is refused.
+    const int slot = slot_of(a.event_id);
+    const Real held = slot >= 0 ? held_[static_cast<std::size_t>(slot)].probability : Real(0);
+    const bool more_dangerous = !a.cancelled && probability > held;
+    if (settings_.authentication.required || !more_dangerous) {
+      return {a.version == e->version ? R::kDuplicate : R::kOutOfOrder, "version"};
+    }
   }
   return {};
 }
@@ -143,17 +156,34 @@ void RegionalAlertState::refuse(RegionalOutcome outcome) {
 }
 
 void RegionalAlertState::refuse_malformed(const char* field) {
+  refuse_unread(RegionalRefusal::kMalformed, field);
+}
+
+void RegionalAlertState::refuse_unread(RegionalRefusal refusal, const char* field) {
   ++status_.received;
-  refuse({RegionalRefusal::kMalformed, field});
+  refuse({refusal, field});
+}
+
+// A refusal of a valid alert more dangerous than the worst one held (what the box shows).
+bool RegionalAlertState::note_if_dangerous(const RegionalAlert& a, Real probability,
+                                           RegionalRefusal refusal) {
+  if (a.cancelled || !(probability > status_.probability) || !(probability > Real(0))) {
+    return false;
+  }
+  ++status_.refused_dangerous;
+  status_.last_refused_dangerous = {a.event_id, a.version, probability, refusal, now_ns_};
+  return true;
 }
 
 RegionalOutcome RegionalAlertState::receive(const RegionalAlert& a, std::int64_t now_ns) {
   now_ns_ = now_ns > now_ns_ ? now_ns : now_ns_;
   ++status_.received;
-  RegionalOutcome outcome = check(a);
+  Real probability = -1;  // known once the numbers passed their checks
+  RegionalOutcome outcome = check(a, probability);
   if (!outcome.accepted()) {
     refuse(outcome);
     update_status(now_ns_);
+    outcome.dangerous = note_if_dangerous(a, probability, outcome.refusal);
     return outcome;
   }
   HeldRegionalAlert h;
@@ -164,8 +194,7 @@ RegionalOutcome RegionalAlertState::receive(const RegionalAlert& a, std::int64_t
   h.expires_ns = h.s_arrival_ns +
                  detail::to_ns(shaking_duration_s(settings_, a.magnitude, a.distance_km) +
                                settings_.expiry_margin_s);
-  h.probability = settings_.fragility_known ? settings_.fragility.probability(a.pga_g, a.sigma_ln)
-                                            : Real(0);
+  h.probability = probability;
   int slot = slot_of(a.event_id);
   outcome.replaced = slot >= 0;
   if (a.cancelled) {

@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <random>
 #include <vector>
 
@@ -129,31 +130,49 @@ TEST(LiftOff, NotWhileGravityStillWins) {
   EXPECT_NEAR(sim.time(), 3.0, 1e-9);
 }
 
+// The paper's eccentric block on its base with friction (mu_s 0.5, mu_k 0.4) and a support of
+// clearance 0.1 m: every rocking phase, about a corner of the body or of the support.
+Scene rocking_phases_scene() {
+  SceneParams p = with_friction(paper_isolated(0.3), 0.5, 0.4);
+  p.has_support = true;
+  p.support = {0.1};
+  return make(p);
+}
+
+// A random rocking (or, `sliding`, slide-rocking) mode about either corner, of the body or
+// (`overhanging`) of the support, and a state in it: |theta| <= max_angle rad, |theta'| <=
+// max_rate rad/s, |u'| and |x'| <= 1 m/s.
+struct RockingSample {
+  Mode mode;
+  State y;
+};
+RockingSample random_rocking_sample(std::mt19937& rng, bool overhanging, bool sliding,
+                                    double max_angle, double max_rate) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  RockingSample r;
+  r.mode.phase = sliding ? Phase::kSlideRocking : Phase::kRocking;
+  r.mode.corner = unit(rng) > 0.0 ? Corner::kLeft : Corner::kRight;
+  const double sign = r.mode.corner == Corner::kLeft ? 1.0 : -1.0;
+  const double x = overhanging ? -sign * (0.1 + 0.2 * std::fabs(unit(rng))) : 0.09 * unit(rng);
+  r.y << 0.1 * unit(rng), x, sign * max_angle * std::fabs(unit(rng)), unit(rng),
+      sliding ? unit(rng) : 0.0, max_rate * unit(rng);
+  r.mode.slide_direction = static_cast<std::int8_t>(unit(rng) > 0.0 ? 1 : -1);
+  r.mode.overhang = static_cast<std::int8_t>(overhanging ? -sign : 0);
+  return r;
+}
+
 // The witness in the rocking phases is the printed normal force: Eq 12 about a body corner
 // (pure rocking and slide-rocking), Eq 14 about the support's corner (slide-rocking, with x'),
 // and contact_force's normal component, for random states and inputs.
 TEST(LiftOff, RockingWitnessIsThePrintedNormalForce) {
-  SceneParams p = with_friction(paper_isolated(0.3), 0.5, 0.4);
-  p.has_support = true;
-  p.support = {0.1};
-  const Scene s = make(p);
+  const Scene s = rocking_phases_scene();
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (int i = 0; i < 300; ++i) {
     const bool overhanging = i % 3 == 2;
     const bool sliding = i % 3 != 0;
-    const Corner corner = unit(rng) > 0.0 ? Corner::kLeft : Corner::kRight;
-    const double sign = corner == Corner::kLeft ? 1.0 : -1.0;
-    const double x = overhanging ? -sign * (0.1 + 0.2 * std::fabs(unit(rng))) : 0.09 * unit(rng);
-    State y;
-    y << 0.1 * unit(rng), x, sign * 0.3 * std::fabs(unit(rng)), unit(rng),
-        sliding ? unit(rng) : 0.0, 3.0 * unit(rng);
+    const auto [mode, y] = random_rocking_sample(rng, overhanging, sliding, 0.3, 3.0);
     const GroundAcceleration ag{10.0 * unit(rng), 8.0 * unit(rng)};
-    Mode mode;
-    mode.phase = sliding ? Phase::kSlideRocking : Phase::kRocking;
-    mode.corner = corner;
-    mode.slide_direction = static_cast<std::int8_t>(unit(rng) > 0.0 ? 1 : -1);
-    mode.overhang = static_cast<std::int8_t>(overhanging ? -sign : 0);
     const Pivot pivot = pivot_of(s, mode, y);
     ASSERT_EQ(pivot.overhanging, overhanging);
     const Accelerations a =
@@ -176,6 +195,91 @@ TEST(LiftOff, RockingWitnessIsThePrintedNormalForce) {
     EXPECT_DOUBLE_EQ(lift_off_guard(s, mode, State::Zero(), {3.0, -2.0}, {}, SinCos{}),
                      -(s.g - 2.0));  // m (g + v_G'') / m, to rounding
   }
+}
+
+// The solver's steps take lift_off_bound for the witness far from lift-off (guards.h): it must
+// be negative only where the witness is, and not below it but by roundings. Random rocking and
+// slide-rocking states about either corner of the body or of the support, the ground's vertical
+// acceleration set so that the witness lies at chosen distances from 0: far below and above it,
+// and within 1e-9 to 1e-15 of the terms' size, where only the margin for roundings tells them
+// apart.
+TEST(LiftOff, TheBoundIsNegativeOnlyWhereTheWitnessIs) {
+  const Scene s = rocking_phases_scene();
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double gaps[] = {-0.5, -1e-3, -1e-9, -1e-12, -1e-15, 0.0, 1e-15, 1e-12, 1e-9, 1e-3, 0.5};
+  int answered[2] = {0, 0};
+  constexpr int kSamples = 20000;
+  for (int i = 0; i < kSamples; ++i) {
+    const bool overhanging = i % 4 == 3;
+    const auto [mode, y] = random_rocking_sample(rng, overhanging, i % 2 == 1, 0.6, 4.0);
+    const Accelerations a{20.0 * unit(rng), 5.0 * unit(rng), 30.0 * unit(rng)};
+    const SinCos trig = internal::sin_cos(y[kTheta]);
+    // The witness with the ground still vertically: -Y / m = -(g + v_G'') cos - rest; set
+    // v_G'' so that -Y / m = -gap times the terms' size.
+    GroundAcceleration ag{10.0 * unit(rng), 0.0};
+    const double cos_weight = overhanging ? trig.cos : 1.0;
+    const double rest = -lift_off_guard(s, mode, y, ag, a, trig) - s.g * cos_weight;
+    const double size = s.g + std::fabs(rest) + 40.0;
+    const double gap = gaps[static_cast<std::size_t>(i) % std::size(gaps)];
+    ag.vertical = (gap * size - rest) / cos_weight - s.g;
+    const double bound = internal::lift_off_bound(s, mode, y, ag, a, trig);
+    const double witness = lift_off_guard(s, mode, y, ag, a, trig);
+    if (bound >= 0.0) continue;
+    ++answered[overhanging ? 1 : 0];
+    EXPECT_LT(witness, 0.0) << "sample " << i << ", gap " << gap;
+    // An upper bound, to roundings (overhanging it is tight: every term has its worst sign).
+    EXPECT_GE(bound, witness - 1e-13 * size) << "sample " << i << ", gap " << gap;
+  }
+  // The bound answers away from lift-off (about a body corner it is not tight: from a gap of
+  // 1e-3 to 0.5 here); nearer, the witness is evaluated.
+  EXPECT_GT(answered[0], kSamples * 3 / 4 / 11 / 2);
+  EXPECT_GT(answered[1], kSamples / 4 / 11 / 2);
+  std::printf("the bound answered %d of %d samples about a body corner, %d of %d overhanging\n",
+              answered[0], kSamples * 3 / 4, answered[1], kSamples / 4);
+}
+
+// Every live mode's guards lead with lift-off (a tie ends the model first) and its phase's
+// guards, the order the step evaluates them in without a switch (internal::leading_guards):
+// every feature set, phase, corner, held stop, sliding direction and overhang.
+template <Features F>
+void expect_leading_guards() {
+  for (int phase = 0; phase <= static_cast<int>(Phase::kSlideRocking); ++phase) {
+    for (const Corner corner : {Corner::kLeft, Corner::kRight}) {
+      for (int held = -1; held <= 1; ++held) {
+        for (int direction = -1; direction <= 1; direction += 2) {
+          for (int overhang = -1; overhang <= 1; ++overhang) {
+            Mode mode;
+            mode.phase = static_cast<Phase>(phase);
+            mode.corner = corner;
+            mode.held_stop = static_cast<std::int8_t>(held);
+            mode.slide_direction = static_cast<std::int8_t>(direction);
+            mode.overhang = static_cast<std::int8_t>(overhang);
+            const internal::ActiveGuards guards = internal::active_guards<F>(mode);
+            const auto leading = internal::leading_guards(mode.rocking());
+            ASSERT_GE(guards.count, internal::kLeadingGuards);
+            for (std::size_t i = 0; i < leading.size(); ++i) {
+              EXPECT_EQ(guards.ids[i], leading[i]) << "phase " << phase << ", guard " << i;
+            }
+          }
+        }
+      }
+    }
+  }
+  Mode ended;
+  ended.phase = Phase::kLiftedOff;
+  EXPECT_EQ(internal::active_guards<F>(ended).count, 0);
+}
+
+TEST(LiftOff, EveryLiveModesGuardsLeadWithLiftOffAndItsPhases) {
+  expect_leading_guards<Features{}>();
+  expect_leading_guards<Features{false, false, true, false, false}>();
+  expect_leading_guards<Features{false, false, true, true, false}>();
+  expect_leading_guards<Features{false, false, true, false, true}>();
+  expect_leading_guards<Features{true, false, false, false, false}>();
+  expect_leading_guards<Features{true, false, true, true, false}>();
+  expect_leading_guards<Features{true, true, false, false, false}>();
+  expect_leading_guards<Features{true, true, true, false, true}>();
 }
 
 // The witness against the simulated motion: C's height above the pivot is h'_i (Eq 6), so the

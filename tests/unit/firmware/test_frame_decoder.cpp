@@ -4,6 +4,8 @@
 
 #include "plinth/firmware/can_frames.h"
 #include "plinth/firmware/frame_decoder.h"
+#include "plinth/monitor/hmac_sha256.h"
+#include "test_support.h"
 
 namespace plinth::firmware {
 
@@ -199,6 +201,199 @@ TEST(FrameDecoder, ARegionalAlertIsItsTwoFrames) {
   EXPECT_STREQ(decoder.decode({short_alert, 6001 * kMs}).malformed_field, "RegionalAlert");
   EXPECT_EQ(decoder.counters().regional_alerts, 1U);
   EXPECT_EQ(decoder.counters().regional_malformed, 6U);
+}
+
+// With a key, the pair waits for its RegionalAlertTag: the HMAC of both frames' data and the
+// counter, the counter above the last taken. A missing tag, a wrong one or a replayed counter is
+// an unauthenticated alert; without a key the tag frame is ignored.
+TEST(FrameDecoder, AKeyedRegionalAlertNeedsItsTag) {
+  MonitorConfig config = two_sensors();
+  monitor::RegionalAlertSettings& room = config.regional;
+  room.authentication.required = true;
+  for (std::size_t i = 0; i < room.authentication.key.size(); ++i) {
+    room.authentication.key[i] = static_cast<std::uint8_t>(3 * i + 1);
+  }
+  FrameDecoder decoder;
+  decoder.start(config);
+  const can::RegionalAlertOrigin origin{77, 2, 7.0, 10.0, 120, false};
+  const can::RegionalAlert alert{77, 2, 0.3, 0.6, 20.0};
+  const can::CanFrame fo = encoded(origin);
+  const can::CanFrame fa = encoded(alert);
+  // The bridge's tag: HMAC-SHA256(key, origin data, alert data, counter bytes), its first 4.
+  const auto tag_frame = [&](std::uint32_t counter, const monitor::RegionalAuthentication& auth) {
+    can::CanFrame probe = encoded(can::RegionalAlertTag{counter, 0});
+    const monitor::ByteSpan parts[] = {
+        {fo.data.data(), 8}, {fa.data.data(), 8}, {probe.data.data(), 4}};
+    const monitor::Sha256Digest mac = monitor::hmac_sha256(auth.key, parts, 3);
+    const std::uint32_t tag = static_cast<std::uint32_t>(mac[0]) |
+                              static_cast<std::uint32_t>(mac[1]) << 8 |
+                              static_cast<std::uint32_t>(mac[2]) << 16 |
+                              static_cast<std::uint32_t>(mac[3]) << 24;
+    return encoded(can::RegionalAlertTag{counter, tag});
+  };
+  EXPECT_EQ(decoder.decode({fo, 1000 * kMs}).kind, FrameInput::Kind::kNone);
+  EXPECT_EQ(decoder.decode({fa, 1010 * kMs}).kind, FrameInput::Kind::kNone) << "waits";
+  const FrameInput taken = decoder.decode({tag_frame(5, room.authentication), 1030 * kMs});
+  ASSERT_EQ(taken.kind, FrameInput::Kind::kRegionalAlert);
+  EXPECT_EQ(taken.regional.event_id, 77U);
+  EXPECT_NEAR(taken.regional.origin_age_s, 10.03, 1e-9) << "relative to the tag's time";
+  EXPECT_NEAR(taken.regional.s_arrival_in_s, 19.98, 1e-9);
+  // The same three frames again: the counter is not above the last taken.
+  (void)decoder.decode({fo, 2000 * kMs});
+  (void)decoder.decode({fa, 2001 * kMs});
+  const FrameInput replay = decoder.decode({tag_frame(5, room.authentication), 2002 * kMs});
+  EXPECT_EQ(replay.kind, FrameInput::Kind::kRegionalUnauthenticated);
+  EXPECT_STREQ(replay.malformed_field, "Counter");
+  // Another key's tag.
+  monitor::RegionalAuthentication other = room.authentication;
+  other.key[0] ^= 1;
+  (void)decoder.decode({fo, 3000 * kMs});
+  (void)decoder.decode({fa, 3001 * kMs});
+  const FrameInput forged = decoder.decode({tag_frame(6, other), 3002 * kMs});
+  EXPECT_EQ(forged.kind, FrameInput::Kind::kRegionalUnauthenticated);
+  EXPECT_STREQ(forged.malformed_field, "Tag");
+  // No tag: the next alert's origin frame says so; a tag too late is no tag.
+  (void)decoder.decode({fo, 4000 * kMs});
+  (void)decoder.decode({fa, 4001 * kMs});
+  const FrameInput untagged = decoder.decode({fo, 5000 * kMs});
+  EXPECT_EQ(untagged.kind, FrameInput::Kind::kRegionalUnauthenticated);
+  EXPECT_STREQ(untagged.malformed_field, "RegionalAlertTag");
+  (void)decoder.decode({fa, 5001 * kMs});
+  EXPECT_EQ(decoder.decode({tag_frame(7, room.authentication), 5200 * kMs}).kind,
+            FrameInput::Kind::kRegionalUnauthenticated);
+  // The right tag after the refusals: taken (7 was never taken).
+  (void)decoder.decode({fo, 6000 * kMs});
+  (void)decoder.decode({fa, 6001 * kMs});
+  EXPECT_EQ(decoder.decode({tag_frame(7, room.authentication), 6002 * kMs}).kind,
+            FrameInput::Kind::kRegionalAlert);
+  EXPECT_EQ(decoder.counters().regional_unauthenticated, 4U);
+  EXPECT_EQ(decoder.counters().regional_tags, 5U);
+  // Without a key: the tag frame is ignored, the pair is the alert.
+  FrameDecoder plain;
+  plain.start(two_sensors());
+  (void)plain.decode({fo, 1000 * kMs});
+  EXPECT_EQ(plain.decode({fa, 1001 * kMs}).kind, FrameInput::Kind::kRegionalAlert);
+  EXPECT_EQ(plain.decode({tag_frame(1, room.authentication), 1002 * kMs}).kind,
+            FrameInput::Kind::kNone);
+}
+
+// Refused bus statements lock the bus out while what they met stays held; a new level latched
+// ends it (BusStatementGuard).
+TEST(BusStatementGuard, FourRefusedInAMinuteLockTheLatchedLevel) {
+  BusStatementGuard guard;
+  const monitor::AlarmLevel alarm = monitor::AlarmLevel::kAlarm;
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(guard.admits(alarm));
+    EXPECT_FALSE(guard.refused(i * 30'000 * kMs, alarm));
+  }
+  // At 0, 30 and 60 s, the fourth at 61 s: 61 s from the first, no lockout.
+  EXPECT_FALSE(guard.refused(61'000 * kMs, alarm));
+  EXPECT_TRUE(guard.admits(alarm));
+  EXPECT_TRUE(guard.refused(62'000 * kMs, alarm)) << "4 refused within 60 s (30, 60, 61, 62 s)";
+  EXPECT_FALSE(guard.admits(alarm));
+  EXPECT_FALSE(guard.admits(alarm));
+  EXPECT_TRUE(guard.admits(monitor::AlarmLevel::kWarning)) << "another level latched: over";
+  EXPECT_TRUE(guard.admits(alarm));
+  // Nothing held: refusals never lock.
+  for (int i = 0; i < 8; ++i) EXPECT_FALSE(guard.refused(70'000 * kMs, monitor::AlarmLevel::kNormal));
+}
+
+// Quiet start-up, then a 1 s push of 0.6 g through `decoder`: the non-isolated block of
+// `monitor` overturns, alarm latched, the collapse held. The newest event's sequence.
+std::uint8_t overturn(Monitor& monitor, FrameDecoder& decoder, std::int64_t& t) {
+  std::uint8_t last_event = 0;
+  for (int n = 0; n < 1400 && !monitor.status().axes[0].mode.terminal(); ++n) {
+    can::SensorAcceleration m;
+    m.node = 1;
+    m.ax_g = n >= 400 && n < 600 ? 0.6 : 0.0;
+    m.az_g = 1.0;
+    m.sequence = static_cast<std::uint8_t>(n);
+    const MonitorUpdate u = on_frame(monitor, decoder, {encoded(m), t});
+    for (std::size_t i = 0; i < u.event_count; ++i) last_event = u.events[i].sequence;
+    t += 5 * kMs;
+  }
+  return last_event;
+}
+
+MonitorConfig sweep_config() {
+  MonitorConfig config;
+  config.estimator.sample_rate_hz = 200.0;
+  config.conditioning.startup_window_s = 0.5;
+  config.sensor_health.stuck_samples = 0;
+  return config;
+}
+
+// The sweep issue 33 met: an Acknowledge frame for every sequence number released a latched
+// alarm. The guard lets 4 be refused, then ignores the rest while the alarm stays latched; the
+// operator's acknowledgement at the box (a call, as Modbus and MQTT make) still releases it.
+TEST(FrameDecoder, ASweepOfTheSequencesCannotReleaseALatch) {
+  const Scene scene = testing::make(testing::paper_block(0.0));
+  const MonitorConfig config = sweep_config();
+  Monitor monitor;
+  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
+  FrameDecoder decoder;
+  decoder.start(config);
+  std::int64_t t = 0;
+  const std::uint8_t last_event = overturn(monitor, decoder, t);
+  ASSERT_EQ(monitor.status().latched, monitor::AlarmLevel::kAlarm);
+  // Every sequence, the right one last (the sweep's worst case for the box).
+  for (int k = 1; k <= 256; ++k) {
+    const auto sequence = static_cast<std::uint8_t>(last_event + k);
+    t += kMs;
+    (void)on_frame(monitor, decoder,
+                   {encoded(can::Acknowledge{can::AlarmLevel::kAlarm, 9, sequence}), t});
+  }
+  EXPECT_EQ(monitor.status().latched, monitor::AlarmLevel::kAlarm) << "the sweep released it";
+  const FrameCounters& c = decoder.counters();
+  EXPECT_EQ(c.acknowledgements, 256U);
+  EXPECT_EQ(c.acknowledgements_refused, 4U);
+  EXPECT_EQ(c.acknowledgements_ignored, 252U);
+  EXPECT_EQ(c.acknowledgement_lockouts, 1U);
+  EXPECT_TRUE(decoder.acknowledgements_locked_out());
+  const MonitorUpdate at_box = monitor.acknowledge({monitor::AlarmLevel::kAlarm, last_event});
+  EXPECT_EQ(at_box.acknowledgement, monitor::AckOutcome::kReleasedConditionHolds);
+  EXPECT_EQ(monitor.status().latched, monitor::AlarmLevel::kNormal);
+  (void)on_frame(monitor, decoder,
+                 {encoded(can::Acknowledge{can::AlarmLevel::kAlarm, 9, last_event}), t + kMs});
+  EXPECT_FALSE(decoder.acknowledgements_locked_out()) << "the latch it met is gone";
+}
+
+// The same sweep of StatueStands frames cannot clear a held collapse: 4 refused, the rest
+// ignored, the collapse still held; a person's statement at the box still clears it.
+TEST(FrameDecoder, ASweepCannotClearAHeldCollapse) {
+  const Scene scene = testing::make(testing::paper_block(0.0));
+  const MonitorConfig config = sweep_config();
+  Monitor monitor;
+  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
+  FrameDecoder decoder;
+  decoder.start(config);
+  std::int64_t t = 0;
+  std::uint8_t last_event = overturn(monitor, decoder, t);
+  ASSERT_TRUE(monitor.status().collapse.held);
+  // Quiet ground after the fall (the estimators' own collapse stays: a person's word clears it).
+  for (int n = 0; n < 200; ++n) {
+    can::SensorAcceleration m;
+    m.node = 1;
+    m.az_g = 1.0;
+    m.sequence = static_cast<std::uint8_t>(n);
+    const MonitorUpdate u = on_frame(monitor, decoder, {encoded(m), t});
+    for (std::size_t i = 0; i < u.event_count; ++i) last_event = u.events[i].sequence;
+    t += 5 * kMs;
+  }
+  for (int k = 1; k <= 256; ++k) {
+    const auto sequence = static_cast<std::uint8_t>(last_event + k);
+    t += kMs;
+    (void)on_frame(monitor, decoder, {encoded(can::StatueStands{9, sequence}), t});
+  }
+  EXPECT_TRUE(monitor.status().collapse.held) << "the sweep cleared it";
+  const FrameCounters& c = decoder.counters();
+  EXPECT_EQ(c.statue_stands, 256U);
+  EXPECT_EQ(c.statue_stands_refused, 4U);
+  EXPECT_EQ(c.statue_stands_ignored, 252U);
+  EXPECT_EQ(c.statue_stands_lockouts, 1U);
+  const MonitorUpdate at_box = monitor.statue_stands(last_event);
+  EXPECT_EQ(at_box.statue_stands, monitor::StandsOutcome::kCleared);
+  EXPECT_FALSE(monitor.status().collapse.held);
 }
 
 }  // namespace

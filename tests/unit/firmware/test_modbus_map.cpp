@@ -29,7 +29,7 @@ TEST(ModbusMap, EveryCauseHasItsCodeInTheCsv) {
   const std::string csv = map_csv();
   EXPECT_NE(csv.find("10=collapse_forecast;11=not_calibrated;12=outside_model;13=p_wave;"
                      "14=statue_unexplained;15=regional_alert;16=statue_sensor_fault;"
-                     "17=restored;18=statue_stands\""),
+                     "17=restored;18=statue_stands;19=commissioning_failed\""),
             std::string::npos);
   EXPECT_NE(csv.find("4=overturned;5=fell;6=lifted_off\""), std::string::npos);
   EXPECT_NE(csv.find("\"0=normal;1=advisory;2=warning;3=alarm;4=fault\""), std::string::npos);
@@ -44,6 +44,7 @@ TEST(ModbusMap, CodesArePinned) {
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kPWave), 13);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kStatueUnexplained), 14);
   EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kRegionalAlert), 15);
+  EXPECT_EQ(kAlarmCauseCodes.code(monitor::AlarmCause::kCommissioningFailed), 19);
   EXPECT_EQ(kAlarmLevelCodes.code(monitor::AlarmLevel::kFault), 4);
   EXPECT_EQ(kPhaseCodes.code(Phase::kFell), 5);
   EXPECT_EQ(kPhaseCodes.code(Phase::kLiftedOff), 6);
@@ -95,7 +96,7 @@ TEST(ModbusMap, ASnapshotsRegisters) {
   EXPECT_EQ(read32(image, reg::kSamplesRejected), 3U);
   EXPECT_EQ(read32(image, reg::kEstimatorRestarts), 0xFFFFFFFFU);
   EXPECT_EQ(at(reg::kAlarmEvents), 4);
-  EXPECT_EQ(at(reg::kMapVersion), 7);
+  EXPECT_EQ(at(reg::kMapVersion), 8);
   EXPECT_EQ(at(reg::kProbability), 5000);
   EXPECT_EQ(at(reg::kForecastAxis), 1);
   EXPECT_EQ(at(reg::kCollapseIn), 2346) << "ms, rounded up";
@@ -153,6 +154,23 @@ TEST(ModbusMap, TheStatueSensorsRegisters) {
   for (int r = 0; r < reg::kCount; ++r) EXPECT_EQ(owners[static_cast<std::size_t>(r)], 1) << r;
 }
 
+// The safety rule's registers (117-118, map 8): the trouble beside the level, coded as the
+// cause register, and the held collapse.
+TEST(ModbusMap, TheTroubleAndTheHeldCollapse) {
+  StatusSnapshot s;
+  Image image;
+  fill(s, 0, image);
+  const auto at = [&](int address) { return image.registers[static_cast<std::size_t>(address)]; };
+  EXPECT_EQ(reg::kCollapseHeld + 1, reg::kCount);
+  EXPECT_EQ(at(reg::kTrouble), 0);
+  EXPECT_EQ(at(reg::kCollapseHeld), 0);
+  s.trouble = monitor::AlarmCause::kStatueSensorFault;
+  s.collapse_held = true;
+  fill(s, 0, image);
+  EXPECT_EQ(at(reg::kTrouble), 16);
+  EXPECT_EQ(at(reg::kCollapseHeld), 1);
+}
+
 // The event recorder's registers (109-116, map 7): kNone in health and problem without one
 // (--record-dir), else their pinned codes and the counts.
 TEST(ModbusMap, TheRecordersRegisters) {
@@ -161,7 +179,7 @@ TEST(ModbusMap, TheRecordersRegisters) {
   fill(s, 0, image);
   const auto at = [&](int address) { return image.registers[static_cast<std::size_t>(address)]; };
   EXPECT_EQ(reg::kRecorderHealth, reg::kStatueEffectiveMembersY + 1);
-  EXPECT_EQ(reg::kCount, 117);
+  EXPECT_EQ(reg::kTrouble, reg::kCapturesTruncated + 2);
   EXPECT_EQ(at(reg::kRecorderHealth), kNone);
   EXPECT_EQ(at(reg::kRecorderProblem), kNone);
   EXPECT_EQ(read32(image, reg::kCapturesWritten), 0U);

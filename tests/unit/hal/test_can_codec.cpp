@@ -252,6 +252,19 @@ TEST(CanGolden, RegionalAlert) {
   EXPECT_EQ(encode(m, f).error, CodecError::kNotFinite);
 }
 
+TEST(CanGolden, RegionalAlertTag) {
+  // Identifier 0x362. Counter 0|32 = 0x01020304 -> 04 03 02 01; Tag 32|32 = 0xA1B2C3D4 ->
+  // D4 C3 B2 A1.
+  const Bytes golden{0x04, 0x03, 0x02, 0x01, 0xD4, 0xC3, 0xB2, 0xA1};
+  RegionalAlertTag m;
+  m.counter = 0x01020304;
+  m.tag = 0xA1B2C3D4;
+  RegionalAlertTag d;
+  ASSERT_NO_FATAL_FAILURE(expect_golden(m, 0x362, golden, d));
+  EXPECT_EQ(d.counter, 0x01020304U);
+  EXPECT_EQ(d.tag, 0xA1B2C3D4U);
+}
+
 TEST(CanGolden, RegionalAlertOrigin) {
   // Identifier 0x361. EventId 0|16 = 0x1234 -> 34 12; Version 16|8 = 5 -> 05;
   // Magnitude 24|8 (0.05): 7.1 = 142 -> 8E; OriginAge 32|16 signed (0.02 s): 12.34 s = 617 =
@@ -737,7 +750,7 @@ TEST(CanRoundTrip, CollapseForecastEveryProbabilityCollapseInHorizonAndSequence)
 
 // A valid frame of every message kind.
 std::vector<CanFrame> valid_frames() {
-  std::vector<CanFrame> frames(10);
+  std::vector<CanFrame> frames(11);
   SensorAcceleration a;
   a.ax_g = 0.1;
   EXPECT_TRUE(encode(a, frames[0]).ok());
@@ -767,6 +780,10 @@ std::vector<CanFrame> valid_frames() {
   StatueStands t;
   t.source_id = 4;
   t.event_sequence = 9;
+  RegionalAlertTag g2;
+  g2.counter = 7;
+  g2.tag = 0xDEADBEEF;
+  EXPECT_TRUE(encode(g2, frames[10]).ok());
   EXPECT_TRUE(encode(t, frames[9]).ok());
   return frames;
 }
@@ -774,7 +791,7 @@ std::vector<CanFrame> valid_frames() {
 // Decodes `f` as every message type; the result of the one `f.id` classifies as, or of all.
 struct AllDecodes {
   DecodeResult acceleration, heartbeat, status, event, acknowledge, forecast, rotation, regional,
-      origin, stands;
+      origin, stands, tag;
 };
 AllDecodes decode_all(const CanFrame& f) {
   SensorAcceleration a;
@@ -787,8 +804,10 @@ AllDecodes decode_all(const CanFrame& f) {
   RegionalAlert g;
   RegionalAlertOrigin o;
   StatueStands t;
+  RegionalAlertTag g2;
   return {decode(f, a), decode(f, h), decode(f, s), decode(f, e), decode(f, k),
-          decode(f, c), decode(f, r), decode(f, g), decode(f, o), decode(f, t)};
+          decode(f, c), decode(f, r), decode(f, g), decode(f, o), decode(f, t),
+          decode(f, g2)};
 }
 DecodeResult decode_as_own_kind(const CanFrame& f) {
   const AllDecodes all = decode_all(f);
@@ -803,6 +822,7 @@ DecodeResult decode_as_own_kind(const CanFrame& f) {
     case MessageKind::kStatueRotation: return all.rotation;
     case MessageKind::kRegionalAlert: return all.regional;
     case MessageKind::kRegionalAlertOrigin: return all.origin;
+    case MessageKind::kRegionalAlertTag: return all.tag;
     case MessageKind::kUnknown: break;
   }
   ADD_FAILURE() << "unknown identifier " << f.id;
@@ -826,7 +846,7 @@ TEST(CanReject, EveryLengthButEight) {
 TEST(CanReject, UnknownIdentifiers) {
   std::set<std::uint32_t> known;
   for (std::uint32_t n = 1; n <= 15; ++n) known.insert({0x300 + n, 0x310 + n, 0x370 + n});
-  known.insert({0x320, 0x321, 0x330, 0x340, 0x341, 0x350, 0x351, 0x360, 0x361});
+  known.insert({0x320, 0x321, 0x330, 0x340, 0x341, 0x350, 0x351, 0x360, 0x361, 0x362});
   std::vector<std::uint32_t> ids;
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) ids.push_back(id);
   // Identifiers with flag bits (SocketCAN's extended / RTR flags) or beyond 11 bits.
@@ -849,8 +869,9 @@ TEST(CanReject, UnknownIdentifiers) {
     EXPECT_EQ(all.regional.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.origin.error, CodecError::kUnknownIdentifier) << id;
     EXPECT_EQ(all.stands.error, CodecError::kUnknownIdentifier) << id;
+    EXPECT_EQ(all.tag.error, CodecError::kUnknownIdentifier) << id;
   }
-  EXPECT_EQ(known.size(), 54U);
+  EXPECT_EQ(known.size(), 55U);
 }
 
 TEST(CanReject, AnotherMessagesIdentifier) {
@@ -874,6 +895,7 @@ TEST(CanReject, AnotherMessagesIdentifier) {
     EXPECT_EQ(all.origin.error == CodecError::kWrongMessage,
               kind != MessageKind::kRegionalAlertOrigin);
     EXPECT_EQ(all.stands.error == CodecError::kWrongMessage, kind != MessageKind::kStatueStands);
+    EXPECT_EQ(all.tag.error == CodecError::kWrongMessage, kind != MessageKind::kRegionalAlertTag);
   }
 }
 
@@ -957,7 +979,7 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
     EXPECT_EQ(rk.error, CodecError::kInvalidEnum);
     EXPECT_STREQ(rk.signal, "Level");
   }
-  for (unsigned v = 19; v <= 255; ++v) {
+  for (unsigned v = 20; v <= 255; ++v) {
     AlarmEvent d;
     const DecodeResult r = decode(make_frame(0x330, Bytes{0, static_cast<std::uint8_t>(v)}), d);
     EXPECT_EQ(r.error, CodecError::kInvalidEnum);
@@ -975,11 +997,12 @@ TEST(CanReject, EnumValuesMissingFromTheValueTables) {
   s.alarm_level = static_cast<AlarmLevel>(5);
   EXPECT_STREQ(encode(s, f).signal, "AlarmLevel");
   AlarmEvent e;
-  e.cause = static_cast<AlarmCause>(19);
+  e.cause = static_cast<AlarmCause>(20);
   EXPECT_EQ(encode(e, f).error, CodecError::kInvalidEnum);
   for (const AlarmCause cause :
        {AlarmCause::kPWave, AlarmCause::kStatueUnexplained, AlarmCause::kRegionalAlert,
-        AlarmCause::kStatueSensorFault, AlarmCause::kRestored, AlarmCause::kStatueStands}) {
+        AlarmCause::kStatueSensorFault, AlarmCause::kRestored, AlarmCause::kStatueStands,
+        AlarmCause::kCommissioningFailed}) {
     e.cause = cause;
     EXPECT_TRUE(encode(e, f).ok()) << static_cast<unsigned>(cause);
   }
@@ -1223,7 +1246,7 @@ TEST(CanReject, ErrorTexts) {
 
 TEST(CanDbc, EveryIdentifierTheCodecKnowsIsAMessageAndNoOther) {
   const Dbc& dbc = plinth_dbc();
-  ASSERT_EQ(dbc.messages.size(), 54U);
+  ASSERT_EQ(dbc.messages.size(), 55U);
   for (std::uint32_t id = 0; id <= 0x7FF; ++id) {
     const MessageKind kind = classify(id);
     const auto it = dbc.messages.find(id);

@@ -299,6 +299,84 @@ TEST(CandumpFormat, AsCandumpWritesIt) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// DROPCOUNT lines: candump -d's report of the frames its socket lost
+
+TEST(CandumpDropCount, AsCandumpWritesIt) {
+  // can-utils' candump.c: "DROPCOUNT: dropped %u CAN frame%s on '%s' socket (total drops %u)".
+  const CandumpLine many =
+      parse_ok("DROPCOUNT: dropped 410 CAN frames on 'vcan0' socket (total drops 410)");
+  EXPECT_EQ(many.kind, CandumpFrameKind::kDropCount);
+  EXPECT_EQ(many.dropped_frames, 410U);
+  EXPECT_EQ(many.total_dropped_frames, 410U);
+  EXPECT_EQ(many.interface_name, "vcan0");
+  // One frame; candump before 2020.12 names the socket by its command-line argument, filters
+  // and all; the largest 32-bit counts; a CR LF line end.
+  const CandumpLine one = parse_ok(
+      "DROPCOUNT: dropped 1 CAN frame on 'vcan0,300:C0000780' socket (total drops 4294967295)\r");
+  EXPECT_EQ(one.kind, CandumpFrameKind::kDropCount);
+  EXPECT_EQ(one.dropped_frames, 1U);
+  EXPECT_EQ(one.total_dropped_frames, 4294967295U);
+  EXPECT_EQ(one.interface_name, "vcan0,300:C0000780");
+  EXPECT_EQ(parse_ok("DROPCOUNT: dropped 4294967295 CAN frames on 'any' socket (total drops 0)")
+                .dropped_frames,
+            4294967295U)
+      << "a counter that wrapped: the total below the count";
+}
+
+TEST(CandumpDropCount, MalformedIsRefusedSayingWhatCandumpWrites) {
+  const std::string shape = "expected a DROPCOUNT line as candump -d writes it, 'DROPCOUNT: "
+                            "dropped N CAN frames on 'vcan0' socket (total drops T)', got '";
+  for (const char* text : {
+           "DROPCOUNT:",
+           "DROPCOUNT: lost 3 frames",
+           "DROPCOUNT: dropped 3 CAN frames",
+           "DROPCOUNT: dropped 3 CAN frames on 'vcan0' socket",
+           "DROPCOUNT: dropped 3 CAN frames on 'vcan0' socket (total drops 3",
+           "DROPCOUNT: dropped 3 CAN frames on 'vcan0' socket (total drops 3) and more",
+           "DROPCOUNT: dropped 3 CAN frames on '' socket (total drops 3)",
+           "DROPCOUNT: dropped 3 frames on 'vcan0' socket (total drops 3)",
+           "DROPCOUNT: dropped 3 CAN frames on vcan0 socket (total drops 3)",
+       }) {
+    const std::string problem = problem_of(text);
+    EXPECT_EQ(problem.rfind(shape, 0), 0U) << text << " -> " << problem;
+  }
+  EXPECT_EQ(problem_of("DROPCOUNT: dropped 0 CAN frames on 'vcan0' socket (total drops 0)"),
+            "DROPCOUNT line: the count '0' is not a number of frames from 1 to 4294967295");
+  // candump before 2023.03 printed its counters with %d: past 2^31 they came out negative.
+  EXPECT_EQ(problem_of("DROPCOUNT: dropped -5 CAN frames on 'vcan0' socket (total drops 12)"),
+            "DROPCOUNT line: the count '-5' is not a number of frames from 1 to 4294967295");
+  EXPECT_EQ(
+      problem_of("DROPCOUNT: dropped 4294967296 CAN frames on 'vcan0' socket (total drops 1)"),
+      "DROPCOUNT line: the count '4294967296' is not a number of frames from 1 to 4294967295");
+  EXPECT_EQ(problem_of("DROPCOUNT: dropped 12a CAN frames on 'vcan0' socket (total drops 1)"),
+            "DROPCOUNT line: the count '12a' is not a number of frames from 1 to 4294967295");
+  EXPECT_EQ(problem_of("DROPCOUNT: dropped 2 CAN frames on 'vcan0' socket (total drops -1)"),
+            "DROPCOUNT line: the total '-1' is not a number of frames from 0 to 4294967295");
+  EXPECT_EQ(problem_of("DROPCOUNT: dropped 2 CAN frames on 'vcan0' socket (total drops )"),
+            "DROPCOUNT line: the total '' is not a number of frames from 0 to 4294967295");
+}
+
+TEST(CandumpDropCount, WrittenAsCandumpWritesItAndReadBack) {
+  const std::string line = format_candump_drop_line(410, "vcan0", 412);
+  EXPECT_EQ(line, "DROPCOUNT: dropped 410 CAN frames on 'vcan0' socket (total drops 412)");
+  EXPECT_EQ(format_candump_drop_line(1, "can0", 1),
+            "DROPCOUNT: dropped 1 CAN frame on 'can0' socket (total drops 1)");
+  const CandumpLine back = parse_ok(line);
+  EXPECT_EQ(back.dropped_frames, 410U);
+  EXPECT_EQ(back.total_dropped_frames, 412U);
+  EXPECT_EQ(back.interface_name, "vcan0");
+  EXPECT_EQ(format_candump_drop_line(0, "vcan0", 0), "") << "no frame lost: no line";
+  EXPECT_EQ(format_candump_drop_line(1, "", 1), "");
+  EXPECT_EQ(format_candump_drop_line(1, "it's", 1), "");
+  EXPECT_EQ(describe_candump_drop(back),
+            "candump lost 410 CAN frames on 'vcan0' before this line (its socket overflowed; 412 "
+            "in all so far)");
+  EXPECT_EQ(describe_candump_drop(parse_ok(format_candump_drop_line(1, "can0", 1))),
+            "candump lost 1 CAN frame on 'can0' before this line (its socket overflowed; 1 in "
+            "all so far)");
+}
+
+// ---------------------------------------------------------------------------------------------
 // The reader as a FrameSource
 
 TEST(CandumpLogReader, StatusPerLineAndEndOfInput) {
@@ -348,6 +426,50 @@ TEST(CandumpLogReader, MalformedLineNamesFileAndLineAndReadingGoesOn) {
   ASSERT_EQ(reader.receive(timed, 0), IoStatus::kOk);
   EXPECT_EQ(timed.frame.id, 0x302U);
   EXPECT_EQ(reader.error(), "");
+  EXPECT_EQ(reader.receive(timed, 0), IoStatus::kEndOfInput);
+}
+
+// A DROPCOUNT line is kOverflow with its count (frames lost before the next frame), line by
+// line; the total runs on; a malformed one is an error naming the file and the line.
+TEST(CandumpLogReader, DropCountIsAnOverflowWithItsLineAndCount) {
+  TempDir dir;
+  const std::string path =
+      dir.write("drops.log",
+                "(1.000000) vcan0 301#00\n"
+                "DROPCOUNT: dropped 410 CAN frames on 'vcan0' socket (total drops 410)\n"
+                "(1.100000) vcan0 301#01\n"
+                "# a comment\n"
+                "DROPCOUNT: dropped 1 CAN frame on 'vcan0' socket (total drops 411)\n"
+                "(1.200000) vcan0 301#02\n"
+                "DROPCOUNT: dropped some CAN frames on 'vcan0' socket (total drops 411)\n"
+                "(1.300000) vcan0 301#03\n"
+                "DROPCOUNT: dropped 7 CAN frames on 'vcan0' socket (total drops 418)\n");
+  CandumpLogReader reader = reader_of(path);
+  TimedFrame timed;
+  EXPECT_EQ(reader.total_dropped_frames(), 0U);
+  ASSERT_EQ(reader.receive(timed, 0), IoStatus::kOk);
+  ASSERT_EQ(reader.receive(timed, 0), IoStatus::kOverflow);
+  EXPECT_EQ(reader.line_number(), 2U);
+  EXPECT_EQ(reader.dropped_frames(), 410U);
+  EXPECT_EQ(reader.total_dropped_frames(), 410U);
+  EXPECT_EQ(reader.last_line().interface_name, "vcan0");
+  EXPECT_EQ(reader.last_line().kind, CandumpFrameKind::kDropCount);
+  ASSERT_EQ(reader.receive(timed, 0), IoStatus::kOk);
+  EXPECT_EQ(timed.frame.data[0], 0x01);
+  ASSERT_EQ(reader.receive(timed, 0), IoStatus::kOverflow);
+  EXPECT_EQ(reader.line_number(), 5U);
+  EXPECT_EQ(reader.dropped_frames(), 1U);
+  EXPECT_EQ(reader.total_dropped_frames(), 411U);
+  ASSERT_EQ(reader.receive(timed, 0), IoStatus::kOk);
+  ASSERT_EQ(reader.receive(timed, 0), IoStatus::kIoError);
+  EXPECT_EQ(reader.error(), path + ":7: DROPCOUNT line: the count 'some' is not a number of "
+                                   "frames from 1 to 4294967295");
+  EXPECT_EQ(reader.total_dropped_frames(), 411U) << "a malformed line counts nothing";
+  ASSERT_EQ(reader.receive(timed, 0), IoStatus::kOk);
+  EXPECT_EQ(timed.frame.data[0], 0x03);
+  ASSERT_EQ(reader.receive(timed, 0), IoStatus::kOverflow) << "the last line: lost at the end";
+  EXPECT_EQ(reader.line_number(), 9U);
+  EXPECT_EQ(reader.total_dropped_frames(), 418U);
   EXPECT_EQ(reader.receive(timed, 0), IoStatus::kEndOfInput);
 }
 

@@ -459,6 +459,92 @@ TEST(EvalMetrics, RunsFileKeepsTheCaseAndItsGridAndReadsEarlierFiles) {
 }
 
 
+// The fault block (plinth-eval run --fault) ends the row, after the regional columns; it is read
+// back field for field, and a file of collapses alone skips the check of its cases' rows.
+TEST(EvalMetrics, RunsFileKeepsTheFaultBlock) {
+  CrossingGrids grids{{0.5}, {0.25}};
+  grids.regional = true;
+  std::vector<EvalRun> runs = case_rows("r.AT2", 2, {0, 2});
+  for (EvalRun& r : runs) {
+    r.risk_crossing_s = {-1.0};
+    r.probability_crossing_s = {-1.0};
+    r.nominal_risk_crossing_s = {-1.0};
+    r.regional = EvalRun::Regional{6.5, 30.0, -12.0, -5.0, 1.0, 0.3, 0.7, 0.25};
+    EvalRun::Faults& f = r.faults.emplace();
+    f.fault = "statue_stuck";
+    f.at = "motion+0.5";
+    f.began_s = -2.045;
+    f.first_trouble_s = 3.25;
+    f.trouble_at_end = true;
+    f.first_statue_unexplained_s = 4.5;
+    f.level_at_end = "fault";
+    f.trouble_at_end_cause = monitor::AlarmCause::kStatueSensorFault;
+  }
+  runs[0].faults->began_s.reset();  // never began
+  runs[1].faults->level_at_end = std::string(kBoxDown);
+  const std::string path = temp_path("faults.csv");
+  const auto write = [&](const std::vector<EvalRun>& rows) {
+    std::FILE* f = std::fopen(path.c_str(), "w");
+    ASSERT_NE(f, nullptr);
+    write_eval_csv_header(f, grids, true, true);
+    for (const EvalRun& r : rows) write_eval_csv_row(f, r);
+    std::fclose(f);
+  };
+  write(runs);
+  const EvalTable t = read_eval_csv(path);
+  ASSERT_TRUE(t.has_faults);
+  EXPECT_TRUE(t.grids.regional);
+  EXPECT_FALSE(t.collapses_only);
+  ASSERT_EQ(t.runs.size(), 3U);
+  const EvalRun::Faults& f = *t.runs[2].faults;
+  EXPECT_EQ(f.fault, "statue_stuck");
+  EXPECT_EQ(f.param, "");
+  EXPECT_EQ(f.at, "motion+0.5");
+  ASSERT_TRUE(f.began_s.has_value());
+  EXPECT_DOUBLE_EQ(*f.began_s, -2.045);
+  EXPECT_FALSE(t.runs[0].faults->began_s.has_value());
+  EXPECT_DOUBLE_EQ(f.first_trouble_s, 3.25);
+  EXPECT_TRUE(f.trouble_at_end);
+  EXPECT_DOUBLE_EQ(f.first_statue_fault_s, -1.0);
+  EXPECT_DOUBLE_EQ(f.first_statue_unexplained_s, 4.5);
+  EXPECT_EQ(f.level_at_end, "fault");
+  EXPECT_EQ(t.runs[1].faults->level_at_end, kBoxDown);
+  EXPECT_EQ(f.trouble_at_end_cause, monitor::AlarmCause::kStatueSensorFault);
+  EXPECT_DOUBLE_EQ(t.runs[2].regional->probability, 0.25);
+  // Collapses alone: the case's rows stop at its collapse without the ones below it.
+  std::vector<EvalRun> collapses{runs[2]};
+  collapses[0].faults->collapses_only = true;
+  write(collapses);
+  const EvalTable c = read_eval_csv(path);
+  EXPECT_TRUE(c.collapses_only);
+  ASSERT_EQ(c.runs.size(), 1U);
+  // A row that did not collapse in such a file, and one that says otherwise, are refused.
+  collapses = {runs[0], runs[2]};
+  collapses[0].faults->collapses_only = true;
+  write(collapses);
+  try {
+    (void)read_eval_csv(path);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(":2: runs_written \"collapses\", but this run did not"),
+              std::string::npos)
+        << e.what();
+  }
+  collapses = {runs[2], runs[2]};
+  collapses[0].faults->collapses_only = true;
+  write(collapses);
+  try {
+    (void)read_eval_csv(path);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(":3: runs_written: \"all\" where the rows above say"),
+              std::string::npos)
+        << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
+
 std::string error_reading(const std::string& text) {
   const std::string path = temp_path("bad.csv");
   std::ofstream(path) << text;
@@ -521,6 +607,30 @@ TEST(EvalMetrics, RunsFileErrorsNameTheLineAndColumn) {
                           "first_advisory_s,first_warning_s,first_alarm_s,colour\n")
                 .find(":1: column 11: unknown column \"colour\""),
             std::string::npos);
+  // The fault block's fields.
+  const std::string fault_header =
+      "record,scene,statue,scale_g,collapsed,collapse_time_s,peak_ratio,first_advisory_s,"
+      "first_warning_s,first_alarm_s,fault,fault_param,fault_at,fault_began_s,"
+      "first_fault_trouble_s,fault_trouble_at_end,first_statue_fault_s,"
+      "first_statue_unexplained_s,level_at_end,trouble_at_end,runs_written\n";
+  const auto refused = [&](const std::string& fields, const std::string& message) {
+    EXPECT_NE(error_reading(fault_header + "r,s,0,0.3,0,-1,0.1,-1,-1,-1," + fields + "\n")
+                  .find(":2: " + message),
+              std::string::npos)
+        << message;
+  };
+  refused("none,,,1,-1,0,-1,-1,normal,none,all",
+          "fault none: its parameter, onset and began_s must be empty");
+  refused("reset,,3,3,-1,2,-1,-1,normal,none,all",
+          "fault_trouble_at_end: expected 0 or 1, got \"2\"");
+  refused("reset,,3,3,-1,0,-1,-1,asleep,none,all",
+          "level_at_end: expected a level or down, got \"asleep\"");
+  refused("reset,,3,3,-1,0,-1,-1,down,sleepy,all",
+          "trouble_at_end: expected a cause, got \"sleepy\"");
+  refused("reset,,3,3,-1,0,-1,-1,down,none,some",
+          "runs_written: expected all or collapses, got \"some\"");
+  refused("reset,,3,x,-1,0,-1,-1,down,none,all",
+          "fault_began_s: expected a finite number, got \"x\"");
 }
 
 // A run whose true statue lifted off has no truth: it counts in no outcome. A runs file

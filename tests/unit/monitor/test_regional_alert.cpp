@@ -175,9 +175,16 @@ TEST(RegionalAlert, ALaterVersionReplacesTheEarlierAndOlderOnesAreRefused) {
   EXPECT_NEAR(st.worst.alert.pga_g, 1.2, 1e-12);  // untouched by the refused
 }
 
+// Settings whose alerts' source is authenticated: the versions' order is trusted.
+RegionalAlertSettings authenticated() {
+  RegionalAlertSettings s = with_fragility();
+  s.authentication.required = true;
+  return s;
+}
+
 // A duplicate of an expired event is still a duplicate: the versions seen outlive the alert.
 TEST(RegionalAlert, TheVersionsSeenOutliveTheirAlerts) {
-  RegionalAlertSettings s = with_fragility();
+  RegionalAlertSettings s = authenticated();
   s.expiry_margin_s = 0.0;
   Room r(s);
   RegionalAlert a = alert(9, 3);
@@ -191,7 +198,7 @@ TEST(RegionalAlert, TheVersionsSeenOutliveTheirAlerts) {
 }
 
 TEST(RegionalAlert, ACancellationDropsTheEvent) {
-  Room r;
+  Room r(authenticated());
   ASSERT_TRUE(r.state.receive(alert(7, 1), 0).accepted());
   RegionalAlert cancel = alert(7, 2);
   cancel.cancelled = true;
@@ -203,6 +210,95 @@ TEST(RegionalAlert, ACancellationDropsTheEvent) {
   // Version 1 arriving after the cancellation stays out.
   EXPECT_EQ(r.state.receive(alert(7, 1), 2 * kS).refusal, RegionalRefusal::kOutOfOrder);
   EXPECT_EQ(r.state.status().held, 0);
+}
+
+// Unauthenticated, anyone may have sent an event's higher version: four spoofed events at
+// version 255 (the ids the bridge numbers next), harmless, fill the room; the bridge's real
+// alerts of those events, more dangerous, are still taken, never refused as out of order. A
+// version no more dangerous than what is held stays refused, and a spoof sent again after the
+// real alert is a duplicate: the highest version seen is kept.
+TEST(RegionalAlert, ASpoofedHigherVersionCannotLockTheBridgeOut) {
+  Room r;  // no authentication
+  for (std::uint32_t id = 20; id < 24; ++id) {
+    RegionalAlert spoof = alert(id, 255);
+    spoof.pga_g = 0.01;
+    ASSERT_TRUE(r.state.receive(spoof, 0).accepted()) << id;
+  }
+  EXPECT_EQ(r.state.status().held, 4);
+  RegionalAlert real = alert(21, 1);
+  real.pga_g = 1.5;
+  const RegionalOutcome taken = r.state.receive(real, kS);
+  EXPECT_TRUE(taken.accepted()) << regional_refusal_name(taken.refusal);
+  EXPECT_TRUE(taken.replaced);
+  EXPECT_EQ(r.state.status().worst.alert.event_id, 21U);
+  EXPECT_EQ(r.state.status().worst.alert.version, 1U);
+  EXPECT_GT(r.state.status().probability, 0.8);
+  RegionalAlert spoof_again = alert(21, 255);
+  spoof_again.pga_g = 0.01;
+  EXPECT_EQ(r.state.receive(spoof_again, 2 * kS).refusal, RegionalRefusal::kDuplicate);
+  RegionalAlert lower = alert(21, 2);
+  lower.pga_g = 0.3;
+  EXPECT_EQ(r.state.receive(lower, 3 * kS).refusal, RegionalRefusal::kOutOfOrder)
+      << "an update no more dangerous than what is held of the event";
+  EXPECT_EQ(r.state.status().worst.alert.version, 1U);
+  // A spoofed cancellation at 255 does not keep the bridge's alert of the event out either.
+  RegionalAlert cancel = alert(30, 255);
+  cancel.cancelled = true;
+  ASSERT_TRUE(r.state.receive(cancel, 4 * kS).accepted());
+  RegionalAlert after = alert(30, 1);
+  after.pga_g = 1.0;
+  EXPECT_TRUE(r.state.receive(after, 5 * kS).accepted());
+  RegionalAlert cancel_again = cancel;
+  EXPECT_EQ(r.state.receive(cancel_again, 6 * kS).refusal, RegionalRefusal::kDuplicate)
+      << "a cancellation is never more dangerous";
+}
+
+// With authenticated sources the same sequence keeps the version order: an older version is
+// out of order, whatever it says.
+TEST(RegionalAlert, AuthenticatedVersionsKeepTheirOrder) {
+  Room r(authenticated());
+  RegionalAlert high = alert(21, 255);
+  high.pga_g = 0.01;
+  ASSERT_TRUE(r.state.receive(high, 0).accepted());
+  RegionalAlert older = alert(21, 1);
+  older.pga_g = 1.5;
+  EXPECT_EQ(r.state.receive(older, kS).refusal, RegionalRefusal::kOutOfOrder);
+}
+
+// A refused alert more dangerous than every held one is counted and kept for the status; a
+// refusal that hides nothing is not.
+TEST(RegionalAlert, ARefusedDangerousAlertShows) {
+  Room r(authenticated());
+  ASSERT_TRUE(r.state.receive(alert(7, 2), 0).accepted());  // 0.4 g
+  const Real held = r.state.status().probability;
+  RegionalAlert stale = alert(8, 1);
+  stale.pga_g = 2.0;
+  stale.origin_age_s = 700.0;
+  stale.s_arrival_in_s = -600.0;
+  const RegionalOutcome refused = r.state.receive(stale, kS);
+  EXPECT_EQ(refused.refusal, RegionalRefusal::kStale);
+  EXPECT_TRUE(refused.dangerous);
+  RegionalAlert older = alert(7, 1);
+  older.pga_g = 3.0;
+  EXPECT_TRUE(r.state.receive(older, 2 * kS).dangerous) << "out of order, more dangerous";
+  const RegionalAlertStatus& st = r.state.status();
+  EXPECT_EQ(st.refused_dangerous, 2U);
+  EXPECT_EQ(st.last_refused_dangerous.event_id, 7U);
+  EXPECT_EQ(st.last_refused_dangerous.version, 1U);
+  EXPECT_EQ(st.last_refused_dangerous.refusal, RegionalRefusal::kOutOfOrder);
+  EXPECT_GT(st.last_refused_dangerous.probability, held);
+  EXPECT_EQ(st.last_refused_dangerous.refused_ns, 2 * kS);
+  RegionalAlert harmless = alert(7, 1);
+  harmless.pga_g = 0.05;
+  EXPECT_FALSE(r.state.receive(harmless, 3 * kS).dangerous);
+  RegionalAlert out_of_range = alert(9, 1);
+  out_of_range.pga_g = 12.0;
+  EXPECT_FALSE(r.state.receive(out_of_range, 3 * kS).dangerous) << "no probability: no danger";
+  EXPECT_EQ(r.state.status().refused_dangerous, 2U);
+  r.state.refuse_unread(RegionalRefusal::kUnauthenticated, "RegionalAlertTag");
+  EXPECT_EQ(r.state.status().refused[static_cast<std::size_t>(RegionalRefusal::kUnauthenticated)],
+            1U);
+  EXPECT_STREQ(r.state.status().last_refusal_field, "RegionalAlertTag");
 }
 
 TEST(RegionalAlert, EachBadFieldIsRefusedWithItsReasonAndCounted) {

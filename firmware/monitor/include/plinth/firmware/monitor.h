@@ -136,6 +136,9 @@ class Monitor {
   [[nodiscard]] MonitorUpdate on_regional_alert(const monitor::RegionalAlert& alert);
   // A regional alert the host could not read (counted as malformed; `field` names what).
   [[nodiscard]] MonitorUpdate regional_alert_malformed(const char* field);
+  // One the host refused before reading it: malformed or unauthenticated (regional_alert.h).
+  [[nodiscard]] MonitorUpdate regional_alert_refused(monitor::RegionalRefusal refusal,
+                                                     const char* field);
   // No input (a frame that is none of the monitor's): the status, if one is due; the alarm
   // policy's first evaluation if none happened since start() (so that no status says the
   // policy's initial `normal`).
@@ -143,6 +146,10 @@ class Monitor {
   // Bus trouble reported by the frame source (bus-off, dropped frames): raises the fault level
   // until `active` is cleared.
   void set_bus_fault(bool active) { bus_fault_ = active; }
+  // A fault the host holds for a reason of its own (kCommissioningFailed: the box refuses to
+  // vouch, docs/commissioning.md): the level is fault with this cause, ahead of every other
+  // fault cause, until `cause` is kNone. start() clears it.
+  void hold_fault(monitor::AlarmCause cause) { held_fault_ = cause; }
 
   [[nodiscard]] const BoxStatus& status() const { return status_; }
   // Frames to send that the codec refused (left out of their update) since start().
@@ -243,6 +250,7 @@ class Monitor {
   bool have_epoch_ = false;
   std::int64_t epoch_ns_ = 0;  // receive time of the first sample
   bool bus_fault_ = false;
+  monitor::AlarmCause held_fault_ = monitor::AlarmCause::kNone;  // hold_fault()
   bool evaluated_ = false;  // the alarm policy has evaluated an input since start()
   bool pending_ack_ = false;
   bool pending_stands_ = false;

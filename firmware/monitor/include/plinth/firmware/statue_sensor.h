@@ -115,8 +115,11 @@ class StatueSensor {
   // rates spread by at most 0.05 rad/s.
   void on_sample(const StatueSample& sample, bool quiet);
   // One accelerometer sample (g, sensor frame): its stream's health and counters, its horizontal
-  // offsets (estimated as the rate's, while `quiet`), the newest specific force.
-  void on_acceleration(const monitor::SensorSample& sample, bool quiet);
+  // offsets (estimated as the rate's, while `quiet`, on its difference to `ground_m_s2`, the
+  // ground sensor's newest conditioned sample: a statue standing moves with the ground, so a
+  // window of small shaking still gives the offset), the newest specific force.
+  void on_acceleration(const monitor::SensorSample& sample, bool quiet,
+                       const Vector3r& ground_m_s2 = Vector3r::Zero());
   void tick(std::int64_t now_ns) {
     rate_health_ = rate_tracker_.tick(now_ns);
     acceleration_health_ = acceleration_tracker_.tick(now_ns);

@@ -50,6 +50,7 @@ inline constexpr std::uint32_t kCollapseForecastBaseId = 0x350;  // + axis (0..1
 // intensity part (docs/regional.md).
 inline constexpr std::uint32_t kRegionalAlertId = 0x360;
 inline constexpr std::uint32_t kRegionalAlertOriginId = 0x361;
+inline constexpr std::uint32_t kRegionalAlertTagId = 0x362;  // its authentication, when keyed
 inline constexpr std::uint32_t kStatueRotationBaseId = 0x370;     // + node (1..15)
 
 inline constexpr std::uint8_t kFirstSensorNode = 1;
@@ -68,6 +69,7 @@ enum class MessageKind : std::uint8_t {
   kStatueRotation,
   kRegionalAlert,
   kRegionalAlertOrigin,
+  kRegionalAlertTag,
 };
 
 // Which plinth message an identifier carries; kUnknown outside the table (node 0, axis 2, ...).
@@ -121,6 +123,7 @@ enum class AlarmCause : std::uint8_t {
   kStatueSensorFault = 16,  // the statue sensor unhealthy or not corroborated: it may not lower
   kRestored = 17,           // a latched level or a collapse restored after a restart
   kStatueStands = 18,       // a person on site stated that the statue stands again
+  kCommissioningFailed = 19,  // the box's commissioning report failed or is missing
 };
 
 // Sensor status flags (SensorAcceleration.Status, SensorHeartbeat.Status). Bits 4-7 reserved.
@@ -244,6 +247,14 @@ struct RegionalAlert {
   double s_arrival_in_s = 0.0;  // s to the expected S arrival, -327.68..327.67 at 0.01 s
 };
 
+// 0x362: a regional alert's authentication, right after its 0x360 frame (docs/regional.md, "Who
+// may send an alert"): the bridge's counter and the first 4 bytes of the HMAC-SHA256 of both
+// frames' data and the counter.
+struct RegionalAlertTag {
+  std::uint32_t counter = 0;  // one more for each alert the bridge signs
+  std::uint32_t tag = 0;      // the HMAC's bytes 0-3, byte 0 in the low byte (Intel)
+};
+
 // ---------------------------------------------------------------------------------------------
 // Results
 
@@ -281,6 +292,7 @@ using DecodeResult = CodecResult;
 [[nodiscard]] EncodeResult encode(const StatueRotation& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const RegionalAlertOrigin& message, CanFrame& frame);
 [[nodiscard]] EncodeResult encode(const RegionalAlert& message, CanFrame& frame);
+[[nodiscard]] EncodeResult encode(const RegionalAlertTag& message, CanFrame& frame);
 
 // On success `message` holds the decoded values (node / axis from the identifier); on failure
 // it is left untouched.
@@ -294,6 +306,7 @@ using DecodeResult = CodecResult;
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, StatueRotation& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, RegionalAlertOrigin& message);
 [[nodiscard]] DecodeResult decode(const CanFrame& frame, RegionalAlert& message);
+[[nodiscard]] DecodeResult decode(const CanFrame& frame, RegionalAlertTag& message);
 
 // ---------------------------------------------------------------------------------------------
 // Signal layouts (as in the DBC) and Intel bit packing

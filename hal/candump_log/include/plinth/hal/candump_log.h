@@ -12,8 +12,15 @@
 // `123#R` / `123#R5` (remote request, optional DLC), `123##1<data>` (CAN FD: flags nibble,
 // up to 64 bytes), `...#<8 bytes>_9` (classic frame with a raw DLC of 9-15) and a trailing
 // direction token `R` or `T` (asc2log writes one). Blank lines and lines starting with '#' are
-// comments. Anything else is malformed and reported with its file and line; canplayer would
-// silently skip a line not starting with '(', this reader refuses it so a wrong file is noticed.
+// comments. candump -d writes, before the next frame it receives after its socket overflowed,
+//
+//     DROPCOUNT: dropped 410 CAN frames on 'vcan0' socket (total drops 410)
+//
+// (the frames the kernel dropped since the previous report; the quoted socket is the interface,
+// or before can-utils 2020.12 the command-line argument with its filters): read as frames lost
+// at that point of the log (docs/record-formats.md, "Frames a log lost"). Anything else is
+// malformed and reported with its file and line; canplayer would silently skip a line not
+// starting with '(', this reader refuses it so a wrong file is noticed.
 //
 // Host code: allocates (never throws for a bad file: open() and receive() say what is wrong).
 #pragma once
@@ -40,15 +47,17 @@ enum class CandumpFrameKind : std::uint8_t {
   kRemote,      // remote transmission request (standard or extended)
   kFd,          // CAN FD frame ("##")
   kErrorFrame,  // error frame (8-digit identifier with CAN_ERR_FLAG 0x20000000)
+  kDropCount,   // candump's "DROPCOUNT: dropped N CAN frames ...": no frame, N frames lost here
 };
 
-inline constexpr NameTable<CandumpFrameKind, 6> kCandumpFrameKindNames{{{
+inline constexpr NameTable<CandumpFrameKind, 7> kCandumpFrameKindNames{{{
     {CandumpFrameKind::kComment, "comment"},
     {CandumpFrameKind::kClassic, "classic"},
     {CandumpFrameKind::kExtended, "extended"},
     {CandumpFrameKind::kRemote, "remote request"},
     {CandumpFrameKind::kFd, "CAN FD"},
     {CandumpFrameKind::kErrorFrame, "error frame"},
+    {CandumpFrameKind::kDropCount, "drop count"},
 }}};
 
 [[nodiscard]] constexpr const char* candump_frame_kind_name(CandumpFrameKind kind) {
@@ -67,6 +76,7 @@ inline constexpr std::uint32_t kCanErrorFlag = 0x20000000;  // SocketCAN's CAN_E
 struct CandumpLine {
   CandumpFrameKind kind = CandumpFrameKind::kComment;
   std::int64_t timestamp_ns = 0;  // since the epoch, a whole number of microseconds
+  // A frame's interface; a DROPCOUNT line's socket as candump names it (see above).
   std::string interface_name;
   std::uint32_t id = 0;      // without flag bits (for error frames: the error class bits)
   bool extended = false;     // 8-digit identifier
@@ -74,11 +84,25 @@ struct CandumpLine {
   std::uint8_t raw_dlc = 0;  // classic frames with 8 bytes and a "_<dlc>" suffix: 9..15, else 0
   std::uint8_t fd_flags = 0;
   std::array<std::uint8_t, kCandumpMaxFdLength> data{};
+  // kDropCount: the frames lost since the socket's previous report (1 or more), and the
+  // socket's total so far (both candump's 32-bit counters).
+  std::uint32_t dropped_frames = 0;
+  std::uint32_t total_dropped_frames = 0;
 };
 
 // Parses one line (without its newline; a trailing '\r' is allowed). Returns "" on success,
 // otherwise what is wrong, e.g. "odd number of hex digits in the data (a truncated byte)".
 [[nodiscard]] std::string parse_candump_line(std::string_view line, CandumpLine& out);
+
+// A DROPCOUNT line as candump -d writes it (no newline): "DROPCOUNT: dropped 1 CAN frame on
+// 'vcan0' socket (total drops 7)". "" when the count is 0 or the socket name is empty or holds
+// a quote or a line break.
+[[nodiscard]] std::string format_candump_drop_line(std::uint32_t dropped_frames,
+                                                   std::string_view socket_name,
+                                                   std::uint32_t total_dropped_frames);
+// What a parsed DROPCOUNT line says, for messages: "candump lost 410 CAN frames on 'vcan0'
+// before this line (its socket overflowed; 410 in all so far)".
+[[nodiscard]] std::string describe_candump_drop(const CandumpLine& line);
 
 // The log line of a classic frame with a standard identifier, as candump -l writes it
 // (uppercase hex, no newline): "(1700000000.123456) vcan0 301#0011223344556677".
@@ -94,6 +118,8 @@ struct CandumpLine {
 //                0..8: whether it is a plinth frame is the codec's business);
 //   kNotPlinth   an extended, remote, CAN FD or raw-DLC frame (only the timestamp is set);
 //   kBusError    a logged error frame (only the timestamp is set);
+//   kOverflow    a DROPCOUNT line: dropped_frames() frames were lost before the next frame
+//                (last_line() has the socket and candump's total; the timestamp is not set);
 //   kIoError     a malformed line or a read error: error() says "file:line: what"; the next
 //                call goes on with the following line (after a line longer than
 //                kCandumpMaxLineBytes, or a read error, the input ends there);
@@ -113,6 +139,10 @@ class CandumpLogReader final : public FrameSource {
   [[nodiscard]] const CandumpLine& last_line() const { return line_; }
   [[nodiscard]] std::size_t line_number() const { return line_number_; }
   [[nodiscard]] const std::string& path() const { return path_; }
+  // After kOverflow: the frames the DROPCOUNT line says were lost; and all so far, every
+  // DROPCOUNT line read (as hal::SocketCanPort's dropped_frames() and total_dropped_frames()).
+  [[nodiscard]] std::uint32_t dropped_frames() const { return line_.dropped_frames; }
+  [[nodiscard]] std::uint64_t total_dropped_frames() const { return total_dropped_frames_; }
 
  private:
   CandumpLogReader(std::string path, std::ifstream in);
@@ -123,6 +153,7 @@ class CandumpLogReader final : public FrameSource {
   std::string text_;
   CandumpLine line_;
   std::size_t line_number_ = 0;
+  std::uint64_t total_dropped_frames_ = 0;
   std::string error_;
   bool ended_ = false;  // after a line too long or a read error
 };
@@ -167,6 +198,7 @@ class CandumpLogWriter final : public FrameSink {
 // logger paused, or the clock was stepped forward) cannot be replayed as logged.
 // plinth-replay and plinth-monitor check every frame with LogTimeCheck and apply the policy
 // --log-time chooses: warn (the default: name each, go on) or refuse (stop at the first).
+// The frames a log lost (its DROPCOUNT lines) have a policy of their own, --log-drops.
 
 enum class LogTimeProblem : std::uint8_t {
   kNone,
@@ -175,10 +207,12 @@ enum class LogTimeProblem : std::uint8_t {
   kJumped,      // stamped more than the gap limit after the previous frame
 };
 
-enum class LogTimePolicy : std::uint8_t { kWarn, kRefuse };
-inline constexpr NameTable<LogTimePolicy, 2> kLogTimePolicyNames{{{
-    {LogTimePolicy::kWarn, "warn"},
-    {LogTimePolicy::kRefuse, "refuse"},
+// What a reader does with a flaw of a log (--log-time, --log-drops): warn (name it, go on) or
+// refuse (stop at the first).
+enum class LogPolicy : std::uint8_t { kWarn, kRefuse };
+inline constexpr NameTable<LogPolicy, 2> kLogPolicyNames{{{
+    {LogPolicy::kWarn, "warn"},
+    {LogPolicy::kRefuse, "refuse"},
 }}};
 
 // A log's frames longer apart than this are a jump: s.

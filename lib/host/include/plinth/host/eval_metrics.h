@@ -76,6 +76,17 @@ inline constexpr std::array<std::string_view, 8> kRegionalColumns{
     "regional_magnitude", "regional_rhyp_km", "regional_origin_s", "regional_alert_s",
     "regional_s_arrival_s", "regional_pga_g", "regional_sigma_ln", "regional_probability"};
 
+// The fault block, ending the row (plinth-eval run since fault injection; docs/safety.md,
+// "Fault injection"): the fault injected and the box's trouble. Files of an earlier plinth-eval
+// have none (EvalTable::has_faults false).
+inline constexpr std::array<std::string_view, 11> kFaultColumns{
+    "fault",          "fault_param",          "fault_at",
+    "fault_began_s",  "first_fault_trouble_s", "fault_trouble_at_end",
+    "first_statue_fault_s", "first_statue_unexplained_s", "level_at_end",
+    "trouble_at_end", "runs_written"};
+// level_at_end of a run that ended while its box was restarting (no level shown).
+inline constexpr std::string_view kBoxDown = "down";
+
 struct EvalRun {
   std::string record;  // file name
   std::string scene;   // file name
@@ -125,6 +136,25 @@ struct EvalRun {
     double probability = 0.0;
   };
   std::optional<Regional> regional;
+  // The fault block (kFaultColumns; times in s from the record's t = 0, -1: never).
+  struct Faults {
+    std::string fault = "none";  // the kind injected (plinth-eval run --fault), "none"
+    std::string param;           // its parameter as given ("" without one)
+    std::string at;              // --fault-at as given ("" without a fault)
+    // When it began (negative: in the box's quiet lead-in, before the record); nullopt: never
+    // (no fault, or its anchor did not come before the run ended). Written "" then.
+    std::optional<double> began_s;
+    double first_trouble_s = -1.0;  // the trouble naming the faulted input, first shown
+    bool trouble_at_end = false;    // ... shown when the run ended (a collapse: just before it)
+    double first_statue_fault_s = -1.0;        // statue_sensor_fault, first shown
+    double first_statue_unexplained_s = -1.0;  // statue_unexplained, first shown
+    // The level and the trouble shown when the run ended: alarm_level names, or kBoxDown.
+    std::string level_at_end = "normal";
+    monitor::AlarmCause trouble_at_end_cause = monitor::AlarmCause::kNone;
+    // plinth-eval run --collapses-only: the file holds only the runs whose truth collapsed.
+    bool collapses_only = false;
+  };
+  std::optional<Faults> faults;
 
   [[nodiscard]] bool outside_model() const { return model_valid_until_s >= 0.0; }
   [[nodiscard]] bool quiet() const { return !collapsed && peak_ratio < kQuietPeakRatio; }
@@ -290,14 +320,21 @@ void assign_case_collapses(std::vector<EvalRun>& runs, const std::string& where)
 // a file of an earlier plinth-eval has none, and its runs have no known grid (has_grid false).
 // With the P-wave stage the row ends with p_pick_s, strong_motion_s, pwave_trigger_s and the
 // pwave_ge_<p> crossings; a file without them reads as runs without the stage. With regional
-// alerts it ends with the regional_ columns (kRegionalColumns).
-void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with_grid);
+// alerts come the regional_ columns (kRegionalColumns); then, with with_faults, the fault block
+// (kFaultColumns). A file that holds only collapses (runs_written "collapses") is read without
+// the check of its cases' rows (EvalTable::collapses_only).
+void write_eval_csv_header(std::FILE* out, const CrossingGrids& grids, bool with_grid,
+                           bool with_faults = false);
 // with_grid: the seed and grid columns. A row has them when run.grid is known (as the header must).
 void write_eval_csv_row(std::FILE* out, const EvalRun& run);
 struct EvalTable {
   CrossingGrids grids;
   std::vector<EvalRun> runs;
   bool has_grid = false;  // the file records each case's grid: collapse margins are known
+  bool has_faults = false;  // the fault block (kFaultColumns)
+  // Only the runs whose truth collapsed (plinth-eval run --collapses-only): no margins, no
+  // outcome of the runs that stood.
+  bool collapses_only = false;
 };
 [[nodiscard]] EvalTable read_eval_csv(const std::string& path);
 

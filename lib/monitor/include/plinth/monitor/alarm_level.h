@@ -42,6 +42,9 @@ enum class AlarmCause : std::uint8_t {
   kStatueSensorFault = 16,
   kRestored = 17,      // a latched level or a collapse restored from the box's saved state
   kStatueStands = 18,  // a person on site stated that the statue stands again
+  // The box refuses to vouch: its newest commissioning report failed or is missing
+  // (docs/commissioning.md).
+  kCommissioningFailed = 19,
 };
 
 // The names in status and alarm lines (also the DBC's VAL_ names).
@@ -53,7 +56,7 @@ inline constexpr NameTable<AlarmLevel, 5> kAlarmLevelNames{{{
     {AlarmLevel::kFault, "fault"},
 }}};
 
-inline constexpr NameTable<AlarmCause, 19> kAlarmCauseNames{{{
+inline constexpr NameTable<AlarmCause, 20> kAlarmCauseNames{{{
     {AlarmCause::kNone, "none"},
     {AlarmCause::kRiskThreshold, "risk_threshold"},
     {AlarmCause::kPhaseChange, "phase_change"},
@@ -73,6 +76,7 @@ inline constexpr NameTable<AlarmCause, 19> kAlarmCauseNames{{{
     {AlarmCause::kStatueSensorFault, "statue_sensor_fault"},
     {AlarmCause::kRestored, "restored"},
     {AlarmCause::kStatueStands, "statue_stands"},
+    {AlarmCause::kCommissioningFailed, "commissioning_failed"},
 }}};
 
 // The levels the risk raises, lowest first (neither normal nor fault): the ones plinth-eval

@@ -57,8 +57,11 @@ enum class RegionalRefusal : std::uint8_t {
   kDuplicate,     // this event's version was taken already
   kOutOfOrder,    // an older version of an event than the one taken
   kNoRoom,        // kMaxRegionalEvents held, each with a higher probability of collapse
+  // The box file requires authenticated alerts (RegionalAuthentication) and this one's tag is
+  // missing or wrong, or its counter is not above the last one taken (a replay).
+  kUnauthenticated,
 };
-inline constexpr std::size_t kRegionalRefusalCount = 10;
+inline constexpr std::size_t kRegionalRefusalCount = 11;
 
 inline constexpr NameTable<RegionalRefusal, kRegionalRefusalCount> kRegionalRefusalNames{{{
     {RegionalRefusal::kNone, "none"},
@@ -71,6 +74,7 @@ inline constexpr NameTable<RegionalRefusal, kRegionalRefusalCount> kRegionalRefu
     {RegionalRefusal::kDuplicate, "duplicate"},
     {RegionalRefusal::kOutOfOrder, "out of order"},
     {RegionalRefusal::kNoRoom, "no room"},
+    {RegionalRefusal::kUnauthenticated, "unauthenticated"},
 }}};
 [[nodiscard]] constexpr const char* regional_refusal_name(RegionalRefusal refusal) {
   return kRegionalRefusalNames.name(refusal);
@@ -82,7 +86,20 @@ struct RegionalOutcome {
   const char* field = "";  // the field at fault ("pga_g", ...), "" when none is
   bool replaced = false;   // taken, replacing an earlier version of the event
   bool cancelled = false;  // taken: a cancellation, the event dropped
+  bool dangerous = false;  // refused, and more dangerous than every alert held (counted)
   [[nodiscard]] constexpr bool accepted() const { return refusal == RegionalRefusal::kNone; }
+};
+
+// The alerts' source authenticated (docs/regional.md, "Who may send an alert"): with a key,
+// every alert must carry an HMAC-SHA256 tag of it made with that key (MQTT: a user property over
+// the payload; CAN: a RegionalAlertTag frame over both frames and a counter), and an alert
+// without, or with a wrong one, is refused (kUnauthenticated) before the room sees it. The
+// hosts check the tags (frame_decoder.h, the MQTT client); the room trusts the versions' order
+// only then.
+inline constexpr std::size_t kRegionalKeyBytes = 32;
+struct RegionalAuthentication {
+  bool required = false;
+  std::array<std::uint8_t, kRegionalKeyBytes> key{};  // regional_alert.key_file's
 };
 
 struct RegionalAlertSettings {
@@ -101,6 +118,7 @@ struct RegionalAlertSettings {
   // taken and shown, and the probability of collapse stays 0.
   bool fragility_known = false;
   LognormalFragility fragility;  // PGA in g: median_g > 0, beta >= 0
+  RegionalAuthentication authentication;
 };
 
 // Checks the settings; the Error names the field ("regional_alert.expiry_margin_s", ...).
@@ -121,6 +139,16 @@ struct HeldRegionalAlert {
   Real probability = 0;          // the statue's probability of collapse under it
 };
 
+// A refused alert that was more dangerous than every alert held (a higher probability of
+// collapse than the worst held one's): the refusal hid a danger, so the status shows it.
+struct RefusedRegionalAlert {
+  std::uint32_t event_id = 0;
+  std::uint32_t version = 0;
+  Real probability = 0;  // of collapse under it
+  RegionalRefusal refusal = RegionalRefusal::kNone;
+  std::int64_t refused_ns = 0;  // when
+};
+
 // The room's status after each update.
 struct RegionalAlertStatus {
   int held = 0;                // alerts held (not expired)
@@ -138,10 +166,20 @@ struct RegionalAlertStatus {
   std::array<std::uint64_t, kRegionalRefusalCount> refused{};  // by RegionalRefusal; [0] unused
   RegionalRefusal last_refusal = RegionalRefusal::kNone;
   const char* last_refusal_field = "";
+  // Refusals of alerts more dangerous than the worst held one (a stale, future-dated, duplicate
+  // or older version's): counted, the latest kept.
+  std::uint64_t refused_dangerous = 0;
+  RefusedRegionalAlert last_refused_dangerous;  // valid when refused_dangerous > 0
 };
 
 // Accept or refuse (in this order: finite, ranges, consistency, future-dated, stale, duplicate
 // or out of order, room), replace, expire, and the worst held alert's probability of collapse:
+// Versions: with authenticated sources an event's version at or below the one taken is refused
+// (duplicate, out of order). Without, anyone may have sent the higher one (a spoofed version
+// 255 would lock the bridge's own out), so such a version is still taken when it is more
+// dangerous than what the room holds of its event (nothing, after a cancellation): a spoofed
+// version can then add a warning, never hide one.
+//
 //   P = Phi(ln(PGA / median) / sqrt(beta^2 + sigma_ln^2))
 // (the fragility under the prediction's lognormal scatter: LognormalFragility::probability).
 // A cancellation is checked like an alert; taken, it drops the event. Times never go back: an
@@ -157,6 +195,9 @@ class RegionalAlertState {
   RegionalOutcome receive(const RegionalAlert& alert, std::int64_t now_ns);
   // An alert the host could not read (counted as malformed).
   void refuse_malformed(const char* field);
+  // An alert the host refused before reading it: malformed, or unauthenticated (`field` names
+  // what: "payload", "RegionalAlertTag", ...).
+  void refuse_unread(RegionalRefusal refusal, const char* field);
   // Drops the alerts expired by `now_ns` and updates the status's time to arrival.
   void tick(std::int64_t now_ns);
 
@@ -168,12 +209,16 @@ class RegionalAlertState {
     std::uint32_t event_id = 0;
     std::uint32_t version = 0;
   };
-  [[nodiscard]] RegionalOutcome check(const RegionalAlert& alert) const;
+  // `probability`: the alert's probability of collapse once its numbers passed their checks.
+  [[nodiscard]] RegionalOutcome check(const RegionalAlert& alert, Real& probability) const;
+  [[nodiscard]] Real probability_of(const RegionalAlert& alert) const;
   [[nodiscard]] const SeenEvent* seen(std::uint32_t event_id) const;
   void remember(std::uint32_t event_id, std::uint32_t version);
   [[nodiscard]] int slot_of(std::uint32_t event_id) const;
   void drop(int slot);
   void refuse(RegionalOutcome outcome);
+  [[nodiscard]] bool note_if_dangerous(const RegionalAlert& alert, Real probability,
+                                       RegionalRefusal refusal);
   void update_status(std::int64_t now_ns);
 
   RegionalAlertSettings settings_;

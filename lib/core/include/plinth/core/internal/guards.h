@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 
 #include "plinth/core/excitation.h"
@@ -46,6 +47,15 @@ struct ActiveGuards {
 
   constexpr void add(GuardId id) { ids[static_cast<std::size_t>(count++)] = id; }
 };
+
+// The guards every live mode of a phase has first, in active_guards' order: kLiftOff, then the
+// rocking ones (rocking and slide-rocking) or the rocking onsets (full contact and sliding). The
+// step evaluates these without a switch (step_interval.h).
+inline constexpr int kLeadingGuards = 3;
+[[nodiscard]] constexpr std::array<GuardId, kLeadingGuards> leading_guards(bool rocking) {
+  if (rocking) return {GuardId::kLiftOff, GuardId::kRockingImpact, GuardId::kOverturning};
+  return {GuardId::kLiftOff, GuardId::kRockingOnsetLeft, GuardId::kRockingOnsetRight};
+}
 
 template <Features F>
 [[nodiscard]] constexpr ActiveGuards active_guards(const Mode& mode) {
@@ -164,6 +174,45 @@ template <Features F>
   return -sticking_contact_force(s, mode, y, ag, acc, trig).normal / s.m;
 }
 
+// The lift-off guard's sign at a glance while rocking, from an upper bound of the guard without
+// the contact's kinematics. About a corner of the body (Eq 12) -Y / m = -(g + v_G'') -
+// b'_i theta'' + h'_i theta'^2 with |b'_i|, |h'_i| <= r_i (Eq 9), so the guard is at most
+// r_i (|theta''| + theta'^2) - (g + v_G''). About the support's corner (Eq 14) -Y / m =
+// -(g + v_G'') cos theta + (u'' + u_G'') sin theta - 2 x' theta' - b_hat_i theta'' + h theta'^2,
+// at most |(u'' + u_G'') sin theta| + 2 |x' theta'| + b_hat_i |theta''| + h theta'^2 -
+// (g + v_G'') cos theta. Returns the bound when it is negative by more than kLiftOffBoundMargin
+// of the size of the terms lift_off_guard adds up (its roundings are a few epsilon of that): the
+// guard is then certainly negative too. Otherwise (near lift-off, or not a number) returns +1,
+// and the guard must be evaluated. The bound is a witness value only for its sign: whoever needs
+// the number (locating a crossing) evaluates lift_off_guard.
+inline constexpr Real kLiftOffBoundMargin = Real(1024) * real_tolerance::kEpsilon;
+
+[[nodiscard]] inline Real lift_off_bound(const Scene& s, const Mode& mode, const State& y,
+                                         GroundAcceleration ag, const Accelerations& acc,
+                                         const SinCos& trig) {
+  const Real support = s.g + ag.vertical;  // per unit mass
+  const Real spin = y[kThetaDot] * y[kThetaDot];
+  Real load = 0.0;
+  Real bound = 0.0;
+  Real size = 0.0;
+  const PivotDistance pivot = pivot_distance(s, mode.corner, mode.overhang, y[kX]);
+  if (!pivot.overhanging) {
+    load = s.corner(mode.corner).radius * (std::fabs(acc.theta) + spin);
+    bound = load - support;
+    size = std::fabs(support) + load;
+  } else {
+    const Real base = std::fabs(acc.u + ag.horizontal);
+    const Real coriolis = Real(2) * std::fabs(y[kXDot] * y[kThetaDot]);
+    load =
+        base * std::fabs(trig.sin) + coriolis + pivot.distance * std::fabs(acc.theta) + s.h * spin;
+    bound = load - support * trig.cos;
+    // The contact's kinematics add terms that cancel (x'', b'_i theta''): their size too.
+    size = std::fabs(support) + base + std::fabs(acc.x) + coriolis +
+           (pivot.distance + s.h) * (std::fabs(acc.theta) + spin);
+  }
+  return bound < -kLiftOffBoundMargin * size ? bound : Real(1);
+}
+
 // det(with friction) / det(frictionless) of slide-rocking about the mode's pivot in `direction`
 // (flows.h, sliding_consistency).
 [[nodiscard]] inline Real sliding_consistency(const Scene& s, const Mode& mode, int direction,
@@ -253,7 +302,9 @@ template <Features F>
 
 // guard_value at a FlowPoint, with the guards every step evaluates written out here, small
 // enough to be inlined into the solver's loop; the costlier ones (Eqs 15/18, the stop's
-// reaction, the support's edge) go through guard_value. The same values.
+// reaction, the support's edge) go through guard_value. The same values, but for the lift-off
+// guard while rocking far from lift-off: its bound (lift_off_bound), of the same sign; a crossing
+// is located on guard_value's (step_interval.h, earliest_crossing).
 [[nodiscard]] inline Real step_guard_value(GuardId id, const Scene& s, const Mode& mode,
                                            const State& y, const FlowPoint& p) {
   const Accelerations& acc = p.acc;
@@ -285,6 +336,9 @@ template <Features F>
       return kPainleveMargin - p.consistency;
     case GuardId::kLiftOff:
       if (!mode.rocking()) return -(s.g + ag.vertical);
+      if (const Real bound = lift_off_bound(s, mode, y, ag, acc, p.trig); bound < Real(0)) {
+        return bound;
+      }
       break;
     default:
       break;
