@@ -66,4 +66,8 @@ set(CPACK_COMPONENT_DEV_DESCRIPTION "plinth's freestanding core: headers and sta
  The model of a rigid block on an oscillating base (no heap, no exceptions, no RTTI), for
  another project: find_package(plinth) gives the imported target plinth::core.")
 
+# A Debian revision given to cpack (-D CPACK_DEBIAN_PACKAGE_RELEASE=N) is carried into
+# plinth-tools' exact Depends on plinth-monitor (tests/integration/image_vm.py upgrades to one).
+set(CPACK_PROJECT_CONFIG_FILE ${CMAKE_CURRENT_LIST_DIR}/cpack-project.cmake)
+
 include(CPack)

@@ -59,6 +59,14 @@ tests=(
   dpkg-dev fakeroot  # the package preset (CPack DEB), its packages unpacked and checked
   python3-openpyxl  # tools/pwave-stations.py reads the NGA-West2 flatfile (xlsx; docs/regional.md)
   stress-ng  # keeps the cores busy while the tests run, as on a user's laptop (README, can-e2e.md)
+  # The box's disk image (firmware/image/build-image.sh, docs/image.md): mmdebstrap makes the
+  # Debian system (zstd keeps its base between runs), mkfs.ext4, mkfs.vfat and mtools its
+  # filesystems, sfdisk its partition table, grub-mkimage its boot loader; qemu-user-static runs
+  # the arm64 image's maintainer scripts (binfmt_misc). Booted by tools/image-test.sh under UEFI
+  # firmware (ovmf; qemu-efi-aarch64 for qemu-system-aarch64, in qemu-system-arm), reached over
+  # SSH (openssh-client).
+  mmdebstrap zstd e2fsprogs dosfstools mtools fdisk grub-common qemu-user-static
+  ovmf qemu-efi-aarch64 openssh-client
   # The package-arm64 preset (docs/install.md): Debian's cross compiler, the libraries for arm64
   # (multiarch), and qemu-user, which runs the arm64 plinth-monitor on this machine.
   g++-aarch64-linux-gnu qemu-user

@@ -704,6 +704,13 @@ int run(const Options& opt, const CLI::App& app) {
   const int sources = (opt.replay_path.empty() ? 0 : 1) + (opt.can_interface.empty() ? 0 : 1);
   if (sources != 1) throw InputError("give exactly one input: --replay FILE or --can INTERFACE");
   const fw::InputOptions input_settings = input_options(opt);
+  // Paced input: each line goes out as it is written, for whoever reads them live. Set before
+  // any output (the restored state's lines): glibc keeps a stream whose buffer already holds
+  // data fully buffered, and under systemd those lines then reached the journal only when 4 KiB
+  // had gathered or at exit, or never, at a kill (seen in the image's test, docs/image.md).
+  if (input_settings.speed > 0.0 || !opt.can_interface.empty()) {
+    std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  }
   fw::MonitorFile file = fw::configure_monitor(opt.config);
   if (!opt.replay_y_path.empty() && file.second_scene_path.empty()) {
     throw InputError("--replay-y needs a second axis: --scene-y or monitor.second_scene");
@@ -757,10 +764,6 @@ int run(const Options& opt, const CLI::App& app) {
     frames_log.emplace(std::move(*opened.writer));
   }
   plinth::hal::FrameSink* const bus = frames_log ? &*frames_log : input->sink();
-  // Paced input: each line goes out as it is written, for whoever reads them live.
-  if (input_settings.speed > 0.0 || !opt.can_interface.empty()) {
-    std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  }
   const std::unique_ptr<fw::RelayOutputs> relays = make_relays(file.relays);
   const std::vector<std::unique_ptr<fw::StatusOutput>> network = start_outputs(file, run_identity);
   std::vector<fw::StatusOutput*> output_list;
