@@ -121,7 +121,9 @@ std::int64_t CommissioningGate::watched_stamp() const {
   const std::int64_t folder = record_dir_.empty() ? -1 : mtime_ns(record_dir_);
   const std::int64_t report =
       mtime_ns(settings_.report.empty() ? verdict_.report : settings_.report);
-  return folder * 31 + report;
+  // Compared for equality only: mixed in unsigned arithmetic (wraps, never overflows).
+  return static_cast<std::int64_t>(static_cast<std::uint64_t>(folder) * 31U +
+                                   static_cast<std::uint64_t>(report));
 }
 
 const GateVerdict& CommissioningGate::check() {
