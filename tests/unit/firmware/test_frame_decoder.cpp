@@ -323,17 +323,24 @@ MonitorConfig sweep_config() {
   return config;
 }
 
-// The sweep issue 33 met: an Acknowledge frame for every sequence number released a latched
-// alarm. The guard lets 4 be refused, then ignores the rest while the alarm stays latched; the
-// operator's acknowledgement at the box (a call, as Modbus and MQTT make) still releases it.
-TEST(FrameDecoder, ASweepOfTheSequencesCannotReleaseALatch) {
+// A non-isolated block's box fed through a FrameDecoder, started and ready to overturn.
+class SweptBox : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
+    decoder.start(config);
+  }
   const Scene scene = testing::make(testing::paper_block(0.0));
   const MonitorConfig config = sweep_config();
   Monitor monitor;
-  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
   FrameDecoder decoder;
-  decoder.start(config);
   std::int64_t t = 0;
+};
+
+// The sweep issue 33 met: an Acknowledge frame for every sequence number released a latched
+// alarm. The guard lets 4 be refused, then ignores the rest while the alarm stays latched; the
+// operator's acknowledgement at the box (a call, as Modbus and MQTT make) still releases it.
+TEST_F(SweptBox, ASweepOfTheSequencesCannotReleaseALatch) {
   const std::uint8_t last_event = overturn(monitor, decoder, t);
   ASSERT_EQ(monitor.status().latched, monitor::AlarmLevel::kAlarm);
   // Every sequence, the right one last (the sweep's worst case for the box).
@@ -360,14 +367,7 @@ TEST(FrameDecoder, ASweepOfTheSequencesCannotReleaseALatch) {
 
 // The same sweep of StatueStands frames cannot clear a held collapse: 4 refused, the rest
 // ignored, the collapse still held; a person's statement at the box still clears it.
-TEST(FrameDecoder, ASweepCannotClearAHeldCollapse) {
-  const Scene scene = testing::make(testing::paper_block(0.0));
-  const MonitorConfig config = sweep_config();
-  Monitor monitor;
-  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
-  FrameDecoder decoder;
-  decoder.start(config);
-  std::int64_t t = 0;
+TEST_F(SweptBox, ASweepCannotClearAHeldCollapse) {
   std::uint8_t last_event = overturn(monitor, decoder, t);
   ASSERT_TRUE(monitor.status().collapse.held);
   // Quiet ground after the fall (the estimators' own collapse stays: a person's word clears it).
@@ -398,14 +398,7 @@ TEST(FrameDecoder, ASweepCannotClearAHeldCollapse) {
 
 // A box restarted with a held collapse, on a silent bus (no estimator runs): a person's
 // statement clears it; the collapse the status shows is the memory's, not a reading.
-TEST(FrameDecoder, AStatementAfterARestartOnASilentBusClearsTheCollapse) {
-  const Scene scene = testing::make(testing::paper_block(0.0));
-  const MonitorConfig config = sweep_config();
-  Monitor monitor;
-  ASSERT_TRUE(monitor.start(config, {&scene, nullptr}).ok());
-  FrameDecoder decoder;
-  decoder.start(config);
-  std::int64_t t = 0;
+TEST_F(SweptBox, AStatementAfterARestartOnASilentBusClearsTheCollapse) {
   (void)overturn(monitor, decoder, t);
   ASSERT_TRUE(monitor.status().collapse.held);
   const BoxMemory memory = monitor.memory();
