@@ -53,7 +53,7 @@ GARBAGE = (
     "320#00F0000000000000", "320#0700000000000000",  # MonitorStatus: bits 12-15; phase 7
     "320#0000112700000000", "320#0000000000000001",  # risk 10001 (> 1); bits 56-63
     "330#0000FE0000000000", "330#0500000000000000",  # AlarmEvent: bits 17-23; level 5
-    "330#0013000000000000",  # cause 19 (beyond the table)
+    "330#00FF000000000000",  # cause 255 (beyond the table)
     "350#1127000100000000", "351#E803050364002800",  # CollapseForecast: probability 10001;
     "350#0000110100000000",  # worst member 5 of 3 members; worst member 17
     "340#F000000000000000", "340#00",  # Acknowledge: bits 4-7; short
@@ -162,6 +162,15 @@ def prepare(args):
     env["SCENARIOS"] = " ".join(scenarios)
     (work / "config.json").write_text(json.dumps(config, indent=1) + "\n")
     (work / "config.env").write_text("".join(f"{k}='{v}'\n" for k, v in env.items()))
+    # Garbage that the DBC accepts would be counted as a valid frame (seen when a cause was
+    # added to the table a garbage frame had used as "beyond" it): refuse to run on such a list.
+    dbc = Dbc(args.dbc)
+    standard = [frame.split("#") for frame in GARBAGE
+                if not frame.endswith("#R") and len(frame.split("#")[0]) == 3]
+    valid = [f"{ident}#{data}" for ident, data in standard
+             if dbc.decode(int(ident, 16), bytes.fromhex(data))[0] is not None]
+    if valid:
+        sys.exit(f"e2e_can.py: GARBAGE frames that {args.dbc} decodes as valid: {valid}")
     (work / "garbage.in.log").write_text("".join(f"(0.000000) vcan0 {frame}\n"
                                                  for frame in GARBAGE))
     print(f"e2e_can.py: {work / 'input.csv'}: {lead} lead-in + {count} record samples at "
