@@ -321,8 +321,8 @@ void Monitor::feed_estimators() {
 // One axis: the nominal statue's mode and state, the worst member's risk, the forecast (the box
 // without the statue sensor). With the statue sensor measuring and corroborated, the measured
 // phase, tilt and rate, the filter's risk (weighted once informative, else the worst member's)
-// and the forecast's probability weighted alike; uncorroborated, the sensor only raises: the
-// higher risk and probability, the further phase (docs/safety.md).
+// and, while it measures motion, the forecast's probability weighted alike; uncorroborated, the
+// sensor only raises: the higher risk and probability, the further phase (docs/safety.md).
 void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
   const auto k = static_cast<std::size_t>(axis_index);
   const Ensemble& statues = ensemble(axis_index);
@@ -347,6 +347,11 @@ void Monitor::update_axis(int axis_index, AxisStatus& axis) const {
     axis.state[kThetaDot] = e.rotation_rate;
     axis.risk = e.risk;
     axis.worst_member = e.risk_member;
+    // Stillness is no evidence against the forecast: a sensor stuck, come off the statue onto
+    // the plinth, or on a neighbour reads what a standing statue reads, and the ground
+    // corroborates it. Only measured motion weighs the forecast (docs/safety.md, "What
+    // stillness cannot rule out").
+    if (e.mode.phase == Phase::kFullContact) return;
     // The collapse named is the first among the members the weighing keeps.
     const std::uint32_t left_out =
         e.weighted ? e.ruled_out_members : e.ruled_out_members | e.disagreeing_members;

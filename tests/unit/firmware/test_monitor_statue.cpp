@@ -112,6 +112,35 @@ TEST(MonitorStatue, AStandingStatueTakesTheFragileMembersRiskAway) {
   EXPECT_NE(s.alarm, monitor::AlarmLevel::kAlarm);
 }
 
+// The same run with the forecast on. Still, the sensor takes the rocking member's present risk
+// away but not its forecast collapse: a sensor on the plinth or stuck reads what a standing
+// statue reads (docs/safety.md, "What stillness cannot rule out"). The status's probability is
+// the ensemble's own, and the paper's block forecast to collapse raises the alarm.
+TEST(MonitorStatue, StillnessDoesNotRuleOutTheForecastCollapse) {
+  StatueRun run;
+  MonitorConfig c = statue_config();
+  c.forecast.enabled = true;
+  ASSERT_TRUE(run.start(c).ok());
+  const auto still = [](long) { return 0.0; };
+  bool forecast_seen = false;
+  bool alarmed = false;
+  for (long n = 0; n < kQuiet + 1200; ++n) {
+    const BoxStatus& s = run.step(n, 0.5, still);
+    const ForecastOutcome& raw = run.monitor->ensemble(0).forecaster().latest();
+    if (!s.axes[0].statue.measured || !s.axes[0].statue.corroborated) continue;
+    ASSERT_EQ(s.axes[0].forecast.probability, raw.probability) << n;
+    ASSERT_EQ(s.axes[0].forecast.collapse_in_s, raw.collapse_in_s) << n;
+    forecast_seen = forecast_seen || (raw.valid && raw.probability > 0.0);
+    alarmed = alarmed || s.alarm == monitor::AlarmLevel::kAlarm;
+  }
+  const BoxStatus& s = *run.monitor->poll().status;
+  EXPECT_TRUE(s.axes[0].statue.corroborated);
+  EXPECT_EQ(s.axes[0].mode.phase, Phase::kFullContact);
+  EXPECT_LT(s.axes[0].risk.total, 0.05);  // the present risk: the standing member's
+  EXPECT_TRUE(forecast_seen);
+  EXPECT_TRUE(alarmed);
+}
+
 // The same statue, its sensor reading rest (come off the statue: no rotation, its accelerometer
 // gravity alone, not the ground's shaking). The ground sensor does not corroborate it: the box
 // keeps the worst member's risk (the box without the sensor's) and names the sensor.
