@@ -103,7 +103,7 @@ if [ "${1:-}" = "--guest" ]; then
   replay() {  # NAME [ARG...]
     local name=$1 rc=0
     shift
-    "$REPLAY" --record input.csv --can vcan0 --rate "$RATE" --speed "$SPEED" --report-json "$@" \
+    "$REPLAY" --record input.csv --can vcan0 --rate "$RATE" --speed "$run_speed" --report-json "$@" \
       >"$name.replay.json" 2>"$name.replay.err" || rc=$?
     echo "$rc" >"$name.replay.rc"
   }
@@ -122,7 +122,7 @@ if [ "${1:-}" = "--guest" ]; then
   # The monitor's level is back to normal after its start-up (the fault of "no data yet" is held
   # 2 s), at most until 1 s before the input ends.
   wait_normal() {  # NAME
-    wait_line "$bus_dir/$1.bus.log" '* 330#40*' "$STOP_WAIT_POLLS" ||
+    wait_line "$bus_dir/$1.bus.log" '* 330#40*' "$stop_wait_polls" ||
       echo "no_normal_level=1" >>"$1.extra"
   }
   # The guest's CPU over a stretch of a run: cpu_mark, then cpu_note NAME adds to NAME.extra the
@@ -164,6 +164,21 @@ if [ "${1:-}" = "--guest" ]; then
   # missing frames, the sensor's silences, plinth-replay's lateness, the bridge's gaps; the
   # checks run it again on the last run) and the reasons go to NAME.rig. The last run's files
   # stay; if the rig spoiled it too, the checks fail naming the rig's losses.
+  # A starved guest gets a slower stream on its next run: the record at half plinth-replay's
+  # speed (then a quarter), the waits that follow the stream stretched alike. The checks judge
+  # the box's logic, not its throughput (monitor_load_host does), so a run is as good at any
+  # speed; each run's speed goes to NAME.extra and the checks use it.
+  slowdown=1
+  set_slowdown() {  # FACTOR
+    slowdown=$1
+    run_speed=$(awk -v s="$SPEED" -v k="$1" 'BEGIN { printf "%g", s / k }')
+    garbage_after=$(awk -v s="$GARBAGE_AFTER" -v k="$1" 'BEGIN { printf "%.3f", s * k }')
+    stop_wait_polls=$((STOP_WAIT_POLLS * $1))
+    # the stop case kills the sensor once the record is on: its lead-in lasts k times longer
+    kill_after_normal=$(awk -v s="$KILL_AFTER_NORMAL" -v l="$LEAD_IN_WALL_S" -v k="$1" \
+      'BEGIN { printf "%.3f", s + (k - 1) * l }')
+  }
+  set_slowdown 1
   attempt() {  # NAME
     local n reasons started
     : >"$1.rig"
@@ -175,7 +190,7 @@ if [ "${1:-}" = "--guest" ]; then
         return 0
       fi
       started=$now
-      : >"$1.extra"
+      echo "speed=$run_speed" >"$1.extra"
       echo "$n: not finished: the guest's time (${GUEST_TIMEOUT_S} s, boot included) ran out" \
         "during this run" >"$1.running"
       "scenario_$1"
@@ -192,6 +207,10 @@ if [ "${1:-}" = "--guest" ]; then
       reasons=${reasons//$'\n'/; }
       echo "$n: $reasons" >>"$1.rig"
       echo "e2e-can (guest): $1, run $n: $reasons" >&2
+      if [[ "$reasons" == *starved* ]] && ((slowdown < MAX_SLOWDOWN)); then
+        set_slowdown $((slowdown * 2))
+        echo "e2e-can (guest): the next runs at --speed $run_speed" >&2
+      fi
     done
     return 0  # the checks say what went wrong
   }
@@ -223,10 +242,10 @@ if [ "${1:-}" = "--guest" ]; then
   scenario_stop() {
     start_capture stop
     start_monitor stop
-    start_replay stop input.csv "$SPEED"
+    start_replay stop input.csv "$run_speed"
     cpu_mark
     wait_normal stop
-    nap "$KILL_AFTER_NORMAL"
+    nap "$kill_after_normal"
     stop_replay stop KILL
     cpu_note stop
     nap 0.3
@@ -247,7 +266,7 @@ if [ "${1:-}" = "--guest" ]; then
     start_monitor garbage
     replay garbage --t-end "$SHORT_T_END" &
     replay_pid=$!
-    nap "$GARBAGE_AFTER"
+    nap "$garbage_after"
     kill -STOP "$monitor_pid" 2>/dev/null || true
     nap 0.15
     kill -CONT "$monitor_pid" 2>/dev/null || true

@@ -48,4 +48,14 @@ for f in "${statue_faults[@]}" "${ground_faults[@]}"; do
   fi
   "$eval_bin" fault-report "$out/$name.csv" --against "$against" --json "$out/$name.json" \
     >"$out/$name.report" 2>&1 || echo "$name: fault-report failed (see $out/$name.report)"
+  # The statue sensor's faults against the box without the sensor too (issue 32's target).
+  if [[ "$kind" == statue_* ]]; then
+    "$eval_bin" fault-report "$out/$name.csv" --against "$out/base.csv" \
+      >"$out/$name.without-sensor.report" 2>&1 ||
+      echo "$name: fault-report failed (see $out/$name.without-sensor.report)"
+  fi
 done
+# The fault-free sensor against the box without it: the lead the sensor itself costs.
+"$eval_bin" fault-report "$out/base-statue.csv" --against "$out/base.csv" \
+  >"$out/base-statue.without-sensor.report" 2>&1 ||
+  echo "base-statue: fault-report failed (see $out/base-statue.without-sensor.report)"

@@ -131,6 +131,7 @@ def prepare(args):
         # the stop case: plinth-replay is killed this long after the monitor's level is back to
         # normal (its start-up fault is held 2 s of wall clock)
         "KILL_AFTER_NORMAL": f"{args.kill_after:g}",
+        "LEAD_IN_WALL_S": f"{args.lead_in / args.speed:.3f}",  # the lead-in's wall time
         # ... waiting for that at most until 1 s before the input ends (10 ms polls)
         "STOP_WAIT_POLLS": str(max(1, round(((lead + count - 1) / args.rate / args.speed - 1.0)
                                             * 100))),
@@ -140,6 +141,7 @@ def prepare(args):
         "GARBAGE_AFTER": f"{(args.lead_in + 0.2) / args.speed:.3f}",
         # after each run: whether the rig carried it (rig_losses), and how often to try
         "RIG_LOSSES_AWK": str(RIG_LOSSES_AWK), "MAX_ATTEMPTS": str(MAX_ATTEMPTS),
+        "MAX_SLOWDOWN": str(MAX_SLOWDOWN),
         "TIMEOUT_US": str(round(config["timeout_s"] * 1e6)),
         "STARVED_LATE_US": str(STARVED_LATE_US), "BACKLOG_LATE_US": str(BACKLOG_LATE_US),
         "MIN_IDLE_PERCENT": str(MIN_IDLE_PERCENT),
@@ -380,6 +382,16 @@ def percentile(values, fraction):
 # the last run is spoiled too, the checks fail naming the rig's losses and judge nothing else.
 
 MAX_ATTEMPTS = 5
+# After a run the guest was starved in, the next runs stream at half the speed, then a quarter:
+# the box's logic is judged at any speed, and a guest that shares a busy host's CPU (stress-ng
+# --cpu 2 beside the tests: idle 0-5 % of the stream at --speed 2) carries a slower stream.
+MAX_SLOWDOWN = 4
+
+
+def run_speed(s, config):
+    """The speed a run streamed at (the guest's note; slower after a starved run)."""
+    return float(s.extra.get("speed", config["speed"]))
+
 # The witness's receive buffer, bytes (candump -r; the kernel doubles it): room for about 11 000
 # frames (measured in the guest: docs/can-e2e.md), 20 s of the main run's traffic, where the
 # kernel's default (rmem_default 212 992) holds 278.
@@ -653,7 +665,7 @@ def replay_checks(check, s, samples):
 
 def samples_checks(check, s, config, expected_m_s2):
     """candump's SensorAcceleration frames decode to the input, within the resolution."""
-    rate, speed = config["rate"], config["speed"]
+    rate, speed = config["rate"], run_speed(s, config)
     worst = 0.0
     problems = []
     for k, (f, raw) in enumerate(s.sensor):
@@ -870,6 +882,7 @@ def check_main(check, work, s, config, figures):
     figures["jitter"] = s.report
     figures["main_wall_s"] = s.report["wall_time_s"]
     figures["main_attempts"] = s.extra.get("attempts", "?")
+    figures["main_speed"] = run_speed(s, config)
     status_index = [i for i, f in enumerate(s.frames) if f.plinth() and f.ident in STATUS_IDS]
     ages = [r["SampleAge"] for i, r in zip(status_index, raw_status or [])
             if s.streaming(i) and s.frames[i].t_us > s.sensor[start][0].t_us]
@@ -1005,7 +1018,7 @@ def run_checks(args):
         print(f"  plinth-replay pacing jitter (send - deadline): median "
               f"{j['jitter_median_us']:.0f} us, p99 {j['jitter_p99_us']:.0f} us, max "
               f"{j['jitter_max_us']:.0f} us over {j['frames_sent']} frames at --speed "
-              f"{config['speed']:g} ({config['rate'] * config['speed']:g} frames/s)")
+              f"{figures['main_speed']:g} ({config['rate'] * figures['main_speed']:g} frames/s)")
         print(f"  the record run took {figures['main_wall_s']:.2f} s (run "
               f"{figures['main_attempts']} of at most {MAX_ATTEMPTS})")
         lo, hi = figures["bus_send_time_deviation_us"]

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "build_options.h"
 #include "plinth/core/internal/flows.h"
@@ -10,6 +11,11 @@ namespace plinth {
 
 namespace {
 
+// The mean score judges the model once it holds this many scored intervals (their decayed
+// count): one interval is no statistic. A rate's noise alone passes the signal gate about once
+// in 200 quiet intervals, and that one interval, selected for being large, scores 3 to 8; a
+// correct model's mean of 3 intervals passes unexplained_score (6) with probability 5e-4.
+constexpr Real kMinScoredIntervals = 3;
 // A change of theta' over an interval is a signal beyond this many times one rate's noise.
 constexpr Real kSignal = 4;
 // A member's own theta' agrees with the measured one within this many standard deviations
@@ -226,6 +232,8 @@ void StatueFilter::reset() {
   evidence_.fill(0);
   score_.fill(0);
   score_norm_.fill(0);
+  span_score_ = 0;
+  span_score_norm_ = 0;
   have_previous_ = false;
   gyroscope_mode_ = Mode{};
   stop_sliding();
@@ -430,7 +438,33 @@ State StatueFilter::measured_state(const PlanarEstimator& member) const {
 
 // The tilt (the rate integrated by the trapezoid rule, back to 0 once still and nearly upright)
 // and the phase.
-void StatueFilter::measure(const Ensemble& members, const StatueMeasurement& measured) {
+// Whether the accelerometer's sample (a block held still: theta' and theta'' 0) reads the block
+// upright on some member's base at least as well as tilted by `tilt`; true where it cannot tell
+// the two apart (g sin(tilt) within its noise and bias) or has no sample. A rocking block held
+// at a swing's end by the ground's push is still too, but leaning: its gravity shows.
+bool StatueFilter::accelerometer_reads_upright(const Ensemble& members, GroundAcceleration ground,
+                                               const StatueMeasurement& measured,
+                                               Real tilt) const {
+  if (!measured.has_acceleration || !std::isfinite(measured.specific_force_m_s2)) return true;
+  const Real g = members.nominal().scene().g;
+  const Real floor =
+      kSlideSigmas * settings_.acceleration_noise_m_s2 + settings_.acceleration_bias_m_s2;
+  if ((g + ground.vertical) * std::fabs(std::sin(tilt)) <= floor) return true;
+  Real upright = std::numeric_limits<Real>::infinity();
+  Real leaning = std::numeric_limits<Real>::infinity();
+  const Vector2r at_rest = Vector2r::Zero();  // theta' = theta'' = 0: the lever plays no part
+  for (int m = 0; m < members_; ++m) {
+    const Vector2r base(members.base_acceleration(m), ground.vertical);
+    const Real f = measured.specific_force_m_s2;
+    upright = std::fmin(upright, std::fabs(f - block_specific_force(base, at_rest, 0, 0, 0, g).x()));
+    leaning =
+        std::fmin(leaning, std::fabs(f - block_specific_force(base, at_rest, tilt, 0, 0, g).x()));
+  }
+  return upright <= leaning;
+}
+
+void StatueFilter::measure(const Ensemble& members, GroundAcceleration ground,
+                           const StatueMeasurement& measured) {
   const Real rate = measured.rotation_rate;
   Real tilt = estimate_.tilt;
   if (have_previous_) tilt += Real(0.5) * (previous_rate_ + rate) * period_;
@@ -445,8 +479,11 @@ void StatueFilter::measure(const Ensemble& members, const StatueMeasurement& mea
   }
   still_samples_ = std::fabs(rate) < settings_.rest_rate_rad_s ? still_samples_ + 1 : 0;
   // Full contact is theta = 0: a block that sat still well inside its smallest critical angle is
-  // back on its base (what the integrated rate says otherwise is the gyroscope's drift).
-  if (still_samples_ >= rest_samples_ && std::fabs(tilt) < Real(0.5) * smallest_critical) {
+  // back on its base (what the integrated rate says otherwise is the gyroscope's drift), unless
+  // its accelerometer reads it leaning (held at a swing's end: taken for rest, the tilt lost put
+  // every later prediction on the wrong corner, a false statue_unexplained).
+  if (still_samples_ >= rest_samples_ && std::fabs(tilt) < Real(0.5) * smallest_critical &&
+      accelerometer_reads_upright(members, ground, measured, tilt)) {
     tilt = 0;
   }
   if ((tilt > 0) != (estimate_.tilt > 0) && estimate_.tilt != 0 && tilt != 0) {
@@ -465,6 +502,11 @@ void StatueFilter::measure(const Ensemble& members, const StatueMeasurement& mea
   if (mode.rocking() && gyroscope_mode_.rocking() && mode.corner != gyroscope_mode_.corner) {
     interval_impact_ = true;
   }
+  // Lifting off or landing within the interval: its predictions are of one phase, the measured
+  // change spans two (at lift-off the tilt's sign, within its noise, may name the wrong corner).
+  if ((mode.phase == Phase::kFullContact) != (gyroscope_mode_.phase == Phase::kFullContact)) {
+    interval_impact_ = true;
+  }
   if (mode.terminal()) interval_terminal_ = true;
   if (mode.phase != Phase::kFullContact) interval_moved_ = true;  // rocked (the gyroscope's)
   estimate_.mode = mode;
@@ -479,7 +521,7 @@ void StatueFilter::on_sample(const Ensemble& members, GroundAcceleration ground,
   if (!std::isfinite(measured.rotation_rate)) return;  // the conditioning passes none
   const Real previous_rate = previous_rate_;
   const bool had_previous = have_previous_;
-  measure(members, measured);
+  measure(members, ground, measured);
   gyroscope_mode_ = estimate_.mode;
   const bool compared =
       compare_with_bases(members, ground, measured, had_previous ? &previous_rate : nullptr);
@@ -510,8 +552,12 @@ void StatueFilter::finish_interval(const Ensemble& members) {
   const Real measured_change = estimate_.rotation_rate - interval_start_rate_;
   if (!interval_impact_ && !interval_terminal_) {
     const Real noise2 = Real(2) * settings_.rate_noise_rad_s * settings_.rate_noise_rad_s;
+    Real lowest = predicted_change_[0];
+    Real highest = predicted_change_[0];
     for (int m = 0; m < members_; ++m) {
       const auto k = static_cast<std::size_t>(m);
+      lowest = std::fmin(lowest, predicted_change_[k]);
+      highest = std::fmax(highest, predicted_change_[k]);
       const Real predicted = predicted_change_[k];
       const Real nu = measured_change - predicted;
       const Real scale =
@@ -525,6 +571,17 @@ void StatueFilter::finish_interval(const Ensemble& members) {
         score_[k] = score_[k] * score_decay_ + chi2;
         score_norm_[k] = score_norm_[k] * score_decay_ + 1;
       }
+    }
+    // The members span the declared uncertainty, so a true statue inside it changes its rate
+    // between theirs: beyond that span, by the same tolerance, it is unexplained.
+    const Real outside = std::fmax(Real(0), std::fmax(lowest - measured_change,
+                                                      measured_change - highest));
+    const Real span_scale = settings_.model_tolerance *
+                            std::fmax(std::fmax(std::fabs(lowest), std::fabs(highest)),
+                                      std::fabs(measured_change));
+    if (span_scale > settings_.model_tolerance * kSignal * settings_.rate_noise_rad_s) {
+      span_score_ = span_score_ * score_decay_ + outside * outside / (noise2 + span_scale * span_scale);
+      span_score_norm_ = span_score_norm_ * score_decay_ + 1;
     }
     ++estimate_.intervals;
   }
@@ -582,7 +639,9 @@ void StatueFilter::weigh(const Ensemble& members) {
       estimate_.best_member = m;
     }
   }
-  estimate_.explained = estimate_.best_score < settings_.unexplained_score;
+  estimate_.span_score = span_score_norm_ > 0 ? span_score_ / span_score_norm_ : Real(0);
+  estimate_.explained = span_score_norm_ < kMinScoredIntervals ||
+                       estimate_.span_score < settings_.unexplained_score;
   // Ruled out: only while some member explains the motion (else every member stays).
   estimate_.ruled_out = 0;
   estimate_.ruled_out_members = 0;

@@ -130,6 +130,7 @@ struct StatueEstimate {
   bool informative = false;
   bool explained = true;
   Real best_score = 0.0;      // the smallest member mean score
+  Real span_score = 0.0;      // the mean score against the span of the members' predictions
   int best_member = 0;        // whose
   int intervals = 0;          // innovations taken since the start
   Risk risk;                  // the filter's risk (as above)
@@ -178,7 +179,12 @@ class StatueFilter {
   [[nodiscard]] const StatueFilterSettings& settings() const { return settings_; }
 
  private:
-  void measure(const Ensemble& members, const StatueMeasurement& measured);
+  void measure(const Ensemble& members, GroundAcceleration ground,
+               const StatueMeasurement& measured);
+  [[nodiscard]] bool accelerometer_reads_upright(const Ensemble& members,
+                                                 GroundAcceleration ground,
+                                                 const StatueMeasurement& measured,
+                                                 Real tilt) const;
   [[nodiscard]] Real predicted_rate_change(const Ensemble& members, int m,
                                            GroundAcceleration ground) const;
   void finish_interval(const Ensemble& members);
@@ -209,7 +215,7 @@ class StatueFilter {
   int interval_count_ = 0;
   Real interval_start_rate_ = 0.0;
   Real interval_start_tilt_ = 0.0;
-  bool interval_impact_ = false;
+  bool interval_impact_ = false;  // an impact, a lift-off or a landing: the interval not scored
   bool interval_terminal_ = false;
   bool interval_moved_ = false;  // the measured statue left full contact in the interval
   std::array<Real, kMaxEnsembleMembers> previous_acceleration_{};  // theta'' rad/s2
@@ -217,6 +223,10 @@ class StatueFilter {
   std::array<Real, kMaxEnsembleMembers> evidence_{};
   std::array<Real, kMaxEnsembleMembers> score_{};
   std::array<Real, kMaxEnsembleMembers> score_norm_{};
+  // The same mean score of the measured change against the span of the members' predictions
+  // (0 inside it): a statue between the members is explained by the ensemble, not by one.
+  Real span_score_ = 0.0;
+  Real span_score_norm_ = 0.0;
   bool have_previous_ = false;
   // The sliding test.
   Mode gyroscope_mode_;  // the phase the gyroscope alone measured last
