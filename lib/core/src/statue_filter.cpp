@@ -436,8 +436,6 @@ State StatueFilter::measured_state(const PlanarEstimator& member) const {
   return y;
 }
 
-// The tilt (the rate integrated by the trapezoid rule, back to 0 once still and nearly upright)
-// and the phase.
 // Whether the accelerometer's sample (a block held still: theta' and theta'' 0) reads the block
 // upright on some member's base at least as well as tilted by `tilt`; true where it cannot tell
 // the two apart (g sin(tilt) within its noise and bias) or has no sample. A rocking block held
@@ -453,16 +451,19 @@ bool StatueFilter::accelerometer_reads_upright(const Ensemble& members, GroundAc
   Real upright = std::numeric_limits<Real>::infinity();
   Real leaning = std::numeric_limits<Real>::infinity();
   const Vector2r at_rest = Vector2r::Zero();  // theta' = theta'' = 0: the lever plays no part
+  const Real f = measured.specific_force_m_s2;
   for (int m = 0; m < members_; ++m) {
     const Vector2r base(members.base_acceleration(m), ground.vertical);
-    const Real f = measured.specific_force_m_s2;
-    upright = std::fmin(upright, std::fabs(f - block_specific_force(base, at_rest, 0, 0, 0, g).x()));
-    leaning =
-        std::fmin(leaning, std::fabs(f - block_specific_force(base, at_rest, tilt, 0, 0, g).x()));
+    const Real reads_upright = block_specific_force(base, at_rest, 0, 0, 0, g).x();
+    const Real reads_leaning = block_specific_force(base, at_rest, tilt, 0, 0, g).x();
+    upright = std::fmin(upright, std::fabs(f - reads_upright));
+    leaning = std::fmin(leaning, std::fabs(f - reads_leaning));
   }
   return upright <= leaning;
 }
 
+// The tilt (the rate integrated by the trapezoid rule, back to 0 once still and nearly upright)
+// and the phase.
 void StatueFilter::measure(const Ensemble& members, GroundAcceleration ground,
                            const StatueMeasurement& measured) {
   const Real rate = measured.rotation_rate;
@@ -580,7 +581,8 @@ void StatueFilter::finish_interval(const Ensemble& members) {
                             std::fmax(std::fmax(std::fabs(lowest), std::fabs(highest)),
                                       std::fabs(measured_change));
     if (span_scale > settings_.model_tolerance * kSignal * settings_.rate_noise_rad_s) {
-      span_score_ = span_score_ * score_decay_ + outside * outside / (noise2 + span_scale * span_scale);
+      span_score_ =
+          span_score_ * score_decay_ + outside * outside / (noise2 + span_scale * span_scale);
       span_score_norm_ = span_score_norm_ * score_decay_ + 1;
     }
     ++estimate_.intervals;
