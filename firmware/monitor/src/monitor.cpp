@@ -28,7 +28,7 @@ double first_counted_collapse(const ForecastOutcome& f, std::uint32_t counted, i
   for (int m = 0; m < f.members && m < kMaxEnsembleMembers; ++m) {
     const std::uint32_t bit = std::uint32_t{1} << static_cast<unsigned>(m);
     if ((f.collapsing_members & counted & bit) == 0U) continue;
-    const double at = f.member_collapse_in_s[static_cast<std::size_t>(m)];
+    const double at = static_cast<double>(f.member_collapse_in_s[static_cast<std::size_t>(m)]);
     if (member < 0 || at < first) {
       first = at;
       member = m;

@@ -354,6 +354,11 @@ TEST(CandumpDropCount, MalformedIsRefusedSayingWhatCandumpWrites) {
             "DROPCOUNT line: the total '-1' is not a number of frames from 0 to 4294967295");
   EXPECT_EQ(problem_of("DROPCOUNT: dropped 2 CAN frames on 'vcan0' socket (total drops )"),
             "DROPCOUNT line: the total '' is not a number of frames from 0 to 4294967295");
+  // Found by fuzz_candump: a quote in the name, two readings of the line.
+  EXPECT_EQ(problem_of("DROPCOUNT: dropped 410 CAN frames on 'vcan0' socket (tfra00780' socket "
+                       "(total drops 411)"),
+            "DROPCOUNT line: the socket name 'vcan0' socket (tfra00780' holds a quote: it cannot "
+            "be read back unambiguously");
 }
 
 TEST(CandumpDropCount, WrittenAsCandumpWritesItAndReadBack) {
