@@ -103,8 +103,8 @@ if [ "${1:-}" = "--guest" ]; then
   replay() {  # NAME [ARG...]
     local name=$1 rc=0
     shift
-    "$REPLAY" --record input.csv --can vcan0 --rate "$RATE" --speed "$run_speed" --report-json "$@" \
-      >"$name.replay.json" 2>"$name.replay.err" || rc=$?
+    "$REPLAY" --record input.csv --can vcan0 --rate "$RATE" --speed "$run_speed" --report-json \
+      "$@" >"$name.replay.json" 2>"$name.replay.err" || rc=$?
     echo "$rc" >"$name.replay.rc"
   }
   # plinth-replay sends RECORD in the background until it ends or stop_replay.

@@ -553,6 +553,7 @@ void StatueFilter::finish_interval(const Ensemble& members) {
   const Real measured_change = estimate_.rotation_rate - interval_start_rate_;
   if (!interval_impact_ && !interval_terminal_) {
     const Real noise2 = Real(2) * settings_.rate_noise_rad_s * settings_.rate_noise_rad_s;
+    const Real signal_scale = settings_.model_tolerance * kSignal * settings_.rate_noise_rad_s;
     Real lowest = predicted_change_[0];
     Real highest = predicted_change_[0];
     for (int m = 0; m < members_; ++m) {
@@ -568,7 +569,7 @@ void StatueFilter::finish_interval(const Ensemble& members) {
       evidence_[k] = evidence_[k] * evidence_decay_ - Real(0.5) * chi2 - Real(0.5) * std::log(s2);
       // The score counts intervals with a change beyond the noise, measured or predicted: an
       // interval where nothing moves and nothing should says nothing about the model.
-      if (scale > settings_.model_tolerance * kSignal * settings_.rate_noise_rad_s) {
+      if (scale > signal_scale) {
         score_[k] = score_[k] * score_decay_ + chi2;
         score_norm_[k] = score_norm_[k] * score_decay_ + 1;
       }
@@ -580,7 +581,7 @@ void StatueFilter::finish_interval(const Ensemble& members) {
     const Real span_scale = settings_.model_tolerance *
                             std::fmax(std::fmax(std::fabs(lowest), std::fabs(highest)),
                                       std::fabs(measured_change));
-    if (span_scale > settings_.model_tolerance * kSignal * settings_.rate_noise_rad_s) {
+    if (span_scale > signal_scale) {
       span_score_ =
           span_score_ * score_decay_ + outside * outside / (noise2 + span_scale * span_scale);
       span_score_norm_ = span_score_norm_ * score_decay_ + 1;
