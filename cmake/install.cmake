@@ -17,7 +17,11 @@ set(PLINTH_INSTALL_DATADIR ${CMAKE_INSTALL_DATADIR}/plinth)
 set(PLINTH_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/plinth)
 
 # The box: plinth-monitor, plinth-replay and plinth-commission, its units, its user, its data.
-install(TARGETS plinth-monitor plinth-replay plinth-commission RUNTIME COMPONENT monitor)
+set(PLINTH_MONITOR_COMPONENT_PROGRAMS plinth-monitor plinth-replay plinth-commission)
+install(TARGETS ${PLINTH_MONITOR_COMPONENT_PROGRAMS} RUNTIME COMPONENT monitor)
+# What cpack's monitor component needs built, alone (tools/image-test.sh: the image's package).
+add_custom_target(plinth-monitor-component)
+add_dependencies(plinth-monitor-component ${PLINTH_MONITOR_COMPONENT_PROGRAMS})
 # The units and the configuration name the install's own folders, decided at install time (a
 # Debian package installs the same build with the prefix /usr that `cmake --install` may give
 # another): @PLINTH_BINDIR@ is PREFIX/bin; @PLINTH_SYSCONFDIR@ is /etc for the prefix /usr

@@ -68,7 +68,7 @@ if [ -z "$debs" ]; then
       build_dir=$work/package-build
       lap "the packages' build (cmake --preset $preset in $build_dir; $work/package-build.log)"
       { cmake --preset "$preset" -S "$src" -B "$build_dir" &&
-        cmake --build "$build_dir" --target plinth-monitor plinth-replay; } \
+        cmake --build "$build_dir" --target plinth-monitor-component; } \
         >"$work/package-build.log" 2>&1 ||
         { tail -n 30 "$work/package-build.log"; echo "$me: the packages' build failed" >&2
           exit 1; }

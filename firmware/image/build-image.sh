@@ -217,6 +217,12 @@ fi
 
 # --- Build ------------------------------------------------------------------------------------
 start=$SECONDS
+# The kernel's postinst leaves its modules and its initramfs to finish_kernels, which compresses
+# the modules on every core and builds the initramfs once, after the packages whose hooks it
+# takes (INITRD=No skips the kernel's own build; initramfs-tools' trigger then finds no
+# initramfs to update). Under emulation (another architecture) the postinst had run 33 min
+# without ending (docs/image.md).
+export INITRD=No PLINTH_IMAGE_KERNEL_ON_HOST=1
 if [ -z "$work" ]; then
   work=$(mktemp -d "${TMPDIR:-/tmp}/plinth-image.XXXXXX")
   trap 'rm -rf "$work"' EXIT
@@ -231,10 +237,37 @@ if [ -n "$cache" ]; then
   cache=$(cd "$cache" && pwd)
 fi
 
+# Each kernel of the image without its initramfs: its modules compressed as
+# 50-plinth-image-compress-modules would, by this machine's xz on every core, indexed by this
+# machine's depmod (kmod reads any architecture's modules), and its initramfs built in the
+# image's root (for another architecture emulated: its shell scripts and copies alone).
+finish_kernels() {
+  local modules version
+  for modules in "$root"/lib/modules/*/; do
+    version=$(basename "$modules")
+    [ -d "$modules" ] && [ ! -f "$root/boot/initrd.img-$version" ] || continue
+    step "kernel $version: modules compressed and indexed here, its initramfs in the image"
+    find "$modules" -name '*.ko' -type f -print0 |
+      xargs -0 -r -P "$(nproc)" -n 64 xz --check=crc32 --lzma2=dict=1MiB --force --threads=1 ||
+      fail "xz of the modules of $version failed"
+    depmod -b "$root" "$version" || fail "depmod of $version failed"
+    unshare --mount --propagation private -- bash -c '
+      set -e
+      for fs in proc sys dev; do mount --rbind "/$fs" "$1/$fs"; done
+      unset INITRD
+      chroot "$1" update-initramfs -c -k "$2"
+      # /initrd.img, which the kernel'"'"'s postinst left out under INITRD=No
+      chroot "$1" linux-update-symlinks install "$2" "/boot/vmlinuz-$2"' finish "$root" "$version" \
+      >>"$work/initramfs.log" 2>&1 ||
+      { tail -n 30 "$work/initramfs.log" >&2
+        fail "the initramfs of $version failed ($work/initramfs.log)"; }
+  done
+}
+
 # 1. Debian: the essential set and base_packages, by mmdebstrap. With --cache, the result is
 # kept (base-ARCH-KEY.tar.zst) and taken again while its recipe (this script's package lists and
-# settings, the kernel hooks) and the ISO week are the same: a week-old base misses at most a
-# week of Debian's updates, which step 2 installs (apt-get upgrade).
+# settings, the kernel hooks, finish_kernels) and the ISO week are the same: a week-old base
+# misses at most a week of Debian's updates, which step 2 installs (apt-get upgrade).
 mm=(mmdebstrap --mode=root --variant=minbase --arch="$arch" --format=directory
   --hook-dir=/usr/share/mmdebstrap/hooks/merged-usr
   --include="$(IFS=,; echo "${base_packages[*]},$(linux_package "$arch")")"
@@ -272,7 +305,7 @@ mm+=(bookworm "$root"
   "deb $mirror bookworm main" "deb $mirror bookworm-updates main"
   "deb $security bookworm-security main")
 base_key=$( {
-  printf '%s\n' "$arch" "${mm[@]}" "$(date -u +%G-W%V)"
+  printf '%s\n' "$arch" "${mm[@]}" "$(date -u +%G-W%V)" "$(declare -f finish_kernels)"
   cat "$here"/rootfs/etc/kernel/*/* "$here"/rootfs/etc/initramfs-tools/conf.d/*
 } | sed "s#$work#WORK#g; s#${cache:-/nonexistent}#CACHE#g" | sha256sum | cut -c1-16)
 base_tar=${cache:+$cache/base-$arch-$base_key.tar.zst}
@@ -288,6 +321,7 @@ else
     { tail -n 40 "$work/mmdebstrap.log" >&2; fail "mmdebstrap failed ($work/mmdebstrap.log)"; }
   # The downloaded .debs are in the cache (sync-out): not in the base.
   rm -f "$root"/var/cache/apt/archives/*.deb
+  finish_kernels
   if [ -n "$base_tar" ]; then
     rm -f "$cache/base-$arch-"*.tar.zst
     tar "${tar_options[@]}" -C "$root" -cf - . | zstd -q -T0 -3 >"$base_tar.part" &&
@@ -325,6 +359,9 @@ unshare --mount --propagation private -- bash -c '
 dpkg-deb -x "$root"/var/tmp/grub-efi-*-bin_*.deb "$work/grub"
 rm -rf "$root/var/tmp/plinth-debs" "$root"/var/tmp/grub-efi-*-bin_*.deb
 chroot "$root" dpkg-query -W -f '${Package} ${Version}\n' >"$work/packages"
+
+# 2b. A kernel that step 2 installed (a newer one from bookworm's updates), finished likewise.
+finish_kernels
 
 # 3. The image's own files, its enabled units, and what no two boxes may share.
 step "the image's files and units"
