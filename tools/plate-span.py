@@ -30,7 +30,8 @@ def base_ranges(text):
         return None
     ranges = {}
     for key in ("period", "damping_ratio"):
-        m = re.search(rf"^{key}\s*=\s*\[\s*([-0-9.eE+]+)\s*,\s*([-0-9.eE+]+)\s*\]", section.group(1),
+        number = r"([-0-9.eE+]+)"
+        m = re.search(rf"^{key}\s*=\s*\[\s*{number}\s*,\s*{number}\s*\]", section.group(1),
                       re.M)
         if not m:
             return None
@@ -102,7 +103,8 @@ def main():
     n = len(member_runs[0][0])
     print(f"{a.scene} under {a.record} at {a.pga}: period {ranges['period']} s, damping ratio "
           f"{ranges['damping_ratio']}; instants where every run is in full contact, every 5 ms")
-    print("| period (s) | damping ratio | outside the members' span | beyond 0.1 m/s2 | worst (m/s2) |")
+    print("| period (s) | damping ratio | outside the members' span | beyond 0.1 m/s2 "
+          "| worst (m/s2) |")
     print("|---|---|---|---|---|")
     for (i, j), (acc, phase) in sorted(runs.items()):
         if (i, j) in members:
