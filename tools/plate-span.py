@@ -23,15 +23,20 @@ import tempfile
 from pathlib import Path
 
 
+def section(text, name):
+    """The body of the TOML table [name] in a scene's text (group 1), or None."""
+    return re.search(rf"^\[{re.escape(name)}\]\s*$(.*?)(?=^\[|\Z)", text, re.M | re.S)
+
+
 def base_ranges(text):
     """The [uncertainty.base] period and damping_ratio ranges of a scene's text."""
-    section = re.search(r"^\[uncertainty\.base\]\s*$(.*?)(?=^\[|\Z)", text, re.M | re.S)
-    if not section:
+    table = section(text, "uncertainty.base")
+    if not table:
         return None
     ranges = {}
     for key in ("period", "damping_ratio"):
         number = r"([-0-9.eE+]+)"
-        m = re.search(rf"^{key}\s*=\s*\[\s*{number}\s*,\s*{number}\s*\]", section.group(1),
+        m = re.search(rf"^{key}\s*=\s*\[\s*{number}\s*,\s*{number}\s*\]", table.group(1),
                       re.M)
         if not m:
             return None
@@ -42,13 +47,15 @@ def base_ranges(text):
 def with_base(text, period, damping):
     """The scene's text with its [base] period and damping ratio set, its uncertainty dropped."""
     text = re.split(r"^\[uncertainty", text, maxsplit=1, flags=re.M)[0]
-    text = re.sub(r"^period\s*=.*$", f"period = {period!r}", text, count=1, flags=re.M)
-    return re.sub(r"^damping_ratio\s*=.*$", f"damping_ratio = {damping!r}", text, count=1,
+    table = section(text, "base")
+    base = re.sub(r"^period\s*=.*$", f"period = {period!r}", table.group(1), count=1, flags=re.M)
+    base = re.sub(r"^damping_ratio\s*=.*$", f"damping_ratio = {damping!r}", base, count=1,
                   flags=re.M)
+    return text[:table.start(1)] + base + text[table.end(1):]
 
 
 def plate_acceleration(path):
-    """Times, plate accelerations (ag + u'', u'' by central differences) and phases of a run."""
+    """A run's plate accelerations (ag + u'', u'' by central differences) and phases."""
     with open(path, newline="") as f:
         rows = list(csv.DictReader(f))
     t = [float(r["t"]) for r in rows]
@@ -72,14 +79,26 @@ def main():
     a = p.parse_args()
     if a.steps < 2 or a.steps % 2:
         p.error("--steps: even, at least 2 (the centre a grid point)")
-    text = Path(a.scene).read_text()
-    ranges = base_ranges(text)
-    if ranges is None:
-        print(f"plate-span: {a.scene}: no [uncertainty.base] with period and damping_ratio "
-              "ranges", file=sys.stderr)
+    try:
+        text = Path(a.scene).read_text()
+    except OSError as e:
+        print(f"plate-span: {a.scene}: cannot read the scene ({e.strerror})", file=sys.stderr)
         return 2
-    work = Path(a.work or tempfile.mkdtemp(prefix="plate-span."))
-    work.mkdir(parents=True, exist_ok=True)
+    ranges = base_ranges(text)
+    if ranges is None or section(text, "base") is None:
+        print(f"plate-span: {a.scene}: no [base] section, or no [uncertainty.base] with period "
+              "and damping_ratio ranges", file=sys.stderr)
+        return 2
+    if a.work:
+        work = Path(a.work)
+        work.mkdir(parents=True, exist_ok=True)
+        return report(a, text, ranges, work)
+    with tempfile.TemporaryDirectory(prefix="plate-span.") as folder:
+        return report(a, text, ranges, Path(folder))
+
+
+def report(a, text, ranges, work):
+    """Runs the grid in `work` and prints the table; the exit status."""
     grid = {}
     for key, (lo, hi) in ranges.items():
         grid[key] = [lo + (hi - lo) * k / a.steps for k in range(a.steps + 1)]
@@ -89,9 +108,13 @@ def main():
             scene = work / f"base-{i}-{j}.toml"
             scene.write_text(with_base(text, period, damping))
             out = work / f"base-{i}-{j}.csv"
-            done = subprocess.run([a.sim, "--scene", str(scene), "--record", a.record, "--pga",
-                                   a.pga, "--out", str(out), "--out-interval", "0.005"],
-                                  capture_output=True, text=True)
+            try:
+                done = subprocess.run([a.sim, "--scene", str(scene), "--record", a.record,
+                                       "--pga", a.pga, "--out", str(out), "--out-interval",
+                                       "0.005"], capture_output=True, text=True)
+            except OSError as e:
+                print(f"plate-span: cannot run {a.sim} ({e.strerror})", file=sys.stderr)
+                return 1
             if done.returncode != 0:
                 print(f"plate-span: plinth-sim failed for T = {period}, xi = {damping}:\n"
                       f"{done.stderr}", file=sys.stderr)
@@ -99,23 +122,26 @@ def main():
             runs[(i, j)] = plate_acceleration(out)
     last, mid = a.steps, a.steps // 2
     members = [(i, j) for i in (0, last) for j in (0, last)] + [(mid, mid)]
-    member_runs = [runs[m] for m in members]
-    n = len(member_runs[0][0])
+    # Per instant, once: whether every run is in full contact, and the members' span.
+    n = len(runs[members[0]][0])
+    in_contact = [all(r[1][k] == "full_contact" for r in runs.values()) for k in range(n)]
+    span = [(min(runs[m][0][k] for m in members), max(runs[m][0][k] for m in members))
+            for k in range(n)]
     print(f"{a.scene} under {a.record} at {a.pga}: period {ranges['period']} s, damping ratio "
           f"{ranges['damping_ratio']}; instants where every run is in full contact, every 5 ms")
     print("| period (s) | damping ratio | outside the members' span | beyond 0.1 m/s2 "
           "| worst (m/s2) |")
     print("|---|---|---|---|---|")
-    for (i, j), (acc, phase) in sorted(runs.items()):
+    for (i, j), (acc, _) in sorted(runs.items()):
         if (i, j) in members:
             continue
         count = outside = beyond = 0
         worst = 0.0
         for k in range(n):
-            if any(r[1][k] != "full_contact" for r in runs.values()):
+            if not in_contact[k]:
                 continue
-            values = [c[0][k] for c in member_runs]
-            excess = max(min(values) - acc[k], acc[k] - max(values), 0.0)
+            lo, hi = span[k]
+            excess = max(lo - acc[k], acc[k] - hi, 0.0)
             count += 1
             outside += excess > 0
             beyond += excess > 0.1
