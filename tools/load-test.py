@@ -21,8 +21,7 @@ it outlives the kill) received after the broker came back, the
 queue's high-water mark and overflow counter, the Modbus answers and the bus load reached, the
 box's file descriptors and memory. --check exits 1 when a sample or an alarm event was lost,
 an answer was wrong, or the box's descriptors grew (above the first count at the last three
-samples); --max-p99-ratio R also when the loaded
-p99 exceeds R times the idle one.
+samples); --max-p99-ratio R also when the loaded p99 exceeds R times the idle one.
 
 Usage: tools/load-test.py [--build DIR] [--work DIR] [--clients 50] [--poll-hz 100]
                           [--bus-load 0.9] [--lead S] [--stall S] [--drop S] [--tail S]
@@ -443,9 +442,8 @@ def report(work, cfg, args):
                             f"received by the witness, dropped {mqtt.get('events_dropped')}, "
                             f"undelivered {mqtt.get('events_undelivered')}")
         # Grown: above the first count at each of the last three samples. One sample above it is
-        # a descriptor open at that instant (the publisher reconnecting to the restarted broker, a
-        # capture being written: seen under ASan, 9 at 17 samples then 10 at the last); a leak
-        # stays.
+        # a descriptor open at that instant (seen under ASan: 9 at 17 samples, then 10 at the
+        # last; which descriptor was not identified); a leak stays.
         if min(extra["box_fds"][-3:]) > extra["box_fds"][0]:
             failures.append(f"{name}: the box's descriptors grew: {extra['box_fds']}")
         if extra["box_exit"] != 0:
